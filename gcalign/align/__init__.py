@@ -1,0 +1,13 @@
+"""Initial alignment (seed 000): coarse alignment, gyrocompass loop gains, loops and modes.
+
+Modules:
+
+- :mod:`gcalign.align.coarse` -- analytic double-vector and inertial-frame coarse alignment.
+- :mod:`gcalign.align.gains` -- loop gains by pole placement (seed 000 §2, eqs. 5-9).
+- :mod:`gcalign.align.kernel` -- numba kernel of the strapdown gyrocompass loops.
+- :mod:`gcalign.align.cycles` -- conventional, full-cycle and half-cycle passes, stages.
+
+Conventions are those of the package (ENU navigation frame, body x right / y forward /
+z up, ``att = [pitch, roll, yaw]`` in radians, ``C_nb = Rz(yaw) Rx(pitch) Ry(roll)``).
+Import the submodules directly; this package file imports nothing.
+"""

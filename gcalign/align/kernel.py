@@ -1,0 +1,151 @@
+"""Numba kernel of the strapdown gyrocompass (seed 000 eqs. 1-4, discrete form eqs. 11-13).
+
+The loop state is one float64 vector so that passes can hand it on (indices below)::
+
+    q_nb (0:4) | v_E, v_N (4:6) | ∫δv_E, ∫δv_N (6:8) | ω_cU (8) | lat, lon, h (9:12)
+
+Per step (data already transformed for a reverse pass: gyro negated, velocity negated,
+``earth_sign = -1``, so Ω = earth_sign·ω_ie·cos L changes sign with the data):
+
+- attitude ``q ← q(−ω_in T) ⊗ q ⊗ q(Δθ)`` with ``ω_in = ω_ie + ω_en(v_R) + ω_c``;
+- horizontal velocity ``v ← v + C_nb Δv − ((2ω_ie + ω_en [+ ω_c]) × v_R) T − K1 δv T``
+  (eqs. 11-13; the Coriolis and frame-rate terms are those of the reference velocity v_R;
+  ω_c is included for an odometer reference, which is resolved with the computed attitude
+  and so turns with the computed frame);
+- control rates from ``δv = v − v_R``:
+  east level   ``ω_cN = δv_E (1 + K_E2)/R_N + K_E3 ∫δv_E dt``            (eq. 1)
+  north level  ``ω_cE = −δv_N (1 + K_N2)/R_M − K_N3 ∫δv_N dt``           (eq. 2, level mode)
+  compass      ``ω_cE = −δv_N (1 + K_U2)/R_M``,
+               ``ω_cU ← (ω_cU + K_U3 δv_N T/Ω)/(1 + K_U4 T)``              (eqs. 3-4, 13)
+
+Modes: ``ATTITUDE`` (no loops: the attitude-only strapdown of a half-cycle reverse pass and
+of the T2→T3 update), ``LEVEL`` (both level loops, azimuth free) and ``COMPASS``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from gcalign.earth import OMEGA_IE
+from gcalign.kernels import earth_at, qmul, qrot, rotate_small, rv2q, transport_rate
+
+ATTITUDE, LEVEL, COMPASS = 0, 1, 2
+STATE_SIZE = 12
+# Loop states that are velocities or rates: they change sign with the data at a change
+# of pass direction (DESIGN.md); the attitude and the position are kept.
+FLIP = slice(4, 9)
+# Gains vector: K_E1, K_E2, K_E3, K_N1, K_N2, K_N3, K_U1, K_U2, K_U3, K_U4.
+GAINS_SIZE = 10
+
+
+@njit(cache=True)
+def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains, mode, q_out):
+    """Run the loops over N increments, updating `state` (12,) in place.
+
+    dtheta, dv : (N, 3) body increments (rad, m/s), in processing order.
+    vref : (N+1, 3) reference velocity at the start (row 0) and at the end of each step
+        (m/s); ENU, or body frame (odometer) if `vref_body`, then resolved with the
+        computed attitude.
+    gains : (10,) loop gains; mode : ATTITUDE, LEVEL or COMPASS.
+    q_out : (N+1, 4) attitude after each step, row 0 = start (preallocated).
+    """
+    ke1, ke2, ke3 = gains[0], gains[1], gains[2]
+    kn1, kn2, kn3 = gains[3], gains[4], gains[5]
+    ku1, ku2, ku3, ku4 = gains[6], gains[7], gains[8], gains[9]
+    q0, q1, q2, q3 = state[0], state[1], state[2], state[3]
+    ve, vn = state[4], state[5]
+    ie, inn = state[6], state[7]
+    wcu = state[8]
+    lat, lon, h = state[9], state[10], state[11]
+    q_out[0, 0], q_out[0, 1], q_out[0, 2], q_out[0, 3] = q0, q1, q2, q3
+    # Reference velocity at the start of the first step.
+    re, rn, ru = vref[0, 0], vref[0, 1], vref[0, 2]
+    if vref_body:
+        re, rn, ru = qrot(q0, q1, q2, q3, re, rn, ru)
+    wce = wcn = 0.0
+    r_m, r_n, g, sl, cl = earth_at(lat, h)
+    if mode != ATTITUDE:
+        # Control rates of the incoming state.
+        dve, dvn = ve - re, vn - rn
+        wcn = dve * (1.0 + ke2) / r_n + ke3 * ie
+        if mode == LEVEL:
+            wce = -dvn * (1.0 + kn2) / r_m - kn3 * inn
+        else:
+            wce = -dvn * (1.0 + ku2) / r_m
+    for k in range(dtheta.shape[0]):
+        r_m, r_n, g, sl, cl = earth_at(lat, h)
+        wie = earth_sign * OMEGA_IE
+        wie_n, wie_u = wie * cl, wie * sl
+        te, tn, tu = transport_rate(re, rn, r_m, r_n, h, sl, cl)
+        cu = wcu if mode == COMPASS else 0.0
+        wx = (te + wce) * ts
+        wy = (wie_n + tn + wcn) * ts
+        wz = (wie_u + tu + cu) * ts
+
+        # Specific-force increment at mid-interval, as in the strapdown step.
+        bx, by, bz = rotate_small(0.5 * dtheta[k, 0], 0.5 * dtheta[k, 1], 0.5 * dtheta[k, 2],
+                                  dv[k, 0], dv[k, 1], dv[k, 2])
+        fx, fy, fz = qrot(q0, q1, q2, q3, bx, by, bz)
+        fx, fy, fz = rotate_small(-0.5 * wx, -0.5 * wy, -0.5 * wz, fx, fy, fz)
+
+        # Attitude update with the platform rate including the control rates.
+        aw, ax, ay, az = rv2q(dtheta[k, 0], dtheta[k, 1], dtheta[k, 2])
+        nw, nx, ny, nz = rv2q(-wx, -wy, -wz)
+        p0, p1, p2, p3 = qmul(q0, q1, q2, q3, aw, ax, ay, az)
+        p0, p1, p2, p3 = qmul(nw, nx, ny, nz, p0, p1, p2, p3)
+        nq = 1.0 / math.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
+        q0, q1, q2, q3 = p0 * nq, p1 * nq, p2 * nq, p3 * nq
+
+        # Reference velocity at the end of the step, and position along it.
+        ne, nn, nu = vref[k + 1, 0], vref[k + 1, 1], vref[k + 1, 2]
+        if vref_body:
+            ne, nn, nu = qrot(q0, q1, q2, q3, ne, nn, nu)
+        lat_new = lat + 0.5 * (rn + nn) * ts / (r_m + h)
+        lon = lon + 0.5 * (re + ne) * ts / ((r_n + h) * cl)
+        h = h + 0.5 * (ru + nu) * ts
+
+        if mode != ATTITUDE:
+            # Coriolis and frame-rate acceleration of the reference velocity (seed §1). With
+            # an odometer the reference is resolved with the computed attitude, so it turns
+            # with every azimuth correction; the loop velocity must turn with the computed
+            # frame too (ω_c in the frame rate), or the compass loop sees a false
+            # δv_N = v_E Δφ_U that detunes it. An ENU (nav) reference does not turn.
+            cc = 1.0 if vref_body else 0.0
+            ce, cn, cu2 = te + cc * wce, 2.0 * wie_n + tn + cc * wcn, 2.0 * wie_u + tu + cc * cu
+            ae = -(cn * ru - cu2 * rn)
+            an = -(cu2 * re - ce * ru)
+            k1e = ke1
+            k1n = kn1 if mode == LEVEL else ku1
+            ve = ve + fx + ae * ts - k1e * (ve - re) * ts
+            vn = vn + fy + an * ts - k1n * (vn - rn) * ts
+            dve, dvn = ve - ne, vn - nn
+            ie += dve * ts
+            wcn = dve * (1.0 + ke2) / r_n + ke3 * ie
+            if mode == LEVEL:
+                inn += dvn * ts
+                wce = -dvn * (1.0 + kn2) / r_m - kn3 * inn
+            else:
+                omega = wie_n  # Ω = ω_ie cos L, signed with the pass direction
+                wcu = (wcu + ku3 * dvn * ts / omega) / (1.0 + ku4 * ts)
+                wce = -dvn * (1.0 + ku2) / r_m
+        else:
+            ve, vn = ne, nn
+        lat = lat_new
+        re, rn, ru = ne, nn, nu
+        q_out[k + 1, 0], q_out[k + 1, 1], q_out[k + 1, 2], q_out[k + 1, 3] = q0, q1, q2, q3
+
+    state[0], state[1], state[2], state[3] = q0, q1, q2, q3
+    state[4], state[5], state[6], state[7], state[8] = ve, vn, ie, inn, wcu
+    state[9], state[10], state[11] = lat, lon, h
+
+
+def new_state(q_nb, v_n, pos) -> np.ndarray:
+    """Loop state vector from attitude, horizontal velocity and position; loop states zero."""
+    s = np.zeros(STATE_SIZE)
+    s[0:4] = q_nb
+    s[4:6] = np.asarray(v_n, float)[:2]
+    s[9:12] = pos
+    return s

@@ -1,0 +1,66 @@
+"""The `gcalign` command line (Typer). It only translates: load the scenario, call a
+pipeline, write the results file, render a table or JSON.
+
+Exit codes: 0 success, 2 bad input (one line naming the field, the value and what is
+allowed), 1 other failures; no traceback for user errors.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import sys
+from pathlib import Path
+
+import typer
+from rich.console import Console
+
+from gcalign.errors import GcalignError
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    help="Strapdown INS alignment and north-finding laboratory (seeds 000-004).",
+)
+
+
+def consoles(as_json: bool) -> Console:
+    """Where tables go: stdout normally, stderr under --json (stdout then holds JSON only)."""
+    return Console(stderr=as_json, highlight=False)
+
+
+def emit_json(obj: dict) -> None:
+    sys.stdout.write(json.dumps(obj) + "\n")
+    sys.stdout.flush()
+
+
+def user_errors(fn):
+    """Turn GcalignError into one line on stderr and its exit code; Ctrl-C into exit 130."""
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        try:
+            return fn(*args, **kwargs)
+        except GcalignError as err:
+            for line in str(err).splitlines():
+                sys.stderr.write(f"error: {line}\n")
+            raise typer.Exit(err.exit_code) from None
+        except KeyboardInterrupt:
+            sys.stderr.write("interrupted\n")
+            raise typer.Exit(130) from None
+
+    return wrapper
+
+
+def default_output(name: str, kind: str, seed: int | None) -> Path:
+    suffix = f"-seed{seed}" if seed is not None else ""
+    return Path("runs") / f"{name}-{kind}{suffix}.h5"
+
+
+def main() -> None:
+    app()
+
+
+# Commands register themselves on `app`.
+from gcalign.cli import data as _data  # noqa: E402,F401

@@ -1,0 +1,137 @@
+"""Foundation commands: simulate, navigate, show, validate."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import typer
+import yaml
+
+from gcalign import report, results
+from gcalign.cli import app, consoles, default_output, emit_json, user_errors
+from gcalign.config import load_scenario, parse_scenario
+from gcalign.config.resolve import resolved_rows
+from gcalign.pipelines.data import HDF5_SUFFIXES, RunData, read_data_file, scenario_data
+from gcalign.pipelines.navigate import navigation_summary, run_navigation
+
+JSON_HELP = "Print one JSON object on stdout (tables go to stderr)."
+OUT_HELP = "Results file (default runs/NAME-COMMAND[-seedN].h5)."
+
+
+def simulation_summary(data: RunData, name: str, compute_s: float) -> dict:
+    imu = data.imu
+    s = {
+        "scenario": name, "seed": data.seed, "samples": len(imu), "rate_hz": 1.0 / imu.ts,
+        "duration_s": float(len(imu) * imu.ts), "compute_s": compute_s,
+        "initial_attitude_deg": None, "final_attitude_deg": None,
+        "final_velocity_mps": None, "distance_m": None,
+    }
+    if data.truth is not None:
+        tr = data.truth
+        step = np.linalg.norm(np.diff(tr.t)[:, None] * 0.5 * (tr.v_n[1:] + tr.v_n[:-1]), axis=1)
+        s.update(
+            initial_attitude_deg=np.degrees(tr.att[0]).tolist(),
+            final_attitude_deg=np.degrees(tr.att[-1]).tolist(),
+            final_velocity_mps=tr.v_n[-1].tolist(),
+            distance_m=float(step.sum()),
+        )
+    return s
+
+
+@app.command()
+@user_errors
+def simulate(
+    scenario: Path = typer.Argument(..., help="Scenario YAML."),
+    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
+    seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
+    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+):
+    """Simulate truth and IMU data; write /truth and /imu."""
+    sc, text = load_scenario(scenario)
+    t0 = time.perf_counter()
+    data = scenario_data(sc, seed)
+    summary = simulation_summary(data, sc.name, time.perf_counter() - t0)
+    out = output or default_output(sc.name, "simulate", data.seed)
+    summary["output"] = str(out)
+    with results.atomic_h5(out) as f:
+        results.write_header(f, "simulate", text, data.seed, summary)
+        if data.truth is not None:
+            results.write_truth(f, data.truth)
+        results.write_imu(f, data.imu)
+    consoles(as_json).print(report.simulate_table(summary))
+    if as_json:
+        emit_json(summary)
+
+
+@app.command()
+@user_errors
+def navigate(
+    source: Path = typer.Argument(..., help="Scenario YAML, or a results file with /imu."),
+    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
+    seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
+    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+):
+    """Free inertial navigation from the true initial state; errors against truth."""
+    if source.suffix.lower() in HDF5_SUFFIXES:
+        text = results.read_scenario_yaml(source)
+        sc = parse_scenario(yaml.safe_load(text) or {}, str(source))
+        imu, truth = read_data_file(source)
+        site = truth.pos[0] if truth is not None else (imu.site if imu.site is not None else None)
+        data = RunData(imu=imu, truth=truth, site=site, seed=None)
+    else:
+        sc, text = load_scenario(source)
+        data = scenario_data(sc, seed)
+    run = run_navigation(data)
+    summary = navigation_summary(run, data, sc.name)
+    out = output or default_output(sc.name, "navigate", data.seed)
+    summary["output"] = str(out)
+    with results.atomic_h5(out) as f:
+        results.write_header(f, "navigate", text, data.seed, summary)
+        if data.truth is not None:
+            results.write_truth(f, data.truth)
+        g = f.create_group("navigate")
+        sol = run.solution
+        results.put(g, "t", sol.t, "s")
+        results.put(g, "att", sol.att, "rad", results.ATT_FRAME)
+        results.put(g, "v_n", sol.v_n, "m/s", "ENU")
+        results.put(g, "pos", sol.pos, "rad, rad, m", "[latitude, longitude, height]")
+        if run.att_error is not None:
+            e = g.create_group("error")
+            results.put(e, "att", run.att_error, "rad", "Euler differences est - true, yaw wrapped")
+            results.put(e, "v_n", run.vel_error, "m/s", "ENU")
+            results.put(e, "pos", run.pos_error, "m", "ENU (east, north, up)")
+    consoles(as_json).print(report.navigate_table(summary))
+    if as_json:
+        emit_json(summary)
+
+
+@app.command()
+@user_errors
+def show(
+    file: Path = typer.Argument(..., help="A gcalign results file."),
+    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+):
+    """Print the summary of a results file again, from the file alone."""
+    kind, summary, attrs = results.read_summary(file)
+    console = consoles(as_json)
+    console.print(report.summary_table(kind, summary))
+    console.print(f"[dim]{attrs.get('command_line', '')}  ({attrs.get('created_utc', '')}, "
+                  f"gcalign {attrs.get('gcalign_version', '?')})[/dim]")
+    if as_json:
+        emit_json({"kind": kind, **summary})
+
+
+@app.command()
+@user_errors
+def validate(
+    scenario: Path = typer.Argument(..., help="Scenario YAML."),
+    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+):
+    """Check a scenario and print its resolved values in user units and SI."""
+    sc, _ = load_scenario(scenario)
+    rows = resolved_rows(sc)
+    consoles(as_json).print(report.kv_table(f"{scenario}: valid", rows, ("field", "value", "SI")))
+    if as_json:
+        emit_json({"valid": True, "values": {k: {"value": v, "si": s} for k, v, s in rows}})

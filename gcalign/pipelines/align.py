@@ -1,0 +1,214 @@
+"""Gyrocompass alignment of a scenario: coarse on [0, T1], passes on [T1, T2], T2 → T3.
+
+Seed 000; DESIGN.md "Gyrocompass fine alignment". Returns an :class:`AlignRun` of plain
+arrays; the CLI writes and prints it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from gcalign import units as u
+from gcalign.align import coarse as coarse_mod
+from gcalign.align import kernel as K
+from gcalign.align.compensate import compensate
+from gcalign.align.cycles import Block, PassRecord, run_passes
+from gcalign.config import Scenario
+from gcalign.config.align import AlignConfig
+from gcalign.errors import ScenarioError
+from gcalign.pipelines.data import RunData
+from gcalign.rotation import attitude_error, euler_to_quat, quat_to_dcm, quat_to_euler
+
+
+@dataclass(frozen=True)
+class AlignRun:
+    """Everything an alignment produced (SI). Truth-dependent fields are None without truth."""
+
+    cfg: AlignConfig
+    azimuth_poles: str
+    t1: float
+    t2: float
+    t3: float
+    coarse_att: np.ndarray
+    passes: list[PassRecord]
+    pass_errors: list[np.ndarray | None]  # (n+1, 3) rad per pass
+    att_t2: np.ndarray
+    att_t3: np.ndarray
+    truth_t2: np.ndarray | None
+    truth_t3: np.ndarray | None
+    compute_s: float
+    equivalent_s: float
+    index_offset: int  # data sample index of alignment time 0
+
+    @property
+    def error_t2(self):
+        return None if self.truth_t2 is None else attitude_error(self.att_t2, self.truth_t2)
+
+    @property
+    def error_t3(self):
+        return None if self.truth_t3 is None else attitude_error(self.att_t3, self.truth_t3)
+
+
+def _index(data: RunData, cfg: AlignConfig, t: float, field: str) -> int:
+    """Data sample index of alignment time t (s); ScenarioError if outside the data."""
+    ts = data.imu.ts
+    k = int(round((cfg.start_s + t) / ts))
+    end = len(data.imu) * ts
+    if k > len(data.imu):
+        raise ScenarioError(
+            f"align.{field}: {t} s (+ start_s {cfg.start_s} s) is past the end of the data "
+            f"({end:.2f} s); lengthen motion.duration_s or choose an earlier time")
+    return k
+
+
+def reference_velocity(data: RunData, cfg: AlignConfig, rng: np.random.Generator):
+    """Reference velocity at every sample, (N+1, 3), and whether it is in the body frame.
+
+    none: zero (static or swing base). nav: the true ENU velocity plus white noise.
+    odometer: the body-frame forward speed plus white noise (seed §1: converted to the
+    navigation frame with the computed attitude inside the loop).
+    """
+    n = len(data.imu) + 1
+    source, noise = cfg.aiding.source, cfg.aiding.noise_mps
+    if source == "none":
+        return np.zeros((n, 3)), False
+    if data.truth is None:
+        raise ScenarioError(f"align.aiding.source: {source!r} needs a simulated motion (truth); "
+                            "recorded data supports 'none'")
+    v_n = data.truth.v_n
+    if source == "nav":
+        return v_n + noise * rng.standard_normal(v_n.shape), False
+    v_b = np.einsum("kji,kj->ki", quat_to_dcm(euler_to_quat(data.truth.att)), v_n)
+    speed = v_b[:, 1] + noise * rng.standard_normal(n)
+    return np.stack([np.zeros(n), speed, np.zeros(n)], -1), True
+
+
+def coarse_attitude(data: RunData, cfg: AlignConfig, i0: int, i1: int, seed: int | None):
+    """Attitude at T1 from the coarse method (rad)."""
+    c = cfg.coarse
+    if c.method == "given":
+        if data.truth is None:
+            raise ScenarioError("align.coarse.method: 'given' needs truth; use 'analytic' or "
+                                "'inertial' for recorded data")
+        return data.truth.att[i1] + np.radians(c.error_deg)
+    lo = i1 - int(round((c.duration_s or cfg.t1_s) / data.imu.ts)) if c.duration_s else i0
+    dth, dv = data.imu.dtheta[lo:i1], data.imu.dv[lo:i1]
+    lat = data.site[0]
+    if c.method == "analytic":
+        return coarse_mod.analytic_coarse(dth, dv, data.imu.ts, lat)
+    return coarse_mod.inertial_frame_coarse(dth, dv, data.imu.ts, lat, data.site[1], data.site[2])
+
+
+def _block(data: RunData, vref, body: bool, lo: int, hi: int) -> Block:
+    imu = data.imu
+    t = (imu.t[0] - imu.ts) + np.arange(lo, hi + 1) * imu.ts
+    return Block(t=t, dtheta=imu.dtheta[lo:hi], dv=imu.dv[lo:hi], vref=vref[lo:hi + 1],
+                 vref_body=body, ts=imu.ts)
+
+
+def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
+    cfg = sc.align or AlignConfig()
+    if abs(data.site[0]) > math.radians(85.0):
+        raise ScenarioError(f"site.lat_deg: gyrocompassing needs |latitude| < 85°, got "
+                            f"{math.degrees(data.site[0]):.4f}° (the horizontal earth rate vanishes)")
+    poles = cfg.poles_for(sc.motion.kind if sc.motion else None)
+    ts = data.imu.ts
+    i0 = _index(data, cfg, 0.0, "start_s")
+    i1 = _index(data, cfg, cfg.t1_s, "t1_s")
+    i2 = _index(data, cfg, cfg.t2_s, "t2_s")
+    rng = np.random.default_rng([0 if data.seed is None else data.seed, 1])
+    vref, body = reference_velocity(data, cfg, rng)
+    att1 = coarse_attitude(data, cfg, i0, i1, data.seed)
+    q1 = euler_to_quat(att1)
+    v1 = quat_to_dcm(q1) @ vref[i1] if body else vref[i1]
+    pos1 = data.truth.pos[i1] if data.truth is not None else data.site
+    state0 = K.new_state(q1, v1, pos1)
+
+    if cfg.mode == "conventional":
+        i3 = _index(data, cfg, cfg.t2_s if cfg.t3_s == "measured" else cfg.t3_s, "t3_s")
+        t_start = time.perf_counter()
+        _, records = run_passes(state0, _block(data, vref, body, i1, i3), cfg.mode, 1,
+                                [s.to_stage() for s in cfg.stages], poles, cfg.level_phase_s)
+        compute = time.perf_counter() - t_start
+        if cfg.t3_s == "measured":
+            # Conventional runs in real time: its answer at T3 is the state at T2 + compute.
+            i3 = min(i2 + math.ceil(compute / ts), len(data.imu))
+        q_series = records[0].q_nb
+        q2, q3 = q_series[i2 - i1], q_series[min(i3, len(q_series) - 1 + i1) - i1]
+        equivalent = (i3 - i0) * ts
+    else:
+        block = _block(data, vref, body, i1, i2)
+        t_start = time.perf_counter()
+        state2, records = run_passes(state0, block, cfg.mode, cfg.passes,
+                                     [s.to_stage() for s in cfg.stages], poles, cfg.level_phase_s)
+        compute = time.perf_counter() - t_start
+        if cfg.t3_s == "measured":
+            i3 = i2 + math.ceil(compute / ts)
+            if i3 > len(data.imu):
+                raise ScenarioError("align.t3_s: 'measured' latency runs past the end of the data")
+        else:
+            i3 = _index(data, cfg, cfg.t3_s, "t3_s")
+        q2 = state2[0:4].copy()
+        q3 = compensate(cfg.compensation, state2, _block(data, vref, body, i2, i3))
+        equivalent = (i1 - i0) * ts + cfg.passes * (i2 - i1) * ts
+
+    truth = data.truth
+    pass_errors = []
+    for rec in records:
+        if truth is None:
+            pass_errors.append(None)
+            continue
+        idx = np.rint((rec.t - (data.imu.t[0] - ts)) / ts).astype(int)
+        pass_errors.append(attitude_error(quat_to_euler(rec.q_nb), truth.att[idx]))
+    return AlignRun(
+        cfg=cfg, azimuth_poles=poles,
+        t1=cfg.t1_s, t2=cfg.t2_s, t3=(i3 - i0) * ts,
+        coarse_att=att1, passes=records, pass_errors=pass_errors,
+        att_t2=quat_to_euler(q2), att_t3=quat_to_euler(q3),
+        truth_t2=None if truth is None else truth.att[i2],
+        truth_t3=None if truth is None else truth.att[i3],
+        compute_s=compute, equivalent_s=equivalent, index_offset=i0,
+    )
+
+
+def _deg(x):
+    return None if x is None else np.degrees(x).tolist()
+
+
+def alignment_summary(run: AlignRun, data: RunData, name: str) -> dict:
+    """Plain-number summary (degrees, seconds): the JSON contract of `gcalign align --json`."""
+    cfg = run.cfg
+    return {
+        "scenario": name,
+        "seed": data.seed,
+        "source": data.imu.source,
+        "mode": cfg.mode,
+        "compensation": cfg.compensation if cfg.mode != "conventional" else "none (real time)",
+        "azimuth_poles": run.azimuth_poles,
+        "stages": [s.model_dump() for s in cfg.stages],
+        "t1_s": run.t1, "t2_s": run.t2, "t3_s": run.t3,
+        "coarse_attitude_deg": _deg(run.coarse_att),
+        "attitude_t2_deg": _deg(run.att_t2),
+        "truth_t2_deg": _deg(run.truth_t2),
+        "error_t2_deg": _deg(run.error_t2),
+        "attitude_t3_deg": _deg(run.att_t3),
+        "truth_t3_deg": _deg(run.truth_t3),
+        "error_t3_deg": _deg(run.error_t3),
+        "passes": [
+            {"index": r.index, "direction": r.direction, "kind": r.kind, "stage": r.stage,
+             "t_end_s": float(r.t[-1]) - run.index_offset * data.imu.ts,
+             "error_deg": None if e is None else np.degrees(e[-1]).tolist(),
+             "attitude_deg": np.degrees(quat_to_euler(r.q_nb[-1])).tolist()}
+            for r, e in zip(run.passes, run.pass_errors)
+        ],
+        "equivalent_s": run.equivalent_s,
+        "data_used_s": run.t2 if cfg.mode != "conventional" else run.t3,
+        "compute_s": run.compute_s,
+    }
+
+
+ARCSEC_PER_DEG = 1.0 / u.ARCSEC * u.DEG

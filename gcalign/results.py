@@ -1,0 +1,138 @@
+"""The HDF5 results file: one schema, written atomically, readable without gcalign.
+
+Layout (README "Results file"): root attributes ``gcalign_version``, ``kind`` (the command),
+``command_line``, ``scenario_yaml`` (the scenario text), ``seed``, ``created_utc`` and
+``summary_json`` (what ``gcalign show`` prints); groups ``/truth``, ``/imu``, ``/navigate``,
+``/align``, ``/northfind``, ``/batch``. Every dataset carries a ``units`` attribute and,
+where it applies, a ``frame`` attribute. Arrays are SI, time along axis 0.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from datetime import datetime, timezone
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from gcalign import __version__
+from gcalign.errors import ScenarioError
+from gcalign.imu import ImuData
+from gcalign.trajectory import Truth
+
+ATT_FRAME = "[pitch, roll, yaw], C_nb = Rz(yaw) Rx(pitch) Ry(roll), ENU, yaw CCW positive"
+
+
+@contextmanager
+def atomic_h5(path: Path) -> Iterator[h5py.File]:
+    """Open `path` for writing under a temporary name; rename on success, delete on failure.
+
+    An interrupted or failed run therefore never leaves a truncated file under the final name.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        with h5py.File(tmp, "w") as f:
+            yield f
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None, **attrs):
+    """Write one dataset with its units (and frame) attributes."""
+    ds = group.create_dataset(name, data=np.asarray(data))
+    ds.attrs["units"] = units
+    if frame:
+        ds.attrs["frame"] = frame
+    for k, v in attrs.items():
+        ds.attrs[k] = v
+    return ds
+
+
+def write_header(f: h5py.File, kind: str, scenario_yaml: str, seed: int | None, summary: dict):
+    f.attrs["gcalign_version"] = __version__
+    f.attrs["kind"] = kind
+    f.attrs["command_line"] = " ".join(["gcalign", *sys.argv[1:]])
+    f.attrs["scenario_yaml"] = scenario_yaml
+    f.attrs["seed"] = -1 if seed is None else int(seed)
+    f.attrs["created_utc"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    f.attrs["summary_json"] = json.dumps(summary)
+
+
+def write_truth(f: h5py.File, truth: Truth):
+    g = f.create_group("truth")
+    put(g, "t", truth.t, "s")
+    put(g, "att", truth.att, "rad", ATT_FRAME)
+    put(g, "v_n", truth.v_n, "m/s", "ENU")
+    put(g, "pos", truth.pos, "rad, rad, m", "[latitude, longitude, height], WGS-84")
+
+
+def write_imu(f: h5py.File, imu: ImuData):
+    g = f.create_group("imu")
+    g.attrs["ts"] = imu.ts
+    g.attrs["source"] = imu.source
+    put(g, "t", imu.t, "s", description="end time of each increment")
+    put(g, "dtheta", imu.dtheta, "rad", "body: x right, y forward, z up")
+    put(g, "dv", imu.dv, "m/s", "body: x right, y forward, z up")
+    for name in ("site", "att0", "v0_n"):
+        value = getattr(imu, name)
+        if value is not None:
+            g.attrs[name] = value
+
+
+def open_results(path: Path) -> h5py.File:
+    """Open a gcalign results file for reading; ScenarioError if it is missing or not ours."""
+    path = Path(path)
+    if not path.is_file():
+        raise ScenarioError(f"{path}: file not found")
+    try:
+        f = h5py.File(path, "r")
+    except OSError:
+        raise ScenarioError(f"{path}: not an HDF5 file (expected a gcalign results file)") from None
+    if "gcalign_version" not in f.attrs:
+        f.close()
+        raise ScenarioError(
+            f"{path}: an HDF5 file, but not a gcalign results file (no 'gcalign_version' attribute)"
+        )
+    return f
+
+
+def read_summary(path: Path) -> tuple[str, dict, dict]:
+    """``(kind, summary, root attributes)`` of a results file."""
+    with open_results(path) as f:
+        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+    return str(attrs["kind"]), json.loads(attrs["summary_json"]), attrs
+
+
+def read_truth(path: Path) -> Truth | None:
+    with open_results(path) as f:
+        if "truth" not in f:
+            return None
+        g = f["truth"]
+        return Truth(t=g["t"][()], att=g["att"][()], v_n=g["v_n"][()], pos=g["pos"][()])
+
+
+def read_imu(path: Path) -> ImuData:
+    """The IMU block stored by ``gcalign simulate`` (so the same data feeds several runs)."""
+    with open_results(path) as f:
+        if "imu" not in f:
+            raise ScenarioError(f"{path}: holds no /imu group (write one with 'gcalign simulate')")
+        g = f["imu"]
+        extra = {k: np.asarray(g.attrs[k]) for k in ("site", "att0", "v0_n") if k in g.attrs}
+        return ImuData(
+            t=g["t"][()], dtheta=g["dtheta"][()], dv=g["dv"][()], ts=float(g.attrs["ts"]),
+            source=str(path), **extra,
+        )
+
+
+def read_scenario_yaml(path: Path) -> str:
+    with open_results(path) as f:
+        return str(f.attrs["scenario_yaml"])
