@@ -30,7 +30,7 @@ def radii(lat):
 
 
 def gravity(lat, h=0.0):
-    """Magnitude of normal gravity (m/s²), pointing down (-U), at latitude `lat` (rad), height `h` (m)."""
+    """Normal gravity (m/s², pointing down) at latitude `lat` (rad) and height `h` (m)."""
     s2 = np.sin(lat) ** 2
     return GE * (1.0 + G_C1 * s2 + G_C2 * s2 * s2) - G_C3 * h
 
@@ -46,9 +46,7 @@ def omega_en_n(lat, h, v_n):
     v_n = np.asarray(v_n, dtype=float)
     r_m, r_n = radii(lat)
     ve, vn = v_n[..., 0], v_n[..., 1]
-    return np.stack(
-        [-vn / (r_m + h), ve / (r_n + h), ve * np.tan(lat) / (r_n + h)], axis=-1
-    )
+    return np.stack([-vn / (r_m + h), ve / (r_n + h), ve * np.tan(lat) / (r_n + h)], axis=-1)
 
 
 def C_en(lat, lon):

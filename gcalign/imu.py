@@ -117,8 +117,9 @@ def ideal_imu(motion, site, ts: float, substeps: int = 2):
     # Attitude and velocity are continuous: one time line of sub-points for the position.
     line = np.r_[(np.arange(n)[:, None] * m + np.arange(substeps)).ravel(), n * m - 1]
     pos_line = integrate_position(grid.ravel()[line], v_n[line], site)
-    pos = np.concatenate([pos_line[:-1].reshape(n, substeps, 3),
-                          pos_line[substeps::substeps][:, None]], 1).reshape(-1, 3)
+    pos = np.concatenate(
+        [pos_line[:-1].reshape(n, substeps, 3), pos_line[substeps::substeps][:, None]], 1
+    ).reshape(-1, 3)
     lat, h = pos[:, 0], pos[:, 2]
     w = 2.0 * earth.omega_ie_n(lat) + earth.omega_en_n(lat, h, v_n)
     f_n = a_n + np.cross(w, v_n)
@@ -134,8 +135,9 @@ def ideal_imu(motion, site, ts: float, substeps: int = 2):
     t, att_s, pos_s = grid.ravel()[k], att[k], pos[k]
     half = 0.5 * earth.OMEGA_IE * t
     q_ie = np.stack([np.cos(half), 0 * half, 0 * half, np.sin(half)], -1)
-    q_ib = quat_mult(quat_mult(q_ie, dcm_to_quat(earth.C_en(pos_s[:, 0], pos_s[:, 1]))),
-                     dcm_to_quat(C_nb[k]))
+    q_ib = quat_mult(
+        quat_mult(q_ie, dcm_to_quat(earth.C_en(pos_s[:, 0], pos_s[:, 1]))), dcm_to_quat(C_nb[k])
+    )
     dtheta = quat_to_rotvec(quat_mult(quat_conj(q_ib[:-1]), q_ib[1:]))
 
     truth = Truth(t=t, att=att_s, v_n=v_n[k].copy(), pos=pos_s)

@@ -136,3 +136,75 @@ def read_imu(path: Path) -> ImuData:
 def read_scenario_yaml(path: Path) -> str:
     with open_results(path) as f:
         return str(f.attrs["scenario_yaml"])
+
+
+GAIN_NAMES = "K_E1, K_E2, K_E3, K_N1, K_N2, K_N3, K_U1, K_U2, K_U3, K_U4"
+
+
+def write_alignment(f: h5py.File, run) -> None:
+    """/align/pass_NN (attitude and error per pass), /align/result, /align/gains."""
+    from gcalign.rotation import quat_to_euler
+
+    g = f.create_group("align")
+    g.attrs["mode"] = run.cfg.mode
+    g.attrs["azimuth_poles"] = run.azimuth_poles
+    g.attrs["t1_s"], g.attrs["t2_s"], g.attrs["t3_s"] = run.t1, run.t2, run.t3
+    for rec, err in zip(run.passes, run.pass_errors):
+        p = g.create_group(f"pass_{rec.index:02d}")
+        p.attrs["direction"], p.attrs["kind"], p.attrs["stage"] = rec.direction, rec.kind, rec.stage
+        put(p, "t", rec.t, "s", description="processing order (decreasing in a reverse pass)")
+        put(p, "att", quat_to_euler(rec.q_nb), "rad", ATT_FRAME)
+        put(p, "gains", rec.gains, "SI", names=GAIN_NAMES)
+        if err is not None:
+            put(p, "error", err, "rad", "Euler differences est - true, yaw wrapped")
+    r = g.create_group("result")
+    put(r, "coarse_att", run.coarse_att, "rad", ATT_FRAME)
+    put(r, "att_t2", run.att_t2, "rad", ATT_FRAME)
+    put(r, "att_t3", run.att_t3, "rad", ATT_FRAME)
+    if run.truth_t2 is not None:
+        put(r, "truth_t2", run.truth_t2, "rad", ATT_FRAME)
+        put(r, "truth_t3", run.truth_t3, "rad", ATT_FRAME)
+        put(r, "error_t2", run.error_t2, "rad", "Euler differences est - true, yaw wrapped")
+        put(r, "error_t3", run.error_t3, "rad", "Euler differences est - true, yaw wrapped")
+    r.attrs["compute_s"] = run.compute_s
+    r.attrs["equivalent_s"] = run.equivalent_s
+
+
+def write_northfind(f: h5py.File, run) -> None:
+    """/northfind: truth, per-method estimates and errors (R repeats × M azimuths), the tilt
+    estimates and the setup as attributes (SI, radians)."""
+    s, res = run.setup, run.result
+    g = f.create_group("northfind")
+    for name in ("positions", "dwell_s", "rate_hz", "lat", "height", "tilt_direction_ref",
+                 "repeats", "gyro_bias", "gyro_arw", "gyro_scale", "accel_bias", "accel_vrw",
+                 "index_error", "n_samples", "gravity"):
+        g.attrs[name] = getattr(s, name)
+    g.attrs["tilt"] = float(s.tilt[0])
+    g.attrs["tilt_direction"] = float(s.tilt_direction[0])
+    g.attrs["methods"] = ",".join(res.methods)
+    g.attrs["samples"] = bool(run.cfg.samples)
+    g.attrs["units"] = ("lat, tilt, tilt_direction, index_error: rad; dwell_s: s; rate_hz: Hz; "
+                        "height: m; gyro_bias: rad/s; gyro_arw: rad/sqrt(s); accel_bias: m/s^2 "
+                        "[x, y]; accel_vrw: m/s/sqrt(s); gravity: m/s^2")
+    az = "clockwise from true north, [0, 2pi)"
+    put(g, "azimuth_true", res.azimuth_true, "rad", az)
+    put(g, "theta", res.theta, "rad", "table angles, counter-clockwise about the table normal")
+    put(g, "tilt_true", res.tilt_true, "rad", "table normal from the vertical")
+    put(g, "tilt_direction_true", res.tilt_direction_true, "rad", "azimuth of descent, " + az)
+    rm = "(repeats, azimuths)"
+    put(g, "tilt_est", res.tilt_est.T, "rad", shape=rm)
+    put(g, "tilt_direction_est", res.tilt_direction_est.T, "rad", "azimuth of descent, " + az,
+        shape=rm)
+    put(g, "pitch_est", res.pitch_est.T, "rad", ATT_FRAME, shape=rm)
+    put(g, "roll_est", res.roll_est.T, "rad", ATT_FRAME, shape=rm)
+    put(g, "gyro_coef", np.swapaxes(res.gyro_coef, 0, 1), "rad/s",
+        shape="(repeats, azimuths, [R, a, b])")
+    put(g, "accel_coef", np.swapaxes(res.accel_coef, 0, 1), "m/s^2",
+        shape="(repeats, azimuths, [x, y], [R, a, b])")
+    for i, name in enumerate(res.methods):
+        m = g.create_group(name)
+        put(m, "estimate", res.azimuth_est[i].T, "rad", az, shape=rm)
+        put(m, "error", res.azimuth_error[i].T, "rad", "estimate - true, wrapped to [-pi, pi)",
+            shape=rm)
+        put(m, "error_pred", res.error_pred[i], "rad", "noise-free closed form (NaN: none)")
+        put(m, "std_pred", res.azimuth_std_pred[i], "rad", "linearised 1-sigma prediction")

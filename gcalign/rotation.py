@@ -40,7 +40,7 @@ def euler_to_dcm(att):
 
 
 def dcm_to_euler(C):
-    """``[pitch, roll, yaw]`` (rad) from C_nb, shape (..., 3, 3) -> (..., 3); pitch in [-90°, 90°]."""
+    """``[pitch, roll, yaw]`` (rad) from C_nb, (..., 3, 3) -> (..., 3); pitch in [-90°, 90°]."""
     C = np.asarray(C, dtype=float)
     pitch = np.arcsin(np.clip(C[..., 2, 1], -1.0, 1.0))
     roll = np.arctan2(-C[..., 2, 0], C[..., 2, 2])
@@ -93,8 +93,16 @@ def dcm_to_quat(C):
     )
     k = np.argmax(cand, axis=-1)
     s = 2.0 * np.sqrt(np.take_along_axis(cand, k[..., None], -1)[..., 0])
-    d21, d02, d10 = C[..., 2, 1] - C[..., 1, 2], C[..., 0, 2] - C[..., 2, 0], C[..., 1, 0] - C[..., 0, 1]
-    s21, s02, s10 = C[..., 2, 1] + C[..., 1, 2], C[..., 0, 2] + C[..., 2, 0], C[..., 1, 0] + C[..., 0, 1]
+    d21, d02, d10 = (
+        C[..., 2, 1] - C[..., 1, 2],
+        C[..., 0, 2] - C[..., 2, 0],
+        C[..., 1, 0] - C[..., 0, 1],
+    )
+    s21, s02, s10 = (
+        C[..., 2, 1] + C[..., 1, 2],
+        C[..., 0, 2] + C[..., 2, 0],
+        C[..., 1, 0] + C[..., 0, 1],
+    )
     options = np.stack(
         [
             np.stack([s / 4, d21 / s, d02 / s, d10 / s], -1),

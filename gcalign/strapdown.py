@@ -75,7 +75,15 @@ def navigate(t, dtheta, dv, ts: float, start: NavState, reverse: bool = False) -
         times, sign, v0 = times[::-1], -1.0, -v0
     q, v, p = empty_states(len(dtheta))
     strapdown_block(
-        np.asarray(start.q_nb, float), v0, np.asarray(start.pos, float),
-        dtheta, dv, float(ts), sign, q, v, p,
+        np.asarray(start.q_nb, float),
+        v0,
+        np.asarray(start.pos, float),
+        dtheta,
+        dv,
+        float(ts),
+        sign,
+        q,
+        v,
+        p,
     )
     return NavSolution(t=times, q_nb=q, v_n=sign * v, pos=p)

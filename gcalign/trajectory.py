@@ -136,7 +136,9 @@ def integrate_position(t, v_n, pos0, iterations: int = 3):
     for _ in range(iterations):
         r_m, r_n = earth.radii(lat)
         lat_rate = v_n[:, 1] / (r_m + h)
-        lat = pos0[0] + np.concatenate([[0.0], np.cumsum(0.5 * (lat_rate[1:] + lat_rate[:-1]) * dt)])
+        lat = pos0[0] + np.concatenate(
+            [[0.0], np.cumsum(0.5 * (lat_rate[1:] + lat_rate[:-1]) * dt)]
+        )
     r_m, r_n = earth.radii(lat)
     lon_rate = v_n[:, 0] / ((r_n + h) * np.cos(lat))
     lon = pos0[1] + np.concatenate([[0.0], np.cumsum(0.5 * (lon_rate[1:] + lon_rate[:-1]) * dt)])

@@ -36,9 +36,13 @@ def _track(pos0, t, v_n):
     """Latitude/longitude/height along ENU velocity samples (trapezoid rule)."""
     dt = np.diff(t)[:, None]
     r_m, r_n = earth.radii(pos0[0])
-    rate = np.stack([v_n[:, 1] / (r_m + pos0[2]),
-                     v_n[:, 0] / ((r_n + pos0[2]) * np.cos(pos0[0])), v_n[:, 2]], -1)
-    return pos0 + np.concatenate([np.zeros((1, 3)), np.cumsum(0.5 * (rate[1:] + rate[:-1]) * dt, 0)])
+    rate = np.stack(
+        [v_n[:, 1] / (r_m + pos0[2]), v_n[:, 0] / ((r_n + pos0[2]) * np.cos(pos0[0])), v_n[:, 2]],
+        -1,
+    )
+    return pos0 + np.concatenate(
+        [np.zeros((1, 3)), np.cumsum(0.5 * (rate[1:] + rate[:-1]) * dt, 0)]
+    )
 
 
 def one_off(state_t2: np.ndarray, after: Block) -> np.ndarray:
@@ -47,8 +51,18 @@ def one_off(state_t2: np.ndarray, after: Block) -> np.ndarray:
     q_b_ib0 = np.empty((n + 1, 4))
     pure = K.new_state(np.array([1.0, 0.0, 0.0, 0.0]), np.zeros(3), state_t2[9:12])
     # Earth rate off and zero reference velocity: the kernel integrates the gyro alone (eq. 18).
-    K.gyrocompass_block(pure, after.dtheta, after.dv, np.zeros((n + 1, 3)), False, after.ts, 0.0,
-                        np.zeros(K.GAINS_SIZE), K.ATTITUDE, q_b_ib0)
+    K.gyrocompass_block(
+        pure,
+        after.dtheta,
+        after.dv,
+        np.zeros((n + 1, 3)),
+        False,
+        after.ts,
+        0.0,
+        np.zeros(K.GAINS_SIZE),
+        K.ATTITUDE,
+        q_b_ib0,
+    )
     pos_t2 = state_t2[9:12]
     C_ib0_i = _C_ni(pos_t2, 0.0) @ quat_to_dcm(state_t2[0:4])  # eq. 14 at T2
     tau = after.t - after.t[0]
@@ -67,8 +81,18 @@ def continued(state_t2: np.ndarray, after: Block) -> np.ndarray:
     n = len(after.dtheta)
     state = state_t2.copy()
     q_out = np.empty((n + 1, 4))
-    K.gyrocompass_block(state, after.dtheta, after.dv, after.vref, after.vref_body, after.ts, 1.0,
-                        np.zeros(K.GAINS_SIZE), K.ATTITUDE, q_out)
+    K.gyrocompass_block(
+        state,
+        after.dtheta,
+        after.dv,
+        after.vref,
+        after.vref_body,
+        after.ts,
+        1.0,
+        np.zeros(K.GAINS_SIZE),
+        K.ATTITUDE,
+        q_out,
+    )
     return q_out[-1]
 
 

@@ -92,23 +92,40 @@ def loop_gains(stage: Stage, lat: float, h: float, azimuth_poles: str) -> np.nda
     east = level_gains(stage.t_xy, stage.xi, g, r_n + h)
     north = level_gains(stage.t_xy, stage.xi, g, r_m + h)
     az = azimuth_gains(stage.t_z, stage.xi, g, r_m + h, azimuth_poles)
-    return np.array([east.k1, east.k2, east.k3, north.k1, north.k2, north.k3,
-                     az.k1, az.k2, az.k3, az.k4])
+    return np.array(
+        [east.k1, east.k2, east.k3, north.k1, north.k2, north.k3, az.k1, az.k2, az.k3, az.k4]
+    )
 
 
 def _run(state, block: Block, lo: int, hi: int, reverse: bool, gains, mode, q_out):
     """Kernel over increments lo..hi-1 of the block (forward) or hi-1..lo (reverse)."""
-    dth, dv, vref = block.dtheta[lo:hi], block.dv[lo:hi], block.vref[lo:hi + 1]
+    dth, dv, vref = block.dtheta[lo:hi], block.dv[lo:hi], block.vref[lo : hi + 1]
     sign = 1.0
     if reverse:
         dth, dv, vref, sign = -dth[::-1], dv[::-1], -vref[::-1], -1.0
-    K.gyrocompass_block(state, np.ascontiguousarray(dth), np.ascontiguousarray(dv),
-                        np.ascontiguousarray(vref), block.vref_body, block.ts, sign,
-                        gains, mode, q_out)
+    K.gyrocompass_block(
+        state,
+        np.ascontiguousarray(dth),
+        np.ascontiguousarray(dv),
+        np.ascontiguousarray(vref),
+        block.vref_body,
+        block.ts,
+        sign,
+        gains,
+        mode,
+        q_out,
+    )
 
 
-def run_passes(state0: np.ndarray, block: Block, mode: str, passes: int, stages: list[Stage],
-               azimuth_poles: str, level_s: float) -> tuple[np.ndarray, list[PassRecord]]:
+def run_passes(
+    state0: np.ndarray,
+    block: Block,
+    mode: str,
+    passes: int,
+    stages: list[Stage],
+    azimuth_poles: str,
+    level_s: float,
+) -> tuple[np.ndarray, list[PassRecord]]:
     """Run the passes of a mode over the block from the kernel state at its start.
 
     The first forward pass begins with `level_s` seconds of level-only loops (azimuth free),

@@ -86,8 +86,9 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains,
         wz = (wie_u + tu + cu) * ts
 
         # Specific-force increment at mid-interval, as in the strapdown step.
-        bx, by, bz = rotate_small(0.5 * dtheta[k, 0], 0.5 * dtheta[k, 1], 0.5 * dtheta[k, 2],
-                                  dv[k, 0], dv[k, 1], dv[k, 2])
+        bx, by, bz = rotate_small(
+            0.5 * dtheta[k, 0], 0.5 * dtheta[k, 1], 0.5 * dtheta[k, 2], dv[k, 0], dv[k, 1], dv[k, 2]
+        )
         fx, fy, fz = qrot(q0, q1, q2, q3, bx, by, bz)
         fx, fy, fz = rotate_small(-0.5 * wx, -0.5 * wy, -0.5 * wz, fx, fy, fz)
 

@@ -63,4 +63,5 @@ def main() -> None:
 
 
 # Commands register themselves on `app`.
+from gcalign.cli import align as _align  # noqa: E402,F401
 from gcalign.cli import data as _data  # noqa: E402,F401

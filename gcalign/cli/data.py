@@ -23,10 +23,16 @@ OUT_HELP = "Results file (default runs/NAME-COMMAND[-seedN].h5)."
 def simulation_summary(data: RunData, name: str, compute_s: float) -> dict:
     imu = data.imu
     s = {
-        "scenario": name, "seed": data.seed, "samples": len(imu), "rate_hz": 1.0 / imu.ts,
-        "duration_s": float(len(imu) * imu.ts), "compute_s": compute_s,
-        "initial_attitude_deg": None, "final_attitude_deg": None,
-        "final_velocity_mps": None, "distance_m": None,
+        "scenario": name,
+        "seed": data.seed,
+        "samples": len(imu),
+        "rate_hz": 1.0 / imu.ts,
+        "duration_s": float(len(imu) * imu.ts),
+        "compute_s": compute_s,
+        "initial_attitude_deg": None,
+        "final_attitude_deg": None,
+        "final_velocity_mps": None,
+        "distance_m": None,
     }
     if data.truth is not None:
         tr = data.truth
@@ -117,8 +123,10 @@ def show(
     kind, summary, attrs = results.read_summary(file)
     console = consoles(as_json)
     console.print(report.summary_table(kind, summary))
-    console.print(f"[dim]{attrs.get('command_line', '')}  ({attrs.get('created_utc', '')}, "
-                  f"gcalign {attrs.get('gcalign_version', '?')})[/dim]")
+    console.print(
+        f"[dim]{attrs.get('command_line', '')}  ({attrs.get('created_utc', '')}, "
+        f"gcalign {attrs.get('gcalign_version', '?')})[/dim]"
+    )
     if as_json:
         emit_json({"kind": kind, **summary})
 

@@ -11,7 +11,6 @@ from pydantic import ValidationError
 from gcalign.config.models import Scenario
 from gcalign.errors import ScenarioError
 
-
 # Model-level checks name their field at the start of the message ("segments: ..."),
 # since pydantic gives them the model's location only.
 _FIELD_PREFIX = re.compile(r"^([a-z_0-9]+(?:\.[a-z_0-9]+)*): ")
@@ -29,7 +28,7 @@ def scenario_errors(err: ValidationError, source: str = "") -> str:
         m = _FIELD_PREFIX.match(msg)
         if m:
             loc.append(m.group(1))
-            msg = msg[m.end():]
+            msg = msg[m.end() :]
         where = ".".join(loc) or "scenario"
         text = f"{where}: {msg}"
         if e["type"] not in {"missing", "model_type", "value_error"}:
@@ -44,7 +43,9 @@ def scenario_errors(err: ValidationError, source: str = "") -> str:
 def parse_scenario(data: dict, source: str = "scenario") -> Scenario:
     """Validate a mapping (parsed YAML) as a scenario; raise ScenarioError on bad input."""
     if not isinstance(data, dict):
-        raise ScenarioError(f"{source}: the scenario must be a YAML mapping, got {type(data).__name__}")
+        raise ScenarioError(
+            f"{source}: the scenario must be a YAML mapping, got {type(data).__name__}"
+        )
     try:
         return Scenario.model_validate(data)
     except ValidationError as err:

@@ -34,14 +34,22 @@ def resolved_rows(sc: Scenario) -> list[tuple[str, str, str]]:
             ("imu.gyro.arw_dprh", _v(imu.gyro.arw_dprh) + " °/√h", _v(err.gyro.noise) + " rad/√s"),
             ("imu.gyro.scale_ppm", _v(imu.gyro.scale_ppm) + " ppm", _v(err.gyro.scale)),
             ("imu.accel.bias_ug", _v(imu.accel.bias_ug) + " µg", _v(err.accel.bias) + " m/s²"),
-            ("imu.accel.vrw_ugrhz", _v(imu.accel.vrw_ugrhz) + " µg/√Hz",
-             _v(err.accel.noise) + " m/s/√s"),
+            (
+                "imu.accel.vrw_ugrhz",
+                _v(imu.accel.vrw_ugrhz) + " µg/√Hz",
+                _v(err.accel.noise) + " m/s/√s",
+            ),
             ("imu.accel.scale_ppm", _v(imu.accel.scale_ppm) + " ppm", _v(err.accel.scale)),
         ]
         for name, sensor, m in (("gyro", imu.gyro, err.gyro), ("accel", imu.accel, err.accel)):
             if sensor.misalignment_arcsec is not None:
-                rows.append((f"imu.{name}.misalignment_arcsec", _v(sensor.misalignment_arcsec) + " ″",
-                             _v(m.misalignment) + " rad"))
+                rows.append(
+                    (
+                        f"imu.{name}.misalignment_arcsec",
+                        _v(sensor.misalignment_arcsec) + " ″",
+                        _v(m.misalignment) + " rad",
+                    )
+                )
             if m.quantum:
                 unit = "rad" if name == "gyro" else "m/s"
                 rows.append((f"imu.{name}.quantum", "", _v(m.quantum) + f" {unit}"))
@@ -50,21 +58,32 @@ def resolved_rows(sc: Scenario) -> list[tuple[str, str, str]]:
         n = int(round(mo.duration_s * sc.imu.rate_hz))
         rows += [
             ("motion.kind", mo.kind, ""),
-            ("motion.attitude_deg", _v(mo.attitude_deg) + " °", _v(np.radians(mo.attitude_deg)) + " rad"),
+            (
+                "motion.attitude_deg",
+                _v(mo.attitude_deg) + " °",
+                _v(np.radians(mo.attitude_deg)) + " rad",
+            ),
             ("motion.duration_s", _v(mo.duration_s) + " s", f"{n} samples"),
         ]
         if mo.kind == "swing":
             sw = mo.to_motion()
             rows += [
-                ("motion.swing.amplitude_deg", _v(mo.swing.amplitude_deg if mo.swing else []) + " °",
-                 _v(sw.amplitude) + " rad"),
+                (
+                    "motion.swing.amplitude_deg",
+                    _v(mo.swing.amplitude_deg if mo.swing else []) + " °",
+                    _v(sw.amplitude) + " rad",
+                ),
                 ("motion.swing.period_s", _v(sw.period) + " s", ""),
                 ("motion.swing.phase_deg", "", _v(sw.phase) + " rad"),
             ]
         for i, s in enumerate(mo.segments or []):
-            rows.append((f"motion.segments.{i}",
-                         f"{s.duration_s:g} s, {s.accel_mps2:g} m/s², {_v(s.rate_dps)} °/s",
-                         _v(np.radians(s.rate_dps)) + " rad/s"))
+            rows.append(
+                (
+                    f"motion.segments.{i}",
+                    f"{s.duration_s:g} s, {s.accel_mps2:g} m/s², {_v(s.rate_dps)} °/s",
+                    _v(np.radians(s.rate_dps)) + " rad/s",
+                )
+            )
     for section in ("align", "northfind"):
         model = getattr(sc, section, None)
         if model is not None and hasattr(model, "resolved_rows"):

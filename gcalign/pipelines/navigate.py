@@ -50,7 +50,7 @@ def initial_state(data: RunData) -> NavState:
         return NavState(euler_to_quat(tr.att[0]), tr.v_n[0], tr.pos[0])
     if data.imu.att0 is None:
         raise ScenarioError(
-            f"imu_file: {data.imu.source} has no initial attitude and there is no truth to start from"
+            f"imu_file: {data.imu.source} gives no initial attitude and there is no truth"
         )
     v0 = data.imu.v0_n if data.imu.v0_n is not None else np.zeros(3)
     return NavState(euler_to_quat(data.imu.att0), v0, data.site)

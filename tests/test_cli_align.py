@@ -1,0 +1,123 @@
+"""`gcalign align` end to end: the JSON contract, the built-in scenario, `show`, bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from gcalign.cli import app
+
+ROOT = Path(__file__).resolve().parents[1]
+runner = CliRunner()
+
+
+def _small(tmp_path: Path, **align) -> Path:
+    """The seed moving scenario shortened: T2 = 60 s, 3 passes."""
+    d = yaml.safe_load((ROOT / "configs/seed000_moving_full_cycle.yaml").read_text())
+    d["motion"]["duration_s"] = 80
+    d["align"].update({"t2_s": 60, "t3_s": 70, "passes": 3, "level_s": 20, **align})
+    p = tmp_path / "small.yaml"
+    p.write_text(yaml.safe_dump(d))
+    return p
+
+
+def test_builtin_equals_configs_copy():
+    from gcalign.cli.align import builtin_scenario_text
+
+    assert builtin_scenario_text() == (ROOT / "configs/seed000_moving_full_cycle.yaml").read_text()
+
+
+def test_align_json_contract_and_show(tmp_path):
+    out = tmp_path / "a.h5"
+    res = runner.invoke(app, ["align", str(_small(tmp_path)), "-o", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    for key in (
+        "error_t2_deg",
+        "error_t3_deg",
+        "attitude_t3_deg",
+        "truth_t3_deg",
+        "passes",
+        "compute_s",
+        "output",
+    ):
+        assert key in s
+    assert [p["direction"] for p in s["passes"]] == ["forward", "reverse", "forward"]
+    assert s["output"] == str(out) and out.is_file()
+    assert s["t3_s"] == 70.0 and s["truth_t3_deg"][2] == pytest.approx(30.0, abs=1e-9)
+    shown = runner.invoke(app, ["show", str(out), "--json"])
+    assert shown.exit_code == 0, shown.output
+    assert json.loads(shown.stdout)["error_t3_deg"] == s["error_t3_deg"]
+    import h5py
+
+    with h5py.File(out) as f:
+        assert f["align/pass_01"].attrs["direction"] == "reverse"
+        assert f["align/pass_00/error"].attrs["units"] == "rad"
+        assert f["align/result/att_t3"].shape == (3,)
+        assert "moving" in f.attrs["scenario_yaml"]
+
+
+def test_same_seed_same_numbers_and_overrides(tmp_path):
+    p = _small(tmp_path)
+    a = runner.invoke(app, ["align", str(p), "-o", str(tmp_path / "1.h5"), "--json", "--seed", "4"])
+    b = runner.invoke(app, ["align", str(p), "-o", str(tmp_path / "2.h5"), "--json", "--seed", "4"])
+    c = runner.invoke(
+        app,
+        [
+            "align",
+            str(p),
+            "-o",
+            str(tmp_path / "3.h5"),
+            "--json",
+            "--seed",
+            "5",
+            "--mode",
+            "half-cycle",
+            "--compensation",
+            "one-off",
+        ],
+    )
+    assert a.exit_code == b.exit_code == c.exit_code == 0, c.output
+    sa, sb, sc = (json.loads(r.stdout) for r in (a, b, c))
+    assert sa["error_t3_deg"] == sb["error_t3_deg"]
+    assert sc["mode"] == "half-cycle" and sc["compensation"] == "one-off"
+    assert [p["kind"] for p in sc["passes"]] == ["compass", "attitude", "compass"]
+    assert sc["error_t3_deg"] != sa["error_t3_deg"]
+
+
+@pytest.mark.parametrize(
+    "align, args, field",
+    [
+        ({"t1_s": 30, "t2_s": 20}, [], "align.t2_s"),
+        ({"t3_s": 50}, [], "align.t3_s"),
+        ({}, ["--t2", "500", "--t3", "510"], "align.t2_s"),
+        ({"stages": [{"t_xy_s": 20, "t_z_s": 0}]}, [], "align.stages.0.t_z_s"),
+        ({"stages": [{"xi": 1.0}]}, [], "align.stages.0.xi"),
+        ({"stages": [{"xi": 0}]}, [], "align.stages.0.xi"),
+        ({"stages": [{"passes": 3}, {"t_z_s": 200}]}, [], "align.stages"),
+        ({"mode": "full-cycle", "passes": 1}, [], "align.passes"),
+        ({}, ["--mode", "half-cycle", "--passes", "1"], "align.passes"),
+        ({}, ["--mode", "sideways"], "align.mode"),
+        ({}, ["--t3", "soon"], "align.t3_s"),
+    ],
+)
+def test_bad_input_exits_2_without_file(tmp_path, align, args, field):
+    out = tmp_path / "bad.h5"
+    res = runner.invoke(app, ["align", str(_small(tmp_path, **align)), "-o", str(out), *args])
+    assert res.exit_code == 2, res.output
+    assert field in res.output and "Traceback" not in res.output
+    assert not out.exists()
+    assert not [p for p in tmp_path.iterdir() if p.suffix in {".h5", ".tmp"}]
+
+
+def test_scenario_file_errors(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: x\nsite: {lat_deg: 45\n")
+    res = runner.invoke(app, ["align", str(bad)])
+    assert res.exit_code == 2 and "YAML syntax error at line" in res.output
+    res = runner.invoke(app, ["align", str(tmp_path / "missing.yaml")])
+    assert res.exit_code == 2 and "file not found" in res.output
