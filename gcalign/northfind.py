@@ -571,7 +571,8 @@ def simulate_table(setup: NorthfindSetup, rng: np.random.Generator, *, samples: 
     theta_true = theta + setup.index_error * rng.standard_normal((m, r, n))
     ideal = _ideal_readings(C_nt, theta_true, setup.lat, g)
     ideal[..., 0] *= 1.0 + setup.gyro_scale
-    bias = np.array([setup.gyro_bias, setup.accel_bias[0], setup.accel_bias[1]])
+    accel_bias = np.asarray(setup.accel_bias, dtype=float)
+    bias = np.array([setup.gyro_bias, accel_bias[0], accel_bias[1]])
     sigma = np.array([setup.gyro_arw, setup.accel_vrw, setup.accel_vrw]) * np.sqrt(
         setup.rate_hz
     )  # per-sample standard deviation, rad/s and m/s²
@@ -746,7 +747,7 @@ class NorthfindEstimate:
     azimuth : (P, *S) float, rad, [0, 2π). Azimuth per method.
     tilt : (*S) float, rad. ``asin √(ux² + uy²)``.
     tilt_direction : (*S) float, rad, [0, 2π). True azimuth of descent, using the
-        ``coordinate`` azimuth: ``ψ̂ + atan2(-ux, -uy uz)``.
+        ``coordinate`` azimuth: ``ψ̂ + atan2(-ux, -uy uz)`` (meaningless, = ψ̂, at zero tilt).
     pitch, roll : (*S) float, rad. PSINS Euler angles of the table.
     ux, uy : (*S) float. Up vector in table axes.
     gyro_coef : (*S, 3) float, rad/s. ``[R, a, b]`` of the gyro.
@@ -964,8 +965,8 @@ def predict_azimuth_std(setup: NorthfindSetup, method: str = "coordinate") -> np
         xp, xm = x0.copy(), x0.copy()
         xp[:, j] += h
         xm[:, j] -= h
-        fp = azimuth_from_harmonics(*xp.T, setup.lat, method)
-        fm = azimuth_from_harmonics(*xm.T, setup.lat, method)
+        fp = azimuth_from_harmonics(xp[:, 0], xp[:, 1], xp[:, 2], xp[:, 3], setup.lat, method)
+        fm = azimuth_from_harmonics(xm[:, 0], xm[:, 1], xm[:, 2], xm[:, 3], setup.lat, method)
         J[:, j] = wrap_pi(fp - fm) / (2.0 * h)
     n_s = setup.n_samples
     sig_g = setup.gyro_arw * np.sqrt(setup.rate_hz / n_s)
@@ -1096,7 +1097,7 @@ def run_northfind(
     return NorthfindResult(
         methods=methods,
         azimuth_true=setup.azimuths.copy(),
-        tilt_true=setup.tilt.copy(),
+        tilt_true=np.array(setup.tilt, dtype=float),
         tilt_direction_true=setup.tilt_direction_north,
         azimuth_est=est.azimuth,
         azimuth_error=err,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
+from rich import box
 from rich.table import Table
 from rich.text import Text
 
@@ -102,7 +103,149 @@ def align_table(s: dict) -> Table:
 
 def summary_table(kind: str, summary: dict) -> Table:
     """The table a command printed, rebuilt from its summary (for `gcalign show`)."""
-    builders = {"simulate": simulate_table, "navigate": navigate_table, "align": align_table}
+    builders = {"simulate": simulate_table, "navigate": navigate_table, "align": align_table,
+                "batch": batch_table}
+    builders["northfind"] = northfind_table
     if kind not in builders:
         return kv_table(f"gcalign {kind}", ((k, str(v)) for k, v in summary.items()))
     return builders[kind](summary)
+
+
+def _rms(values) -> float | None:
+    v = [x for x in values if x is not None]
+    return (sum(x * x for x in v) / len(v)) ** 0.5 if v else None
+
+
+def _arcmin(x):
+    return None if x is None else x * 60.0
+
+
+def northfind_table(s: dict) -> Table:
+    """North-finding per method: a single determination, the seed's Table 1 (repeats of one
+    azimuth: estimates, mean, std, bias) or a sweep (max and RMS error per method)."""
+    r, m = s["shape"]
+    order, ms = s["method_order"], s["methods"]
+    ref = "from the reference axis" if s["tilt_reference"] == "table" else "true azimuth"
+    table = Table(
+        title=f"gcalign northfind: {s['scenario']} — {s['positions']} positions × "
+              f"{s['dwell_s']:g} s, lat {s['latitude_deg']:g}°, tilt {s['tilt_deg']:.4g}° toward "
+              f"{s['tilt_direction_deg']:.4g}° ({ref})",
+        title_justify="left", header_style="bold")
+    tilt = s["tilt_est_deg"]
+    tail = (f"seed {s['seed']}; compute {s['compute_s'] * 1e3:.1f} ms; "
+            f"output {s.get('output') or '—'}")
+    if m == 1 and r == 1:
+        for name in ("method", "azimuth (deg)", "error (deg)", "error (′)", "pred. σ (′)",
+                     "tilt est (deg)"):
+            table.add_column(name, justify="left" if name == "method" else "right")
+        for name in order:
+            d = ms[name]
+            table.add_row(Text(name), fmt(d["estimates_deg"][0], 5), fmt(d["errors_deg"][0], 5),
+                          fmt(_arcmin(d["errors_deg"][0]), 3),
+                          fmt(_arcmin(d["std_pred_deg"][0]), 3),
+                          "—" if name == "none" else fmt(tilt[0], 4))
+        table.caption = (f"true azimuth {s['azimuth_true_deg'][0]:.4f}°; estimated tilt "
+                         f"{tilt[0]:.4f}° toward {s['tilt_direction_est_deg'][0]:.3f}° (true "
+                         f"{s['tilt_deg']:.4g}° toward {s['tilt_direction_true_deg'][0]:.4g}°, "
+                         f"from north); {tail}")
+    elif m == 1:
+        table.add_column("group", justify="left")
+        for name in order:
+            table.add_column(f"{name} (deg)", justify="right")
+        table.add_column("tilt est (deg)", justify="right")
+        shown = range(r) if r <= 25 else [*range(10), None, *range(r - 5, r)]
+        for i in shown:
+            if i is None:
+                table.add_row(Text("…"), *["…"] * (len(order) + 1))
+                continue
+            table.add_row(Text(str(i + 1)), *[fmt(ms[n]["estimates_deg"][i], 5) for n in order],
+                          fmt(tilt[i], 4), end_section=i == r - 1)
+        stats = (("mean (deg)", "mean_deg", 1.0, 5), ("std (′)", "std_deg", 60.0, 4),
+                 ("bias (′)", "bias_deg", 60.0, 4), ("pred. σ (′)", "std_pred_deg", 60.0, 4))
+        for label, key, scale, digits in stats:
+            cells = []
+            for n in order:
+                v = ms[n][key][0]
+                cells.append(fmt(None if v is None else v * scale, digits))
+            table.add_row(Text(label), *cells, "")
+        table.add_row(Text("max |err| (′)"),
+                      *[fmt(ms[n]["max_abs_error_deg"] * 60.0, 4) for n in order], "")
+        table.caption = (f"true azimuth {s['azimuth_true_deg'][0]:.4f}°; {r} independent "
+                         f"determinations; std: sample standard deviation (ddof 1); bias: mean − "
+                         f"truth; {tail}")
+    else:
+        cols = ["method", "max |error| (deg)", "RMS error (deg)", "mean error (deg)",
+                "closed-form max (deg)", "pred. σ (′)"]
+        if r > 1:
+            cols.append("std over repeats (′)")
+        for name in cols:
+            table.add_column(name, justify="left" if name == "method" else "right")
+        for name in order:
+            d = ms[name]
+            bias = [b for b in d["bias_deg"] if b is not None]
+            row = [fmt(d["max_abs_error_deg"], 4), fmt(d["rms_error_deg"], 4),
+                   fmt(sum(bias) / len(bias) if bias else None, 4),
+                   fmt(d["max_abs_error_pred_deg"], 4), fmt(_arcmin(_rms(d["std_pred_deg"])), 3)]
+            if r > 1:
+                row.append(fmt(_arcmin(_rms(d["std_deg"])), 3))
+            table.add_row(Text(name), *row)
+        sweep = s.get("sweep")
+        az = (f"sweep {sweep['start_deg']:g}…{sweep['stop_deg']:g}° step {sweep['step_deg']:g}°"
+              if sweep else "azimuths")
+        table.caption = (f"{az}: {m} true azimuths × {r} repeat(s); closed-form: noise-free "
+                         f"tilt error; predicted σ and std: RMS over the sweep; estimated tilt "
+                         f"{min(tilt):.4f}…{max(tilt):.4f}°; {tail}")
+    return table
+
+
+def batch_table(s: dict) -> Table:
+    """Variants compared: for each metric (and vector component) a section with one row per
+    variant; columns are the statistics over seeds (mean, std, RMS, median, 5 and 95 %
+    percentiles), three significant digits (``--json`` has them all)."""
+    variants = s["variants"]
+    keys = list(s.get("grid") or {})
+    tails = [k.rsplit(".", 1)[-1] for k in keys]
+    short = {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails)}
+    title = (f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) × "
+             f"{s['seeds']} seed(s) {s['seed_start']}…{s['seed_start'] + s['seeds'] - 1}")
+    table = Table(title=title, title_justify="left", header_style="bold",
+                  box=box.SIMPLE_HEAD, pad_edge=False, padding=(0, 0, 0, 1))
+    for name in ("variant", "n", "mean", "std", "RMS", "median", "5 %", "95 %"):
+        table.add_column(name, justify="left" if name == "variant" else "right",
+                         overflow="fold" if name == "variant" else "ellipsis")
+    for m in s["metrics"]:
+        per = [(v, v["stats"].get(m)) for v in variants]
+        comps = next((st["components"] for _, st in per if st and st.get("components")), None)
+        units = next((st.get("units") for _, st in per if st and st.get("units")), "")
+        for ci, comp in enumerate(comps or [None]):
+            label = m + (f" {comp}" if comp is not None else "") + (f" ({units})" if units else "")
+            table.add_row(Text(label, style="bold"), *[""] * 7)
+            for j, (v, st) in enumerate(per):
+                name = "\n".join(f"{short.get(k, k)}={_plain(x)}"
+                                 for k, x in v["overrides"].items()) or "base"
+                if v["failed"]:
+                    name += f"\n[{v['failed']} failed]"
+                cells = []
+                for stat in ("mean", "std", "rms", "median", "p05", "p95"):
+                    x = None if st is None else st.get(stat)
+                    if isinstance(x, list):
+                        x = x[ci] if ci < len(x) else None
+                    cells.append("—" if x is None else f"{x:.3g}")
+                table.add_row(Text(name), str(0 if st is None else st["n"]), *cells,
+                              end_section=j == len(per) - 1)
+    done = (f"{s['runs']} runs" if s["complete"]
+            else f"{s['finished']} of {s['runs']} runs finished")
+    notes = [f"{done}: {s['ok']} ok, {s['failed']} failed"]
+    for f in s.get("failures", [])[:3]:
+        notes.append(f"failed: variant {f['variant']} seed {f['seed']}: {f['error']}")
+    if s.get("wall_s") is not None:
+        notes.append(f"{s.get('executor') or ''}; wall {s['wall_s']:.1f} s".lstrip("; "))
+    notes.append(f"output {s.get('output') or '—'}")
+    table.caption = "\n".join(notes)
+    table.caption_justify = "left"
+    return table
+
+
+def _plain(x) -> str:
+    """An override value as the user wrote it (150, 0.5, full-cycle, [1, 1, 10])."""
+    return x if isinstance(x, str) else f"{x:g}" if isinstance(x, float) else str(x)

@@ -11,6 +11,7 @@ from pydantic import BeforeValidator, Field, field_validator, model_validator
 from gcalign import units as u
 from gcalign.config.align import AlignConfig
 from gcalign.config.base import Model, NonNegVec3, PosVec3, Vec3
+from gcalign.config.northfind import NorthfindConfig
 from gcalign.imu import ImuErrors, SensorErrors
 from gcalign.trajectory import Motion, Segment
 
@@ -164,6 +165,7 @@ class Scenario(Model):
     motion: MotionModel | None = None
     imu_file: Path | None = None
     align: AlignConfig | None = None
+    northfind: NorthfindConfig | None = None
 
     @model_validator(mode="after")
     def _source(self):

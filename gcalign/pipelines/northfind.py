@@ -21,7 +21,7 @@ import numpy as np
 from gcalign import northfind as nf
 from gcalign import units as u
 from gcalign.config import Scenario
-from gcalign.config.northfind import NorthfindConfig
+from gcalign.config.northfind import NorthfindConfig, axis
 from gcalign.errors import ScenarioError
 
 __all__ = ["NorthfindRun", "northfind_summary", "run_northfind", "run_northfind_scenario"]
@@ -62,7 +62,7 @@ def run_northfind(sc: Scenario, seed: int | None = None) -> NorthfindRun:
     setup = cfg.to_setup(sc)
     seed = sc.imu.seed if seed is None else int(seed)
     if seed < 0:
-        raise ScenarioError(f"imu.seed: must be >= 0, got {seed}")
+        raise ScenarioError(f"imu.seed (--seed): must be >= 0, got {seed}")
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
     result = nf.run_northfind(setup, rng, methods=tuple(cfg.methods), samples=cfg.samples)
@@ -107,6 +107,7 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
     est = np.swapaxes(res.azimuth_est, 1, 2)  # (P, R, M)
     err = np.swapaxes(res.azimuth_error, 1, 2)
     mean_err = err.mean(1)  # (P, M)
+    truth_deg = np.mod(cfg.azimuths_deg(), 360.0)  # as configured, no round trip through rad
     std = err.std(1, ddof=1) if r > 1 else np.full((p, m), np.nan)
     methods = {}
     for i, name in enumerate(res.methods):
@@ -117,7 +118,7 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
             "rms_error_deg": float(np.degrees(np.sqrt(np.mean(e * e)))),
             "errors_deg": _deg(e),
             "estimates_deg": _deg360(est[i]),
-            "mean_deg": _deg360(res.azimuth_true + mean_err[i]),
+            "mean_deg": _list(np.mod(truth_deg + np.degrees(mean_err[i]), 360.0)),
             "std_deg": _deg(std[i]),
             "bias_deg": _deg(mean_err[i]),
             "std_pred_deg": _deg(res.azimuth_std_pred[i]),
@@ -129,11 +130,13 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
     n_dwell = setup.n_samples
     dwell_time = n_dwell / setup.rate_hz
     g, a = sc.imu.gyro, sc.imu.accel
+    site = sc.site
+    assert site is not None  # run_northfind checked it
     return {
         "scenario": sc.name,
         "seed": run.seed,
-        "latitude_deg": float(sc.site.lat_deg),
-        "height_m": float(sc.site.height_m),
+        "latitude_deg": float(site.lat_deg),
+        "height_m": setup.height,
         "positions": setup.positions,
         "dwell_s": setup.dwell_s,
         "rate_hz": setup.rate_hz,
@@ -142,7 +145,7 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
         "repeats": r,
         "shape": [r, m],
         "index_error_arcsec": cfg.index_error_arcsec,
-        "azimuth_true_deg": _deg360(res.azimuth_true),
+        "azimuth_true_deg": _list(truth_deg),
         "sweep": None if cfg.sweep is None else cfg.sweep.model_dump(),
         "tilt_deg": float(np.degrees(tilt)),
         "tilt_direction_deg": float(np.degrees(direction)),
@@ -152,12 +155,14 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
         "tilt_direction_est_deg": _deg360(res.tilt_direction_est.T),
         "gyro": {
             "axis": "body y (in the table plane)",
-            "bias_dph": g.bias_dph[1], "arw_dprh": g.arw_dprh[1], "scale_ppm": g.scale_ppm[1],
+            "bias_dph": axis(g.bias_dph, 1), "arw_dprh": axis(g.arw_dprh, 1),
+            "scale_ppm": axis(g.scale_ppm, 1),
             "dwell_sigma_dph": setup.gyro_arw / math.sqrt(dwell_time) / u.DPH,
         },
         "accel": {
             "axes": "body x, y",
-            "bias_ug": list(a.bias_ug[:2]), "vrw_ugrhz": a.vrw_ugrhz[0],
+            "bias_ug": [axis(a.bias_ug, 0), axis(a.bias_ug, 1)],
+            "vrw_ugrhz": axis(a.vrw_ugrhz, 0),
             "dwell_sigma_ug": setup.accel_vrw / math.sqrt(dwell_time) / u.UG,
         },
         "method_order": list(res.methods),
