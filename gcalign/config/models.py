@@ -16,7 +16,11 @@ from gcalign.imu import ImuErrors, SensorErrors
 from gcalign.trajectory import Motion, Segment
 
 def _broadcast_scalar(x):
-    return [x, x, x] if isinstance(x, (int, float)) and not isinstance(x, bool) else x
+    if isinstance(x, (int, float)) and not isinstance(x, bool):
+        if x < 0:
+            raise ValueError(f"must be ≥ 0 (one number, or one per axis), got {x}")
+        return [x, x, x]
+    return x
 
 
 # A noise density: one number for all three axes, or one per axis.

@@ -1,0 +1,142 @@
+"""Foundation commands end to end: simulate, navigate, show, validate; bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from gcalign.cli import app
+
+ROOT = Path(__file__).resolve().parents[1]
+runner = CliRunner()
+
+SCENARIO = {
+    "name": "swing-test",
+    "site": {"lat_deg": 45.7796, "lon_deg": 126.6705, "height_m": 0},
+    "imu": {
+        "rate_hz": 100,
+        "seed": 3,
+        "gyro": {"bias_dph": [0.01, 0.01, 0.01], "arw_dprh": 0.001},
+        "accel": {"bias_ug": [50, 50, 50], "vrw_ugrhz": 10},
+    },
+    "motion": {
+        "kind": "swing",
+        "attitude_deg": [0, 0, 30],
+        "duration_s": 20,
+        "swing": {"amplitude_deg": [2, 3, 4], "period_s": [10, 10, 20]},
+    },
+}
+
+
+def write(tmp_path: Path, data, name="s.yaml") -> Path:
+    p = tmp_path / name
+    p.write_text(data if isinstance(data, str) else yaml.safe_dump(data))
+    return p
+
+
+def test_simulate_navigate_show_roundtrip(tmp_path):
+    sim = tmp_path / "sim.h5"
+    res = runner.invoke(app, ["simulate", str(write(tmp_path, SCENARIO)), "-o", str(sim), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["samples"] == 2000 and s["seed"] == 3 and s["output"] == str(sim)
+    with h5py.File(sim) as f:
+        assert f["imu/dtheta"].shape == (2000, 3) and f["truth/att"].shape == (2001, 3)
+        assert f["imu/dtheta"].attrs["units"] == "rad" and f["truth/v_n"].attrs["frame"] == "ENU"
+        assert yaml.safe_load(f.attrs["scenario_yaml"])["name"] == "swing-test"
+    nav = tmp_path / "nav.h5"
+    res = runner.invoke(app, ["navigate", str(sim), "-o", str(nav), "--json"])
+    assert res.exit_code == 0, res.output
+    n = json.loads(res.stdout)
+    assert set(n["final_error"]) == {"attitude_deg", "velocity_mps", "position_m"}
+    assert n["output"] == str(nav)
+    # 20 s of a navigation-grade IMU: small but non-zero errors.
+    assert 0 < np.abs(n["final_error"]["velocity_mps"]).max() < 0.05
+    shown = runner.invoke(app, ["show", str(nav), "--json"])
+    assert shown.exit_code == 0 and json.loads(shown.stdout)["final_error"] == n["final_error"]
+
+
+def test_same_seed_same_file_numbers(tmp_path):
+    p = write(tmp_path, SCENARIO)
+    outs = []
+    for i, seed in enumerate(["5", "5", "6"]):
+        out = tmp_path / f"{i}.h5"
+        assert (
+            runner.invoke(app, ["simulate", str(p), "-o", str(out), "--seed", seed]).exit_code == 0
+        )
+        with h5py.File(out) as f:
+            outs.append(f["imu/dtheta"][()])
+    assert np.array_equal(outs[0], outs[1]) and not np.array_equal(outs[0], outs[2])
+
+
+def test_validate_prints_si(tmp_path):
+    res = runner.invoke(app, ["validate", str(write(tmp_path, SCENARIO)), "--json"])
+    assert res.exit_code == 0, res.output
+    v = json.loads(res.stdout)["values"]
+    assert "4.84814e-08" in v["imu.gyro.bias_dph"]["si"]  # 0.01 °/h = 4.8481e-8 rad/s
+
+
+def _bad(tmp_path, mutate):
+    d = json.loads(json.dumps(SCENARIO))
+    mutate(d)
+    return d
+
+
+@pytest.mark.parametrize(
+    "content, field",
+    [
+        ("name: x\nsite: {lat_deg: 45\n", "YAML syntax error at line"),
+        (lambda d: d["site"].update(latitude=4), "site.latitude: unknown key"),
+        (lambda d: d["site"].update(lat_deg=95), "site.lat_deg"),
+        (lambda d: d["imu"].update(rate_hz=-100), "imu.rate_hz"),
+        (lambda d: d["motion"].update(kind="moving", swing=None), "motion.segments"),
+        (lambda d: d["imu"]["gyro"].update(arw_dprh=-1), "imu.gyro.arw_dprh"),
+        (lambda d: d["motion"].update(kind="orbit"), "motion.kind"),
+    ],
+)
+@pytest.mark.parametrize("command", ["simulate", "navigate", "validate"])
+def test_bad_scenario_exits_2(tmp_path, content, field, command):
+    data = content if isinstance(content, str) else _bad(tmp_path, content)
+    if isinstance(data, dict) and data["motion"].get("swing") is None:
+        data["motion"].pop("swing", None)
+    out = tmp_path / "out.h5"
+    args = [command, str(write(tmp_path, data))] + (
+        ["-o", str(out)] if command != "validate" else []
+    )
+    res = runner.invoke(app, args)
+    assert res.exit_code == 2, res.output
+    assert field in res.output, res.output
+    assert "Traceback" not in res.output and res.output.count("\n") <= 2
+    assert not out.exists() and not list(tmp_path.glob(".*.tmp"))
+
+
+def test_missing_and_foreign_files(tmp_path):
+    res = runner.invoke(app, ["simulate", str(tmp_path / "nope.yaml")])
+    assert res.exit_code == 2 and "file not found" in res.output
+    foreign = tmp_path / "foreign.h5"
+    with h5py.File(foreign, "w") as f:
+        f["x"] = [1, 2, 3]
+    for command in ("show", "navigate"):
+        res = runner.invoke(app, [command, str(foreign)])
+        assert res.exit_code == 2, res.output
+        assert "not a gcalign results file" in res.output
+    text = tmp_path / "text.h5"
+    text.write_text("hello")
+    res = runner.invoke(app, ["show", str(text)])
+    assert res.exit_code == 2 and "not an HDF5 file" in res.output
+
+
+def test_recorded_psins_file_navigates(tmp_path):
+    data = (ROOT / "../shared/data/lasergyro.imu").resolve()
+    if not data.is_file():
+        pytest.skip("shared/data is not beside the repository")
+    p = write(tmp_path, {"name": "real", "imu_file": str(data)})
+    res = runner.invoke(app, ["simulate", str(p), "-o", str(tmp_path / "r.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["samples"] == 184718
