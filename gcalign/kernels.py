@@ -2,7 +2,7 @@
 
 Scalar helpers here are inlined into the kernels by LLVM; they repeat the vectorised
 formulas of :mod:`gcalign.earth` and :mod:`gcalign.rotation`, and
-``tests/test_kernels.py`` holds the two in step (kernel vs slow NumPy reference, 1e-12).
+``tests/test_strapdown.py`` holds the two in step (kernel vs slow NumPy reference, 1e-12).
 
 One update serves both directions (DESIGN.md "Reverse navigation"): a reverse pass feeds
 time-reversed data with negated gyro increments, negated velocity and ``earth_sign = -1``.

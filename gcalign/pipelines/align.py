@@ -159,46 +159,35 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
     pos1 = data.truth.pos[i1] if data.truth is not None else data.site
     state0 = K.new_state(q1, v1, pos1)
 
-    if cfg.mode == "conventional" and cfg.realtime:
-        i3 = _index(data, cfg, cfg.t2_s if cfg.t3_s == "measured" else cfg.t3_s, "t3_s")
-        t_start = time.perf_counter()
-        _, records = run_passes(
-            state0,
-            _block(data, vref, body, i1, i3),
-            cfg.mode,
-            1,
-            [s.to_stage() for s in cfg.stages],
-            poles,
-            cfg.level_phase_s,
-        )
-        compute = time.perf_counter() - t_start
-        if cfg.t3_s == "measured":
-            # Conventional runs in real time: its answer at T3 is the state at T2 + compute.
-            i3 = min(i2 + math.ceil(compute / ts), len(data.imu))
-        q_series = records[0].q_nb
-        q2, q3 = q_series[i2 - i1], q_series[min(i3, len(q_series) - 1 + i1) - i1]
+    # Real-time conventional: one forward pass over live data to T3, no latency to
+    # compensate ('measured' then means T3 = T2). Otherwise the passes run over the stored
+    # block [T1, T2] and the compensation carries the attitude on to T3.
+    realtime = cfg.mode == "conventional" and cfg.realtime
+    if realtime:
+        i3 = i2 if cfg.t3_s == "measured" else _index(data, cfg, cfg.t3_s, "t3_s")
+    t_start = time.perf_counter()
+    state_end, records = run_passes(
+        state0,
+        _block(data, vref, body, i1, i3 if realtime else i2),
+        cfg.mode,
+        cfg.pass_count,
+        [s.to_stage() for s in cfg.stages],
+        poles,
+        cfg.level_phase_s,
+    )
+    compute = time.perf_counter() - t_start
+    if realtime:
+        q2, q3 = records[0].q_nb[i2 - i1], state_end[0:4].copy()
         equivalent = (i3 - i0) * ts
     else:
-        block = _block(data, vref, body, i1, i2)
-        t_start = time.perf_counter()
-        state2, records = run_passes(
-            state0,
-            block,
-            cfg.mode,
-            cfg.pass_count,
-            [s.to_stage() for s in cfg.stages],
-            poles,
-            cfg.level_phase_s,
-        )
-        compute = time.perf_counter() - t_start
         if cfg.t3_s == "measured":
             i3 = i2 + math.ceil(compute / ts)
             if i3 > len(data.imu):
                 raise ScenarioError("align.t3_s: 'measured' latency runs past the end of the data")
         else:
             i3 = _index(data, cfg, cfg.t3_s, "t3_s")
-        q2 = state2[0:4].copy()
-        q3 = compensate(cfg.compensation, state2, _block(data, vref, body, i2, i3))
+        q2 = state_end[0:4].copy()
+        q3 = compensate(cfg.compensation, state_end, _block(data, vref, body, i2, i3))
         equivalent = (i1 - i0) * ts + cfg.pass_count * (i2 - i1) * ts
 
     truth = data.truth
