@@ -106,7 +106,8 @@ def seed000_section(seeds: int, workers: int) -> list[str]:
         out += [
             f"### {title}",
             "",
-            "| variant | seed (pitch, roll, yaw) | ours pitch | ours roll | ours yaw | ours median \\|yaw\\| |",
+            "| variant | seed (pitch, roll, yaw) | ours pitch | ours roll | ours yaw "
+            "| ours median \\|yaw\\| |",
             "| --- | --- | --- | --- | --- | --- |",
         ]
         for name, label, seed_vals in rows:

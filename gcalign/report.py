@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
-from rich import box
 from rich.table import Table
 from rich.text import Text
 
@@ -54,7 +53,7 @@ def navigate_table(s: dict) -> Table:
     table.add_column("quantity")
     table.add_column("final", justify="right")
     table.add_column("max |error|", justify="right")
-    fe, me = s.get("final_error"), s.get("max_error")
+    fe, me = s.get("final_error"), s.get("max_error") or {}
     if fe is None:
         st = s["final_state"]
         rows = [
@@ -86,7 +85,8 @@ def align_table(s: dict) -> Table:
     for when in ("t2", "t3"):
         for what, name in (("truth", "truth"), ("attitude", "estimate"), ("error", "error")):
             vals = s.get(f"{what}_{when}_deg")
-            cells = ["—"] * 3 if vals is None else [fmt(v, 4 if what != "error" else 5) for v in vals]
+            digits = 5 if what == "error" else 4
+            cells = ["—"] * 3 if vals is None else [fmt(v, digits) for v in vals]
             table.add_row(Text(f"{name} at T{when[1]}"), fmt(s[f"{when}_s"], 2), *cells,
                           end_section=what == "error")
     for p in s["passes"]:
@@ -137,7 +137,8 @@ def northfind_table(s: dict) -> Table:
     if m == 1 and r == 1:
         for name in ("method", "azimuth (deg)", "error (deg)", "error (′)", "pred. σ (′)",
                      "tilt est (deg)"):
-            table.add_column(name, justify="left" if name == "method" else "right")
+            table.add_column(name, justify="left" if name == "method" else "right",
+                             no_wrap=name == "method")
         for name in order:
             d = ms[name]
             table.add_row(Text(name), fmt(d["estimates_deg"][0], 5), fmt(d["errors_deg"][0], 5),
@@ -175,11 +176,12 @@ def northfind_table(s: dict) -> Table:
                          f"truth; {tail}")
     else:
         cols = ["method", "max |error| (deg)", "RMS error (deg)", "mean error (deg)",
-                "closed-form max (deg)", "pred. σ (′)"]
+                "closed form max (deg)", "pred. σ (′)"]
         if r > 1:
             cols.append("std over repeats (′)")
         for name in cols:
-            table.add_column(name, justify="left" if name == "method" else "right")
+            table.add_column(name, justify="left" if name == "method" else "right",
+                             no_wrap=name == "method")
         for name in order:
             d = ms[name]
             bias = [b for b in d["bias_deg"] if b is not None]
@@ -192,7 +194,7 @@ def northfind_table(s: dict) -> Table:
         sweep = s.get("sweep")
         az = (f"sweep {sweep['start_deg']:g}…{sweep['stop_deg']:g}° step {sweep['step_deg']:g}°"
               if sweep else "azimuths")
-        table.caption = (f"{az}: {m} true azimuths × {r} repeat(s); closed-form: noise-free "
+        table.caption = (f"{az}: {m} true azimuths × {r} repeat(s); closed form: noise-free "
                          f"tilt error; predicted σ and std: RMS over the sweep; estimated tilt "
                          f"{min(tilt):.4f}…{max(tilt):.4f}°; {tail}")
     return table
@@ -202,10 +204,15 @@ def batch_table(s: dict) -> Table:
     """Variants compared: for each metric (and vector component) a section with one row per
     variant; columns are the statistics over seeds (mean, std, RMS, median, 5 and 95 %
     percentiles), three significant digits (``--json`` has them all)."""
+    from rich import box
+
+    def _plain(x) -> str:  # an override value as the user wrote it (150, 0.5, full-cycle)
+        return x if isinstance(x, str) else f"{x:g}" if isinstance(x, float) else str(x)
+
     variants = s["variants"]
     keys = list(s.get("grid") or {})
     tails = [k.rsplit(".", 1)[-1] for k in keys]
-    short = {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails)}
+    short = {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
     title = (f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) × "
              f"{s['seeds']} seed(s) {s['seed_start']}…{s['seed_start'] + s['seeds'] - 1}")
     table = Table(title=title, title_justify="left", header_style="bold",
@@ -217,8 +224,11 @@ def batch_table(s: dict) -> Table:
         per = [(v, v["stats"].get(m)) for v in variants]
         comps = next((st["components"] for _, st in per if st and st.get("components")), None)
         units = next((st.get("units") for _, st in per if st and st.get("units")), "")
-        for ci, comp in enumerate(comps or [None]):
+        shown = (comps or [None])[:6]  # a long vector (e.g. one error per azimuth): the start
+        for ci, comp in enumerate(shown):
             label = m + (f" {comp}" if comp is not None else "") + (f" ({units})" if units else "")
+            if ci == len(shown) - 1 and comps and len(comps) > len(shown):
+                label += f"  (+{len(comps) - len(shown)} more components in --json / the file)"
             table.add_row(Text(label, style="bold"), *[""] * 7)
             for j, (v, st) in enumerate(per):
                 name = "\n".join(f"{short.get(k, k)}={_plain(x)}"
@@ -239,13 +249,8 @@ def batch_table(s: dict) -> Table:
     for f in s.get("failures", [])[:3]:
         notes.append(f"failed: variant {f['variant']} seed {f['seed']}: {f['error']}")
     if s.get("wall_s") is not None:
-        notes.append(f"{s.get('executor') or ''}; wall {s['wall_s']:.1f} s".lstrip("; "))
+        notes.append(f"{s.get('executor') or ''}; wall {s['wall_s']:.2f} s".lstrip("; "))
     notes.append(f"output {s.get('output') or '—'}")
     table.caption = "\n".join(notes)
     table.caption_justify = "left"
     return table
-
-
-def _plain(x) -> str:
-    """An override value as the user wrote it (150, 0.5, full-cycle, [1, 1, 10])."""
-    return x if isinstance(x, str) else f"{x:g}" if isinstance(x, float) else str(x)

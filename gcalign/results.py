@@ -126,7 +126,7 @@ def read_imu(path: Path) -> ImuData:
         if "imu" not in f:
             raise ScenarioError(f"{path}: holds no /imu group (write one with 'gcalign simulate')")
         g = f["imu"]
-        extra = {k: np.asarray(g.attrs[k]) for k in ("site", "att0", "v0_n") if k in g.attrs}
+        extra: dict = {k: np.asarray(g.attrs[k]) for k in ("site", "att0", "v0_n") if k in g.attrs}
         return ImuData(
             t=g["t"][()], dtheta=g["dtheta"][()], dv=g["dv"][()], ts=float(g.attrs["ts"]),
             source=str(path), **extra,
@@ -149,7 +149,7 @@ def write_alignment(f: h5py.File, run) -> None:
     g.attrs["mode"] = run.cfg.mode
     g.attrs["azimuth_poles"] = run.azimuth_poles
     g.attrs["t1_s"], g.attrs["t2_s"], g.attrs["t3_s"] = run.t1, run.t2, run.t3
-    for rec, err in zip(run.passes, run.pass_errors):
+    for rec, err in zip(run.passes, run.pass_errors, strict=True):
         p = g.create_group(f"pass_{rec.index:02d}")
         p.attrs["direction"], p.attrs["kind"], p.attrs["stage"] = rec.direction, rec.kind, rec.stage
         put(p, "t", rec.t, "s", description="processing order (decreasing in a reverse pass)")

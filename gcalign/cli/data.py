@@ -13,6 +13,7 @@ from gcalign import report, results
 from gcalign.cli import app, consoles, default_output, emit_json, user_errors
 from gcalign.config import load_scenario, parse_scenario
 from gcalign.config.resolve import resolved_rows
+from gcalign.errors import ScenarioError
 from gcalign.pipelines.data import HDF5_SUFFIXES, RunData, read_data_file, scenario_data
 from gcalign.pipelines.navigate import navigation_summary, run_navigation
 
@@ -84,7 +85,9 @@ def navigate(
         text = results.read_scenario_yaml(source)
         sc = parse_scenario(yaml.safe_load(text) or {}, str(source))
         imu, truth = read_data_file(source)
-        site = truth.pos[0] if truth is not None else (imu.site if imu.site is not None else None)
+        site = truth.pos[0] if truth is not None else imu.site
+        if site is None:
+            raise ScenarioError(f"{source}: holds neither truth nor the site of its IMU data")
         data = RunData(imu=imu, truth=truth, site=site, seed=None)
     else:
         sc, text = load_scenario(source)

@@ -15,6 +15,7 @@ from gcalign.config.northfind import NorthfindConfig
 from gcalign.imu import ImuErrors, SensorErrors
 from gcalign.trajectory import Motion, Segment
 
+
 def _broadcast_scalar(x):
     if isinstance(x, (int, float)) and not isinstance(x, bool):
         if x < 0:
@@ -58,7 +59,7 @@ class Site(Model):
 
 class Gyro(Model):
     bias_dph: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    arw_dprh: Noise = 0.0
+    arw_dprh: Noise = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     scale_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     misalignment_arcsec: list[list[float]] | None = None
     quantum_arcsec: float = Field(0.0, ge=0)
@@ -77,7 +78,7 @@ class Gyro(Model):
 
 class Accel(Model):
     bias_ug: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    vrw_ugrhz: Noise = 0.0
+    vrw_ugrhz: Noise = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     scale_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     misalignment_arcsec: list[list[float]] | None = None
     quantum_ugs: float = Field(0.0, ge=0, description="velocity quantum, µg·s (PSINS header unit)")
@@ -151,7 +152,7 @@ class MotionModel(Model):
             att0=tuple(np.asarray(self.attitude_deg) * u.DEG),
             duration=self.duration_s,
             amplitude=tuple(np.asarray(swing.amplitude_deg) * u.DEG),
-            period=tuple(swing.period_s),
+            period=(swing.period_s[0], swing.period_s[1], swing.period_s[2]),
             phase=tuple(np.asarray(swing.phase_deg) * u.DEG),
             segments=tuple(
                 Segment(s.duration_s, s.accel_mps2, tuple(np.asarray(s.rate_dps) * u.DEG))

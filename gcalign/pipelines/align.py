@@ -191,7 +191,7 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
         equivalent = (i1 - i0) * ts + cfg.pass_count * (i2 - i1) * ts
 
     truth = data.truth
-    pass_errors = []
+    pass_errors: list[np.ndarray | None] = []
     for rec in records:
         if truth is None:
             pass_errors.append(None)

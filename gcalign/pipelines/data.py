@@ -57,10 +57,22 @@ def scenario_data(scenario: Scenario, seed: int | None = None) -> RunData:
                 f"site: missing; {scenario.imu_file} does not give the site, so the scenario must"
             )
         return RunData(imu=imu, truth=truth, site=site, seed=None)
+    return with_errors(scenario, noise_free(scenario), seed)
+
+
+def noise_free(scenario: Scenario) -> RunData:
+    """Truth and ideal increments of a simulated scenario: the part that no seed changes
+    (a batch computes it once per variant)."""
     if scenario.motion is None:
         raise ScenarioError("motion: missing; the scenario needs 'motion' or 'imu_file'")
-    seed = scenario.imu.seed if seed is None else seed
+    assert scenario.site is not None  # the model requires a site with a motion
     site = scenario.site.to_si()
     truth, ideal = ideal_imu(scenario.motion.to_motion(), site, scenario.imu.ts)
-    imu = apply_errors(ideal, scenario.imu.errors(), np.random.default_rng(seed))
-    return RunData(imu=imu, truth=truth, site=site, seed=seed)
+    return RunData(imu=ideal, truth=truth, site=site, seed=None)
+
+
+def with_errors(scenario: Scenario, ideal: RunData, seed: int | None = None) -> RunData:
+    """The scenario's sensor errors applied to noise-free data; `seed` overrides imu.seed."""
+    seed = scenario.imu.seed if seed is None else seed
+    imu = apply_errors(ideal.imu, scenario.imu.errors(), np.random.default_rng(seed))
+    return RunData(imu=imu, truth=ideal.truth, site=ideal.site.copy(), seed=seed)

@@ -1,0 +1,94 @@
+"""`gcalign batch`: sweeps and Monte Carlo over seeds, on local processes or a Dask cluster.
+
+The engine is :mod:`gcalign.batch`; this module only loads the sweep, shows progress,
+prints the table (or JSON) and maps failures to exit codes (0 all runs ok, 1 some run
+failed or the cluster is unreachable, 2 bad sweep, 130 interrupted).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import typer
+
+from gcalign import batch as engine
+from gcalign import report
+from gcalign.cli import app, consoles, default_output, emit_json, user_errors
+from gcalign.cli.data import JSON_HELP
+from gcalign.errors import ScenarioError
+
+
+def _progress_bar(total_hint: str):
+    """A rich progress bar with ETA on stderr, or None when stderr is not a terminal."""
+    if not sys.stderr.isatty():
+        return None
+    from rich.console import Console
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    return Progress(TextColumn(f"[bold]{total_hint}"), BarColumn(), MofNCompleteColumn(),
+                    TextColumn("{task.fields[failed]}"), TimeElapsedColumn(),
+                    TextColumn("ETA"), TimeRemainingColumn(),
+                    console=Console(stderr=True), transient=False)
+
+
+@app.command()
+@user_errors
+def batch(
+    sweep: Path = typer.Argument(..., help="Sweep YAML: base scenario, grid of overrides, "
+                                          "seeds, metrics (docs/batch.md)."),
+    workers: int | None = typer.Option(None, "--workers", "-w",
+                                       help="Local worker processes (default: all cores)."),
+    scheduler: str | None = typer.Option(
+        None, "--scheduler",
+        help="Run on an existing Dask cluster, e.g. tcp://host:8786 (pip install -e \".[dask]\")."),
+    output: Path | None = typer.Option(
+        None, "-o", "--output", help="Results file (default runs/SWEEP-batch.h5); the journal "
+                                     "FILE.journal.jsonl sits next to it while runs are missing."),
+    resume: bool = typer.Option(False, "--resume",
+                                help="Run only what an earlier, interrupted batch did not finish."),
+    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+):
+    """Run a sweep (variants × seeds); aggregate each metric per variant into one HDF5 file."""
+    if workers is not None and workers < 1:
+        raise ScenarioError(f"--workers: must be at least 1, got {workers}")
+    if workers is not None and scheduler:
+        raise ScenarioError("--workers: applies to the local process pool; with --scheduler "
+                            "the cluster's workers run the batch (give one or the other)")
+    sw = engine.load_sweep(sweep)
+    out = output or default_output(sw.name, "batch", None)
+    err = consoles(True)  # notes always on stderr
+
+    bar = _progress_bar(f"{sw.name}")
+    task = None
+
+    def progress(done: int, total: int, failed: int) -> None:
+        nonlocal task
+        if bar is None:
+            return
+        if task is None:
+            task = bar.add_task("runs", total=total, completed=done, failed="")
+        bar.update(task, completed=done, failed=f"[red]{failed} failed" if failed else "")
+
+    if bar is not None:
+        bar.start()
+    try:
+        result = engine.run_batch(sw, out, workers=workers, scheduler=scheduler, resume=resume,
+                                  progress=progress,
+                                  log=lambda msg: err.print(f"[dim]{msg}[/dim]", soft_wrap=True))
+    finally:
+        if bar is not None:
+            bar.stop()
+    summary = result.summary
+    consoles(as_json).print(report.batch_table(summary))
+    if as_json:
+        emit_json(summary)
+    if summary["failed"]:
+        raise typer.Exit(1)

@@ -1,0 +1,424 @@
+"""`gcalign batch`: sweep validation, the engine (local pool, Dask), journal and resume.
+
+The reference for every aggregate is the same sweep run another way (one worker, an
+uninterrupted batch, the single-run pipeline): a batch must not change the numbers.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from concurrent.futures import Future
+from importlib import resources
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from gcalign import batch as B
+from gcalign.cli import app
+from gcalign.config import parse_scenario
+from gcalign.errors import ScenarioError
+
+runner = CliRunner()
+
+# The seed 000 §5.3 moving scenario shortened: 80 s of data, T2 = 60 s, 3 passes.
+SMALL = {
+    "name": "small-moving",
+    "site": {"lat_deg": 45.7796, "lon_deg": 126.6705, "height_m": 0},
+    "imu": {"rate_hz": 100,
+            "gyro": {"bias_dph": [0.01, 0.01, 0.01], "arw_dprh": 0.001},
+            "accel": {"bias_ug": [50, 50, 50], "vrw_ugrhz": 10}},
+    "motion": {"kind": "moving", "attitude_deg": [0, 0, 30], "duration_s": 80,
+               "segments": [{"duration_s": 10}, {"duration_s": 10, "accel_mps2": 1.0},
+                            {"duration_s": 10, "rate_dps": [0, 0, -1]},
+                            {"duration_s": 10, "rate_dps": [0, 0, 1]}, {"duration_s": 40}]},
+    "align": {"coarse": {"method": "given", "error_deg": [1, 1, 10]}, "mode": "full-cycle",
+              "t1_s": 10, "t2_s": 60, "t3_s": 70, "passes": 3, "level_s": 20,
+              "azimuth_poles": "double-oscillator",
+              "aiding": {"source": "odometer", "noise_mps": 0.01}},
+}
+GRID = {"align.mode": ["conventional", "full-cycle", "half-cycle"],
+        "align.stages.0.t_z_s": [40, 60]}
+METRICS = ["error_t3_deg", "passes.0.error_deg"]
+
+
+def write_sweep(folder: Path, name: str = "sweep", **over) -> Path:
+    d = {"name": name, "base": copy.deepcopy(SMALL), "grid": copy.deepcopy(GRID), "seeds": 4,
+         "metrics": list(METRICS)}
+    d.update(over)
+    p = folder / f"{name}.yaml"
+    p.write_text(yaml.safe_dump(d, sort_keys=False))
+    return p
+
+
+def batch_cli(*args):
+    return runner.invoke(app, ["batch", *map(str, args)])
+
+
+def runs_of(path: Path) -> list[tuple[int, int]]:
+    with h5py.File(path, "r") as f:
+        r = f["batch/runs"]
+        return list(zip(r["variant"][()].tolist(), r["seed"][()].tolist(), strict=True))
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The small sweep with one local worker: summary, sweep file and output."""
+    folder = tmp_path_factory.mktemp("ref")
+    sweep = write_sweep(folder)
+    out = folder / "ref.h5"
+    res = batch_cli(sweep, "--workers", 1, "-o", out, "--json")
+    assert res.exit_code == 0, res.output
+    return json.loads(res.stdout), sweep, out
+
+
+# ------------------------------------------------------------------ sweep model
+
+
+def test_grid_is_a_cartesian_product_in_grid_order(tmp_path):
+    sw = B.load_sweep(write_sweep(tmp_path))
+    assert len(sw.variants) == 6 and sw.seed_values == range(1, 5)
+    assert sw.variants[1].overrides == {"align.mode": "conventional", "align.stages.0.t_z_s": 60}
+    assert sw.run_keys()[:5] == [(0, 1), (0, 2), (0, 3), (0, 4), (1, 1)]
+    assert sw.command == "align"  # from the base's align section
+    sc = parse_scenario(copy.deepcopy(sw.variants[5].scenario))
+    assert sc.align.mode == "half-cycle" and sc.align.stages[0].t_z_s == 60
+    # The base gives no stages: the default stage list was filled in, its defaults kept.
+    assert sc.align.stages[0].t_xy_s == 20.0 and len(sc.align.stages) == 1
+
+
+def test_seed_start_and_command_from_northfind_section(tmp_path):
+    base = str(Path(resources.files("gcalign")).parent / "configs/seed001_simulation.yaml")
+    sw = B.sweep_from_mapping({"base": base, "seeds": 3, "seed_start": 10,
+                               "grid": {"northfind.tilt_deg": [0, 5]}}, "s.yaml", tmp_path)
+    assert sw.command == "northfind" and list(sw.seed_values) == [10, 11, 12]
+
+
+def test_apply_override_checks_the_schema_not_only_the_mapping():
+    base = parse_scenario(copy.deepcopy(SMALL))
+    d = copy.deepcopy(SMALL)
+    B.apply_override(d, "align.coarse.error_deg.2", 5.0, base)
+    assert d["align"]["coarse"]["error_deg"] == [1, 1, 5.0]
+    with pytest.raises(ScenarioError, match=r"align.mdoe: unknown key; align has: .*mode"):
+        B.apply_override(copy.deepcopy(SMALL), "align.mdoe", "x", base)
+    with pytest.raises(ScenarioError, match=r"no item 5; align.stages has 1 item\(s\): index 0"):
+        B.apply_override(copy.deepcopy(SMALL), "align.stages.5.t_z_s", 100, base)
+    with pytest.raises(ScenarioError, match="single value"):
+        B.apply_override(copy.deepcopy(SMALL), "align.t2_s.x", 1, base)
+    # An optional section the base leaves out is still checked against its model.
+    no_align = {k: v for k, v in copy.deepcopy(SMALL).items() if k != "align"}
+    base2 = parse_scenario(copy.deepcopy(no_align))
+    with pytest.raises(ScenarioError, match="align.foo: unknown key"):
+        B.apply_override(copy.deepcopy(no_align), "align.foo", 1, base2)
+    d2 = copy.deepcopy(no_align)
+    B.apply_override(d2, "align.mode", "conventional", base2)
+    assert d2["align"] == {"mode": "conventional"}
+
+
+@pytest.mark.parametrize(("grid", "message"), [
+    ({"align.mdoe": ["full-cycle"]}, "grid: align.mdoe = 'full-cycle': align.mdoe: unknown key"),
+    ({"align.mode": []}, "grid: align.mode = []: empty list of values"),
+    ({"align.stages.5.t_z_s": [100]}, "align.stages.5: no item 5; align.stages has 1 item"),
+    ({"align.mode": ["fast"]}, "grid: align.mode = 'fast': align.mode: Input should be"),
+    ({"align.passes": [3, 4]}, "grid: align.passes = 4: align.passes: mode 'full-cycle' needs"),
+])
+def test_bad_grid_exits_2_before_any_run(tmp_path, grid, message):
+    out = tmp_path / "o.h5"
+    res = batch_cli(write_sweep(tmp_path, grid=grid), "-o", out)
+    assert res.exit_code == 2, res.output
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], res.stderr
+    assert "Traceback" not in res.output
+    assert not out.exists() and not B.journal_path(out).exists()
+
+
+def test_bad_sweep_keys_and_options(tmp_path):
+    res = batch_cli(write_sweep(tmp_path, frobnicate=1))
+    assert res.exit_code == 2 and "frobnicate: unknown key" in res.stderr
+    res = batch_cli(write_sweep(tmp_path, seeds=0))
+    assert res.exit_code == 2 and "seeds: must be a whole number" in res.stderr
+    res = batch_cli(write_sweep(tmp_path), "--workers", 0)
+    assert res.exit_code == 2 and "--workers" in res.stderr
+    res = batch_cli(write_sweep(tmp_path), "--workers", 2, "--scheduler", "tcp://x:1")
+    assert res.exit_code == 2
+
+
+def test_unknown_metric_stops_the_batch_with_exit_2(tmp_path):
+    out = tmp_path / "m.h5"
+    sweep = write_sweep(tmp_path, grid={}, seeds=2, metrics=["error_t9_deg"])
+    res = batch_cli(sweep, "--workers", 1, "-o", out)
+    assert res.exit_code == 2, res.output
+    assert "metric 'error_t9_deg'" in res.stderr and "error_t3_deg" in res.stderr
+
+
+# ------------------------------------------------------------------ engine
+
+
+def test_batch_equals_single_runs(reference):
+    """The batch's numbers are those of the single-run pipeline (`gcalign align --seed`),
+    also with the noise-free simulation shared between seeds."""
+    summary, sweep, out = reference
+    sw = B.load_sweep(sweep)
+    v = sw.variants[3]
+    sc = parse_scenario(copy.deepcopy(v.scenario))
+    from gcalign.pipelines.align import alignment_summary, run_alignment
+    from gcalign.pipelines.data import scenario_data
+
+    values = []
+    for seed in sw.seed_values:
+        data = scenario_data(sc, seed)
+        s = alignment_summary(run_alignment(sc, data), data, sc.name)
+        values.append(s["error_t3_deg"])
+        cached = B.run_summary("align", sc, seed, cache_key="test")
+        assert cached["error_t3_deg"] == s["error_t3_deg"]  # bit for bit
+    st = summary["variants"][3]["stats"]["error_t3_deg"]
+    arr = np.array(values)
+    np.testing.assert_array_equal(st["mean"], arr.mean(0))
+    np.testing.assert_array_equal(st["rms"], np.sqrt((arr**2).mean(0)))
+    np.testing.assert_array_equal(st["p95"], np.percentile(arr, 95, axis=0))
+    assert st["components"] == ["pitch", "roll", "yaw"] and st["units"] == "deg"
+
+
+def test_same_aggregate_with_one_and_two_workers(reference, tmp_path):
+    ref, sweep, ref_out = reference
+    out = tmp_path / "w2.h5"
+    res = batch_cli(sweep, "--workers", 2, "-o", out, "--json")
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["variants"] == ref["variants"]
+    assert s["runs"] == s["ok"] == 24 and s["failed"] == 0 and s["complete"]
+    assert runs_of(out) == runs_of(ref_out) == B.load_sweep(sweep).run_keys()
+    assert not B.journal_path(out).exists()  # complete: the file holds everything
+    with h5py.File(out, "r") as f:
+        assert f.attrs["kind"] == "batch"
+        assert json.loads(f.attrs["summary_json"])["variants"] == ref["variants"]
+        g = f["batch/aggregate/v005"]
+        assert g.attrs["align.mode"] == "half-cycle" and g.attrs["align.stages.0.t_z_s"] == 60
+        np.testing.assert_array_equal(g["error_t3_deg/median"][()],
+                                      ref["variants"][5]["stats"]["error_t3_deg"]["median"])
+        assert f["batch/runs/metrics/error_t3_deg"].shape == (24, 3)
+        assert f["batch/runs/metrics/error_t3_deg"].attrs["units"] == "deg"
+    # `gcalign show` prints the batch table again from the file alone.
+    res = runner.invoke(app, ["show", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "gcalign batch: sweep" in res.stdout and "error_t3_deg" in res.stdout
+    assert "half-cycle" in res.stdout
+
+
+def test_numba_cache_is_loaded_not_compiled_in_fresh_processes():
+    B.warm_up()  # populates the on-disk cache if this checkout has none yet
+    code = "import json; from gcalign.batch import warm_up; print(json.dumps(warm_up()))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    stats = json.loads(out.stdout)
+    assert stats["cache_hits"] >= 1 and stats["cache_misses"] == 0
+    backend = B.LocalBackend(1, "align")
+    try:
+        assert all(s["cache_misses"] == 0 for s in backend.run_on_workers(B.kernel_cache_stats))
+    finally:
+        backend.close()
+
+
+def test_failing_runs_are_recorded_and_exit_1(tmp_path):
+    # T3 past the end of the data passes validation but fails in the run.
+    sweep = write_sweep(tmp_path, grid={"align.t3_s": [70, 500]}, seeds=2, metrics=["error_t3_deg"])
+    out = tmp_path / "f.h5"
+    res = batch_cli(sweep, "--workers", 1, "-o", out, "--json")
+    assert res.exit_code == 1, res.output
+    s = json.loads(res.stdout)
+    assert (s["ok"], s["failed"]) == (2, 2)
+    assert s["variants"][0]["ok"] == 2 and s["variants"][1]["failed"] == 2
+    assert "past the end of the data" in s["failures"][0]["error"]
+    with h5py.File(out, "r") as f:
+        status = [x.decode() for x in f["batch/runs/status"][()]]
+        assert status == ["ok", "ok", "failed", "failed"]
+        assert np.isnan(f["batch/runs/metrics/error_t3_deg"][2]).all()
+        assert "t3_s" in f["batch/runs/error"][2].decode()
+
+
+class _FlakyBackend:
+    """In-process executor whose worker "dies" whenever it meets seed 2 of variant 0."""
+
+    workers = 2
+    description = "fake"
+
+    def __init__(self):
+        self.submitted = []
+
+    def submit(self, chunk):
+        self.submitted.append([(t["variant"], t["seed"]) for t in chunk])
+        fut = Future()
+        if any((t["variant"], t["seed"]) == (0, 2) for t in chunk):
+            fut.set_exception(B.WorkerLost("killed"))
+        else:
+            fut.set_result(B.run_chunk(chunk))
+        return fut
+
+    def wait(self, futures, timeout):
+        return set(futures)
+
+    def result(self, fut):
+        return fut.result()
+
+    def close(self, cancel=False):
+        pass
+
+
+def test_a_dying_worker_costs_only_its_own_run(tmp_path):
+    sw = B.load_sweep(write_sweep(tmp_path, grid={"align.mode": ["full-cycle"]}, seeds=6,
+                                  metrics=["error_t3_deg"]))
+    fake = _FlakyBackend()
+    res = B.run_batch(sw, tmp_path / "k.h5", backend=fake, chunk_size=3)
+    s = res.summary
+    assert (s["ok"], s["failed"]) == (5, 1)
+    assert "worker process died" in s["failures"][0]["error"] and s["failures"][0]["seed"] == 2
+    # The chunk was retried run by run: its other runs were not lost.
+    assert [(0, 1)] in fake.submitted and [(0, 3)] in fake.submitted
+    assert runs_of(tmp_path / "k.h5") == sw.run_keys()
+
+
+# ------------------------------------------------------------------ journal and resume
+
+
+def test_resume_after_sigkill_completes_every_run_once(tmp_path):
+    """Kill `gcalign batch` (SIGKILL, workers included) mid-way; --resume finishes it with
+    every run once and the aggregate of an uninterrupted batch."""
+    base = str(resources.files("gcalign.scenarios").joinpath("seed000_moving_full_cycle.yaml"))
+    sweep = tmp_path / "kill.yaml"
+    sweep.write_text(yaml.safe_dump({"name": "kill", "base": base, "seeds": 40,
+                                     "grid": {"align.mode": ["full-cycle", "conventional"]},
+                                     "metrics": ["error_t3_deg"]}))
+    out = tmp_path / "kill.h5"
+    journal = B.journal_path(out)
+    cmd = [sys.executable, "-c", "from gcalign.cli import main; main()", "batch", str(sweep),
+           "--workers", "1", "-o", str(out)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    try:
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline and proc.poll() is None:
+            if journal.is_file() and journal.read_text().count('"type": "run"') >= 4:
+                break
+            time.sleep(0.005)
+        assert proc.poll() is None, "the batch finished before it could be killed"
+        os.killpg(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait(10)
+    done_before = journal.read_text().count('"type": "run"')
+    assert 4 <= done_before < 80
+    if out.exists():  # a periodic rebuild happened: the file is whole, never truncated
+        with h5py.File(out, "r") as f:
+            assert f["batch"].attrs["complete"] == 0
+
+    res = batch_cli(sweep, "--workers", 2, "-o", out, "--resume", "--json")
+    assert res.exit_code == 0, res.output
+    assert f"{done_before} of 80 run(s) already finished" in res.stderr
+    resumed = json.loads(res.stdout)
+    keys = runs_of(out)
+    assert keys == B.load_sweep(sweep).run_keys() and len(set(keys)) == 80
+
+    fresh = tmp_path / "fresh.h5"
+    res = batch_cli(sweep, "--workers", 2, "-o", fresh, "--json")
+    assert res.exit_code == 0, res.output
+    assert resumed["variants"] == json.loads(res.stdout)["variants"]
+
+
+def test_resume_skips_a_torn_journal_line(tmp_path):
+    sw = B.load_sweep(write_sweep(tmp_path, grid={"align.mode": ["full-cycle"]}, seeds=5,
+                                  metrics=["error_t3_deg"]))
+    out = tmp_path / "t.h5"
+    tasks = B._tasks(sw, sw.run_keys()[:3])
+    journal = B.Journal(B.journal_path(out), {"type": "header"})
+    journal.append(B.run_chunk(tasks))
+    journal.close()
+    with open(B.journal_path(out), "a") as f:
+        f.write('{"type": "run", "variant": 0, "se')  # killed mid-write
+    res = B.run_batch(sw, out, workers=1, resume=True)
+    assert res.reused == 3 and res.summary["ok"] == 5
+    assert runs_of(out) == sw.run_keys()
+    fresh = B.run_batch(sw, tmp_path / "u.h5", workers=1)
+    assert fresh.summary["variants"] == res.summary["variants"]
+
+
+def test_resume_from_the_file_with_more_seeds_reuses_what_is_there(reference, tmp_path):
+    ref, sweep, ref_out = reference
+    out = tmp_path / "grow.h5"
+    out.write_bytes(ref_out.read_bytes())  # complete batch of 4 seeds, no journal
+    bigger = write_sweep(tmp_path, name="sweep", seeds=5)
+    res = batch_cli(bigger, "--workers", 2, "-o", out, "--resume", "--json")
+    assert res.exit_code == 0, res.output
+    assert "24 of 30 run(s) already finished" in res.stderr
+    s = json.loads(res.stdout)
+    assert s["runs"] == s["ok"] == 30 and runs_of(out) == B.load_sweep(bigger).run_keys()
+    fresh = B.run_batch(B.load_sweep(bigger), tmp_path / "fresh.h5", workers=2)
+    assert fresh.summary["variants"] == s["variants"]
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_unreachable_scheduler_fails_fast_and_keeps_the_journal(tmp_path):
+    sw_path = write_sweep(tmp_path, grid={"align.mode": ["full-cycle"]}, seeds=3,
+                          metrics=["error_t3_deg"])
+    sw = B.load_sweep(sw_path)
+    out = tmp_path / "d.h5"
+    journal = B.Journal(B.journal_path(out), {"type": "header"})
+    journal.append(B.run_chunk(B._tasks(sw, sw.run_keys()[:1])))
+    journal.close()
+    before = B.journal_path(out).read_bytes()
+    t0 = time.monotonic()
+    res = batch_cli(sw_path, "--scheduler", f"tcp://127.0.0.1:{_free_port()}", "-o", out,
+                    "--resume")
+    elapsed = time.monotonic() - t0
+    assert res.exit_code == 1, res.output
+    assert elapsed < 10
+    assert "cannot reach the Dask scheduler at tcp://127.0.0.1:" in res.stderr
+    assert len(res.stderr.strip().splitlines()) <= 2 and "Traceback" not in res.output
+    assert B.journal_path(out).read_bytes() == before and not out.exists()
+
+
+def test_dask_cluster_gives_the_local_numbers(reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    ref, sweep, _ = reference
+    out = tmp_path / "dask.h5"
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  host="127.0.0.1", dashboard_address=None) as cluster:
+        res = batch_cli(sweep, "--scheduler", cluster.scheduler_address, "-o", out, "--json")
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["executor"].startswith("Dask scheduler tcp://127.0.0.1:")
+    assert s["variants"] == ref["variants"]
+    assert runs_of(out) == B.load_sweep(sweep).run_keys()
+
+
+def test_northfind_sweep(tmp_path):
+    base = str(Path(resources.files("gcalign")).parent / "configs/seed001_simulation.yaml")
+    if not Path(base).is_file():
+        pytest.skip("configs/ not next to the package")
+    sweep = tmp_path / "nf.yaml"
+    sweep.write_text(yaml.safe_dump({
+        "base": base, "seeds": 3, "grid": {"northfind.tilt_deg": [0, 10]},
+        "metrics": ["methods.coordinate.rms_error_deg", "methods.none.max_abs_error_deg"]}))
+    res = batch_cli(sweep, "--workers", 1, "-o", tmp_path / "nf.h5", "--json")
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["command"] == "northfind" and s["ok"] == 6
+    none = [v["stats"]["methods.none.max_abs_error_deg"]["mean"] for v in s["variants"]]
+    coord = [v["stats"]["methods.coordinate.rms_error_deg"]["mean"] for v in s["variants"]]
+    # Without compensation the 10° tilt costs degrees (≈ asin(tan L sin ε) = 8.4° at 40°N);
+    # the coordinate method stays at the noise level.
+    assert none[0] < 0.5 and 7.5 < none[1] < 9.5
+    assert coord[1] < 0.1
