@@ -17,7 +17,8 @@ import numpy as np
 
 from gcalign.align import kernel as K
 from gcalign.align.cycles import Stage, loop_gains
-from gcalign.cli.align import load_with_overrides
+from gcalign.cli.align import BUILTIN
+from gcalign.cli.common import load_with_overrides
 from gcalign.pipelines.align import run_alignment
 from gcalign.pipelines.data import scenario_data
 
@@ -51,7 +52,7 @@ def main() -> None:
     rate = n / t / 1e6
     rows.append(("gyrocompass steps (M/s, one core)", f"{rate:.1f}", "≥ 5", f"{rate / 5:.2f}×"))
 
-    sc, _ = load_with_overrides(None, {})
+    sc, _, _ = load_with_overrides(None, BUILTIN, "align", {})
     data = scenario_data(sc)
     run_alignment(sc, data)  # warm
     comp = min(run_alignment(sc, data).compute_s for _ in range(5)) * 1e3

@@ -128,14 +128,33 @@ def read_imu(path: Path) -> ImuData:
         g = f["imu"]
         extra: dict = {k: np.asarray(g.attrs[k]) for k in ("site", "att0", "v0_n") if k in g.attrs}
         return ImuData(
-            t=g["t"][()], dtheta=g["dtheta"][()], dv=g["dv"][()], ts=float(g.attrs["ts"]),
-            source=str(path), **extra,
+            t=g["t"][()],
+            dtheta=g["dtheta"][()],
+            dv=g["dv"][()],
+            ts=float(g.attrs["ts"]),
+            source=str(path),
+            **extra,
         )
 
 
 def read_scenario_yaml(path: Path) -> str:
     with open_results(path) as f:
         return str(f.attrs["scenario_yaml"])
+
+
+def write_navigation(f: h5py.File, run) -> None:
+    """/navigate: the free-navigation solution and, with truth, its errors."""
+    g = f.create_group("navigate")
+    sol = run.solution
+    put(g, "t", sol.t, "s")
+    put(g, "att", sol.att, "rad", ATT_FRAME)
+    put(g, "v_n", sol.v_n, "m/s", "ENU")
+    put(g, "pos", sol.pos, "rad, rad, m", "[latitude, longitude, height]")
+    if run.att_error is not None:
+        e = g.create_group("error")
+        put(e, "att", run.att_error, "rad", "Euler differences est - true, yaw wrapped")
+        put(e, "v_n", run.vel_error, "m/s", "ENU")
+        put(e, "pos", run.pos_error, "m", "ENU (east, north, up)")
 
 
 GAIN_NAMES = "K_E1, K_E2, K_E3, K_N1, K_N2, K_N3, K_U1, K_U2, K_U3, K_U4"
@@ -175,17 +194,33 @@ def write_northfind(f: h5py.File, run) -> None:
     estimates and the setup as attributes (SI, radians)."""
     s, res = run.setup, run.result
     g = f.create_group("northfind")
-    for name in ("positions", "dwell_s", "rate_hz", "lat", "height", "tilt_direction_ref",
-                 "repeats", "gyro_bias", "gyro_arw", "gyro_scale", "accel_bias", "accel_vrw",
-                 "index_error", "n_samples", "gravity"):
+    for name in (
+        "positions",
+        "dwell_s",
+        "rate_hz",
+        "lat",
+        "height",
+        "tilt_direction_ref",
+        "repeats",
+        "gyro_bias",
+        "gyro_arw",
+        "gyro_scale",
+        "accel_bias",
+        "accel_vrw",
+        "index_error",
+        "n_samples",
+        "gravity",
+    ):
         g.attrs[name] = getattr(s, name)
     g.attrs["tilt"] = float(s.tilt[0])
     g.attrs["tilt_direction"] = float(s.tilt_direction[0])
     g.attrs["methods"] = ",".join(res.methods)
     g.attrs["samples"] = bool(run.cfg.samples)
-    g.attrs["units"] = ("lat, tilt, tilt_direction, index_error: rad; dwell_s: s; rate_hz: Hz; "
-                        "height: m; gyro_bias: rad/s; gyro_arw: rad/sqrt(s); accel_bias: m/s^2 "
-                        "[x, y]; accel_vrw: m/s/sqrt(s); gravity: m/s^2")
+    g.attrs["units"] = (
+        "lat, tilt, tilt_direction, index_error: rad; dwell_s: s; rate_hz: Hz; "
+        "height: m; gyro_bias: rad/s; gyro_arw: rad/sqrt(s); accel_bias: m/s^2 "
+        "[x, y]; accel_vrw: m/s/sqrt(s); gravity: m/s^2"
+    )
     az = "clockwise from true north, [0, 2pi)"
     put(g, "azimuth_true", res.azimuth_true, "rad", az)
     put(g, "theta", res.theta, "rad", "table angles, counter-clockwise about the table normal")
@@ -193,18 +228,40 @@ def write_northfind(f: h5py.File, run) -> None:
     put(g, "tilt_direction_true", res.tilt_direction_true, "rad", "azimuth of descent, " + az)
     rm = "(repeats, azimuths)"
     put(g, "tilt_est", res.tilt_est.T, "rad", shape=rm)
-    put(g, "tilt_direction_est", res.tilt_direction_est.T, "rad", "azimuth of descent, " + az,
-        shape=rm)
+    put(
+        g,
+        "tilt_direction_est",
+        res.tilt_direction_est.T,
+        "rad",
+        "azimuth of descent, " + az,
+        shape=rm,
+    )
     put(g, "pitch_est", res.pitch_est.T, "rad", ATT_FRAME, shape=rm)
     put(g, "roll_est", res.roll_est.T, "rad", ATT_FRAME, shape=rm)
-    put(g, "gyro_coef", np.swapaxes(res.gyro_coef, 0, 1), "rad/s",
-        shape="(repeats, azimuths, [R, a, b])")
-    put(g, "accel_coef", np.swapaxes(res.accel_coef, 0, 1), "m/s^2",
-        shape="(repeats, azimuths, [x, y], [R, a, b])")
+    put(
+        g,
+        "gyro_coef",
+        np.swapaxes(res.gyro_coef, 0, 1),
+        "rad/s",
+        shape="(repeats, azimuths, [R, a, b])",
+    )
+    put(
+        g,
+        "accel_coef",
+        np.swapaxes(res.accel_coef, 0, 1),
+        "m/s^2",
+        shape="(repeats, azimuths, [x, y], [R, a, b])",
+    )
     for i, name in enumerate(res.methods):
         m = g.create_group(name)
         put(m, "estimate", res.azimuth_est[i].T, "rad", az, shape=rm)
-        put(m, "error", res.azimuth_error[i].T, "rad", "estimate - true, wrapped to [-pi, pi)",
-            shape=rm)
+        put(
+            m,
+            "error",
+            res.azimuth_error[i].T,
+            "rad",
+            "estimate - true, wrapped to [-pi, pi)",
+            shape=rm,
+        )
         put(m, "error_pred", res.error_pred[i], "rad", "noise-free closed form (NaN: none)")
         put(m, "std_pred", res.azimuth_std_pred[i], "rad", "linearised 1-sigma prediction")

@@ -33,35 +33,53 @@ def _progress_bar(total_hint: str):
         TimeRemainingColumn,
     )
 
-    return Progress(TextColumn(f"[bold]{total_hint}"), BarColumn(), MofNCompleteColumn(),
-                    TextColumn("{task.fields[failed]}"), TimeElapsedColumn(),
-                    TextColumn("ETA"), TimeRemainingColumn(),
-                    console=Console(stderr=True), transient=False)
+    return Progress(
+        TextColumn(f"[bold]{total_hint}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[failed]}"),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        transient=False,
+    )
 
 
 @app.command()
 @user_errors
 def batch(
-    sweep: Path = typer.Argument(..., help="Sweep YAML: base scenario, grid of overrides, "
-                                          "seeds, metrics (docs/batch.md)."),
-    workers: int | None = typer.Option(None, "--workers", "-w",
-                                       help="Local worker processes (default: all cores)."),
+    sweep: Path = typer.Argument(
+        ..., help="Sweep YAML: base scenario, grid of overrides, seeds, metrics (docs/batch.md)."
+    ),
+    workers: int | None = typer.Option(
+        None, "--workers", "-w", help="Local worker processes (default: all cores)."
+    ),
     scheduler: str | None = typer.Option(
-        None, "--scheduler",
-        help="Run on an existing Dask cluster, e.g. tcp://host:8786 (pip install -e \".[dask]\")."),
+        None,
+        "--scheduler",
+        help='Run on an existing Dask cluster, e.g. tcp://host:8786 (pip install -e ".[dask]").',
+    ),
     output: Path | None = typer.Option(
-        None, "-o", "--output", help="Results file (default runs/SWEEP-batch.h5); the journal "
-                                     "FILE.journal.jsonl sits next to it while runs are missing."),
-    resume: bool = typer.Option(False, "--resume",
-                                help="Run only what an earlier, interrupted batch did not finish."),
+        None,
+        "-o",
+        "--output",
+        help="Results file (default runs/SWEEP-batch.h5); the journal "
+        "FILE.journal.jsonl sits next to it while runs are missing.",
+    ),
+    resume: bool = typer.Option(
+        False, "--resume", help="Run only what an earlier, interrupted batch did not finish."
+    ),
     as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ):
     """Run a sweep (variants × seeds); aggregate each metric per variant into one HDF5 file."""
     if workers is not None and workers < 1:
         raise ScenarioError(f"--workers: must be at least 1, got {workers}")
     if workers is not None and scheduler:
-        raise ScenarioError("--workers: applies to the local process pool; with --scheduler "
-                            "the cluster's workers run the batch (give one or the other)")
+        raise ScenarioError(
+            "--workers: applies to the local process pool; with --scheduler "
+            "the cluster's workers run the batch (give one or the other)"
+        )
     sw = engine.load_sweep(sweep)
     out = output or default_output(sw.name, "batch", None)
     err = consoles(True)  # notes always on stderr
@@ -80,9 +98,15 @@ def batch(
     if bar is not None:
         bar.start()
     try:
-        result = engine.run_batch(sw, out, workers=workers, scheduler=scheduler, resume=resume,
-                                  progress=progress,
-                                  log=lambda msg: err.print(f"[dim]{msg}[/dim]", soft_wrap=True))
+        result = engine.run_batch(
+            sw,
+            out,
+            workers=workers,
+            scheduler=scheduler,
+            resume=resume,
+            progress=progress,
+            log=lambda msg: err.print(f"[dim]{msg}[/dim]", soft_wrap=True),
+        )
     finally:
         if bar is not None:
             bar.stop()

@@ -11,6 +11,7 @@ import yaml
 
 from gcalign import report, results
 from gcalign.cli import app, consoles, default_output, emit_json, user_errors
+from gcalign.cli.common import save_and_show
 from gcalign.config import load_scenario, parse_scenario
 from gcalign.config.resolve import resolved_rows
 from gcalign.errors import ScenarioError
@@ -61,15 +62,17 @@ def simulate(
     data = scenario_data(sc, seed)
     summary = simulation_summary(data, sc.name, time.perf_counter() - t0)
     out = output or default_output(sc.name, "simulate", data.seed)
-    summary["output"] = str(out)
-    with results.atomic_h5(out) as f:
-        results.write_header(f, "simulate", text, data.seed, summary)
-        if data.truth is not None:
-            results.write_truth(f, data.truth)
-        results.write_imu(f, data.imu)
-    consoles(as_json).print(report.simulate_table(summary))
-    if as_json:
-        emit_json(summary)
+    save_and_show(
+        out,
+        "simulate",
+        text,
+        data.seed,
+        summary,
+        report.simulate_table,
+        as_json,
+        lambda f: results.write_imu(f, data.imu),
+        data.truth,
+    )
 
 
 @app.command()
@@ -95,25 +98,17 @@ def navigate(
     run = run_navigation(data)
     summary = navigation_summary(run, data, sc.name)
     out = output or default_output(sc.name, "navigate", data.seed)
-    summary["output"] = str(out)
-    with results.atomic_h5(out) as f:
-        results.write_header(f, "navigate", text, data.seed, summary)
-        if data.truth is not None:
-            results.write_truth(f, data.truth)
-        g = f.create_group("navigate")
-        sol = run.solution
-        results.put(g, "t", sol.t, "s")
-        results.put(g, "att", sol.att, "rad", results.ATT_FRAME)
-        results.put(g, "v_n", sol.v_n, "m/s", "ENU")
-        results.put(g, "pos", sol.pos, "rad, rad, m", "[latitude, longitude, height]")
-        if run.att_error is not None:
-            e = g.create_group("error")
-            results.put(e, "att", run.att_error, "rad", "Euler differences est - true, yaw wrapped")
-            results.put(e, "v_n", run.vel_error, "m/s", "ENU")
-            results.put(e, "pos", run.pos_error, "m", "ENU (east, north, up)")
-    consoles(as_json).print(report.navigate_table(summary))
-    if as_json:
-        emit_json(summary)
+    save_and_show(
+        out,
+        "navigate",
+        text,
+        data.seed,
+        summary,
+        report.navigate_table,
+        as_json,
+        lambda f: results.write_navigation(f, run),
+        data.truth,
+    )
 
 
 @app.command()

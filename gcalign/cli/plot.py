@@ -15,8 +15,12 @@ from gcalign.cli.data import JSON_HELP
 def plot(
     file: Path = typer.Argument(..., help="A gcalign results file (.h5)."),
     out_dir: Path | None = typer.Option(
-        None, "-o", "--output", help="Folder for the PNG files (default: FILE without its "
-                                     "suffix + '_plots/', next to the file)."),
+        None,
+        "-o",
+        "--output",
+        help="Folder for the PNG files (default: FILE without its "
+        "suffix + '_plots/', next to the file).",
+    ),
     as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ):
     """Write PNG figures: alignment error and attitude per pass (equivalent time),

@@ -1,0 +1,79 @@
+"""What the commands share: loading a scenario with option overrides, saving and showing."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from importlib import resources
+from pathlib import Path
+
+import yaml
+
+from gcalign import results
+from gcalign.cli import consoles, emit_json
+from gcalign.config import Scenario, parse_scenario
+from gcalign.config.loader import read_yaml
+
+
+def builtin_text(name: str) -> str:
+    """YAML text of a built-in scenario (package data in gcalign/scenarios)."""
+    return resources.files("gcalign.scenarios").joinpath(name).read_text(encoding="utf-8")
+
+
+def load_with_overrides(
+    path: Path | None,
+    builtin: str,
+    section: str,
+    overrides: dict,
+    adjust: Callable[[dict, dict], None] | None = None,
+) -> tuple[Scenario, str, str]:
+    """Scenario (the file, or the built-in one), its text and its source name, with the
+    options that were given written into `section` before validation, so that a bad
+    option is reported like a bad key in the file. `adjust(section, given)` may drop keys
+    that a given option replaces. The text stored in results files records the overrides.
+    """
+    if path is None:
+        text, source = builtin_text(builtin), f"<built-in {builtin}>"
+        data = yaml.safe_load(text)
+    else:
+        data, source = read_yaml(path), str(path)
+        text = Path(path).read_text(encoding="utf-8")
+    given = {k: v for k, v in overrides.items() if v is not None}
+    if isinstance(data, dict) and given:
+        current = data.get(section)
+        merged = dict(current) if isinstance(current, dict) else {}
+        if adjust is not None:
+            adjust(merged, given)
+        merged.update(given)
+        data[section] = merged
+    sc = parse_scenario(data, source)
+    if sc.imu_file is not None and path is not None and not sc.imu_file.is_absolute():
+        sc.imu_file = (Path(path).parent / sc.imu_file).resolve()
+    if given:
+        text += f"\n# command-line overrides of {section}:\n" + yaml.safe_dump(
+            {section: given}, sort_keys=False
+        )
+    return sc, text, source
+
+
+def save_and_show(
+    out: Path,
+    kind: str,
+    text: str,
+    seed,
+    summary: dict,
+    table,
+    as_json: bool,
+    write: Callable,
+    truth=None,
+) -> None:
+    """Write the results file atomically (header, truth, then `write(f)`), print the table
+    built by `table(summary)`, and the JSON summary under --json."""
+    summary["output"] = str(out)
+    with results.atomic_h5(out) as f:
+        results.write_header(f, kind, text, seed, summary)
+        if truth is not None:
+            results.write_truth(f, truth)
+        write(f)
+    consoles(as_json).print(table(summary))
+    if as_json:
+        emit_json(summary)
