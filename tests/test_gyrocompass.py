@@ -42,15 +42,16 @@ def reference_block(state, dtheta, dv, vref, body, ts, sign, gains, mode):
     r_m, r_n = earth.radii(lat)
     wcn = wce = 0.0
     if mode != K.ATTITUDE:
-        wcn = (ve - r[0]) * (1 + ke2) / r_n + ke3 * ie
+        wcn = (ve - r[0]) * (1 + ke2) / (r_n + h) + ke3 * ie
         wce = (
-            -(vn - r[1]) * (1 + kn2) / r_m - kn3 * inn
+            -(vn - r[1]) * (1 + kn2) / (r_m + h) - kn3 * inn
             if mode == K.LEVEL
-            else -(vn - r[1]) * (1 + ku2) / r_m
+            else -(vn - r[1]) * (1 + ku2) / (r_m + h)
         )
     out = [q.copy()]
     for k in range(len(dtheta)):
         r_m, r_n = earth.radii(lat)
+        rmh, rnh = r_m + h, r_n + h
         w_ie = sign * earth.omega_ie_n(lat)
         w_en = earth.omega_en_n(lat, h, r)
         w_c = np.array([wce, wcn, wcu if mode == K.COMPASS else 0.0])
@@ -64,7 +65,7 @@ def reference_block(state, dtheta, dv, vref, body, ts, sign, gains, mode):
         h = h + 0.5 * (r[2] + nxt[2]) * ts
         if mode != K.ATTITUDE:
             frame = 2 * w_ie + w_en + (w_c if body else 0.0)
-            a = -np.cross(frame, r)
+            a = -np.cross(frame, 0.5 * (r + nxt))
             k1n = kn1 if mode == K.LEVEL else ku1
             ve, vn = (
                 ve + f[0] + a[0] * ts - ke1 * (ve - r[0]) * ts,
@@ -72,13 +73,13 @@ def reference_block(state, dtheta, dv, vref, body, ts, sign, gains, mode):
             )
             dve, dvn = ve - nxt[0], vn - nxt[1]
             ie += dve * ts
-            wcn = dve * (1 + ke2) / r_n + ke3 * ie
+            wcn = dve * (1 + ke2) / rnh + ke3 * ie
             if mode == K.LEVEL:
                 inn += dvn * ts
-                wce = -dvn * (1 + kn2) / r_m - kn3 * inn
+                wce = -dvn * (1 + kn2) / rmh - kn3 * inn
             else:
                 wcu = (wcu + ku3 * dvn * ts / w_ie[1]) / (1 + ku4 * ts)
-                wce = -dvn * (1 + ku2) / r_m
+                wce = -dvn * (1 + ku2) / rmh
         else:
             ve, vn = nxt[0], nxt[1]
         lat, r = lat_new, nxt

@@ -8,14 +8,14 @@ Per step (data already transformed for a reverse pass: gyro negated, velocity ne
 ``earth_sign = -1``, so Ω = earth_sign·ω_ie·cos L changes sign with the data):
 
 - attitude ``q ← q(−ω_in T) ⊗ q ⊗ q(Δθ)`` with ``ω_in = ω_ie + ω_en(v_R) + ω_c``;
-- horizontal velocity ``v ← v + C_nb Δv − ((2ω_ie + ω_en [+ ω_c]) × v_R) T − K1 δv T``
+- horizontal velocity ``v ← v + C_nb Δv − ((2ω_ie + ω_en [+ ω_c]) × v_R,mid) T − K1 δv T``
   (eqs. 11-13; the Coriolis and frame-rate terms are those of the reference velocity v_R;
   ω_c is included for an odometer reference, which is resolved with the computed attitude
   and so turns with the computed frame);
 - control rates from ``δv = v − v_R``:
-  east level   ``ω_cN = δv_E (1 + K_E2)/R_N + K_E3 ∫δv_E dt``            (eq. 1)
-  north level  ``ω_cE = −δv_N (1 + K_N2)/R_M − K_N3 ∫δv_N dt``           (eq. 2, level mode)
-  compass      ``ω_cE = −δv_N (1 + K_U2)/R_M``,
+  east level   ``ω_cN = δv_E (1 + K_E2)/(R_N + h) + K_E3 ∫δv_E dt``      (eq. 1)
+  north level  ``ω_cE = −δv_N (1 + K_N2)/(R_M + h) − K_N3 ∫δv_N dt``     (eq. 2, level mode)
+  compass      ``ω_cE = −δv_N (1 + K_U2)/(R_M + h)``,
                ``ω_cU ← (ω_cU + K_U3 δv_N T/Ω)/(1 + K_U4 T)``              (eqs. 3-4, 13)
 
 Modes: ``ATTITUDE`` (no loops: the attitude-only strapdown of a half-cycle reverse pass and
@@ -70,13 +70,14 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains,
     if mode != ATTITUDE:
         # Control rates of the incoming state.
         dve, dvn = ve - re, vn - rn
-        wcn = dve * (1.0 + ke2) / r_n + ke3 * ie
+        wcn = dve * (1.0 + ke2) / (r_n + h) + ke3 * ie
         if mode == LEVEL:
-            wce = -dvn * (1.0 + kn2) / r_m - kn3 * inn
+            wce = -dvn * (1.0 + kn2) / (r_m + h) - kn3 * inn
         else:
-            wce = -dvn * (1.0 + ku2) / r_m
+            wce = -dvn * (1.0 + ku2) / (r_m + h)
     for k in range(dtheta.shape[0]):
         r_m, r_n, g, sl, cl = earth_at(lat, h)
+        rmh, rnh = r_m + h, r_n + h  # radii at the start of the step
         wie = earth_sign * OMEGA_IE
         wie_n, wie_u = wie * cl, wie * sl
         te, tn, tu = transport_rate(re, rn, r_m, r_n, h, sl, cl)
@@ -114,24 +115,26 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains,
             # with every azimuth correction; the loop velocity must turn with the computed
             # frame too (ω_c in the frame rate), or the compass loop sees a false
             # δv_N = v_E Δφ_U that detunes it. An ENU (nav) reference does not turn.
+            # Evaluated at the mid-step reference velocity, as the strapdown step does.
             cc = 1.0 if vref_body else 0.0
             ce, cn, cu2 = te + cc * wce, 2.0 * wie_n + tn + cc * wcn, 2.0 * wie_u + tu + cc * cu
-            ae = -(cn * ru - cu2 * rn)
-            an = -(cu2 * re - ce * ru)
+            me, mn, mu = 0.5 * (re + ne), 0.5 * (rn + nn), 0.5 * (ru + nu)
+            ae = -(cn * mu - cu2 * mn)
+            an = -(cu2 * me - ce * mu)
             k1e = ke1
             k1n = kn1 if mode == LEVEL else ku1
             ve = ve + fx + ae * ts - k1e * (ve - re) * ts
             vn = vn + fy + an * ts - k1n * (vn - rn) * ts
             dve, dvn = ve - ne, vn - nn
             ie += dve * ts
-            wcn = dve * (1.0 + ke2) / r_n + ke3 * ie
+            wcn = dve * (1.0 + ke2) / rnh + ke3 * ie
             if mode == LEVEL:
                 inn += dvn * ts
-                wce = -dvn * (1.0 + kn2) / r_m - kn3 * inn
+                wce = -dvn * (1.0 + kn2) / rmh - kn3 * inn
             else:
                 omega = wie_n  # Ω = ω_ie cos L, signed with the pass direction
                 wcu = (wcu + ku3 * dvn * ts / omega) / (1.0 + ku4 * ts)
-                wce = -dvn * (1.0 + ku2) / r_m
+                wce = -dvn * (1.0 + ku2) / rmh
         else:
             ve, vn = ne, nn
         lat = lat_new

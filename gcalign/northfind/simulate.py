@@ -1,0 +1,298 @@
+"""Simulated indexing turntable (seed 001 §3.1): the setup and the dwell means.
+
+:class:`NorthfindSetup` holds and validates the plain parameters of a run (truth, timing,
+sensor errors; SI and radians); :func:`simulate_table` draws the dwell means of the gyro
+and the two accelerometers (:class:`TableData`), either directly from their exact law or
+sample by sample in the numba kernel ``_dwell_means_kernel``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from gcalign import earth
+from gcalign.northfind.geometry import _ideal_readings, _wrap_2pi, position_angles, table_dcm
+
+__all__ = ["NorthfindSetup", "TableData", "simulate_table"]
+
+
+def _deg(x) -> str:
+    return f"{np.degrees(x):.6g} deg"
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class NorthfindSetup:
+    """Plain parameters of a north-finding run, SI units and radians.
+
+    Parameters
+    ----------
+    azimuths : (M,) float, rad
+        True azimuths of the table reference axis (clockwise from true north); a sweep.
+        Stored wrapped to [0, 2π).
+    lat : float, rad
+        Site latitude; ``|lat| < π/2`` (north is undefined at the poles).
+    positions : int
+        Number n of equally spaced table positions per turn, n >= 3.
+    dwell_s : float, s
+        Dwell at each position (> 0); ``round(dwell_s * rate_hz)`` samples are averaged.
+    rate_hz : float, Hz
+        Sampling rate (> 0).
+    tilt : float or (M,) float, rad
+        Tilt ε of the table normal from the vertical, ``0 <= ε < π/2``.
+    tilt_direction : float or (M,) float, rad
+        Azimuth ζ toward which the table surface descends; see `tilt_direction_ref`.
+    tilt_direction_ref : {"north", "table"}
+        ``"north"``: ζ is a true azimuth (tilted base, fixed to the earth). ``"table"``: ζ is
+        measured clockwise from the reference axis in the horizontal plane (tilt fixed to
+        the instrument, turns with it; the true direction is ``azimuth + ζ``).
+    repeats : int
+        Independent repeats R per azimuth (>= 1); results have shape (M, R).
+    height : float, m
+        Site height, for gravity.
+    gyro_bias : float, rad/s
+        Constant gyro bias (R of seed eq. 4).
+    gyro_arw : float, rad/√s
+        Gyro white noise (angle random walk), >= 0.
+    gyro_scale : float
+        Gyro scale-factor error (fraction): reading = (1 + scale) · rate + bias + noise.
+    accel_bias : float or (2,) float, m/s²
+        Constant bias of the [x, y] accelerometers (scalar: both).
+    accel_vrw : float, m/s/√s
+        Accelerometer white noise (velocity random walk), >= 0, both accelerometers.
+    index_error : float, rad
+        1σ of the table indexing error, drawn independently per position and run (truth
+        only; the estimator uses the nominal angles), >= 0.
+    """
+
+    azimuths: np.ndarray
+    lat: float
+    positions: int = 24
+    dwell_s: float = 60.0
+    rate_hz: float = 100.0
+    tilt: float | np.ndarray = 0.0
+    tilt_direction: float | np.ndarray = 0.0
+    tilt_direction_ref: str = "north"
+    repeats: int = 1
+    height: float = 0.0
+    gyro_bias: float = 0.0
+    gyro_arw: float = 0.0
+    gyro_scale: float = 0.0
+    accel_bias: float | tuple[float, float] | np.ndarray = 0.0
+    accel_vrw: float = 0.0
+    index_error: float = 0.0
+
+    def __post_init__(self) -> None:
+        def setf(name, value):
+            object.__setattr__(self, name, value)
+
+        az = np.atleast_1d(np.asarray(self.azimuths, dtype=float))
+        if az.ndim != 1:
+            raise ValueError(f"azimuths must have shape (M,), got {az.shape}")
+        if az.size == 0:
+            raise ValueError("azimuths must hold at least one azimuth (empty sweep), got []")
+        if not np.all(np.isfinite(az)):
+            raise ValueError(f"azimuths must be finite, got {az.tolist()}")
+        setf("azimuths", _wrap_2pi(az))
+        m = az.size
+
+        lat = float(self.lat)
+        if not np.isfinite(lat) or abs(lat) >= 0.5 * np.pi:
+            raise ValueError(
+                f"lat must satisfy |lat| < pi/2 rad (north is undefined at the poles), "
+                f"got {lat!r} rad ({_deg(lat)})"
+            )
+        setf("lat", lat)
+
+        pos = self.positions
+        if isinstance(pos, (bool, np.bool_)) or int(pos) != pos or int(pos) < 3:
+            raise ValueError(
+                f"positions must be an integer >= 3 (three unknowns R, a, b per sensor), "
+                f"got {pos!r}"
+            )
+        setf("positions", int(pos))
+
+        for name in ("dwell_s", "rate_hz"):
+            v = float(getattr(self, name))
+            if not np.isfinite(v) or v <= 0.0:
+                raise ValueError(f"{name} must be > 0, got {getattr(self, name)!r}")
+            setf(name, v)
+        if round(self.dwell_s * self.rate_hz) < 1:
+            raise ValueError(
+                f"dwell_s * rate_hz must give at least one sample per position, got "
+                f"dwell_s={self.dwell_s!r} s at rate_hz={self.rate_hz!r} Hz"
+            )
+
+        tilt = np.asarray(self.tilt, dtype=float)
+        if tilt.ndim > 1 or (tilt.ndim == 1 and tilt.size != m):
+            raise ValueError(f"tilt must be a scalar or have shape ({m},), got {tilt.shape}")
+        bad = ~np.isfinite(tilt) | (tilt < 0.0) | (tilt >= 0.5 * np.pi)
+        if np.any(bad):
+            v = float(np.atleast_1d(tilt)[np.argmax(np.atleast_1d(bad))])
+            raise ValueError(
+                f"tilt must satisfy 0 <= tilt < pi/2 rad (0 <= tilt < 90 deg), "
+                f"got {v!r} rad ({_deg(v)})"
+            )
+        setf("tilt", np.broadcast_to(tilt, (m,)).copy())
+
+        tdir = np.asarray(self.tilt_direction, dtype=float)
+        if tdir.ndim > 1 or (tdir.ndim == 1 and tdir.size != m):
+            raise ValueError(
+                f"tilt_direction must be a scalar or have shape ({m},), got {tdir.shape}"
+            )
+        if not np.all(np.isfinite(tdir)):
+            raise ValueError(f"tilt_direction must be finite, got {tdir.tolist()}")
+        setf("tilt_direction", np.broadcast_to(tdir, (m,)).copy())
+        if self.tilt_direction_ref not in ("north", "table"):
+            raise ValueError(
+                f"tilt_direction_ref must be 'north' or 'table', got {self.tilt_direction_ref!r}"
+            )
+
+        rep = self.repeats
+        if isinstance(rep, (bool, np.bool_)) or int(rep) != rep or int(rep) < 1:
+            raise ValueError(f"repeats must be an integer >= 1, got {rep!r}")
+        setf("repeats", int(rep))
+
+        for name in ("height", "gyro_bias", "gyro_scale"):
+            v = float(getattr(self, name))
+            if not np.isfinite(v):
+                raise ValueError(f"{name} must be finite, got {getattr(self, name)!r}")
+            setf(name, v)
+        if self.gyro_scale <= -1.0:
+            raise ValueError(f"gyro_scale must be > -1, got {self.gyro_scale!r}")
+        for name in ("gyro_arw", "accel_vrw", "index_error"):
+            v = float(getattr(self, name))
+            if not np.isfinite(v) or v < 0.0:
+                raise ValueError(f"{name} must be >= 0, got {getattr(self, name)!r}")
+            setf(name, v)
+        ab = np.asarray(self.accel_bias, dtype=float)
+        if ab.shape not in ((), (2,)) or not np.all(np.isfinite(ab)):
+            raise ValueError(
+                f"accel_bias must be a finite scalar or shape (2,) [x, y], got {ab.tolist()}"
+            )
+        setf("accel_bias", np.broadcast_to(ab, (2,)).copy())
+
+    @property
+    def theta(self) -> np.ndarray:
+        """Nominal table angles θ_i = (i-1)·2π/n (rad), shape (n,)."""
+        return position_angles(self.positions)
+
+    @property
+    def n_samples(self) -> int:
+        """Samples averaged per position, ``round(dwell_s * rate_hz)``."""
+        return int(round(self.dwell_s * self.rate_hz))
+
+    @property
+    def tilt_direction_north(self) -> np.ndarray:
+        """True tilt direction as an azimuth from north (rad, [0, 2π)), shape (M,)."""
+        if self.tilt_direction_ref == "table":
+            return _wrap_2pi(self.azimuths + self.tilt_direction)
+        return _wrap_2pi(self.tilt_direction)
+
+    @property
+    def gravity(self) -> float:
+        """Normal gravity at the site (m/s²)."""
+        return float(earth.gravity(self.lat, self.height))
+
+
+@dataclass(frozen=True, eq=False)
+class TableData:
+    """Per-position dwell means of the north-finder's sensors.
+
+    Attributes
+    ----------
+    theta : (n,) float, rad. Nominal table angles (what the estimator uses).
+    theta_true : (M, R, n) float, rad. Actual angles (nominal + indexing error).
+    gyro : (M, R, n) float, rad/s. Gyro dwell means.
+    accel : (M, R, n, 2) float, m/s². Dwell means of the [x, y] accelerometers.
+    C_nt : (M, 3, 3) float. True table attitude per azimuth.
+    n_samples : int. Samples averaged per position.
+    gravity : float, m/s². Gravity used by the truth.
+    """
+
+    theta: np.ndarray
+    theta_true: np.ndarray
+    gyro: np.ndarray
+    accel: np.ndarray
+    C_nt: np.ndarray
+    n_samples: int
+    gravity: float
+
+
+@numba.njit(cache=True)
+def _dwell_means_kernel(rng, ideal, bias, sigma, n_samples):  # pragma: no cover - numba
+    """Sample-level dwell means: every sample ``ideal + bias + sigma * w``, then averaged.
+
+    ``ideal`` (K, n, S); draws are consumed in the C order of (K, n, S, n_samples).
+    """
+    K, n, S = ideal.shape
+    out = np.empty_like(ideal)
+    for k in range(K):
+        for i in range(n):
+            for s in range(S):
+                acc = 0.0
+                for _ in range(n_samples):
+                    acc += ideal[k, i, s] + bias[s] + sigma[s] * rng.standard_normal()
+                out[k, i, s] = acc / n_samples
+    return out
+
+
+def simulate_table(setup: NorthfindSetup, rng: np.random.Generator, *, samples: bool = False):
+    """Simulate the dwell means of the gyro and accelerometers for every azimuth and repeat.
+
+    Parameters
+    ----------
+    setup : NorthfindSetup
+        Truth, timing and sensor errors (SI).
+    rng : numpy.random.Generator
+        The only source of randomness. Draw order: indexing errors (M, R, n), then the
+        sensor noise.
+    samples : bool
+        False (default): draw each dwell mean of white noise directly as
+        ``N(0, σ_s²/N)`` (σ_s = density·√rate, N samples): the mean of N independent
+        normal samples has exactly that law, so this is statistically exact and N times
+        cheaper. True: draw every sample (numba kernel, same stream as
+        ``rng.standard_normal((M*R, n, 3, N))``) and average; a reference for small cases.
+
+    Returns
+    -------
+    TableData
+        Dwell means, shapes (M, R, n) for the gyro and (M, R, n, 2) for the accelerometers.
+
+    Notes
+    -----
+    The estimators use only the dwell means. The mean of N independent N(0, σ²) samples is
+    exactly N(0, σ²/N), so the default path draws it directly (one number per position
+    and sensor instead of N): statistically identical, N times cheaper. ``samples=True``
+    draws every sample instead (a numba kernel that consumes the same ``Generator`` stream as
+    ``rng.standard_normal((K, n, 3, N))`` would); a test checks that the two agree.
+    """
+    m, r, n, N = setup.azimuths.size, setup.repeats, setup.positions, setup.n_samples
+    g = setup.gravity
+    C_nt = table_dcm(setup.azimuths, setup.tilt, setup.tilt_direction_north)
+    theta = setup.theta
+    theta_true = theta + setup.index_error * rng.standard_normal((m, r, n))
+    ideal = _ideal_readings(C_nt, theta_true, setup.lat, g)
+    ideal[..., 0] *= 1.0 + setup.gyro_scale
+    accel_bias = np.asarray(setup.accel_bias, dtype=float)
+    bias = np.array([setup.gyro_bias, accel_bias[0], accel_bias[1]])
+    sigma = np.array([setup.gyro_arw, setup.accel_vrw, setup.accel_vrw]) * np.sqrt(
+        setup.rate_hz
+    )  # per-sample standard deviation, rad/s and m/s²
+    if samples:
+        flat = np.ascontiguousarray(ideal.reshape(m * r, n, 3))
+        means = _dwell_means_kernel(rng, flat, bias, sigma, N).reshape(m, r, n, 3)
+    else:
+        # dwell mean of N white samples ~ N(0, σ_s²/N), drawn directly
+        means = ideal + bias + (sigma / np.sqrt(N)) * rng.standard_normal((m, r, n, 3))
+    return TableData(
+        theta=theta,
+        theta_true=theta_true,
+        gyro=means[..., 0],
+        accel=means[..., 1:],
+        C_nt=C_nt,
+        n_samples=N,
+        gravity=g,
+    )
