@@ -48,8 +48,12 @@ def simulate_table(s: dict) -> Table:
 
 
 def navigate_table(s: dict) -> Table:
-    table = Table(title=f"gcalign navigate: {s['scenario']} ({s['samples']} samples, "
-                  f"{s['duration_s']:.1f} s)", title_justify="left", header_style="bold")
+    table = Table(
+        title=f"gcalign navigate: {s['scenario']} ({s['samples']} samples, "
+        f"{s['duration_s']:.1f} s)",
+        title_justify="left",
+        header_style="bold",
+    )
     table.add_column("quantity")
     table.add_column("final", justify="right")
     table.add_column("max |error|", justify="right")
@@ -63,14 +67,22 @@ def navigate_table(s: dict) -> Table:
         ]
     else:
         rows = [
-            ("attitude error (pitch, roll, yaw) (deg)", fmt(fe["attitude_deg"]),
-             fmt(me["attitude_deg"])),
+            (
+                "attitude error (pitch, roll, yaw) (deg)",
+                fmt(fe["attitude_deg"]),
+                fmt(me["attitude_deg"]),
+            ),
             ("velocity error ENU (m/s)", fmt(fe["velocity_mps"]), fmt(me["velocity_mps"])),
             ("position error ENU (m)", fmt(fe["position_m"]), fmt(me["position_m"])),
         ]
     for row in rows:
         table.add_row(*map(Text, row))
     table.caption = f"compute {s['compute_s'] * 1e3:.1f} ms; output {s.get('output') or '—'}"
+    if fe is None:
+        table.caption = (
+            "recorded data: free navigation from the file header's nominal state, "
+            "unaided (the vertical channel diverges); " + table.caption
+        )
     return table
 
 
@@ -78,8 +90,10 @@ def align_table(s: dict) -> Table:
     """Truth, estimate and error at T2 and T3, the error after each pass, timing."""
     table = Table(
         title=f"gcalign align: {s['scenario']} — {s['mode']}, compensation {s['compensation']}, "
-              f"poles {s['azimuth_poles']}",
-        title_justify="left", header_style="bold")
+        f"poles {s['azimuth_poles']}",
+        title_justify="left",
+        header_style="bold",
+    )
     for name in ("", "t (s)", "pitch (deg)", "roll (deg)", "yaw (deg)"):
         table.add_column(name, justify="left" if not name else "right")
     for when in ("t2", "t3"):
@@ -87,24 +101,39 @@ def align_table(s: dict) -> Table:
             vals = s.get(f"{what}_{when}_deg")
             digits = 5 if what == "error" else 4
             cells = ["—"] * 3 if vals is None else [fmt(v, digits) for v in vals]
-            table.add_row(Text(f"{name} at T{when[1]}"), fmt(s[f"{when}_s"], 2), *cells,
-                          end_section=what == "error")
+            table.add_row(
+                Text(f"{name} at T{when[1]}"),
+                fmt(s[f"{when}_s"], 2),
+                *cells,
+                end_section=what == "error",
+            )
     for p in s["passes"]:
         has_error = p["error_deg"] is not None
         vals = p["error_deg"] if has_error else p["attitude_deg"]
-        table.add_row(Text(f"pass {p['index'] + 1} {p['direction'][0].upper()} {p['kind']} "
-                           f"s{p['stage'] + 1} {'error' if has_error else 'attitude'}"),
-                      fmt(p["t_end_s"], 1), *[fmt(v, 5) for v in vals])
-    table.caption = (f"data used {s['data_used_s']:.1f} s, equivalent length "
-                     f"{s['equivalent_s']:.1f} s; compute {s['compute_s'] * 1e3:.1f} ms; "
-                     f"output {s.get('output') or '—'}")
+        table.add_row(
+            Text(
+                f"pass {p['index'] + 1} {p['direction'][0].upper()} {p['kind']} "
+                f"s{p['stage'] + 1} {'error' if has_error else 'attitude'}"
+            ),
+            fmt(p["t_end_s"], 1),
+            *[fmt(v, 5) for v in vals],
+        )
+    table.caption = (
+        f"data used {s['data_used_s']:.1f} s, equivalent length "
+        f"{s['equivalent_s']:.1f} s; compute {s['compute_s'] * 1e3:.1f} ms; "
+        f"output {s.get('output') or '—'}"
+    )
     return table
 
 
 def summary_table(kind: str, summary: dict) -> Table:
     """The table a command printed, rebuilt from its summary (for `gcalign show`)."""
-    builders = {"simulate": simulate_table, "navigate": navigate_table, "align": align_table,
-                "batch": batch_table}
+    builders = {
+        "simulate": simulate_table,
+        "navigate": navigate_table,
+        "align": align_table,
+        "batch": batch_table,
+    }
     builders["northfind"] = northfind_table
     if kind not in builders:
         return kv_table(f"gcalign {kind}", ((k, str(v)) for k, v in summary.items()))
@@ -128,27 +157,43 @@ def northfind_table(s: dict) -> Table:
     ref = "from the reference axis" if s["tilt_reference"] == "table" else "true azimuth"
     table = Table(
         title=f"gcalign northfind: {s['scenario']} — {s['positions']} positions × "
-              f"{s['dwell_s']:g} s, lat {s['latitude_deg']:g}°, tilt {s['tilt_deg']:.4g}° toward "
-              f"{s['tilt_direction_deg']:.4g}° ({ref})",
-        title_justify="left", header_style="bold")
+        f"{s['dwell_s']:g} s, lat {s['latitude_deg']:g}°, tilt {s['tilt_deg']:.4g}° toward "
+        f"{s['tilt_direction_deg']:.4g}° ({ref})",
+        title_justify="left",
+        header_style="bold",
+    )
     tilt = s["tilt_est_deg"]
-    tail = (f"seed {s['seed']}; compute {s['compute_s'] * 1e3:.1f} ms; "
-            f"output {s.get('output') or '—'}")
+    tail = (
+        f"seed {s['seed']}; compute {s['compute_s'] * 1e3:.1f} ms; output {s.get('output') or '—'}"
+    )
     if m == 1 and r == 1:
-        for name in ("method", "azimuth (deg)", "error (deg)", "error (′)", "pred. σ (′)",
-                     "tilt est (deg)"):
-            table.add_column(name, justify="left" if name == "method" else "right",
-                             no_wrap=name == "method")
+        for name in (
+            "method",
+            "azimuth (deg)",
+            "error (deg)",
+            "error (′)",
+            "pred. σ (′)",
+            "tilt est (deg)",
+        ):
+            table.add_column(
+                name, justify="left" if name == "method" else "right", no_wrap=name == "method"
+            )
         for name in order:
             d = ms[name]
-            table.add_row(Text(name), fmt(d["estimates_deg"][0], 5), fmt(d["errors_deg"][0], 5),
-                          fmt(_arcmin(d["errors_deg"][0]), 3),
-                          fmt(_arcmin(d["std_pred_deg"][0]), 3),
-                          "—" if name == "none" else fmt(tilt[0], 4))
-        table.caption = (f"true azimuth {s['azimuth_true_deg'][0]:.4f}°; estimated tilt "
-                         f"{tilt[0]:.4f}° toward {s['tilt_direction_est_deg'][0]:.3f}° (true "
-                         f"{s['tilt_deg']:.4g}° toward {s['tilt_direction_true_deg'][0]:.4g}°, "
-                         f"from north); {tail}")
+            table.add_row(
+                Text(name),
+                fmt(d["estimates_deg"][0], 5),
+                fmt(d["errors_deg"][0], 5),
+                fmt(_arcmin(d["errors_deg"][0]), 3),
+                fmt(_arcmin(d["std_pred_deg"][0]), 3),
+                "—" if name == "none" else fmt(tilt[0], 4),
+            )
+        table.caption = (
+            f"true azimuth {s['azimuth_true_deg'][0]:.4f}°; estimated tilt "
+            f"{tilt[0]:.4f}° toward {s['tilt_direction_est_deg'][0]:.3f}° (true "
+            f"{s['tilt_deg']:.4g}° toward {s['tilt_direction_true_deg'][0]:.4g}°, "
+            f"from north); {tail}"
+        )
     elif m == 1:
         table.add_column("group", justify="left")
         for name in order:
@@ -159,44 +204,71 @@ def northfind_table(s: dict) -> Table:
             if i is None:
                 table.add_row(Text("…"), *["…"] * (len(order) + 1))
                 continue
-            table.add_row(Text(str(i + 1)), *[fmt(ms[n]["estimates_deg"][i], 5) for n in order],
-                          fmt(tilt[i], 4), end_section=i == r - 1)
-        stats = (("mean (deg)", "mean_deg", 1.0, 5), ("std (′)", "std_deg", 60.0, 4),
-                 ("bias (′)", "bias_deg", 60.0, 4), ("pred. σ (′)", "std_pred_deg", 60.0, 4))
+            table.add_row(
+                Text(str(i + 1)),
+                *[fmt(ms[n]["estimates_deg"][i], 5) for n in order],
+                fmt(tilt[i], 4),
+                end_section=i == r - 1,
+            )
+        stats = (
+            ("mean (deg)", "mean_deg", 1.0, 5),
+            ("std (′)", "std_deg", 60.0, 4),
+            ("bias (′)", "bias_deg", 60.0, 4),
+            ("pred. σ (′)", "std_pred_deg", 60.0, 4),
+        )
         for label, key, scale, digits in stats:
             cells = []
             for n in order:
                 v = ms[n][key][0]
                 cells.append(fmt(None if v is None else v * scale, digits))
             table.add_row(Text(label), *cells, "")
-        table.add_row(Text("max |err| (′)"),
-                      *[fmt(ms[n]["max_abs_error_deg"] * 60.0, 4) for n in order], "")
-        table.caption = (f"true azimuth {s['azimuth_true_deg'][0]:.4f}°; {r} independent "
-                         f"determinations; std: sample standard deviation (ddof 1); bias: mean − "
-                         f"truth; {tail}")
+        table.add_row(
+            Text("max |err| (′)"), *[fmt(ms[n]["max_abs_error_deg"] * 60.0, 4) for n in order], ""
+        )
+        table.caption = (
+            f"true azimuth {s['azimuth_true_deg'][0]:.4f}°; {r} independent "
+            f"determinations; std: sample standard deviation (ddof 1); bias: mean − "
+            f"truth; {tail}"
+        )
     else:
-        cols = ["method", "max |error| (deg)", "RMS error (deg)", "mean error (deg)",
-                "closed form max (deg)", "pred. σ (′)"]
+        cols = [
+            "method",
+            "max |error| (deg)",
+            "RMS error (deg)",
+            "mean error (deg)",
+            "closed form max (deg)",
+            "pred. σ (′)",
+        ]
         if r > 1:
             cols.append("std over repeats (′)")
         for name in cols:
-            table.add_column(name, justify="left" if name == "method" else "right",
-                             no_wrap=name == "method")
+            table.add_column(
+                name, justify="left" if name == "method" else "right", no_wrap=name == "method"
+            )
         for name in order:
             d = ms[name]
             bias = [b for b in d["bias_deg"] if b is not None]
-            row = [fmt(d["max_abs_error_deg"], 4), fmt(d["rms_error_deg"], 4),
-                   fmt(sum(bias) / len(bias) if bias else None, 4),
-                   fmt(d["max_abs_error_pred_deg"], 4), fmt(_arcmin(_rms(d["std_pred_deg"])), 3)]
+            row = [
+                fmt(d["max_abs_error_deg"], 4),
+                fmt(d["rms_error_deg"], 4),
+                fmt(sum(bias) / len(bias) if bias else None, 4),
+                fmt(d["max_abs_error_pred_deg"], 4),
+                fmt(_arcmin(_rms(d["std_pred_deg"])), 3),
+            ]
             if r > 1:
                 row.append(fmt(_arcmin(_rms(d["std_deg"])), 3))
             table.add_row(Text(name), *row)
         sweep = s.get("sweep")
-        az = (f"sweep {sweep['start_deg']:g}…{sweep['stop_deg']:g}° step {sweep['step_deg']:g}°"
-              if sweep else "azimuths")
-        table.caption = (f"{az}: {m} true azimuths × {r} repeat(s); closed form: noise-free "
-                         f"tilt error; predicted σ and std: RMS over the sweep; estimated tilt "
-                         f"{min(tilt):.4f}…{max(tilt):.4f}°; {tail}")
+        az = (
+            f"sweep {sweep['start_deg']:g}…{sweep['stop_deg']:g}° step {sweep['step_deg']:g}°"
+            if sweep
+            else "azimuths"
+        )
+        table.caption = (
+            f"{az}: {m} true azimuths × {r} repeat(s); closed form: noise-free "
+            f"tilt error; predicted σ and std: RMS over the sweep; estimated tilt "
+            f"{min(tilt):.4f}…{max(tilt):.4f}°; {tail}"
+        )
     return table
 
 
@@ -213,13 +285,24 @@ def batch_table(s: dict) -> Table:
     keys = list(s.get("grid") or {})
     tails = [k.rsplit(".", 1)[-1] for k in keys]
     short = {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
-    title = (f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) × "
-             f"{s['seeds']} seed(s) {s['seed_start']}…{s['seed_start'] + s['seeds'] - 1}")
-    table = Table(title=title, title_justify="left", header_style="bold",
-                  box=box.SIMPLE_HEAD, pad_edge=False, padding=(0, 0, 0, 1))
+    title = (
+        f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) × "
+        f"{s['seeds']} seed(s) {s['seed_start']}…{s['seed_start'] + s['seeds'] - 1}"
+    )
+    table = Table(
+        title=title,
+        title_justify="left",
+        header_style="bold",
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,
+        padding=(0, 0, 0, 1),
+    )
     for name in ("variant", "n", "mean", "std", "RMS", "median", "5 %", "95 %"):
-        table.add_column(name, justify="left" if name == "variant" else "right",
-                         overflow="fold" if name == "variant" else "ellipsis")
+        table.add_column(
+            name,
+            justify="left" if name == "variant" else "right",
+            overflow="fold" if name == "variant" else "ellipsis",
+        )
     for m in s["metrics"]:
         per = [(v, v["stats"].get(m)) for v in variants]
         comps = next((st["components"] for _, st in per if st and st.get("components")), None)
@@ -231,8 +314,10 @@ def batch_table(s: dict) -> Table:
                 label += f"  (+{len(comps) - len(shown)} more components in --json / the file)"
             table.add_row(Text(label, style="bold"), *[""] * 7)
             for j, (v, st) in enumerate(per):
-                name = "\n".join(f"{short.get(k, k)}={_plain(x)}"
-                                 for k, x in v["overrides"].items()) or "base"
+                name = (
+                    "\n".join(f"{short.get(k, k)}={_plain(x)}" for k, x in v["overrides"].items())
+                    or "base"
+                )
                 if v["failed"]:
                     name += f"\n[{v['failed']} failed]"
                 cells = []
@@ -241,10 +326,13 @@ def batch_table(s: dict) -> Table:
                     if isinstance(x, list):
                         x = x[ci] if ci < len(x) else None
                     cells.append("—" if x is None else f"{x:.3g}")
-                table.add_row(Text(name), str(0 if st is None else st["n"]), *cells,
-                              end_section=j == len(per) - 1)
-    done = (f"{s['runs']} runs" if s["complete"]
-            else f"{s['finished']} of {s['runs']} runs finished")
+                table.add_row(
+                    Text(name),
+                    str(0 if st is None else st["n"]),
+                    *cells,
+                    end_section=j == len(per) - 1,
+                )
+    done = f"{s['runs']} runs" if s["complete"] else f"{s['finished']} of {s['runs']} runs finished"
     notes = [f"{done}: {s['ok']} ok, {s['failed']} failed"]
     for f in s.get("failures", [])[:3]:
         notes.append(f"failed: variant {f['variant']} seed {f['seed']}: {f['error']}")

@@ -19,12 +19,14 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import yaml
 
 from gcalign import __version__
 from gcalign.errors import ScenarioError
 from gcalign.imu import ImuData
 from gcalign.trajectory import Truth
 
+PHI_FRAME = "misalignment, ENU: C_nb,est C_nb,true^T = exp(-[phi x])"
 ATT_FRAME = "[pitch, roll, yaw], C_nb = Rz(yaw) Rx(pitch) Ry(roll), ENU, yaw CCW positive"
 
 
@@ -127,12 +129,16 @@ def read_imu(path: Path) -> ImuData:
             raise ScenarioError(f"{path}: holds no /imu group (write one with 'gcalign simulate')")
         g = f["imu"]
         extra: dict = {k: np.asarray(g.attrs[k]) for k in ("site", "att0", "v0_n") if k in g.attrs}
+        scenario = yaml.safe_load(str(f.attrs.get("scenario_yaml", ""))) or {}
+        motion = scenario.get("motion") if isinstance(scenario, dict) else None
+        kind = motion.get("kind") if isinstance(motion, dict) else None
         return ImuData(
             t=g["t"][()],
             dtheta=g["dtheta"][()],
             dv=g["dv"][()],
             ts=float(g.attrs["ts"]),
             source=str(path),
+            meta={"motion_kind": kind} if kind else {},
             **extra,
         )
 
@@ -168,14 +174,16 @@ def write_alignment(f: h5py.File, run) -> None:
     g.attrs["mode"] = run.cfg.mode
     g.attrs["azimuth_poles"] = run.azimuth_poles
     g.attrs["t1_s"], g.attrs["t2_s"], g.attrs["t3_s"] = run.t1, run.t2, run.t3
-    for rec, err in zip(run.passes, run.pass_errors, strict=True):
+    for rec, err, phi in zip(run.passes, run.pass_errors, run.pass_phi, strict=True):
         p = g.create_group(f"pass_{rec.index:02d}")
         p.attrs["direction"], p.attrs["kind"], p.attrs["stage"] = rec.direction, rec.kind, rec.stage
-        put(p, "t", rec.t, "s", description="processing order (decreasing in a reverse pass)")
+        put(p, "t", rec.t, "s",
+            description="data time, processing order (decreasing in a reverse pass)")
         put(p, "att", quat_to_euler(rec.q_nb), "rad", ATT_FRAME)
         put(p, "gains", rec.gains, "SI", names=GAIN_NAMES)
         if err is not None:
             put(p, "error", err, "rad", "Euler differences est - true, yaw wrapped")
+            put(p, "phi", phi, "rad", PHI_FRAME)
     r = g.create_group("result")
     put(r, "coarse_att", run.coarse_att, "rad", ATT_FRAME)
     put(r, "att_t2", run.att_t2, "rad", ATT_FRAME)
@@ -185,6 +193,8 @@ def write_alignment(f: h5py.File, run) -> None:
         put(r, "truth_t3", run.truth_t3, "rad", ATT_FRAME)
         put(r, "error_t2", run.error_t2, "rad", "Euler differences est - true, yaw wrapped")
         put(r, "error_t3", run.error_t3, "rad", "Euler differences est - true, yaw wrapped")
+        put(r, "phi_t2", run.phi_t2, "rad", PHI_FRAME)
+        put(r, "phi_t3", run.phi_t3, "rad", PHI_FRAME)
     r.attrs["compute_s"] = run.compute_s
     r.attrs["equivalent_s"] = run.equivalent_s
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from typer.testing import CliRunner
@@ -121,3 +122,62 @@ def test_scenario_file_errors(tmp_path):
     assert res.exit_code == 2 and "YAML syntax error at line" in res.output
     res = runner.invoke(app, ["align", str(tmp_path / "missing.yaml")])
     assert res.exit_code == 2 and "file not found" in res.output
+
+
+@pytest.mark.parametrize(
+    "align, args, field",
+    [
+        ({}, ["--t3", "nan"], "align.t3_s"),
+        ({"t3_s": float("nan")}, [], "align.t3_s"),
+        (
+            {"coarse": {"method": "given", "error_deg": [float("inf"), 0, 0]}},
+            [],
+            "align.coarse.error_deg.0",
+        ),
+        ({"coarse": {"method": "inertial", "duration_s": 0.01}}, [], "align.coarse.duration_s"),
+    ],
+)
+def test_non_finite_and_too_short_inputs_exit_2_on_one_line(tmp_path, align, args, field):
+    res = runner.invoke(app, ["align", str(_small(tmp_path, **align)), *args])
+    assert res.exit_code == 2, res.output
+    assert field in res.output and res.output.count("\n") == 1, res.output
+
+
+def test_unwritable_output_is_a_clear_error(tmp_path):
+    res = runner.invoke(app, ["align", str(_small(tmp_path)), "-o", str(tmp_path)])
+    assert res.exit_code == 2 and "--output: cannot write" in res.output
+
+
+def test_moving_base_without_aiding_warns(tmp_path):
+    res = runner.invoke(
+        app,
+        [
+            "align",
+            str(_small(tmp_path, aiding={"source": "none"})),
+            "-o",
+            str(tmp_path / "w.h5"),
+            "--json",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["warnings"] and "warning: a moving base" in res.stderr
+
+
+def test_misalignment_reported_and_pole_default_survives_a_data_file(tmp_path):
+    sim = tmp_path / "sim.h5"
+    assert runner.invoke(app, ["simulate", str(_small(tmp_path)), "-o", str(sim)]).exit_code == 0
+    d = yaml.safe_load((tmp_path / "small.yaml").read_text())
+    d.pop("motion")
+    d.pop("site")
+    d["align"].pop("azimuth_poles")
+    d["align"]["aiding"] = {"source": "none"}
+    d["imu_file"] = str(sim)
+    p = tmp_path / "from_file.yaml"
+    p.write_text(yaml.safe_dump(d))
+    res = runner.invoke(app, ["align", str(p), "-o", str(tmp_path / "f.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["azimuth_poles"] == "double-oscillator"  # the stored motion is a moving base
+    phi, err = np.array(s["misalignment_t3_deg"]), np.array(s["error_t3_deg"])
+    # Level base, small angles: yaw error = -φ_U.
+    assert phi[2] == pytest.approx(-err[2], abs=1e-3)

@@ -140,3 +140,21 @@ def test_recorded_psins_file_navigates(tmp_path):
     res = runner.invoke(app, ["simulate", str(p), "-o", str(tmp_path / "r.h5"), "--json"])
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout)["samples"] == 184718
+
+
+def test_navigate_a_bare_psins_file(tmp_path):
+    data = (ROOT / "../shared/data/lasergyro.imu").resolve()
+    if not data.is_file():
+        pytest.skip("shared/data is not beside the repository")
+    res = runner.invoke(app, ["navigate", str(data), "-o", str(tmp_path / "n.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["final_error"] is None and s["samples"] == 184718
+    assert "recorded data" in res.stderr
+
+
+def test_pole_latitude_rejected(tmp_path):
+    d = json.loads(json.dumps(SCENARIO))
+    d["site"]["lat_deg"] = -90
+    res = runner.invoke(app, ["navigate", str(write(tmp_path, d))])
+    assert res.exit_code == 2 and "site.lat_deg" in res.output and "poles" in res.output

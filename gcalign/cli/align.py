@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+import sys
 from pathlib import Path
 
 import typer
@@ -10,6 +12,7 @@ from gcalign import report, results
 from gcalign.cli import app, default_output, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, save_and_show
 from gcalign.cli.data import JSON_HELP, OUT_HELP
+from gcalign.errors import ScenarioError
 from gcalign.pipelines.align import alignment_summary, run_alignment
 from gcalign.pipelines.data import scenario_data
 
@@ -22,12 +25,17 @@ def builtin_scenario_text() -> str:
 
 
 def _t3(value: str | None):
+    """--t3: seconds or 'measured' (validated here: a union would give two messages)."""
     if value is None or value == "measured":
         return value
     try:
-        return float(value)
+        seconds = float(value)
     except ValueError:
-        return value  # pydantic names the field and what is allowed
+        seconds = math.nan
+    if not math.isfinite(seconds):
+        msg = f"align.t3_s: --t3 takes seconds or 'measured', got {value!r}"
+        raise ScenarioError(msg)
+    return seconds
 
 
 @app.command()
@@ -59,6 +67,8 @@ def align(
     data = scenario_data(sc, seed)
     run = run_alignment(sc, data)
     summary = alignment_summary(run, data, sc.name)
+    for line in summary["warnings"]:
+        sys.stderr.write(f"warning: {line}\n")
     out = output or default_output(sc.name, "align", data.seed)
     save_and_show(
         out,

@@ -12,6 +12,7 @@ from gcalign import results
 from gcalign.cli import consoles, emit_json
 from gcalign.config import Scenario, parse_scenario
 from gcalign.config.loader import read_yaml
+from gcalign.errors import ScenarioError
 
 
 def builtin_text(name: str) -> str:
@@ -69,11 +70,14 @@ def save_and_show(
     """Write the results file atomically (header, truth, then `write(f)`), print the table
     built by `table(summary)`, and the JSON summary under --json."""
     summary["output"] = str(out)
-    with results.atomic_h5(out) as f:
-        results.write_header(f, kind, text, seed, summary)
-        if truth is not None:
-            results.write_truth(f, truth)
-        write(f)
+    try:
+        with results.atomic_h5(out) as f:
+            results.write_header(f, kind, text, seed, summary)
+            if truth is not None:
+                results.write_truth(f, truth)
+            write(f)
+    except OSError as err:
+        raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
     consoles(as_json).print(table(summary))
     if as_json:
         emit_json(summary)

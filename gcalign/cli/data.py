@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from gcalign.errors import ScenarioError
 from gcalign.pipelines.data import HDF5_SUFFIXES, RunData, read_data_file, scenario_data
 from gcalign.pipelines.navigate import navigation_summary, run_navigation
 
+DATA_SUFFIXES = {".imu", ".csv", ".txt"}
 JSON_HELP = "Print one JSON object on stdout (tables go to stderr)."
 OUT_HELP = "Results file (default runs/NAME-COMMAND[-seedN].h5)."
 
@@ -78,13 +80,25 @@ def simulate(
 @app.command()
 @user_errors
 def navigate(
-    source: Path = typer.Argument(..., help="Scenario YAML, or a results file with /imu."),
+    source: Path = typer.Argument(
+        ..., help="Scenario YAML, a results file with /imu, or a PSINS .imu / CSV data file."
+    ),
     output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
     seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
     as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ):
-    """Free inertial navigation from the true initial state; errors against truth."""
-    if source.suffix.lower() in HDF5_SUFFIXES:
+    """Free inertial navigation from the true initial state; errors against truth.
+
+    Recorded data have no truth: the run starts from the file header's state and the
+    table shows the final state instead of errors (`final_error` is null in the JSON).
+    """
+    if source.suffix.lower() in DATA_SUFFIXES:
+        # A bare data file stands for the scenario `imu_file: SOURCE`.
+        name = re.sub(r"[^A-Za-z0-9_.+-]", "_", source.stem) or "data"
+        text = yaml.safe_dump({"name": name, "imu_file": str(source.resolve())})
+        sc = parse_scenario(yaml.safe_load(text), str(source))
+        data = scenario_data(sc, seed)
+    elif source.suffix.lower() in HDF5_SUFFIXES:
         text = results.read_scenario_yaml(source)
         sc = parse_scenario(yaml.safe_load(text) or {}, str(source))
         imu, truth = read_data_file(source)

@@ -46,7 +46,7 @@ class AlignConfig(Model):
     coarse: Coarse = Field(default_factory=Coarse)
     mode: Literal["conventional", "full-cycle", "half-cycle"] = "full-cycle"
     start_s: float = Field(
-        0.0, ge=0, description="data time taken as t = 0 (windows of recorded data)"
+        0.0, ge=0, description="offset from the first sample taken as t = 0 (data windows)"
     )
     t1_s: float = Field(10.0, ge=0)
     t2_s: float = Field(300.0, gt=0)
@@ -121,15 +121,32 @@ class AlignConfig(Model):
 
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
         kind = sc.motion.kind if sc.motion is not None else None
+        realtime = self.mode == "conventional" and self.realtime
         rows = [
             ("align.mode", self.mode, f"{self.pass_count} pass(es)"),
+            (
+                "align.realtime",
+                str(self.realtime),
+                "loop runs to T3 on live data"
+                if realtime
+                else (
+                    "stops at T2, then compensation"
+                    if self.mode == "conventional"
+                    else "(unused by the cycle modes)"
+                ),
+            ),
+            ("align.start_s", f"{self.start_s} s", "offset of t = 0 from the first sample"),
             (
                 "align.coarse",
                 f"{self.coarse.method}, error {self.coarse.error_deg} °",
                 str(np.radians(self.coarse.error_deg).round(6).tolist()) + " rad",
             ),
             ("align.t1_s / t2_s / t3_s", f"{self.t1_s} / {self.t2_s} / {self.t3_s} s", ""),
-            ("align.compensation", self.compensation, ""),
+            (
+                "align.compensation",
+                self.compensation,
+                "(unused: real-time conventional)" if realtime else "",
+            ),
             ("align.azimuth_poles", self.poles_for(kind), ""),
             ("align.aiding", f"{self.aiding.source}, {self.aiding.noise_mps} m/s", ""),
             ("align.level_s", f"{self.level_phase_s} s", ""),

@@ -12,6 +12,6 @@ PosVec3 = Annotated[list[Annotated[float, Field(gt=0)]], Field(min_length=3, max
 
 
 class Model(BaseModel):
-    """Strict base: unknown keys are errors, values are validated on assignment too."""
+    """Strict base: unknown keys and NaN/inf are errors; assignments are validated too."""
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, allow_inf_nan=False)

@@ -16,28 +16,37 @@ from gcalign.errors import ScenarioError
 _FIELD_PREFIX = re.compile(r"^([a-z_0-9]+(?:\.[a-z_0-9]+)*): ")
 
 
+# Location parts that name a member of a union type, not a key the user wrote.
+_UNION_TAG = re.compile(r"^(float|int|str|bool|constrained-\w+|\w+\[.*\])$")
+
+
 def scenario_errors(err: ValidationError, source: str = "") -> str:
-    """One line per invalid field: ``source: field: what is wrong, got VALUE``."""
-    lines = []
+    """One line per invalid field: ``source: field: what is wrong, got VALUE``.
+
+    Pydantic reports every failed member of a union (``float | 'measured'``) separately;
+    those become one line whose alternatives are joined by "or".
+    """
+    by_field: dict[str, list[str]] = {}
+    got_of: dict[str, str] = {}
     for e in err.errors():
-        # Pydantic reports each failed member of a union; the tag-like loc parts
-        # ('float', 'list[...]') only confuse, so keep the user's path.
-        loc = [str(x) for x in e["loc"]]
+        loc = [str(x) for x in e["loc"] if not _UNION_TAG.match(str(x))]
         msg = e["msg"].removeprefix("Value error, ")
-        got = e.get("input")
         m = _FIELD_PREFIX.match(msg)
         if m:
             loc.append(m.group(1))
             msg = msg[m.end() :]
         where = ".".join(loc) or "scenario"
-        text = f"{where}: {msg}"
-        if e["type"] not in {"missing", "model_type", "value_error"}:
-            text += f", got {got!r}"
         if e["type"] == "extra_forbidden":
-            text = f"{where}: unknown key (check the spelling; see README 'Scenario format')"
-        lines.append(f"{source}: {text}" if source else text)
-    # Union members repeat the same complaint; keep the first of each.
-    return "\n".join(dict.fromkeys(lines))
+            msg = "unknown key (check the spelling; see README 'Scenario format')"
+        elif e["type"] not in {"missing", "model_type", "value_error"}:
+            got_of[where] = f", got {e.get('input')!r}"
+        by_field.setdefault(where, [])
+        if msg not in by_field[where]:
+            by_field[where].append(msg)
+    lines = [
+        f"{where}: {' or '.join(msgs)}{got_of.get(where, '')}" for where, msgs in by_field.items()
+    ]
+    return "\n".join(f"{source}: {line}" if source else line for line in lines)
 
 
 def parse_scenario(data: dict, source: str = "scenario") -> Scenario:

@@ -48,9 +48,17 @@ def _check_misalignment(m):
 
 
 class Site(Model):
-    lat_deg: float = Field(ge=-90, le=90, description="geodetic latitude, deg")
+    lat_deg: float = Field(description="geodetic latitude, deg, within (-90, 90)")
     lon_deg: float = Field(ge=-180, le=360, description="longitude, deg")
     height_m: float = Field(0.0, ge=-1000, le=1e5, description="height above the ellipsoid, m")
+
+    @field_validator("lat_deg")
+    @classmethod
+    def _not_a_pole(cls, v):
+        if not -90 < v < 90:
+            raise ValueError(f"must be within (-90, 90) deg (the ENU frame is undefined at "
+                             f"the poles), got {v}")
+        return v
 
     def to_si(self) -> np.ndarray:
         """``[lat (rad), lon (rad), h (m)]``."""

@@ -20,7 +20,14 @@ from gcalign.config import Scenario
 from gcalign.config.align import AlignConfig
 from gcalign.errors import ScenarioError
 from gcalign.pipelines.data import RunData
-from gcalign.rotation import attitude_error, euler_to_quat, quat_to_dcm, quat_to_euler
+from gcalign.rotation import (
+    attitude_error,
+    euler_to_dcm,
+    euler_to_quat,
+    misalignment,
+    quat_to_dcm,
+    quat_to_euler,
+)
 
 
 @dataclass(frozen=True)
@@ -34,7 +41,8 @@ class AlignRun:
     t3: float
     coarse_att: np.ndarray
     passes: list[PassRecord]
-    pass_errors: list[np.ndarray | None]  # (n+1, 3) rad per pass
+    pass_errors: list[np.ndarray | None]  # (n+1, 3) rad per pass, Euler differences
+    pass_phi: list[np.ndarray | None]  # (n+1, 3) rad per pass, misalignment φ (ENU)
     att_t2: np.ndarray
     att_t3: np.ndarray
     truth_t2: np.ndarray | None
@@ -42,6 +50,8 @@ class AlignRun:
     compute_s: float
     equivalent_s: float
     index_offset: int  # data sample index of alignment time 0
+    t3_source: str  # "configured" or "measured"
+    warnings: tuple[str, ...] = ()
 
     @property
     def error_t2(self):
@@ -50,6 +60,19 @@ class AlignRun:
     @property
     def error_t3(self):
         return None if self.truth_t3 is None else attitude_error(self.att_t3, self.truth_t3)
+
+    @property
+    def phi_t2(self):
+        """Misalignment φ at T2 (rad, ENU): C_nb,est C_nb,true^T = exp(−[φ×])."""
+        return None if self.truth_t2 is None else _phi(self.att_t2, self.truth_t2)
+
+    @property
+    def phi_t3(self):
+        return None if self.truth_t3 is None else _phi(self.att_t3, self.truth_t3)
+
+
+def _phi(att_est, att_true):
+    return misalignment(euler_to_dcm(att_est), euler_to_dcm(att_true))
 
 
 def _index(data: RunData, cfg: AlignConfig, t: float, field: str) -> int:
@@ -102,9 +125,15 @@ def coarse_attitude(data: RunData, cfg: AlignConfig, i0: int, i1: int):
         return data.truth.att[i1] + np.radians(c.error_deg) + offset
     lo = i1 - int(round(c.duration_s / data.imu.ts)) if c.duration_s else i0
     dth, dv, ts, site = data.imu.dtheta[lo:i1], data.imu.dv[lo:i1], data.imu.ts, data.site
-    if c.method == "analytic":
-        return coarse_mod.analytic_coarse(dth, dv, ts, site[0]) + offset
-    return coarse_mod.inertial_frame_coarse(dth, dv, ts, site[0], site[1], site[2]) + offset
+    try:
+        if c.method == "analytic":
+            return coarse_mod.analytic_coarse(dth, dv, ts, site[0]) + offset
+        return coarse_mod.inertial_frame_coarse(dth, dv, ts, site[0], site[1], site[2]) + offset
+    except ValueError as err:  # too short a window
+        raise ScenarioError(
+            f"align.coarse.duration_s: the coarse window [{(lo - i0) * ts:g}, "
+            f"{(i1 - i0) * ts:g}] s does not fit method {c.method!r}: {err}"
+        ) from None
 
 
 def _block(data: RunData, vref, body: bool, lo: int, hi: int) -> Block:
@@ -146,7 +175,15 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
             f"site.lat_deg: gyrocompassing needs |latitude| < 85°, got "
             f"{math.degrees(data.site[0]):.4f}° (the horizontal earth rate vanishes)"
         )
-    poles = cfg.poles_for(sc.motion.kind if sc.motion else None)
+    # The motion kind picks the default pole set; data simulated earlier carry it along.
+    kind = sc.motion.kind if sc.motion else data.imu.meta.get("motion_kind")
+    poles = cfg.poles_for(kind)
+    warnings = []
+    if kind == "moving" and cfg.aiding.source == "none":
+        warnings.append(
+            "a moving base with align.aiding.source 'none': the loops take the "
+            "vehicle's accelerations for tilt; expect degrees of error"
+        )
     ts = data.imu.ts
     i0 = _index(data, cfg, 0.0, "start_s")
     i1 = _index(data, cfg, cfg.t1_s, "t1_s")
@@ -192,21 +229,25 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
 
     truth = data.truth
     pass_errors: list[np.ndarray | None] = []
+    pass_phi: list[np.ndarray | None] = []
     for rec in records:
         if truth is None:
             pass_errors.append(None)
+            pass_phi.append(None)
             continue
         idx = np.rint((rec.t - (data.imu.t[0] - ts)) / ts).astype(int)
         pass_errors.append(attitude_error(quat_to_euler(rec.q_nb), truth.att[idx]))
+        pass_phi.append(misalignment(quat_to_dcm(rec.q_nb), euler_to_dcm(truth.att[idx])))
     return AlignRun(
         cfg=cfg,
         azimuth_poles=poles,
-        t1=cfg.t1_s,
-        t2=cfg.t2_s,
+        t1=(i1 - i0) * ts,  # the sample times actually used
+        t2=(i2 - i0) * ts,
         t3=(i3 - i0) * ts,
         coarse_att=att1,
         passes=records,
         pass_errors=pass_errors,
+        pass_phi=pass_phi,
         att_t2=quat_to_euler(q2),
         att_t3=quat_to_euler(q3),
         truth_t2=None if truth is None else truth.att[i2],
@@ -214,6 +255,8 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
         compute_s=compute,
         equivalent_s=equivalent,
         index_offset=i0,
+        t3_source="measured" if cfg.t3_s == "measured" else "configured",
+        warnings=tuple(warnings),
     )
 
 
@@ -225,6 +268,11 @@ def alignment_summary(run: AlignRun, data: RunData, name: str) -> dict:
     """Plain-number summary (degrees, seconds): the JSON contract of `gcalign align --json`."""
     cfg = run.cfg
     realtime = cfg.mode == "conventional" and cfg.realtime
+    start = data.imu.t[0] - data.imu.ts  # data time of sample 0
+
+    def aligned_time(t_data: float) -> float:
+        return (round((t_data - start) / data.imu.ts) - run.index_offset) * data.imu.ts
+
     return {
         "scenario": name,
         "seed": data.seed,
@@ -236,6 +284,7 @@ def alignment_summary(run: AlignRun, data: RunData, name: str) -> dict:
         "t1_s": run.t1,
         "t2_s": run.t2,
         "t3_s": run.t3,
+        "t3_source": run.t3_source,
         "coarse_attitude_deg": _deg(run.coarse_att),
         "attitude_t2_deg": _deg(run.att_t2),
         "truth_t2_deg": _deg(run.truth_t2),
@@ -243,13 +292,15 @@ def alignment_summary(run: AlignRun, data: RunData, name: str) -> dict:
         "attitude_t3_deg": _deg(run.att_t3),
         "truth_t3_deg": _deg(run.truth_t3),
         "error_t3_deg": _deg(run.error_t3),
+        "misalignment_t2_deg": _deg(run.phi_t2),
+        "misalignment_t3_deg": _deg(run.phi_t3),
         "passes": [
             {
                 "index": r.index,
                 "direction": r.direction,
                 "kind": r.kind,
                 "stage": r.stage,
-                "t_end_s": float(r.t[-1]) - run.index_offset * data.imu.ts,
+                "t_end_s": aligned_time(float(r.t[-1])),
                 "error_deg": None if e is None else np.degrees(e[-1]).tolist(),
                 "attitude_deg": np.degrees(quat_to_euler(r.q_nb[-1])).tolist(),
             }
@@ -258,4 +309,5 @@ def alignment_summary(run: AlignRun, data: RunData, name: str) -> dict:
         "equivalent_s": run.equivalent_s,
         "data_used_s": run.t3 if realtime else run.t2,
         "compute_s": run.compute_s,
+        "warnings": list(run.warnings),
     }
