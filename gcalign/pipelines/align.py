@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -41,8 +42,7 @@ class AlignRun:
     t3: float
     coarse_att: np.ndarray
     passes: list[PassRecord]
-    pass_errors: list[np.ndarray | None]  # (n+1, 3) rad per pass, Euler differences
-    pass_phi: list[np.ndarray | None]  # (n+1, 3) rad per pass, misalignment φ (ENU)
+    pass_truth: list[np.ndarray] | None  # true attitude along each pass (rad), if known
     att_t2: np.ndarray
     att_t3: np.ndarray
     truth_t2: np.ndarray | None
@@ -60,6 +60,33 @@ class AlignRun:
     @property
     def error_t3(self):
         return None if self.truth_t3 is None else attitude_error(self.att_t3, self.truth_t3)
+
+    @cached_property
+    def pass_errors(self) -> list[np.ndarray | None]:
+        """Euler-angle error (n+1, 3) rad along each pass; computed when first asked for
+        (a batch needs only the end of each pass)."""
+        if self.pass_truth is None:
+            return [None] * len(self.passes)
+        return [
+            attitude_error(quat_to_euler(r.q_nb), tr)
+            for r, tr in zip(self.passes, self.pass_truth, strict=True)
+        ]
+
+    @cached_property
+    def pass_phi(self) -> list[np.ndarray | None]:
+        """Misalignment φ (n+1, 3) rad, ENU, along each pass."""
+        if self.pass_truth is None:
+            return [None] * len(self.passes)
+        return [
+            misalignment(quat_to_dcm(r.q_nb), euler_to_dcm(tr))
+            for r, tr in zip(self.passes, self.pass_truth, strict=True)
+        ]
+
+    def pass_end_error(self, i: int) -> np.ndarray | None:
+        """Euler-angle error at the end of pass i (rad)."""
+        if self.pass_truth is None:
+            return None
+        return attitude_error(quat_to_euler(self.passes[i].q_nb[-1]), self.pass_truth[i][-1])
 
     @property
     def phi_t2(self):
@@ -107,7 +134,7 @@ def reference_velocity(data: RunData, cfg: AlignConfig, rng: np.random.Generator
     v_n = data.truth.v_n
     if source == "nav":
         return v_n + noise * rng.standard_normal(v_n.shape), False
-    v_b = np.einsum("kji,kj->ki", quat_to_dcm(euler_to_quat(data.truth.att)), v_n)
+    v_b = np.einsum("kji,kj->ki", euler_to_dcm(data.truth.att), v_n)
     speed = v_b[:, 1] + noise * rng.standard_normal(n)
     return np.stack([np.zeros(n), speed, np.zeros(n)], -1), True
 
@@ -228,16 +255,12 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
         equivalent = (i1 - i0) * ts + cfg.pass_count * (i2 - i1) * ts
 
     truth = data.truth
-    pass_errors: list[np.ndarray | None] = []
-    pass_phi: list[np.ndarray | None] = []
-    for rec in records:
-        if truth is None:
-            pass_errors.append(None)
-            pass_phi.append(None)
-            continue
-        idx = np.rint((rec.t - (data.imu.t[0] - ts)) / ts).astype(int)
-        pass_errors.append(attitude_error(quat_to_euler(rec.q_nb), truth.att[idx]))
-        pass_phi.append(misalignment(quat_to_dcm(rec.q_nb), euler_to_dcm(truth.att[idx])))
+    start = data.imu.t[0] - ts  # data time of sample 0
+    pass_truth = (
+        None
+        if truth is None
+        else [truth.att[np.rint((rec.t - start) / ts).astype(int)] for rec in records]
+    )
     return AlignRun(
         cfg=cfg,
         azimuth_poles=poles,
@@ -246,8 +269,7 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
         t3=(i3 - i0) * ts,
         coarse_att=att1,
         passes=records,
-        pass_errors=pass_errors,
-        pass_phi=pass_phi,
+        pass_truth=pass_truth,
         att_t2=quat_to_euler(q2),
         att_t3=quat_to_euler(q3),
         truth_t2=None if truth is None else truth.att[i2],
@@ -301,10 +323,10 @@ def alignment_summary(run: AlignRun, data: RunData, name: str) -> dict:
                 "kind": r.kind,
                 "stage": r.stage,
                 "t_end_s": aligned_time(float(r.t[-1])),
-                "error_deg": None if e is None else np.degrees(e[-1]).tolist(),
+                "error_deg": _deg(run.pass_end_error(r.index)),
                 "attitude_deg": np.degrees(quat_to_euler(r.q_nb[-1])).tolist(),
             }
-            for r, e in zip(run.passes, run.pass_errors, strict=True)
+            for r in run.passes
         ],
         "equivalent_s": run.equivalent_s,
         "data_used_s": run.t3 if realtime else run.t2,
