@@ -15,8 +15,7 @@ from gcalign.cli import app, consoles, default_output, emit_json, user_errors
 from gcalign.cli.common import save_and_show
 from gcalign.config import load_scenario, parse_scenario
 from gcalign.config.resolve import resolved_rows
-from gcalign.errors import ScenarioError
-from gcalign.pipelines.data import HDF5_SUFFIXES, RunData, read_data_file, scenario_data
+from gcalign.pipelines.data import HDF5_SUFFIXES, RunData, scenario_data
 from gcalign.pipelines.navigate import navigation_summary, run_navigation
 
 DATA_SUFFIXES = {".imu", ".csv", ".txt"}
@@ -92,23 +91,20 @@ def navigate(
     Recorded data have no truth: the run starts from the file header's state and the
     table shows the final state instead of errors (`final_error` is null in the JSON).
     """
-    if source.suffix.lower() in DATA_SUFFIXES:
-        # A bare data file stands for the scenario `imu_file: SOURCE`.
-        name = re.sub(r"[^A-Za-z0-9_.+-]", "_", source.stem) or "data"
-        text = yaml.safe_dump({"name": name, "imu_file": str(source.resolve())})
-        sc = parse_scenario(yaml.safe_load(text), str(source))
-        data = scenario_data(sc, seed)
-    elif source.suffix.lower() in HDF5_SUFFIXES:
-        text = results.read_scenario_yaml(source)
-        sc = parse_scenario(yaml.safe_load(text) or {}, str(source))
-        imu, truth = read_data_file(source)
-        site = truth.pos[0] if truth is not None else imu.site
-        if site is None:
-            raise ScenarioError(f"{source}: holds neither truth nor the site of its IMU data")
-        data = RunData(imu=imu, truth=truth, site=site, seed=None)
+    suffix = source.suffix.lower()
+    if suffix in DATA_SUFFIXES | HDF5_SUFFIXES:
+        # A bare data file stands for the scenario `imu_file: SOURCE`; our own results
+        # file keeps the name and text of the scenario that made it.
+        text = results.read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
+        stored = yaml.safe_load(text) if text else None
+        name = stored.get("name") if isinstance(stored, dict) else None
+        name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.stem) or "data"
+        scenario = {"name": name, "imu_file": str(source.resolve())}
+        text = text or yaml.safe_dump(scenario)
+        sc = parse_scenario(scenario, str(source))
     else:
         sc, text = load_scenario(source)
-        data = scenario_data(sc, seed)
+    data = scenario_data(sc, seed)
     run = run_navigation(data)
     summary = navigation_summary(run, data, sc.name)
     out = output or default_output(sc.name, "navigate", data.seed)

@@ -10,7 +10,7 @@ import numpy as np
 from gcalign import earth
 from gcalign.errors import ScenarioError
 from gcalign.pipelines.data import RunData
-from gcalign.rotation import attitude_error, euler_to_quat
+from gcalign.rotation import attitude_error
 from gcalign.strapdown import NavSolution, NavState, navigate
 
 
@@ -47,13 +47,13 @@ def initial_state(data: RunData) -> NavState:
     """The true initial state, or the one in the IMU file's header for recorded data."""
     if data.truth is not None:
         tr = data.truth
-        return NavState(euler_to_quat(tr.att[0]), tr.v_n[0], tr.pos[0])
+        return NavState.from_euler(tr.att[0], tr.v_n[0], tr.pos[0])
     if data.imu.att0 is None:
         raise ScenarioError(
             f"imu_file: {data.imu.source} gives no initial attitude and there is no truth"
         )
     v0 = data.imu.v0_n if data.imu.v0_n is not None else np.zeros(3)
-    return NavState(euler_to_quat(data.imu.att0), v0, data.site)
+    return NavState.from_euler(data.imu.att0, v0, data.site)
 
 
 def run_navigation(data: RunData) -> NavRun:
