@@ -17,10 +17,10 @@ import numpy as np
 
 from gcalign.align import kernel as K
 from gcalign.align.cycles import Stage, loop_gains
+from gcalign.app.align.run import run_alignment
+from gcalign.app.data import scenario_data
 from gcalign.cli.align import BUILTIN
 from gcalign.cli.common import load_with_overrides
-from gcalign.pipelines.align import run_alignment
-from gcalign.pipelines.data import scenario_data
 
 
 def best(fn, repeat=5):

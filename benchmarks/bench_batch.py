@@ -57,7 +57,7 @@ def run(sweep: Path, workers: int, out: Path) -> tuple[float, dict]:
 
 def worker_cache_stats() -> list[dict]:
     """Numba cache hits/misses in fresh pool workers after their warm-up."""
-    from gcalign.batch import LocalBackend, kernel_cache_stats
+    from gcalign.app.batch import LocalBackend, kernel_cache_stats
 
     backend = LocalBackend(2, "align")
     try:
@@ -74,7 +74,7 @@ def main() -> None:
         tmp = Path(tmp)
         sweep = sweep_file(tmp, args.seeds)
         # Populate the on-disk JIT cache first (a no-op when it is already there).
-        subprocess.run([sys.executable, "-c", "from gcalign.batch import warm_up; warm_up()"],
+        subprocess.run([sys.executable, "-c", "from gcalign.app.batch import warm_up; warm_up()"],
                        check=True)
         t1, s1 = run(sweep, 1, tmp / "w1.h5")
         t2, s2 = run(sweep, 2, tmp / "w2.h5")

@@ -37,11 +37,11 @@ from pathlib import Path
 
 import numpy as np
 
-from gcalign.imu import ImuErrors, SensorErrors, apply_errors, ideal_imu
-from gcalign.kernels import empty_states, strapdown_block
-from gcalign.rotation import euler_to_quat, quat_to_dcm
-from gcalign.strapdown import NavState, navigate
-from gcalign.trajectory import Motion, Segment
+from gcalign.nav._kernels import empty_states, strapdown_block
+from gcalign.nav.rotation import euler_to_quat, quat_to_dcm
+from gcalign.nav.strapdown import NavState, navigate
+from gcalign.sim.imu import ImuErrors, SensorErrors, apply_errors, ideal_imu
+from gcalign.sim.motions import Motion, Segment
 from gcalign.units import DEG, DPH, DPSH, UG, UGPSHZ
 
 ROOT = Path(__file__).resolve().parents[1]

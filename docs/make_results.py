@@ -59,9 +59,9 @@ SEED000 = [
 
 def align_errors(job):
     """Error at T3 (deg) of one config and seed."""
-    from gcalign.config import load_scenario
-    from gcalign.pipelines.align import run_alignment
-    from gcalign.pipelines.data import scenario_data
+    from gcalign.app.align.run import run_alignment
+    from gcalign.app.data import scenario_data
+    from gcalign.io.scenario import load_scenario
 
     name, seed = job
     sc, _ = load_scenario(ROOT / "configs" / name)
@@ -70,7 +70,7 @@ def align_errors(job):
 
 
 def imu_line(name: str) -> str:
-    from gcalign.config import load_scenario
+    from gcalign.io.scenario import load_scenario
 
     sc, _ = load_scenario(ROOT / "configs" / name)
     g, a = sc.imu.gyro, sc.imu.accel
@@ -124,9 +124,9 @@ def seed000_section(seeds: int, workers: int) -> list[str]:
 
 def real_data_section() -> list[str]:
     """Alignment on lasergyro.imu: windows and initial yaw offsets against yaw −90.6°."""
-    from gcalign.config import load_scenario
-    from gcalign.pipelines.align import run_alignment
-    from gcalign.pipelines.data import scenario_data
+    from gcalign.app.align.run import run_alignment
+    from gcalign.app.data import scenario_data
+    from gcalign.io.scenario import load_scenario
 
     cfg = ROOT / "configs/lasergyro_align.yaml"
     out = [

@@ -27,10 +27,10 @@ pyins conventions (read from the installed source, ``pyins/__init__.py``,
   ``v_k = v + C_nb(k-1) Δv - ((χ + Ω) × v - g_n + ½ χ × (C_nb Δv)) dt``, gravity magnitude
   evaluated at ``(lat_{k-1}, alt_{k-1} - ½ VD dt)``; position by the trapezoid rule;
   ``C_nb(k) = exp(-[χ' dt ×]) C_nb(k-1) exp([θ ×])`` with χ' from the mid-step velocity.
-* Earth: WGS-84 a, e² (same as ``gcalign.earth``), rate 7.292115e-5 rad/s (ours
+* Earth: WGS-84 a, e² (same as ``gcalign.nav.earth``), rate 7.292115e-5 rad/s (ours
   7.2921151467e-5, 1.5e-12 rad/s apart); gravity the closed Somigliana formula with a
   linear height term, ``g = GE (1 + k sin²L) / sqrt(1 - e² sin²L) (1 - 2h/a)``,
-  GE = 9.7803253359. ``gcalign.earth.gravity`` is the PSINS series
+  GE = 9.7803253359. ``gcalign.nav.earth.gravity`` is the PSINS series
   ``9.7803267715 (1 + 5.27094e-3 sin²L + 2.32718e-5 sin⁴L) - 3.086e-6 h``; ours minus
   pyins is +0.15 µg at the equator, -2.4 µg at 34.25° (-3.0 µg at 380 m), -8.1 µg at
   the pole, and -17 µg at 10 km (the height terms differ: 3.086e-6 vs 2g/a = 3.07e-6 per
@@ -62,7 +62,7 @@ Expected agreement (measured with pyins 1.0, ts = 0.01 s)
 * At rest with data built from pyins's own gravity and earth rate: 4.6e-10 m/s after
   100 s. Not round-off: pyins applies its ``½ χ × Δv_n`` term to the rotation-compensated
   Δv, leaving ``¼ |χ| ω_ie g ts³`` ≈ 6e-15 m/s per step.
-* Data built with ``gcalign.earth.gravity``: the vertical velocity drifts by
+* Data built with ``gcalign.nav.earth.gravity``: the vertical velocity drifts by
   ``(g_ours - g_pyins) t`` (-2.9e-3 m/s after 100 s at the lasergyro site) and the east
   velocity follows by Coriolis. Pass ``with_altitude=False`` to compare the horizontal
   channels without the gravity models; what then remains of the attitude difference is
@@ -94,8 +94,8 @@ from pyins import strapdown, transform
 from pyins._numba_integrate import integrate as _pyins_kernel
 from pyins.util import ACCEL_COLS, DV_COLS, GYRO_COLS, THETA_COLS, TRAJECTORY_COLS
 
-from gcalign import earth
-from gcalign.rotation import dcm_to_euler, euler_to_dcm
+from gcalign.nav import earth
+from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
 
 #: Body RFU <-> FRD and navigation ENU <-> NED (symmetric, involutory, det +1).
 P = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])

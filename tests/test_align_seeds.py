@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gcalign.config import load_scenario
-from gcalign.pipelines.align import run_alignment
-from gcalign.pipelines.data import scenario_data
+from gcalign.app.align.run import run_alignment
+from gcalign.app.data import scenario_data
+from gcalign.io.scenario import load_scenario
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 SEEDS = range(1, 21)

@@ -24,10 +24,10 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from gcalign import batch as B
+from gcalign.app import batch as B
 from gcalign.cli import app
-from gcalign.config import parse_scenario
 from gcalign.errors import ScenarioError
+from gcalign.io.scenario import parse_scenario
 
 runner = CliRunner()
 
@@ -171,8 +171,8 @@ def test_batch_equals_single_runs(reference):
     sw = B.load_sweep(sweep)
     v = sw.variants[3]
     sc = parse_scenario(copy.deepcopy(v.scenario))
-    from gcalign.pipelines.align import alignment_summary, run_alignment
-    from gcalign.pipelines.data import scenario_data
+    from gcalign.app.align.run import alignment_summary, run_alignment
+    from gcalign.app.data import scenario_data
 
     values = []
     for seed in sw.seed_values:
@@ -217,7 +217,7 @@ def test_same_aggregate_with_one_and_two_workers(reference, tmp_path):
 
 def test_numba_cache_is_loaded_not_compiled_in_fresh_processes():
     B.warm_up()  # populates the on-disk cache if this checkout has none yet
-    code = "import json; from gcalign.batch import warm_up; print(json.dumps(warm_up()))"
+    code = "import json; from gcalign.app.batch import warm_up; print(json.dumps(warm_up()))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     stats = json.loads(out.stdout)

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gcalign import earth, rotation
 from gcalign.align.coarse import analytic_coarse, inertial_frame_coarse
+from gcalign.nav import earth, rotation
 from gcalign.units import ARCSEC, DEG, DPH, UG
 
 TS = 0.01

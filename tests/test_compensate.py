@@ -9,9 +9,9 @@ import pytest
 from gcalign.align import kernel as K
 from gcalign.align.compensate import compensate
 from gcalign.align.cycles import Block
-from gcalign.imu import ideal_imu
-from gcalign.rotation import euler_to_dcm, euler_to_quat, misalignment, quat_to_dcm
-from gcalign.trajectory import Motion, Segment
+from gcalign.nav.rotation import euler_to_dcm, euler_to_quat, misalignment, quat_to_dcm
+from gcalign.sim.imu import ideal_imu
+from gcalign.sim.motions import Motion, Segment
 
 D = np.pi / 180
 SITE = np.array([45.7796 * D, 126.6705 * D, 0.0])

@@ -21,8 +21,8 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from gcalign import earth
 from gcalign.align import gains as G
+from gcalign.nav import earth
 
 T_D = [10.0, 20.0, 50.0, 100.0, 200.0, 400.0]
 XI = [0.3, 0.5, 0.707, 0.9]

@@ -8,17 +8,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gcalign import earth
 from gcalign import units as u
 from gcalign.align import kernel as K
 from gcalign.align.cycles import Stage, loop_gains
 from gcalign.align.gains import azimuth_gains
-from gcalign.config import parse_scenario
-from gcalign.imu import ideal_imu
-from gcalign.pipelines.align import run_alignment
-from gcalign.pipelines.data import scenario_data
-from gcalign.rotation import euler_to_dcm, misalignment, quat_mult, quat_to_dcm, rotvec_to_quat
-from gcalign.trajectory import Motion
+from gcalign.app.align.run import run_alignment
+from gcalign.app.data import scenario_data
+from gcalign.io.scenario import parse_scenario
+from gcalign.nav import earth
+from gcalign.nav.rotation import euler_to_dcm, misalignment, quat_mult, quat_to_dcm, rotvec_to_quat
+from gcalign.sim.imu import ideal_imu
+from gcalign.sim.motions import Motion
 
 SITE = {"lat_deg": 45.7796, "lon_deg": 126.6705, "height_m": 0.0}
 LAT = np.radians(SITE["lat_deg"])

@@ -1,4 +1,4 @@
-"""The IMU error model does what gcalign.imu says (`apply_errors`, `SensorErrors`, `ImuErrors`).
+"""The IMU error model does what gcalign.sim.imu says (`apply_errors`, `SensorErrors`, `ImuErrors`).
 
 Model (per sensor triad, increments of one sample of length ts):
 ``measured = (I + diag(scale) + misalignment) @ ideal + bias ts + noise sqrt(ts) n_k``,
@@ -15,10 +15,10 @@ import math
 import numpy as np
 import pytest
 
-from gcalign.config import parse_scenario
 from gcalign.errors import ScenarioError
-from gcalign.imu import ImuData, ImuErrors, SensorErrors, apply_errors, ideal_imu
-from gcalign.trajectory import Motion
+from gcalign.io.scenario import parse_scenario
+from gcalign.sim.imu import ImuData, ImuErrors, SensorErrors, apply_errors, ideal_imu
+from gcalign.sim.motions import Motion
 
 TS = 0.01
 DEG = math.pi / 180.0

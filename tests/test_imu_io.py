@@ -1,4 +1,4 @@
-"""Tests of gcalign.imu_io: the real PSINS file, bad inputs, and the CSV round trip."""
+"""Tests of gcalign.io.imu_files: the real PSINS file, bad inputs, and the CSV round trip."""
 
 from __future__ import annotations
 
@@ -8,15 +8,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gcalign import earth
-from gcalign.imu import ImuData
-from gcalign.imu_io import (
+from gcalign.io.imu_files import (
     ImuFileError,
     read_csv_imu,
     read_imu_file,
     read_psins_imu,
     write_csv_imu,
 )
+from gcalign.nav import earth
+from gcalign.sim.imu import ImuData
 from gcalign.units import ARCSEC, DEG
 
 LASERGYRO = Path("/work/shared/data/lasergyro.imu")

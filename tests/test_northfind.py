@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gcalign import earth
+from gcalign.nav import earth
+from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm, wrap_pi
 from gcalign.northfind import (
     METHODS,
     NorthfindSetup,
@@ -26,7 +27,6 @@ from gcalign.northfind import (
     table_dcm,
     tilt_from_pitch_roll,
 )
-from gcalign.rotation import dcm_to_euler, euler_to_dcm, wrap_pi
 from gcalign.units import ARCMIN, ARCSEC, DEG, DPH, DPSH, UG, UGPSHZ
 
 LAT40 = 40.0 * DEG

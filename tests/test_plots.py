@@ -1,4 +1,4 @@
-"""`gcalign plot` and gcalign.plots: which figures, which axes, how many series, PNG files."""
+"""`gcalign plot` and gcalign.app.plots: which figures, which axes, how many series, PNG files."""
 
 from __future__ import annotations
 
@@ -11,8 +11,9 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from gcalign import plots, results
+from gcalign.app import plots
 from gcalign.cli import app
+from gcalign.io import results
 
 runner = CliRunner()
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -1,7 +1,7 @@
 """Cross-check of our strapdown against pyins (nmayorov/pyins, PyPI ``python-ins``).
 
 The same ideal IMU data of the seed 000 swing (§5.2) and moving base (§5.3), 400 s at
-100 Hz from the true initial state, goes to :func:`gcalign.strapdown.navigate` and to
+100 Hz from the true initial state, goes to :func:`gcalign.nav.strapdown.navigate` and to
 pyins's ``Integrator`` through ``tests/pyins_ref.py`` (frames, Euler angles and units
 converted there). Requirement: attitude within 1e-3°, horizontal position within 0.5 m.
 The two agree far better; the tighter bounds below hold what remains, and it is
@@ -51,9 +51,9 @@ from test_strapdown import (  # noqa: E402
     true_start,
 )
 
-from gcalign import earth  # noqa: E402
-from gcalign.rotation import euler_to_dcm, misalignment, quat_to_dcm  # noqa: E402
-from gcalign.strapdown import navigate  # noqa: E402
+from gcalign.nav import earth  # noqa: E402
+from gcalign.nav.rotation import euler_to_dcm, misalignment, quat_to_dcm  # noqa: E402
+from gcalign.nav.strapdown import navigate  # noqa: E402
 
 _RUNS: dict = {}
 

@@ -17,8 +17,8 @@ from pyins import sim  # noqa: E402
 from pyins.strapdown import Integrator, compute_increments_from_imu  # noqa: E402
 from pyins.util import ACCEL_COLS, GYRO_COLS  # noqa: E402
 
-from gcalign import earth  # noqa: E402
-from gcalign.rotation import euler_to_dcm, skew, wrap_pi  # noqa: E402
+from gcalign.nav import earth  # noqa: E402
+from gcalign.nav.rotation import euler_to_dcm, skew, wrap_pi  # noqa: E402
 
 DEG = np.pi / 180.0
 SITE = np.array([34.246048 * DEG, 108.909664 * DEG, 380.0])  # lasergyro.imu site
@@ -165,7 +165,7 @@ def _axis_rotation(e, angles):
 
 
 def test_stationary_100s_with_our_gravity():
-    """Ideal data built with gcalign.earth.gravity: the only inconsistency is gravity."""
+    """Ideal data built with gcalign.nav.earth.gravity: the only inconsistency is gravity."""
     att = np.radians([1.0, -2.0, 30.0])
     n = 10_000  # 100 s
     dtheta, dv = pr.stationary_increments(n, TS, SITE, att)  # ours: gravity and ω_ie

@@ -1,5 +1,5 @@
-"""Strapdown navigation and the ideal IMU it is fed with (gcalign.strapdown, gcalign.kernels,
-gcalign.imu.ideal_imu).
+"""Strapdown navigation and the ideal IMU it is fed with (gcalign.nav.strapdown,
+gcalign.nav._kernels, gcalign.sim.imu.ideal_imu).
 
 References come from physics, never from our own earlier output:
 
@@ -8,10 +8,10 @@ References come from physics, never from our own earlier output:
 - forward then reverse over the same block (DESIGN.md "Reverse navigation") must return
   the initial state;
 - the numba kernel must equal a slow NumPy reference of the same update, written here
-  line by line from the docstring of :func:`gcalign.kernels.strapdown_step`;
+  line by line from the docstring of :func:`gcalign.nav._kernels.strapdown_step`;
 - the generator's Δv must not depend on its Simpson sub-step count, and a static body's
   increments are known in closed form: Δθ = C_bn ω_ie^n ts, Δv = C_bn [0, 0, g] ts;
-- the scalar earth helpers of the kernels equal the vectorised :mod:`gcalign.earth`.
+- the scalar earth helpers of the kernels equal the vectorised :mod:`gcalign.nav.earth`.
 """
 
 from __future__ import annotations
@@ -19,12 +19,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gcalign import earth
-from gcalign.imu import ideal_imu
-from gcalign.kernels import earth_at, empty_states, strapdown_block, transport_rate
-from gcalign.rotation import euler_to_dcm, misalignment, quat_to_dcm
-from gcalign.strapdown import NavState, navigate, reverse_data
-from gcalign.trajectory import Motion, Segment
+from gcalign.nav import earth
+from gcalign.nav._kernels import earth_at, empty_states, strapdown_block, transport_rate
+from gcalign.nav.rotation import euler_to_dcm, misalignment, quat_to_dcm
+from gcalign.nav.strapdown import NavState, navigate, reverse_data
+from gcalign.sim.imu import ideal_imu
+from gcalign.sim.motions import Motion, Segment
 from gcalign.units import DEG
 
 TS = 0.01

@@ -16,7 +16,7 @@ Both methods take a block of body increments (PSINS layout: sample k holds Δθ_
   See its Notes for the equations.
 
 >>> import numpy as np
->>> from gcalign import earth, rotation
+>>> from gcalign.nav import earth, rotation
 >>> lat, ts, n = np.radians(45.78), 0.01, 6000
 >>> att = np.radians([1.0, -2.0, 30.0])
 >>> C_bn = rotation.euler_to_dcm(att).T
@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-from gcalign import earth, rotation
+from gcalign.nav import earth, rotation
 
 COARSE_EPOCHS = ("end", "start")
 """Allowed values of ``at`` in :func:`inertial_frame_coarse`."""

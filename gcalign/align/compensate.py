@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from gcalign import earth
 from gcalign.align import kernel as K
 from gcalign.align.cycles import Block
-from gcalign.rotation import dcm_to_quat, quat_to_dcm
+from gcalign.nav import earth
+from gcalign.nav.rotation import dcm_to_quat, quat_to_dcm
 
 METHODS = ("none", "one-off", "continued")
 

@@ -1,7 +1,7 @@
 """Fine-alignment passes: conventional, full-cycle and half-cycle modes (seed 000 §3-4, §6).
 
 A *pass* runs the gyrocompass kernel over the stored block [T1, T2] forward or in reverse
-(reverse = the data transform of :mod:`gcalign.strapdown`). At each change of direction
+(reverse = the data transform of :mod:`gcalign.nav.strapdown`). At each change of direction
 the loop states that are velocities or rates change sign with the data; the attitude is
 kept. Full-cycle alternates forward/reverse compass passes; half-cycle alternates forward
 compass passes with reverse attitude-only passes; conventional is one forward pass.
@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gcalign import earth
 from gcalign.align import kernel as K
 from gcalign.align.gains import azimuth_gains, level_gains
+from gcalign.nav import earth
 
 MODES = ("conventional", "full-cycle", "half-cycle")
 

@@ -29,8 +29,8 @@ import math
 import numpy as np
 from numba import njit
 
-from gcalign.earth import OMEGA_IE
-from gcalign.kernels import earth_at, qmul, qrot, rotate_small, rv2q, transport_rate
+from gcalign.nav._kernels import earth_at, qmul, qrot, rotate_small, rv2q, transport_rate
+from gcalign.nav.earth import OMEGA_IE
 
 ATTITUDE, LEVEL, COMPASS = 0, 1, 2
 STATE_SIZE = 12

@@ -8,13 +8,14 @@ from pathlib import Path
 
 import typer
 
-from gcalign import report, results
+from gcalign.app import report
+from gcalign.app.align.run import alignment_summary, run_alignment
+from gcalign.app.data import scenario_data
 from gcalign.cli import app, default_output, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, save_and_show
 from gcalign.cli.data import JSON_HELP, OUT_HELP
 from gcalign.errors import ScenarioError
-from gcalign.pipelines.align import alignment_summary, run_alignment
-from gcalign.pipelines.data import scenario_data
+from gcalign.io import results
 
 BUILTIN = "seed000_moving_full_cycle.yaml"
 

@@ -1,6 +1,6 @@
 """`gcalign batch`: sweeps and Monte Carlo over seeds, on local processes or a Dask cluster.
 
-The engine is :mod:`gcalign.batch`; this module only loads the sweep, shows progress,
+The engine is :mod:`gcalign.app.batch`; this module only loads the sweep, shows progress,
 prints the table (or JSON) and maps failures to exit codes (0 all runs ok, 1 some run
 failed or the cluster is unreachable, 2 bad sweep, 130 interrupted).
 """
@@ -12,8 +12,8 @@ from pathlib import Path
 
 import typer
 
-from gcalign import batch as engine
-from gcalign import report
+from gcalign.app import batch as engine
+from gcalign.app import report
 from gcalign.cli import app, consoles, default_output, emit_json, user_errors
 from gcalign.cli.data import JSON_HELP
 from gcalign.errors import ScenarioError

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import yaml
 
-from gcalign import results
 from gcalign.cli import consoles, emit_json
-from gcalign.config import Scenario, parse_scenario
-from gcalign.config.loader import read_yaml
 from gcalign.errors import ScenarioError
+from gcalign.io import results
+from gcalign.io.scenario import Scenario, parse_scenario
+from gcalign.io.scenario.loader import read_yaml
 
 
 def builtin_text(name: str) -> str:

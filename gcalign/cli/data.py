@@ -10,13 +10,14 @@ import numpy as np
 import typer
 import yaml
 
-from gcalign import report, results
+from gcalign.app import report
+from gcalign.app.data import HDF5_SUFFIXES, RunData, scenario_data
+from gcalign.app.navigate.run import navigation_summary, run_navigation
 from gcalign.cli import app, consoles, default_output, emit_json, user_errors
 from gcalign.cli.common import save_and_show
-from gcalign.config import load_scenario, parse_scenario
-from gcalign.config.resolve import resolved_rows
-from gcalign.pipelines.data import HDF5_SUFFIXES, RunData, scenario_data
-from gcalign.pipelines.navigate import navigation_summary, run_navigation
+from gcalign.io import results
+from gcalign.io.scenario import load_scenario, parse_scenario
+from gcalign.io.scenario.resolve import resolved_rows
 
 DATA_SUFFIXES = {".imu", ".csv", ".txt"}
 JSON_HELP = "Print one JSON object on stdout (tables go to stderr)."

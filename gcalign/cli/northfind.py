@@ -6,12 +6,13 @@ from pathlib import Path
 
 import typer
 
-from gcalign import report, results
+from gcalign.app import report
+from gcalign.app.northfind.run import northfind_summary, run_northfind
 from gcalign.cli import app, default_output, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, save_and_show
 from gcalign.cli.data import JSON_HELP, OUT_HELP
 from gcalign.errors import ScenarioError
-from gcalign.pipelines.northfind import northfind_summary, run_northfind
+from gcalign.io import results
 
 BUILTIN = "seed001_simulation.yaml"
 

@@ -25,7 +25,8 @@ def plot(
 ):
     """Write PNG figures: alignment error and attitude per pass (equivalent time),
     north-finding error against true azimuth, batch distributions per variant."""
-    from gcalign import plots, results
+    from gcalign.app import plots
+    from gcalign.io import results
 
     kind, _, _ = results.read_summary(file)
     written = plots.plot_file(file, out_dir)

@@ -34,7 +34,7 @@ rest ``f^n = g U`` (g = ``earth.gravity(L, h)``).
 
 Table frame t: ``x_t`` (right), ``y_t`` (reference axis, the north-finder's "forward"),
 ``z_t`` (table normal, up). ``C_nt`` has the columns ``x_t, y_t, z_t`` resolved in ENU, and
-is a PSINS body attitude: ``C_nt = Rz(-ψ) Rx(p) Ry(r)`` (:func:`gcalign.rotation.euler_to_dcm`
+is a PSINS body attitude: ``C_nt = Rz(-ψ) Rx(p) Ry(r)`` (:func:`gcalign.nav.rotation.euler_to_dcm`
 with ``att = [p, r, -ψ]``). The truth is given by
 
 * ``ψ`` — the *azimuth* of the table: the azimuth (clockwise from true north) of the
@@ -94,7 +94,7 @@ from gcalign.northfind.run import NorthfindResult, run_northfind
 from gcalign.northfind.simulate import (
     NorthfindSetup,
     TableData,
-    # in this namespace for `gcalign.batch.kernel_cache_stats`, which counts the cache
+    # in this namespace for `gcalign.app.batch.kernel_cache_stats`, which counts the cache
     # hits of the numba dispatchers it finds in `gcalign.northfind`
     _dwell_means_kernel,  # noqa: F401
     simulate_table,

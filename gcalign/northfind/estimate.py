@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gcalign import earth
+from gcalign.nav import earth
+from gcalign.nav.rotation import euler_to_dcm
 from gcalign.northfind.geometry import _uz, _wrap_2pi
-from gcalign.rotation import euler_to_dcm
 
 __all__ = [
     "METHODS",

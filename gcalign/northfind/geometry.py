@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gcalign import earth
+from gcalign.nav import earth
 
 __all__ = ["pitch_roll_from_tilt", "position_angles", "table_dcm", "tilt_from_pitch_roll"]
 

@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gcalign.nav.rotation import wrap_pi
 from gcalign.northfind.estimate import METHODS, estimate_northfind
 from gcalign.northfind.simulate import NorthfindSetup, simulate_table
 from gcalign.northfind.theory import predict_azimuth_std, predicted_error
-from gcalign.rotation import wrap_pi
 
 __all__ = ["NorthfindResult", "run_northfind"]
 

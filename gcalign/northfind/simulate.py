@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from gcalign import earth
+from gcalign.nav import earth
 from gcalign.northfind.geometry import _ideal_readings, _wrap_2pi, position_angles, table_dcm
 
 __all__ = ["NorthfindSetup", "TableData", "simulate_table"]

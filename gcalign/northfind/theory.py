@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from gcalign import earth
+from gcalign.nav import earth
+from gcalign.nav.rotation import wrap_pi
 from gcalign.northfind.estimate import (
     METHODS,
     _design,
@@ -19,7 +20,6 @@ from gcalign.northfind.estimate import (
 )
 from gcalign.northfind.geometry import _ideal_readings, table_dcm
 from gcalign.northfind.simulate import NorthfindSetup
-from gcalign.rotation import wrap_pi
 
 __all__ = [
     "azimuth_std_level",

@@ -1,0 +1,1 @@
+"""`gcalign align`: the pipeline, its summary, results file, table and figures."""

@@ -1,0 +1,126 @@
+"""Sweeps and Monte Carlo batches: a base scenario × a grid of overrides × seeds.
+
+DESIGN.md "CLI" (``gcalign batch``), "Results file", "Performance"; the sweep format is
+described in ``docs/batch.md``. This package is the engine; it never imports typer or rich
+(the command line gives it a progress callback).
+
+Modules
+-------
+:mod:`~gcalign.app.batch.sweep`
+    The sweep model (:class:`Sweep`, :class:`Variant`): reading and validating a sweep file.
+:mod:`~gcalign.app.batch.overrides`
+    Dotted-key overrides (:func:`apply_override`) checked against the scenario schema.
+:mod:`~gcalign.app.batch.runs`
+    What one run does in a worker process: the run summary, its metrics, the JIT warm-up.
+:mod:`~gcalign.app.batch.backends`
+    Where runs execute: a local process pool or an existing Dask cluster.
+:mod:`~gcalign.app.batch.engine`
+    :func:`run_batch`: resume, submit, retry, journal, progress, rebuild the file.
+:mod:`~gcalign.app.batch.store`
+    The journal, the HDF5 results file and the records a resume reads back.
+:mod:`~gcalign.app.batch.aggregate`
+    Per-variant statistics over seeds and the batch summary.
+"""
+
+from gcalign.app.batch.aggregate import (
+    ATT_COMPONENTS,
+    STATS,
+    aggregate,
+    batch_summary,
+    components,
+    metric_units,
+    stats_of,
+)
+from gcalign.app.batch.backends import (
+    SCHEDULER_TIMEOUT_S,
+    DaskBackend,
+    LocalBackend,
+    WorkerLost,
+    dask_client,
+    make_backend,
+)
+from gcalign.app.batch.engine import (
+    MAX_ATTEMPTS,
+    REBUILD_EVERY_S,
+    BatchResult,
+    Progress,
+    run_batch,
+)
+from gcalign.app.batch.engine import _tasks as _tasks  # the tests build tasks with it
+from gcalign.app.batch.overrides import apply_override
+from gcalign.app.batch.runs import (
+    WARM_SCENARIO,
+    MetricError,
+    kernel_cache_stats,
+    metric_value,
+    run_chunk,
+    run_data,
+    run_summary,
+    run_task,
+    warm_up,
+)
+from gcalign.app.batch.store import (
+    JOURNAL_SUFFIX,
+    Journal,
+    journal_path,
+    previous_records,
+    read_batch,
+    read_journal,
+    read_runs_h5,
+    write_batch_h5,
+)
+from gcalign.app.batch.sweep import (
+    COMMANDS,
+    DEFAULT_METRICS,
+    SWEEP_KEYS,
+    Sweep,
+    Variant,
+    load_sweep,
+    sweep_from_mapping,
+)
+
+__all__ = [
+    "ATT_COMPONENTS",
+    "COMMANDS",
+    "DEFAULT_METRICS",
+    "JOURNAL_SUFFIX",
+    "MAX_ATTEMPTS",
+    "REBUILD_EVERY_S",
+    "SCHEDULER_TIMEOUT_S",
+    "STATS",
+    "SWEEP_KEYS",
+    "WARM_SCENARIO",
+    "BatchResult",
+    "DaskBackend",
+    "Journal",
+    "LocalBackend",
+    "MetricError",
+    "Progress",
+    "Sweep",
+    "Variant",
+    "WorkerLost",
+    "aggregate",
+    "apply_override",
+    "batch_summary",
+    "components",
+    "dask_client",
+    "journal_path",
+    "kernel_cache_stats",
+    "load_sweep",
+    "make_backend",
+    "metric_units",
+    "metric_value",
+    "previous_records",
+    "read_batch",
+    "read_journal",
+    "read_runs_h5",
+    "run_batch",
+    "run_chunk",
+    "run_data",
+    "run_summary",
+    "run_task",
+    "stats_of",
+    "sweep_from_mapping",
+    "warm_up",
+    "write_batch_h5",
+]

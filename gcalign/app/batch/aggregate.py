@@ -1,0 +1,119 @@
+"""Per-variant statistics of the metrics over seeds, and the batch summary.
+
+The aggregate is computed from the records sorted by (variant, seed): the same sweep gives
+the same numbers whatever the number of workers or the order in which runs finished.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from gcalign.app.batch.sweep import Sweep
+
+STATS = ("mean", "std", "rms", "median", "p05", "p95")
+ATT_COMPONENTS = ("pitch", "roll", "yaw")
+
+
+def _finite(x):
+    """JSON-safe numbers: NaN -> None."""
+    if isinstance(x, list):
+        return [_finite(v) for v in x]
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def components(command: str, metric: str, k: int | None) -> list[str] | None:
+    if k is None:
+        return None
+    if command == "align" and k == 3 and metric.endswith("_deg"):
+        return list(ATT_COMPONENTS)
+    return [str(i) for i in range(k)]
+
+
+def metric_units(metric: str) -> str:
+    last = metric.rsplit(".", 1)[-1]
+    for suffix, units in (("_deg", "deg"), ("_s", "s"), ("_dph", "deg/h"), ("_m", "m"),
+                          ("_mps", "m/s"), ("_arcsec", "arcsec")):
+        if last.endswith(suffix):
+            return units
+    return ""
+
+
+def stats_of(values: np.ndarray) -> dict:
+    """mean, std (ddof 1), RMS, median, 5 and 95 % percentiles along axis 0."""
+    n = values.shape[0]
+    if n == 0:
+        nan = np.full(values.shape[1:], np.nan)
+        return {s: nan for s in STATS}
+    return {
+        "mean": values.mean(0),
+        "std": values.std(0, ddof=1) if n > 1 else np.full(values.shape[1:], np.nan),
+        "rms": np.sqrt(np.mean(values * values, 0)),
+        "median": np.median(values, 0),
+        "p05": np.percentile(values, 5, axis=0),
+        "p95": np.percentile(values, 95, axis=0),
+    }
+
+
+def _as_py(a):
+    a = np.asarray(a, dtype=float)
+    return _finite(a.tolist()) if a.ndim else _finite(float(a))
+
+
+def aggregate(sweep: Sweep, records: dict[tuple[int, int], dict]) -> list[dict]:
+    """Per-variant statistics of every metric, per vector component, from the records of
+    finished runs (keyed by (variant, seed)); canonical order, so reproducible."""
+    out = []
+    for v in sweep.variants:
+        recs = [records[(v.index, s)] for s in sweep.seed_values if (v.index, s) in records]
+        ok = [r for r in recs if r["status"] == "ok"]
+        stats: dict[str, dict] = {}
+        entry = {"index": v.index, "label": v.label, "overrides": v.overrides,
+                 "ok": len(ok), "failed": len(recs) - len(ok), "stats": stats}
+        for m in sweep.metrics:
+            vals = [r["metrics"][m] for r in ok]
+            lengths = {len(x) if isinstance(x, list) else None for x in vals}
+            if len(lengths) > 1:
+                stats[m] = {"n": len(vals), "components": None,
+                            "note": "runs gave values of different lengths",
+                            **{s: None for s in STATS}}
+                continue
+            k = lengths.pop() if lengths else None
+            arr = np.asarray(vals, dtype=float)
+            if arr.size == 0:
+                arr = np.zeros((0, k) if k else (0,))
+            st = stats_of(arr)
+            stats[m] = {"n": len(vals), "components": components(sweep.command, m, k),
+                        "units": metric_units(m), **{s: _as_py(st[s]) for s in STATS}}
+        out.append(entry)
+    return out
+
+
+def batch_summary(sweep: Sweep, records: dict, *, output: Path | None = None,
+                  extra: dict | None = None) -> dict:
+    """The summary stored in ``summary_json`` and printed by ``--json``."""
+    keys = sweep.run_keys()
+    finished = [records[k] for k in keys if k in records]
+    failed = [r for r in finished if r["status"] != "ok"]
+    return {
+        "sweep": sweep.name,
+        "command": sweep.command,
+        "source": sweep.source,
+        "base": sweep.base_source,
+        "seeds": sweep.seeds,
+        "seed_start": sweep.seed_start,
+        "metrics": list(sweep.metrics),
+        "grid": sweep.grid,
+        "runs": len(keys),
+        "finished": len(finished),
+        "ok": len(finished) - len(failed),
+        "failed": len(failed),
+        "complete": len(finished) == len(keys),
+        "variants": aggregate(sweep, records),
+        "failures": [{"variant": r["variant"], "seed": r["seed"], "error": r["error"]}
+                     for r in failed[:20]],
+        **(extra or {}),
+        "output": None if output is None else str(output),
+    }

@@ -1,0 +1,188 @@
+"""Where the chunks of runs execute: a local process pool, or an existing Dask cluster.
+
+Both backends offer the same small interface to the engine (``submit``, ``wait``,
+``result``, ``restart``, ``run_on_workers``, ``close``) and turn the death of a worker
+into :class:`WorkerLost`. The functions they send to workers live in
+:mod:`gcalign.app.batch.runs`.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+
+from gcalign.app.batch.runs import run_chunk, warm_up
+from gcalign.errors import GcalignError
+
+SCHEDULER_TIMEOUT_S = 5.0  # connecting to a Dask scheduler; the message comes within 10 s
+
+
+def _watch_parent(parent: int) -> None:  # pragma: no cover - runs in workers
+    while True:
+        time.sleep(0.5)
+        if os.getppid() != parent:
+            os._exit(1)  # the batch process died (SIGKILL): do not linger as an orphan
+
+
+def _init_worker(command: str) -> None:  # pragma: no cover - runs in workers
+    """Process-pool initializer: Ctrl-C is the parent's business; exit with the parent;
+    load the JIT cache once."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True).start()
+    warm_up(command)
+
+
+class WorkerLost(Exception):
+    """The process running a chunk died (killed, crashed, out of memory)."""
+
+
+class LocalBackend:
+    """``concurrent.futures.ProcessPoolExecutor`` of `workers` processes, each warming the
+    JIT cache once (initializer).
+
+    Start method: ``fork`` when this process has no other thread (the workers then start
+    with every module already imported: no interpreter start, no re-import), else the fork
+    server (forking a multi-threaded process can deadlock the child). The processes are
+    started here, before the caller starts a progress-bar thread.
+    """
+
+    def __init__(self, workers: int, command: str):
+        self.workers = workers
+        self.command = command
+        self.description = f"local pool, {workers} worker(s)"
+        self._pool = self._new_pool()
+
+    def _new_pool(self):
+        import multiprocessing as mp
+        from concurrent.futures import ProcessPoolExecutor
+
+        methods = mp.get_all_start_methods()
+        if "fork" in methods and threading.active_count() == 1:
+            ctx = mp.get_context("fork")
+        elif "forkserver" in methods:
+            ctx = mp.get_context("forkserver")
+            # The fork server imports the engine (numpy, numba, pipelines) once; every
+            # worker forked from it starts with those modules loaded.
+            ctx.set_forkserver_preload(["gcalign.app.batch", "gcalign.app.align.run"])
+        else:
+            ctx = mp.get_context("spawn")
+        self.start_method = ctx.get_start_method()
+        pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx,
+                                   initializer=_init_worker, initargs=(self.command,))
+        if self.start_method == "fork":
+            pool.submit(os.getpid).result()  # forks every worker now (all at once for fork)
+        return pool
+
+    def submit(self, chunk):
+        return self._pool.submit(run_chunk, chunk)
+
+    def wait(self, futures, timeout: float):
+        from concurrent.futures import FIRST_COMPLETED, wait
+
+        return wait(futures, timeout=timeout, return_when=FIRST_COMPLETED)[0]
+
+    def result(self, fut) -> list[dict]:
+        from concurrent.futures.process import BrokenProcessPool
+
+        try:
+            return fut.result()
+        except BrokenProcessPool as err:
+            raise WorkerLost(str(err) or "a worker process died") from None
+
+    def restart(self) -> None:
+        self.close(cancel=True)
+        self._pool = self._new_pool()
+
+    def run_on_workers(self, fn) -> list:
+        return [f.result() for f in [self._pool.submit(fn) for _ in range(self.workers)]]
+
+    def close(self, cancel: bool = False) -> None:
+        if cancel:
+            procs = list((getattr(self._pool, "_processes", None) or {}).values())
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            for p in procs:  # do not wait for chunks in flight after Ctrl-C
+                if p.is_alive():
+                    p.terminate()
+        else:
+            self._pool.shutdown(wait=True)
+
+
+def dask_client(address: str, timeout: float = SCHEDULER_TIMEOUT_S):
+    """A ``distributed.Client`` connected to `address`; GcalignError if Dask is missing or
+    the scheduler does not answer within `timeout` seconds."""
+    try:
+        import distributed
+    except ImportError:
+        raise GcalignError('--scheduler needs Dask distributed, which is not installed: '
+                           'pip install -e ".[dask]"') from None
+    try:
+        return distributed.Client(address, timeout=timeout, set_as_default=False)
+    except Exception as err:  # OSError, TimeoutError, ValueError (bad address), ...
+        msg = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise GcalignError(f"cannot reach the Dask scheduler at {address} "
+                           f"(waited {timeout:g} s): {msg}") from None
+
+
+class DaskBackend:
+    """Runs chunks on an existing Dask distributed cluster (``client.submit``)."""
+
+    def __init__(self, address: str, command: str, timeout: float = SCHEDULER_TIMEOUT_S):
+        self.client = dask_client(address, timeout)
+        self.address = address
+        nthreads = self.client.nthreads()
+        self.workers = max(1, sum(nthreads.values()))
+        self.description = f"Dask scheduler {address}, {len(nthreads)} worker(s)"
+        self.command = command
+        try:  # load the JIT cache on every worker, in parallel; checks gcalign is there
+            self.client.run(warm_up, command)
+        except Exception as err:
+            self.close()
+            raise GcalignError(f"the Dask workers of {address} cannot run gcalign "
+                               f"({type(err).__name__}: {err}); install gcalign where the "
+                               "workers run") from None
+
+    def _check_connected(self) -> None:
+        if self.client.status not in ("running", "connecting"):
+            raise GcalignError(f"lost the Dask scheduler at {self.address} (client "
+                               f"{self.client.status}); the finished runs are kept: rerun "
+                               "with --resume")
+
+    def submit(self, chunk):
+        self._check_connected()
+        return self.client.submit(run_chunk, chunk, pure=False)
+
+    def wait(self, futures, timeout: float):
+        # distributed.wait needs a default client; polling the futures does not.
+        deadline = time.monotonic() + timeout
+        while True:
+            done = {f for f in futures if f.done()}
+            if done or time.monotonic() >= deadline:
+                return done
+            time.sleep(0.02)
+
+    def result(self, fut) -> list[dict]:
+        try:
+            return fut.result()
+        except Exception as err:  # KilledWorker, CancelledError, CommClosedError, ...
+            self._check_connected()
+            raise WorkerLost(f"{type(err).__name__}: {err}") from None
+
+    def restart(self) -> None:
+        pass  # the scheduler replaces lost workers itself
+
+    def run_on_workers(self, fn) -> list:
+        return list(self.client.run(fn).values())
+
+    def close(self, cancel: bool = False) -> None:
+        try:
+            self.client.close(timeout=SCHEDULER_TIMEOUT_S)
+        except Exception:  # noqa: BLE001 - closing a broken connection
+            pass
+
+
+def make_backend(command: str, workers: int | None = None, scheduler: str | None = None):
+    if scheduler:
+        return DaskBackend(scheduler, command)
+    return LocalBackend(workers or os.cpu_count() or 1, command)

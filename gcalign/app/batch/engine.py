@@ -1,0 +1,210 @@
+"""The batch engine: run every unfinished (variant, seed) of a sweep and keep the results.
+
+DESIGN.md "CLI" (``gcalign batch``), "Performance". :func:`run_batch` resumes what it can
+(:mod:`gcalign.app.batch.store`), submits chunks of runs to a backend
+(:mod:`gcalign.app.batch.backends`) through a bounded window, journals every result, retries
+once, alone, each run lost with a dying worker, reports progress through a callback and
+rebuilds the results file every few seconds and at the end.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from gcalign.app.batch.aggregate import batch_summary
+from gcalign.app.batch.backends import LocalBackend, WorkerLost, make_backend
+from gcalign.app.batch.store import (
+    Journal,
+    _clean_stale_tmp,
+    journal_path,
+    previous_records,
+    read_journal,
+    write_batch_h5,
+)
+from gcalign.app.batch.sweep import Sweep
+from gcalign.errors import ScenarioError
+
+MAX_ATTEMPTS = 2  # a run in flight when a worker process died is retried once, alone
+REBUILD_EVERY_S = 2.0  # HDF5 rebuilt from the journal at most this often while running
+
+
+@dataclass
+class BatchResult:
+    summary: dict
+    records: dict = field(repr=False)
+    reused: int = 0  # runs taken from an earlier (resumed) batch
+
+    @property
+    def failed(self) -> int:
+        return self.summary["failed"]
+
+
+Progress = Callable[[int, int, int], None]  # (finished, total, failed)
+
+
+def _tasks(sweep: Sweep, keys: list[tuple[int, int]]) -> list[dict]:
+    by_index = {v.index: v for v in sweep.variants}
+    out = []
+    for vi, seed in keys:
+        v = by_index[vi]
+        out.append({"command": sweep.command, "variant": vi, "vkey": v.key, "seed": seed,
+                    "scenario": v.scenario, "source": f"{sweep.source}: variant {v.label}",
+                    "metrics": list(sweep.metrics)})
+    return out
+
+
+def _chunks(tasks: list[dict], workers: int, size: int | None) -> list[list[dict]]:
+    if size is None:  # ≥ 4 chunks per worker (load balance), ≤ 8 runs each (progress, resume)
+        size = max(1, min(8, math.ceil(len(tasks) / (4 * workers))))
+    return [tasks[i:i + size] for i in range(0, len(tasks), size)]
+
+
+def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
+              scheduler: str | None = None, resume: bool = False,
+              progress: Progress | None = None, log: Callable[[str], None] | None = None,
+              chunk_size: int | None = None, rebuild_every_s: float = REBUILD_EVERY_S,
+              backend=None) -> BatchResult:
+    """Run every (variant, seed) of `sweep` not yet finished, journal and write `output`.
+
+    Parameters
+    ----------
+    workers : local worker processes (default: all cores). Ignored with `scheduler`.
+    scheduler : address of a Dask scheduler (``tcp://host:port``) to run on instead.
+    resume : reuse the finished runs recorded in the journal (or in `output`).
+    progress : called with (finished, total, failed) as results arrive.
+    log : called with one-line notes (resume counts, discarded journal).
+
+    Returns the summary (also in the file) and the records. A failing run never raises;
+    a worker process that dies takes its runs with it, and each is retried once alone.
+    """
+    output = Path(output)
+    log = log or (lambda msg: None)
+    t_start = time.perf_counter()
+    _clean_stale_tmp(output)
+    keys = sweep.run_keys()
+    records: dict[tuple[int, int], dict] = {}
+    reused = 0
+    if resume:
+        records, where = previous_records(sweep, output)
+        reused = len(records)
+        if where:
+            log(f"resuming from {where}: {reused} of {len(keys)} run(s) already finished")
+        else:
+            log(f"nothing to resume at {output}: starting afresh")
+    todo = [k for k in keys if k not in records]
+
+    # Connect before touching the journal: an unreachable scheduler loses nothing.
+    if backend is None and todo:
+        backend = make_backend(sweep.command, min(workers or os.cpu_count() or 1, len(todo)),
+                               scheduler)
+    jpath = journal_path(output)
+    if not resume and jpath.is_file():
+        n_old = len(read_journal(jpath))
+        if n_old:
+            log(f"discarding {jpath} ({n_old} finished run(s)); use --resume to continue it")
+    header = {"type": "header", "sweep": sweep.name, "source": sweep.source,
+              "fingerprint": sweep.fingerprint, "runs": len(keys)}
+    journal = Journal(jpath, header, [{"type": "run", **r} for r in records.values()])
+
+    extra = {"workers": None if backend is None else backend.workers,
+             "executor": None if backend is None else backend.description}
+
+    def rebuild() -> dict:
+        summary = batch_summary(sweep, records, output=output,
+                                extra={**extra, "wall_s": time.perf_counter() - t_start})
+        write_batch_h5(output, sweep, records, summary)
+        return summary
+
+    if progress:
+        progress(len(records), len(keys), 0)
+    try:
+        if todo:
+            _drive(backend, sweep, todo, records, journal, progress, len(keys),
+                   chunk_size, rebuild, rebuild_every_s)
+        summary = rebuild()
+    except BaseException:
+        # Ctrl-C, a bad metric, ...: keep what finished (journal + a consistent file).
+        if backend is not None:
+            backend.close(cancel=True)
+            backend = None
+        journal.close()
+        try:
+            rebuild()
+        except Exception:  # noqa: BLE001 - the journal still holds every finished run
+            pass
+        raise
+    finally:
+        if backend is not None:
+            backend.close()
+    journal.close()
+    if summary["complete"]:
+        jpath.unlink(missing_ok=True)  # the file holds everything; resume reads it
+    return BatchResult(summary=summary, records=records, reused=reused)
+
+
+def _drive(backend, sweep, todo, records, journal, progress, total, chunk_size, rebuild,
+           rebuild_every_s) -> int:
+    """Submit chunks (a bounded window), collect results, journal them, rebuild the file."""
+    queue = _chunks(_tasks(sweep, todo), backend.workers, chunk_size)
+    queue.reverse()  # pop() from the end = canonical order
+    attempts: dict[tuple[int, int], int] = {}
+    in_flight: dict[Any, list[dict]] = {}
+    window = 2 * backend.workers
+    failed = 0
+    last_rebuild = time.monotonic()
+    while queue or in_flight:
+        while queue and len(in_flight) < window:
+            chunk = queue.pop()
+            in_flight[backend.submit(chunk)] = chunk
+        done = backend.wait(list(in_flight), timeout=0.5)
+        lost: list[dict] = []
+        broken = None
+        for fut in done:
+            chunk = in_flight.pop(fut)
+            try:
+                recs = backend.result(fut)
+            except WorkerLost as err:
+                lost.extend(chunk)
+                broken = err
+                continue
+            for r in recs:
+                if r["status"] == "bad-metric":
+                    raise ScenarioError(f"{sweep.source}: metrics: {r['error']}")
+            journal.append(recs)
+            for r in recs:
+                records[(r["variant"], r["seed"])] = r
+                failed += r["status"] != "ok"
+        if broken is not None:
+            if isinstance(backend, LocalBackend):
+                # A broken pool fails every chunk in flight: take them all, start a new pool.
+                for chunk in in_flight.values():
+                    lost.extend(chunk)
+                in_flight.clear()
+                backend.restart()
+            dead = []
+            for t in lost:
+                k = (t["variant"], t["seed"])
+                attempts[k] = attempts.get(k, 0) + 1
+                if attempts[k] >= MAX_ATTEMPTS:
+                    dead.append({"variant": t["variant"], "vkey": t["vkey"], "seed": t["seed"],
+                                 "status": "failed", "metrics": {}, "wall_s": float("nan"),
+                                 "error": f"worker process died while running it ({broken})"})
+                else:
+                    queue.append([t])  # retried alone: a crasher only takes itself down
+            if dead:
+                journal.append(dead)
+                for r in dead:
+                    records[(r["variant"], r["seed"])] = r
+                failed += len(dead)
+        if progress and done:
+            progress(len(records), total, failed)
+        if time.monotonic() - last_rebuild >= rebuild_every_s and (queue or in_flight):
+            rebuild()
+            last_rebuild = time.monotonic()
+    return failed

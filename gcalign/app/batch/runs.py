@@ -1,0 +1,177 @@
+"""One run of a batch, as it executes in a worker process (local pool or Dask worker).
+
+Everything here is a top-level, picklable function that never imports rich: a task
+(a plain dict) goes in, a record (a plain dict) comes out, and a failing run is recorded,
+never raised. Each worker process caches the parsed scenario and the noise-free
+simulation of a variant, so successive seeds only add their sensor errors.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+import sys
+import time
+from typing import Any
+
+import numpy as np
+
+from gcalign.errors import GcalignError
+
+
+class MetricError(Exception):
+    """A metric path that the run summary does not have (the sweep is wrong, not the run)."""
+
+
+_PARSED: dict[str, Any] = {}
+
+
+def _scenario(task: dict):
+    from gcalign.io.scenario import parse_scenario
+
+    sc = _PARSED.get(task["vkey"])
+    if sc is None:
+        if len(_PARSED) > 256:
+            _PARSED.clear()
+        sc = _PARSED[task["vkey"]] = parse_scenario(copy.deepcopy(task["scenario"]),
+                                                    task["source"])
+    return sc
+
+
+_NOISE_FREE: dict = {}  # cache key -> noise-free RunData (truth, ideal IMU) in this worker
+
+
+def run_data(sc, seed: int, cache_key: str | None = None):
+    """:func:`gcalign.app.data.scenario_data` with the noise-free simulation (truth
+    and ideal increments: about 2/3 of a seed 000 run) computed once per variant in each
+    worker; only the sensor errors depend on the seed. Same numbers, bit for bit (tested).
+    The cached arrays are made read-only, so code that would modify them fails loudly.
+    """
+    from gcalign.app.data import noise_free, scenario_data, with_errors
+
+    if cache_key is None or sc.imu_file is not None or sc.motion is None or sc.site is None:
+        return scenario_data(sc, seed)
+    hit = _NOISE_FREE.get(cache_key)
+    if hit is None:
+        if len(_NOISE_FREE) >= 4:
+            _NOISE_FREE.pop(next(iter(_NOISE_FREE)))
+        hit = _NOISE_FREE[cache_key] = noise_free(sc)
+        for obj in (hit.truth, hit.imu):
+            for value in vars(obj).values():
+                if isinstance(value, np.ndarray):
+                    value.flags.writeable = False
+    return with_errors(sc, hit, seed)
+
+
+def run_summary(command: str, sc, seed: int, cache_key: str | None = None) -> dict:
+    """The summary dict a single ``gcalign align`` / ``gcalign northfind`` run would print.
+
+    `cache_key` (the variant) lets successive seeds share the noise-free simulation.
+    """
+    if command == "align":
+        from gcalign.app.align.run import alignment_summary, run_alignment
+
+        data = run_data(sc, seed, cache_key)
+        return alignment_summary(run_alignment(sc, data), data, sc.name)
+    if command == "northfind":
+        try:
+            from gcalign.app.northfind.run import northfind_summary, run_northfind
+        except ImportError as err:  # pragma: no cover - until the pipeline lands
+            raise GcalignError(f"northfind pipeline not available: {err}") from None
+        return northfind_summary(run_northfind(sc, seed), sc)
+    raise GcalignError(f"unknown command {command!r}")
+
+
+def metric_value(summary: dict, path: str):
+    """The value at a dotted path of a run summary: a float or a list of floats."""
+    node: Any = summary
+    parts = path.split(".")
+    for depth, part in enumerate(parts):
+        here = ".".join(parts[:depth]) or "the run summary"
+        if isinstance(node, dict):
+            if part not in node:
+                raise MetricError(f"metric {path!r}: {here} has no {part!r}; it has: "
+                                  f"{', '.join(map(str, node))}")
+            node = node[part]
+        elif isinstance(node, list):
+            if not part.isdigit() or int(part) >= len(node):
+                raise MetricError(f"metric {path!r}: {here} is a list of {len(node)} item(s); "
+                                  f"{part!r} is not one of its indices")
+            node = node[int(part)]
+        else:
+            raise MetricError(f"metric {path!r}: {here} is a single value, it has no {part!r}")
+    if node is None:
+        raise ValueError(f"metric {path!r} is empty in this run (no truth to compare with?)")
+    if isinstance(node, bool) or not isinstance(node, (int, float, list)):
+        raise MetricError(f"metric {path!r}: not a number or a list of numbers, "
+                          f"got {type(node).__name__}")
+    if isinstance(node, list):
+        if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in node):
+            raise MetricError(f"metric {path!r}: a list, but not of numbers")
+        return [float(x) for x in node]
+    return float(node)
+
+
+def run_task(task: dict) -> dict:
+    """One run: ``task`` = command, variant, vkey, seed, scenario (mapping), source, metrics.
+
+    Never raises for a failing run: the record says ``status: failed`` and the error.
+    """
+    t0 = time.perf_counter()
+    rec = {"variant": task["variant"], "vkey": task["vkey"], "seed": task["seed"],
+           "status": "ok", "metrics": {}, "error": ""}
+    try:
+        summary = run_summary(task["command"], _scenario(task), task["seed"], task["vkey"])
+        rec["metrics"] = {m: metric_value(summary, m) for m in task["metrics"]}
+    except MetricError as err:
+        rec.update(status="bad-metric", error=str(err), metrics={})
+    except Exception as err:  # a failing run is recorded, the others go on
+        msg = str(err).strip().replace("\n", "; ")
+        rec.update(status="failed", metrics={},
+                   error=msg if isinstance(err, GcalignError) else f"{type(err).__name__}: {msg}")
+    rec["wall_s"] = time.perf_counter() - t0
+    return rec
+
+
+def run_chunk(tasks: list[dict]) -> list[dict]:
+    """Several runs in one worker call (amortises the per-call overhead)."""
+    return [run_task(t) for t in tasks]
+
+
+def kernel_cache_stats() -> dict:
+    """Numba dispatchers of gcalign loaded in this process: cache hits and misses.
+
+    A miss means the kernel was compiled here instead of loaded from the on-disk cache.
+    """
+    hits = misses = 0
+    for name in ("gcalign.nav._kernels", "gcalign.align.kernel", "gcalign.northfind"):
+        mod = sys.modules.get(name)
+        for obj in vars(mod).values() if mod else ():
+            stats = getattr(obj, "stats", None)
+            if stats is not None and hasattr(stats, "cache_misses"):
+                hits += sum(stats.cache_hits.values())
+                misses += sum(stats.cache_misses.values())
+    return {"pid": os.getpid(), "cache_hits": hits, "cache_misses": misses}
+
+
+WARM_SCENARIO = {
+    "name": "warm-up",
+    "site": {"lat_deg": 45.0, "lon_deg": 126.0},
+    "imu": {"gyro": {"bias_dph": [0.01, 0.01, 0.01]}, "accel": {"bias_ug": [50, 50, 50]}},
+    "motion": {"kind": "moving", "attitude_deg": [0, 0, 30], "duration_s": 3,
+               "segments": [{"duration_s": 1}, {"duration_s": 2, "accel_mps2": 0.5}]},
+    "align": {"t1_s": 1, "t2_s": 2, "t3_s": 2.5, "passes": 3, "level_s": 0.1,
+              "aiding": {"source": "odometer"}},
+}
+
+
+def warm_up(command: str = "align") -> dict:
+    """Load the numba kernels (from the on-disk JIT cache) with a tiny run, once per process."""
+    if command == "align":
+        from gcalign.io.scenario import parse_scenario
+
+        try:
+            run_summary("align", parse_scenario(copy.deepcopy(WARM_SCENARIO), "warm-up"), 1)
+        except Exception:  # noqa: BLE001 - warming is an optimisation only
+            pass
+    return kernel_cache_stats()

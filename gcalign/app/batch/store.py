@@ -1,0 +1,239 @@
+"""The journal and the HDF5 results file of a batch, and what a resume reads back.
+
+DESIGN.md "Results file". Every finished run is appended to a journal next to the output
+(``FILE.journal.jsonl``: one JSON line per run, flushed and fsync'd per batch of results).
+The HDF5 file is rebuilt from the journal under a temporary name and renamed
+(:func:`gcalign.io.results.atomic_h5`) every few seconds and at the end, so a SIGKILL never
+leaves a corrupt file, and ``resume=True`` runs only what is missing (from the journal, or
+from the HDF5 file if the journal is gone). Runs are identified by a hash of their
+variant's scenario, command and metrics plus the seed, so a resumed sweep with more seeds
+or more grid values reuses every run it already has.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+from gcalign.app.batch.aggregate import STATS, components, metric_units
+from gcalign.app.batch.sweep import Sweep
+from gcalign.errors import ScenarioError
+
+JOURNAL_SUFFIX = ".journal.jsonl"
+
+
+def journal_path(output: Path) -> Path:
+    output = Path(output)
+    return output.with_name(output.name + JOURNAL_SUFFIX)
+
+
+class Journal:
+    """Append-only JSON lines; each batch of lines is flushed and fsync'd."""
+
+    def __init__(self, path: Path, header: dict, keep: Iterable[dict] = ()):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        # Start from a clean file (a torn last line from a SIGKILL must not be appended to):
+        # header + the records kept, written under a temporary name and renamed.
+        tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
+        with open(tmp, "w", encoding="utf-8") as f:
+            for obj in (header, *keep):
+                f.write(json.dumps(obj) + "\n")
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, self.path)
+        self._f = open(self.path, "a", encoding="utf-8")  # noqa: SIM115
+
+    def append(self, records: Iterable[dict]) -> None:
+        for r in records:
+            self._f.write(json.dumps({"type": "run", **r}) + "\n")
+        self._f.flush()
+        os.fsync(self._f.fileno())
+
+    def close(self) -> None:
+        self._f.close()
+
+
+def read_journal(path: Path) -> list[dict]:
+    """Run records of a journal; a torn line (the process was killed mid-write) is skipped."""
+    out = []
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            try:
+                obj = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            if isinstance(obj, dict) and obj.get("type") == "run":
+                out.append(obj)
+    return out
+
+
+def read_runs_h5(path: Path) -> list[dict]:
+    """Run records from a batch results file (``/batch/runs``)."""
+    from gcalign.io import results
+
+    with results.open_results(path) as f:
+        if "batch/runs" not in f:
+            raise ScenarioError(f"{path}: not a batch results file (no /batch/runs)")
+        g = f["batch/runs"]
+        metrics = {m: g["metrics"][m][()] for m in g["metrics"]}
+        lengths = g["metrics"].attrs
+        recs = []
+        for i in range(g["seed"].shape[0]):
+            status = _s(g["status"][i])
+            vals = {}
+            if status == "ok":
+                for m, arr in metrics.items():
+                    x = arr[i]
+                    n = int(lengths.get(m + ".length", -1))
+                    vals[m] = float(x) if n < 0 else [float(v) for v in x[:n]]
+            recs.append({"variant": int(g["variant"][i]), "vkey": _s(g["vkey"][i]),
+                         "seed": int(g["seed"][i]), "status": status, "metrics": vals,
+                         "error": _s(g["error"][i]), "wall_s": float(g["wall_s"][i])})
+    return recs
+
+
+def _s(x) -> str:
+    return x.decode() if isinstance(x, bytes) else str(x)
+
+
+def write_batch_h5(output: Path, sweep: Sweep, records: dict, summary: dict) -> None:
+    """(Re)build the whole results file from the run records, atomically."""
+    import h5py
+
+    from gcalign.io import results
+
+    keys = [k for k in sweep.run_keys() if k in records]
+    recs = [records[k] for k in keys]
+    by_index = {v.index: v for v in sweep.variants}
+    scenario_text = sweep.text + f"\n# base scenario: {sweep.base_source}\n" + "".join(
+        f"# {line}\n" for line in sweep.base_text.splitlines())
+    with results.atomic_h5(output) as f:
+        results.write_header(f, "batch", scenario_text, None, summary)
+        b = f.create_group("batch")
+        b.attrs["command"] = sweep.command
+        b.attrs["sweep"] = sweep.name
+        b.attrs["seeds"], b.attrs["seed_start"] = sweep.seeds, sweep.seed_start
+        b.attrs["metrics"] = json.dumps(list(sweep.metrics))
+        b.attrs["grid_json"] = json.dumps(sweep.grid, default=str)
+        b.attrs["base_yaml"] = sweep.base_text
+        b.attrs["fingerprint"] = sweep.fingerprint
+        b.attrs["complete"] = bool(summary["complete"])
+        r = b.create_group("runs")
+        r.attrs["description"] = ("one row per finished run, sorted by (variant, seed); "
+                                  "metric values NaN where the run failed")
+        str_dt = h5py.string_dtype()
+        results.put(r, "variant", np.array([k[0] for k in keys], dtype=np.int32), "1")
+        results.put(r, "seed", np.array([k[1] for k in keys], dtype=np.int64), "1")
+        for name, what in (("status", "ok | failed"), ("error", "error message ('' if ok)"),
+                           ("vkey", "hash of the variant's command, metrics and scenario")):
+            ds = r.create_dataset(name, data=np.array([x[name] for x in recs], dtype=object),
+                                  dtype=str_dt)
+            ds.attrs["units"], ds.attrs["description"] = "none", what
+        results.put(r, "wall_s", np.array([x.get("wall_s", np.nan) for x in recs]), "s")
+        mg = r.create_group("metrics")
+        for m in sweep.metrics:
+            vals = [x["metrics"].get(m) if x["status"] == "ok" else None for x in recs]
+            lens = {len(v) for v in vals if isinstance(v, list)}
+            if lens:
+                k = max(lens)
+                arr = np.full((len(recs), k), np.nan)
+                for i, v in enumerate(vals):
+                    if isinstance(v, list):
+                        arr[i, : len(v)] = v
+                mg.attrs[m + ".length"] = k
+            else:
+                arr = np.array([np.nan if v is None else v for v in vals], dtype=float)
+            ds = results.put(mg, m, arr, metric_units(m))
+            comps = components(sweep.command, m, arr.shape[1] if arr.ndim == 2 else None)
+            if comps:
+                ds.attrs["components"] = ", ".join(comps)
+        a = b.create_group("aggregate")
+        for entry in summary["variants"]:
+            v = by_index[entry["index"]]
+            g = a.create_group(f"v{v.index:03d}")
+            g.attrs["index"], g.attrs["label"] = v.index, v.label
+            g.attrs["overrides_json"] = json.dumps(v.overrides, default=str)
+            g.attrs["ok"], g.attrs["failed"] = entry["ok"], entry["failed"]
+            for key, value in v.overrides.items():
+                g.attrs[key] = _attr(value)
+            for m, st in entry["stats"].items():
+                mg = g.create_group(m)
+                mg.attrs["n"] = st["n"]
+                if st.get("components"):
+                    mg.attrs["components"] = ", ".join(st["components"])
+                for s in STATS:
+                    val = st[s]
+                    if val is None:
+                        val = np.nan
+                    results.put(mg, s, np.array(val, dtype=float) if not isinstance(val, list)
+                                else np.array([np.nan if x is None else x for x in val]),
+                                metric_units(m))
+
+
+def _attr(value):
+    """An override value as an HDF5 attribute (JSON text where HDF5 has no type for it)."""
+    if isinstance(value, (bool, int, float, str)):
+        return value
+    if isinstance(value, list) and all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                       for x in value):
+        return np.asarray(value, dtype=float)
+    return json.dumps(value, default=str)
+
+
+def _clean_stale_tmp(output: Path) -> None:
+    """Remove temporary files of our output left by a killed batch (dead pid only)."""
+    for p in output.parent.glob(f".{output.name}.*.tmp"):
+        try:
+            pid = int(p.name.rsplit(".", 2)[-2])
+        except ValueError:
+            continue
+        if pid != os.getpid() and not _alive(pid):
+            p.unlink(missing_ok=True)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def previous_records(sweep: Sweep, output: Path) -> tuple[dict, str]:
+    """Finished runs of an earlier batch into `output` that this sweep still contains:
+    from the journal, else from the HDF5 file. Failed runs are not kept (they run again)."""
+    jpath = journal_path(output)
+    if jpath.is_file():
+        recs, where = read_journal(jpath), str(jpath)
+    elif Path(output).is_file():
+        recs, where = read_runs_h5(output), str(output)
+    else:
+        return {}, ""
+    index = {v.key: v.index for v in sweep.variants}
+    seeds = set(sweep.seed_values)
+    kept: dict[tuple[int, int], dict] = {}
+    for r in recs:  # a later record of the same run wins
+        vi = index.get(str(r.get("vkey")))
+        if vi is None or r.get("seed") not in seeds or r.get("status") != "ok":
+            continue
+        r = {k: v for k, v in r.items() if k != "type"}
+        r["variant"] = vi
+        kept[(vi, r["seed"])] = r
+    return kept, where
+
+
+def read_batch(path: Path) -> tuple[dict, list[dict]]:
+    """Summary and run records of a batch results file."""
+    from gcalign.io import results
+
+    kind, summary, _ = results.read_summary(path)
+    if kind != "batch":
+        raise ScenarioError(f"{path}: a {kind!r} results file, not a batch")
+    return summary, read_runs_h5(path)

@@ -1,0 +1,241 @@
+"""The sweep model: a base scenario × a grid of overrides × seeds, validated up front.
+
+The sweep format is described in ``docs/batch.md``.
+
+A *sweep* is a base scenario (a path relative to the sweep file, or an inline mapping), a
+*grid* of overrides by dotted key (``align.stages.0.t_z_s: [100, 150, 200]``), a seed count
+and the *metrics* to aggregate (dotted paths into the run summary, e.g. ``error_t3_deg``).
+A *variant* is one point of the Cartesian product of the grid; a *run* is a variant and a
+seed. Every variant runs the same seeds ``seed_start .. seed_start + seeds - 1`` (common
+random numbers), so differences between variants are not masked by different noise.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from gcalign.app.batch.overrides import apply_override
+from gcalign.errors import ScenarioError
+
+COMMANDS = ("align", "northfind")
+DEFAULT_METRICS = {
+    "align": ("error_t3_deg",),
+    "northfind": ("methods.coordinate.rms_error_deg",),
+}
+SWEEP_KEYS = ("name", "base", "command", "grid", "seeds", "seed_start", "metrics")
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One grid point: its overrides (dotted key -> value) and the resulting scenario."""
+
+    index: int
+    overrides: dict
+    scenario: dict
+    key: str  # hash of command, metrics and scenario: identifies its runs across resumes
+
+    @property
+    def label(self) -> str:
+        if not self.overrides:
+            return "base"
+        return ", ".join(f"{k}={_short(v)}" for k, v in self.overrides.items())
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A validated sweep: every variant's scenario has passed ``parse_scenario``."""
+
+    name: str
+    command: str
+    source: str
+    text: str
+    base_source: str
+    base_text: str
+    grid: dict
+    seeds: int
+    seed_start: int
+    metrics: tuple[str, ...]
+    variants: tuple[Variant, ...]
+
+    @property
+    def seed_values(self) -> range:
+        return range(self.seed_start, self.seed_start + self.seeds)
+
+    def run_keys(self) -> list[tuple[int, int]]:
+        """``(variant, seed)`` of every run, in canonical order."""
+        return [(v.index, s) for v in self.variants for s in self.seed_values]
+
+    @property
+    def fingerprint(self) -> str:
+        return _hash([v.key for v in self.variants], list(self.seed_values))
+
+
+def _short(v) -> str:
+    text = json.dumps(v) if not isinstance(v, str) else v
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _hash(*parts) -> str:
+    text = json.dumps(parts, sort_keys=True, default=str, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def load_sweep(path: Path) -> Sweep:
+    """Read and validate a sweep file (ScenarioError, exit 2, on any bad input)."""
+    from gcalign.io.scenario.loader import read_yaml
+
+    path = Path(path)
+    data = read_yaml(path)
+    return sweep_from_mapping(data, str(path), path.parent, path.read_text(encoding="utf-8"),
+                              default_name=path.stem)
+
+
+def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None,
+                       text: str | None = None, default_name: str = "sweep") -> Sweep:
+    """Validate a parsed sweep mapping; every variant is parsed before anything runs.
+
+    Raises ScenarioError with one line naming the key and the value that is wrong.
+    """
+    import yaml
+
+    from gcalign.io.scenario import parse_scenario
+    from gcalign.io.scenario.loader import read_yaml
+
+    base_dir = Path(base_dir or ".")
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{source}: a sweep must be a YAML mapping, got {type(data).__name__}")
+    for k in data:
+        if k not in SWEEP_KEYS:
+            raise ScenarioError(f"{source}: {k}: unknown key (a sweep has: "
+                                f"{', '.join(SWEEP_KEYS)})")
+    text = text if text is not None else yaml.safe_dump(data, sort_keys=False)
+
+    name = data.get("name", default_name)
+    if not isinstance(name, str) or not name or any(c in name for c in "/\\ \t"):
+        raise ScenarioError(f"{source}: name: must be a non-empty word (used in file names), "
+                            f"got {name!r}")
+
+    # Base scenario: a file relative to the sweep, or an inline mapping.
+    if "base" not in data:
+        raise ScenarioError(f"{source}: base: missing; give a scenario file (relative to the "
+                            "sweep file) or an inline scenario mapping")
+    base = data["base"]
+    if isinstance(base, str):
+        base_path = (base_dir / base) if not Path(base).is_absolute() else Path(base)
+        if not base_path.is_file():
+            raise ScenarioError(f"{source}: base: {base!r}: file not found ({base_path})")
+        base_data = read_yaml(base_path)
+        base_source, base_text = str(base_path), base_path.read_text(encoding="utf-8")
+        imu_dir = base_path.parent
+    elif isinstance(base, dict):
+        base_data, base_source = copy.deepcopy(base), f"{source}: base"
+        base_text, imu_dir = yaml.safe_dump(base, sort_keys=False), base_dir
+    else:
+        raise ScenarioError(f"{source}: base: must be a scenario file name or a mapping, "
+                            f"got {type(base).__name__} {base!r}")
+    if isinstance(base_data, dict) and isinstance(base_data.get("imu_file"), str):
+        p = Path(base_data["imu_file"])  # workers may run elsewhere: make it absolute
+        base_data["imu_file"] = str(p if p.is_absolute() else (imu_dir / p).resolve())
+    base_model = parse_scenario(base_data, base_source)
+
+    command = data.get("command")
+    if command is None:
+        has = [c for c in COMMANDS if isinstance(base_data, dict) and c in base_data]
+        if len(has) > 1:
+            raise ScenarioError(f"{source}: command: the base has both 'align' and 'northfind' "
+                                "sections; say which to run (command: align | northfind)")
+        command = has[0] if has else "align"
+    if command not in COMMANDS:
+        raise ScenarioError(f"{source}: command: must be one of {', '.join(COMMANDS)}, "
+                            f"got {command!r}")
+
+    seeds = data.get("seeds", 1)
+    if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
+        raise ScenarioError(f"{source}: seeds: must be a whole number ≥ 1 (the seed count), "
+                            f"got {seeds!r}")
+    seed_start = data.get("seed_start", 1)
+    if isinstance(seed_start, bool) or not isinstance(seed_start, int) or seed_start < 0:
+        raise ScenarioError(f"{source}: seed_start: must be a whole number ≥ 0, got {seed_start!r}")
+
+    metrics = data.get("metrics", list(DEFAULT_METRICS[command]))
+    if isinstance(metrics, str):
+        metrics = [metrics]
+    if not isinstance(metrics, list) or not metrics:
+        raise ScenarioError(f"{source}: metrics: must be a non-empty list of dotted paths into "
+                            f"the run summary (e.g. [error_t3_deg]), got {metrics!r}")
+    for m in metrics:
+        if not isinstance(m, str) or not m or "/" in m or any(p == "" for p in m.split(".")):
+            raise ScenarioError(f"{source}: metrics: {m!r} is not a dotted path "
+                                "(e.g. error_t3_deg, passes.2.error_deg)")
+    if len(set(metrics)) != len(metrics):
+        raise ScenarioError(f"{source}: metrics: {metrics!r} names a metric twice")
+
+    grid = data.get("grid") or {}
+    if not isinstance(grid, dict):
+        raise ScenarioError(f"{source}: grid: must be a mapping of dotted key -> list of values, "
+                            f"got {type(grid).__name__}")
+    axes: dict[str, list] = {}
+    for key, values in grid.items():
+        if not isinstance(key, str) or not key:
+            raise ScenarioError(f"{source}: grid: {key!r}: keys must be dotted paths "
+                                "(e.g. align.mode)")
+        if not isinstance(values, list):
+            values = [values]  # one fixed value
+        if not values:
+            raise ScenarioError(f"{source}: grid: {key} = []: empty list of values; give at "
+                                "least one value")
+        seen = [json.dumps(v, sort_keys=True, default=str) for v in values]
+        for i, s in enumerate(seen):
+            if s in seen[:i]:
+                raise ScenarioError(f"{source}: grid: {key}: value {values[i]!r} appears twice")
+        axes[key] = values
+
+    # Each key and value alone against the base: a message that names exactly that pair.
+    for key, values in axes.items():
+        for value in values:
+            trial = copy.deepcopy(base_data)
+            try:
+                apply_override(trial, key, value, base_model)
+            except ScenarioError as err:
+                raise ScenarioError(f"{source}: grid: {key} = {value!r}: {err}") from None
+            where = f"{source}: grid: {key} = {value!r}"
+            _check_section(parse_scenario(trial, where), command, where)
+
+    # Then every combination (a value may be valid alone but not with another one).
+    keys = list(axes)
+    variants = []
+    for i, combo in enumerate(itertools.product(*(axes[k] for k in keys))):
+        overrides = dict(zip(keys, combo, strict=True))
+        scenario = copy.deepcopy(base_data)
+        label = ", ".join(f"{k} = {v!r}" for k, v in overrides.items())
+        try:
+            for k, v in overrides.items():
+                apply_override(scenario, k, v, base_model)
+        except ScenarioError as err:
+            raise ScenarioError(f"{source}: grid: variant {label}: {err}") from None
+        where = f"{source}: grid: variant {label}"
+        _check_section(parse_scenario(scenario, where), command, where)
+        variants.append(Variant(i, overrides, scenario,
+                                _hash(command, list(metrics), scenario)))
+    return Sweep(name=name, command=command, source=source, text=text,
+                 base_source=base_source, base_text=base_text, grid=axes, seeds=seeds,
+                 seed_start=seed_start, metrics=tuple(metrics), variants=tuple(variants))
+
+
+def _check_section(sc, command: str, where: str) -> None:
+    """The command's own checks that need the whole scenario (e.g. ``northfind.check``)."""
+    section = getattr(sc, command, None)
+    if section is None and command != "align":
+        raise ScenarioError(f"{where}: {command}: missing; command {command!r} needs a "
+                            f"'{command}' section in the base scenario")
+    check = getattr(section, "check", None)
+    if callable(check):
+        try:
+            check(sc)
+        except ScenarioError as err:
+            raise ScenarioError(f"{where}: {err}") from None

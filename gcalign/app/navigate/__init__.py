@@ -1,0 +1,1 @@
+"""`gcalign navigate`: the pipeline, its summary, results file, table and figures."""

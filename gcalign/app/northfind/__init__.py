@@ -1,0 +1,1 @@
+"""`gcalign northfind`: the pipeline, its summary, results file, table and figures."""

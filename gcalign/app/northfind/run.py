@@ -1,0 +1,171 @@
+"""Multi-position north-finding of a scenario (seed 001; DESIGN.md "North-finding").
+
+``run_northfind(sc, seed)`` converts the scenario's ``northfind`` section to a
+:class:`gcalign.northfind.NorthfindSetup`, simulates the turntable and estimates the azimuth
+by each method; ``northfind_summary(run, sc)`` turns the result into the plain dict that
+``gcalign northfind --json`` prints, the results file stores and ``gcalign show`` reprints.
+
+Array layout: the core returns ``(P, M, R)`` (methods × azimuths × repeats); the summary and
+the results file use ``(R, M)`` per method (repeats × azimuths). Flat lists in the summary
+are that ``(R, M)`` array in C order: ``errors_deg[r * M + m]``; ``shape`` is ``[R, M]``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from gcalign import northfind as nf
+from gcalign import units as u
+from gcalign.errors import ScenarioError
+from gcalign.io.scenario import Scenario
+from gcalign.io.scenario.northfind import NorthfindConfig, axis
+
+__all__ = ["NorthfindRun", "northfind_summary", "run_northfind", "run_northfind_scenario"]
+
+
+@dataclass(frozen=True)
+class NorthfindRun:
+    """A north-finding run: configuration, SI setup, core result (radians), seed, timing."""
+
+    cfg: NorthfindConfig
+    setup: nf.NorthfindSetup
+    result: nf.NorthfindResult
+    seed: int
+    compute_s: float
+
+
+def run_northfind(sc: Scenario, seed: int | None = None) -> NorthfindRun:
+    """Simulate and solve the scenario's north-finder.
+
+    Parameters
+    ----------
+    sc : Scenario
+        Needs ``site`` and a ``northfind`` section.
+    seed : int, optional
+        Overrides ``imu.seed``; the same scenario and seed give the same numbers.
+
+    Raises
+    ------
+    ScenarioError
+        Missing section or a value the north-finder cannot use (names the field).
+    """
+    cfg = sc.northfind
+    if cfg is None:
+        raise ScenarioError(
+            "northfind: missing; the scenario needs a 'northfind' section "
+            "(positions, dwell_s, azimuth_deg or sweep, tilt_deg, …)"
+        )
+    setup = cfg.to_setup(sc)
+    seed = sc.imu.seed if seed is None else int(seed)
+    if seed < 0:
+        raise ScenarioError(f"imu.seed (--seed): must be >= 0, got {seed}")
+    rng = np.random.default_rng(seed)
+    t0 = time.perf_counter()
+    result = nf.run_northfind(setup, rng, methods=tuple(cfg.methods), samples=cfg.samples)
+    return NorthfindRun(cfg=cfg, setup=setup, result=result, seed=seed,
+                        compute_s=time.perf_counter() - t0)
+
+
+#: The name the brief and older callers use.
+run_northfind_scenario = run_northfind
+
+
+def _num(x) -> float | None:
+    x = float(x)
+    return None if math.isnan(x) else x
+
+
+def _list(a) -> list:
+    """Plain floats (NaN -> None) of any array, flattened in C order."""
+    return [_num(v) for v in np.asarray(a, float).ravel()]
+
+
+def _deg(a) -> list:
+    return _list(np.degrees(a))
+
+
+def _deg360(a) -> list:
+    return _list(np.mod(np.degrees(a), 360.0))
+
+
+def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
+    """Plain-number summary (degrees): the JSON contract of ``gcalign northfind --json``.
+
+    Per method (``methods[name]``): ``max_abs_error_deg`` and ``rms_error_deg`` over all
+    azimuths and repeats; ``errors_deg`` and ``estimates_deg`` (flat ``(R, M)``); per azimuth
+    (length M) ``mean_deg`` (mean estimate), ``std_deg`` (sample std over repeats, ddof 1,
+    None for one repeat), ``bias_deg`` (mean error, the seed's "deviation from truth"),
+    ``std_pred_deg`` (linearised prediction) and ``error_pred_deg`` (noise-free closed form,
+    None where there is none); ``max_abs_error_pred_deg``.
+    """
+    res, setup, cfg = run.result, run.setup, run.cfg
+    p, m, r = res.azimuth_est.shape
+    est = np.swapaxes(res.azimuth_est, 1, 2)  # (P, R, M)
+    err = np.swapaxes(res.azimuth_error, 1, 2)
+    mean_err = err.mean(1)  # (P, M)
+    truth_deg = np.mod(cfg.azimuths_deg(), 360.0)  # as configured, no round trip through rad
+    std = err.std(1, ddof=1) if r > 1 else np.full((p, m), np.nan)
+    methods = {}
+    for i, name in enumerate(res.methods):
+        e = err[i]
+        pred = res.error_pred[i]
+        methods[name] = {
+            "max_abs_error_deg": float(np.degrees(np.abs(e).max())),
+            "rms_error_deg": float(np.degrees(np.sqrt(np.mean(e * e)))),
+            "errors_deg": _deg(e),
+            "estimates_deg": _deg360(est[i]),
+            "mean_deg": _list(np.mod(truth_deg + np.degrees(mean_err[i]), 360.0)),
+            "std_deg": _deg(std[i]),
+            "bias_deg": _deg(mean_err[i]),
+            "std_pred_deg": _deg(res.azimuth_std_pred[i]),
+            "error_pred_deg": _deg(pred),
+            "max_abs_error_pred_deg": (None if np.all(np.isnan(pred))
+                                       else float(np.degrees(np.nanmax(np.abs(pred))))),
+        }
+    tilt, direction = cfg.tilt_rad()
+    n_dwell = setup.n_samples
+    dwell_time = n_dwell / setup.rate_hz
+    g, a = sc.imu.gyro, sc.imu.accel
+    site = sc.site
+    assert site is not None  # run_northfind checked it
+    return {
+        "scenario": sc.name,
+        "seed": run.seed,
+        "latitude_deg": float(site.lat_deg),
+        "height_m": setup.height,
+        "positions": setup.positions,
+        "dwell_s": setup.dwell_s,
+        "rate_hz": setup.rate_hz,
+        "samples_per_dwell": n_dwell,
+        "samples": cfg.samples,
+        "repeats": r,
+        "shape": [r, m],
+        "index_error_arcsec": cfg.index_error_arcsec,
+        "azimuth_true_deg": _list(truth_deg),
+        "sweep": None if cfg.sweep is None else cfg.sweep.model_dump(),
+        "tilt_deg": float(np.degrees(tilt)),
+        "tilt_direction_deg": float(np.degrees(direction)),
+        "tilt_reference": cfg.reference,
+        "tilt_direction_true_deg": _deg360(res.tilt_direction_true),
+        "tilt_est_deg": _deg(res.tilt_est.T),
+        "tilt_direction_est_deg": _deg360(res.tilt_direction_est.T),
+        "gyro": {
+            "axis": "body y (in the table plane)",
+            "bias_dph": axis(g.bias_dph, 1), "arw_dprh": axis(g.arw_dprh, 1),
+            "scale_ppm": axis(g.scale_ppm, 1),
+            "dwell_sigma_dph": setup.gyro_arw / math.sqrt(dwell_time) / u.DPH,
+        },
+        "accel": {
+            "axes": "body x, y",
+            "bias_ug": [axis(a.bias_ug, 0), axis(a.bias_ug, 1)],
+            "vrw_ugrhz": axis(a.vrw_ugrhz, 0),
+            "dwell_sigma_ug": setup.accel_vrw / math.sqrt(dwell_time) / u.UG,
+        },
+        "method_order": list(res.methods),
+        "methods": methods,
+        "compute_s": run.compute_s,
+    }

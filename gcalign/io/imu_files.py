@@ -1,0 +1,397 @@
+"""Readers (and a CSV writer) for recorded IMU increments.
+
+Two text formats arrive from outside gcalign (DESIGN "Truth and IMU simulation"):
+
+* PSINS ``.imu`` (Yan Gongmin's toolbox, e.g. ``shared/data/lasergyro.imu``): ``%``
+  comment lines, three header rows, then one row of six integer counts per sample::
+
+      pitch0 roll0 yaw0 (deg)  VE0 VN0 VU0 (m/s)          nominal initial state
+      lat lon (deg)  h (m)  t0 (s)  interval (ms)  g (m/s²)
+      gyro scale ×3 (arcsec/count)  accel scale ×3 (µg·s/count)
+      gx gy gz ax ay az                                     counts, one row per sample
+
+  Conversion: ``Δθ = counts · scale_arcsec · ARCSEC`` (rad) and
+  ``Δv = counts · scale_ugs · 1e-6 · g`` (m/s) with ``g`` from header 2 (9.780327 in
+  lasergyro.imu, 2.3e-8 relative from :data:`gcalign.units.G0`). Body axes x right,
+  y forward, z up and ENU navigation, as in gcalign, so no axis change is needed.
+* Plain text/CSV of ``t, Δθx, Δθy, Δθz, Δvx, Δvy, Δvz`` (s, rad, m/s), comma or
+  whitespace separated, ``#`` comments, an optional header line of column names.
+
+HDF5 files written by ``gcalign simulate`` are read by the results layer, not here.
+Every reading problem raises :class:`ImuFileError` with one line that names the file,
+the line (and field) and what was expected.
+
+>>> import os, tempfile
+>>> import numpy as np
+>>> from gcalign.sim.imu import ImuData
+>>> imu = ImuData(t=np.array([0.01, 0.02, 0.03]), dtheta=np.zeros((3, 3)),
+...               dv=np.tile([0.0, 0.0, 0.098], (3, 1)), ts=0.01)
+>>> path = os.path.join(tempfile.mkdtemp(), "imu.csv")
+>>> write_csv_imu(path, imu)
+>>> back = read_imu_file(path)
+>>> len(back), back.ts, back.dv[0].tolist()
+(3, 0.01, [0.0, 0.0, 0.098])
+>>> try:
+...     read_imu_file(os.path.join(os.path.dirname(path), "missing.imu"))
+... except ImuFileError as exc:
+...     print(str(exc).endswith("missing.imu: file not found"))
+True
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from gcalign.errors import ScenarioError
+from gcalign.sim.imu import ImuData
+from gcalign.units import ARCSEC, DEG
+
+__all__ = [
+    "ImuFileError",
+    "read_psins_imu",
+    "read_csv_imu",
+    "read_imu_file",
+    "write_csv_imu",
+]
+
+_HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
+_CSV_COLUMNS = ("t", "dtheta_x", "dtheta_y", "dtheta_z", "dv_x", "dv_y", "dv_z")
+_PSINS_HEADERS = (
+    ("initial state", ("pitch0_deg", "roll0_deg", "yaw0_deg", "VE0", "VN0", "VU0")),
+    ("site and timing", ("lat_deg", "lon_deg", "height_m", "t0_s", "interval_ms", "g")),
+    ("scale factors", ("gx_arcsec", "gy_arcsec", "gz_arcsec", "ax_ugs", "ay_ugs", "az_ugs")),
+)
+
+
+class ImuFileError(ScenarioError):
+    """An IMU file that cannot be read; the message is one line naming file, line and field.
+
+    A :class:`ValueError` (through :class:`gcalign.errors.ScenarioError`), so the command
+    line reports it as bad input (exit code 2) without a traceback.
+    """
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _read_lines(path) -> tuple[str, list[str]]:
+    """Text lines of `path` (without line ends); missing/unreadable files -> ImuFileError."""
+    name = os.fspath(path)
+    p = Path(name)
+    if not p.exists():
+        raise ImuFileError(f"{name}: file not found")
+    if p.is_dir():
+        raise ImuFileError(f"{name}: is a directory, expected an IMU data file")
+    try:
+        text = p.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise ImuFileError(f"{name}: cannot read file ({exc.strerror or exc})") from None
+    return name, text.splitlines()
+
+
+def _strip(line: str, comment: str) -> str:
+    """The line without its trailing comment and surrounding blanks."""
+    i = line.find(comment)
+    return (line if i < 0 else line[:i]).strip()
+
+
+def _fields(line: str, delimiter: str | None) -> list[str]:
+    return [f.strip() for f in line.split(delimiter)] if delimiter else line.split()
+
+
+def _to_float(name: str, lineno: int, col: int, what: str, text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise ImuFileError(
+            f"{name}:{lineno}: field {col} ({what}) must be a number, got {text!r}"
+        ) from None
+
+
+def _diagnose(name, lines, start, ncols, comment, delimiter, labels) -> ImuFileError:
+    """Find the first bad data line after a fast parse failed and describe it (slow path)."""
+    for i in range(start, len(lines)):
+        body = _strip(lines[i], comment)
+        if not body:
+            continue
+        parts = _fields(body, delimiter)
+        if len(parts) != ncols:
+            return ImuFileError(
+                f"{name}:{i + 1}: expected {ncols} columns ({', '.join(labels)}), got {len(parts)}"
+            )
+        for col, (part, label) in enumerate(zip(parts, labels, strict=True), start=1):
+            _to_float(name, i + 1, col, label, part)
+    return ImuFileError(f"{name}: cannot parse the data rows (no single bad line found)")
+
+
+def _parse_block(name, lines, start, ncols, comment, delimiter, labels) -> np.ndarray:
+    """Rows ``lines[start:]`` as an (N, ncols) float array; errors name the offending line."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data": ours below
+            data = np.loadtxt(
+                lines[start:], comments=comment, delimiter=delimiter, ndmin=2, dtype=float
+            )
+    except ValueError:
+        raise _diagnose(name, lines, start, ncols, comment, delimiter, labels) from None
+    if data.size == 0:
+        raise ImuFileError(f"{name}: no data rows after line {start}, expected {ncols} columns")
+    if data.shape[1] != ncols:
+        # Consistent but wrong column count everywhere: report the first data line.
+        raise _diagnose(name, lines, start, ncols, comment, delimiter, labels)
+    bad = ~np.isfinite(data)
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        lineno = _data_lineno(lines, start, comment, int(row))
+        raise ImuFileError(
+            f"{name}:{lineno}: field {col + 1} ({labels[col]}) must be finite, "
+            f"got {float(data[row, col])!r}"
+        )
+    return data
+
+
+def _data_lineno(lines, start, comment, row) -> int:
+    """1-based file line of data row `row` (counting only non-blank, non-comment lines)."""
+    k = -1
+    for i in range(start, len(lines)):
+        if _strip(lines[i], comment):
+            k += 1
+            if k == row:
+                return i + 1
+    return len(lines)
+
+
+# --------------------------------------------------------------------------- PSINS
+
+
+def read_psins_imu(path) -> ImuData:
+    """Read a PSINS text ``.imu`` file of integer increment counts.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    ImuData
+        ``t`` (N,) s: ``t0 + ts · (1..N)``, end time of each increment; ``dtheta`` (N, 3)
+        rad; ``dv`` (N, 3) m/s; ``ts`` s; ``site = [lat (rad), lon (rad), h (m)]``;
+        ``att0 = [pitch, roll, yaw]`` (rad) and ``v0_n`` (ENU, m/s) from header 1 (the
+        file calls them nominal, "maybe inaccurate"); ``source`` the path; ``meta`` all
+        header values in the file's own units plus ``format="psins"``.
+
+    Raises
+    ------
+    ImuFileError
+        Missing file, a header row without six numbers, interval or g not positive,
+        a sample row without six numbers, no samples.
+    """
+    name, lines = _read_lines(path)
+    header: list[list[float]] = []
+    i = 0
+    while len(header) < 3 and i < len(lines):
+        body = _strip(lines[i], "%")
+        i += 1
+        if not body:
+            continue
+        what, labels = _PSINS_HEADERS[len(header)]
+        parts = body.split()
+        if len(parts) != 6:
+            raise ImuFileError(
+                f"{name}:{i}: PSINS header row {len(header) + 1} ({what}) must have 6 numbers "
+                f"({', '.join(labels)}), got {len(parts)}"
+            )
+        header.append([_to_float(name, i, c + 1, labels[c], s) for c, s in enumerate(parts)])
+    if len(header) < 3:
+        raise ImuFileError(
+            f"{name}: PSINS file ends after {len(header)} of 3 header rows "
+            "(initial state; site and timing; scale factors)"
+        )
+    (pitch, roll, yaw, ve, vn, vu), (lat, lon, h, t0, interval_ms, g), scales = header
+    if not interval_ms > 0:
+        raise ImuFileError(
+            f"{name}: header row 2 field 5 (sampling interval, ms) must be > 0, got {interval_ms!r}"
+        )
+    if not g > 0:
+        raise ImuFileError(f"{name}: header row 2 field 6 (g, m/s²) must be > 0, got {g!r}")
+
+    labels = ("gyro x", "gyro y", "gyro z", "accel x", "accel y", "accel z")
+    counts = _parse_block(name, lines, i, 6, "%", None, labels)
+    gyro_scale = np.asarray(scales[:3]) * ARCSEC  # rad per count
+    accel_scale = np.asarray(scales[3:]) * 1e-6 * g  # µg·s per count -> m/s per count
+    dtheta = counts[:, :3] * gyro_scale
+    dv = counts[:, 3:] * accel_scale
+    ts = interval_ms * 1e-3
+    n = len(counts)
+    t = t0 + ts * np.arange(1, n + 1)
+    meta = {
+        "format": "psins",
+        "att0_deg": [pitch, roll, yaw],
+        "v0_n": [ve, vn, vu],
+        "lat_deg": lat,
+        "lon_deg": lon,
+        "height_m": h,
+        "t0_s": t0,
+        "interval_ms": interval_ms,
+        "g": g,
+        "gyro_scale_arcsec": list(scales[:3]),
+        "accel_scale_ugs": list(scales[3:]),
+    }
+    return ImuData(
+        t=t,
+        dtheta=dtheta,
+        dv=dv,
+        ts=ts,
+        site=np.array([lat * DEG, lon * DEG, h]),
+        att0=np.array([pitch, roll, yaw]) * DEG,
+        v0_n=np.array([ve, vn, vu], dtype=float),
+        source=name,
+        meta=meta,
+    )
+
+
+# --------------------------------------------------------------------------- CSV
+
+
+def _is_number(s: str) -> bool:
+    try:
+        float(s)
+    except ValueError:
+        return False
+    return True
+
+
+def read_csv_imu(path, ts: float | None = None) -> ImuData:
+    """Read ``t, Δθx, Δθy, Δθz, Δvx, Δvy, Δvz`` rows (s, rad, m/s) from a text/CSV file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file: comma- or whitespace-separated (decided from the first data line),
+        ``#`` starts a comment, the first non-comment line may be a header of names.
+    ts : float, optional
+        Sample interval, s. Default: the median of the time differences (to 12
+        significant digits).
+
+    Returns
+    -------
+    ImuData
+        ``t`` (N,) s as written (end time of each increment), ``dtheta`` (N, 3) rad,
+        ``dv`` (N, 3) m/s, ``ts``; ``site``, ``att0``, ``v0_n`` are None; ``meta`` holds
+        the header names (if any), the delimiter and the min/max time step.
+
+    Raises
+    ------
+    ImuFileError
+        Missing file, wrong column count, non-numeric or non-finite value, no data,
+        time not strictly increasing, ``ts`` not positive, one row and no ``ts``.
+    """
+    name, lines = _read_lines(path)
+    i = 0
+    while i < len(lines) and not _strip(lines[i], "#"):
+        i += 1
+    if i == len(lines):
+        raise ImuFileError(f"{name}: no data rows, expected 7 columns ({', '.join(_CSV_COLUMNS)})")
+    first = _strip(lines[i], "#")
+    delimiter = "," if "," in first else None
+    names = None
+    parts = _fields(first, delimiter)
+    if not all(_is_number(p) for p in parts) and any(c.isalpha() for c in first):
+        if not any(_is_number(p) for p in parts):
+            names = parts
+            i += 1
+    data = _parse_block(name, lines, i, 7, "#", delimiter, _CSV_COLUMNS)
+    t = data[:, 0].copy()
+    dt = np.diff(t)
+    if (dt <= 0).any():
+        k = int(np.argmax(dt <= 0)) + 1
+        lineno = _data_lineno(lines, i, "#", k)
+        raise ImuFileError(
+            f"{name}:{lineno}: time must increase strictly, got t = {float(t[k])!r} "
+            f"after {float(t[k - 1])!r}"
+        )
+    if ts is None:
+        if len(t) < 2:
+            raise ImuFileError(f"{name}: one sample only, cannot infer ts; pass ts explicitly")
+        # Median step, rounded to 12 significant digits: decimal time stamps such as
+        # 0.01, 0.02, ... give ts = 0.01 rather than 0.009999999999999998.
+        ts = float(f"{np.median(dt):.12g}")
+    ts = float(ts)
+    if not (math.isfinite(ts) and ts > 0):
+        raise ImuFileError(f"{name}: sample interval ts must be > 0 s, got {ts!r}")
+    meta = {
+        "format": "csv",
+        "columns": names,
+        "delimiter": delimiter or "whitespace",
+        "dt_min": float(dt.min()) if len(dt) else ts,
+        "dt_max": float(dt.max()) if len(dt) else ts,
+    }
+    return ImuData(
+        t=t,
+        dtheta=np.ascontiguousarray(data[:, 1:4]),
+        dv=np.ascontiguousarray(data[:, 4:7]),
+        ts=ts,
+        source=name,
+        meta=meta,
+    )
+
+
+def write_csv_imu(path, imu: ImuData) -> None:
+    """Write `imu` as CSV ``t, Δθx, Δθy, Δθz, Δvx, Δvy, Δvz`` with a header line.
+
+    Values are written with 17 significant digits, so :func:`read_csv_imu` gives back
+    the same float64 numbers bit for bit.
+    """
+    data = np.column_stack([imu.t, imu.dtheta, imu.dv])
+    with open(os.fspath(path), "w", encoding="utf-8") as fh:
+        fh.write(
+            "# gcalign IMU increments: t s, dtheta rad, dv m/s; body x right, y forward, z up; "
+            f"ts = {imu.ts!r}; source = {imu.source}\n"
+        )
+        fh.write(",".join(_CSV_COLUMNS) + "\n")
+        np.savetxt(fh, data, fmt="%.17g", delimiter=",")
+
+
+# --------------------------------------------------------------------------- dispatch
+
+
+def read_imu_file(path, ts: float | None = None) -> ImuData:
+    """Read IMU increments from a PSINS ``.imu`` or a text/CSV file.
+
+    Dispatch: ``.imu`` -> :func:`read_psins_imu`; ``.csv``/``.txt`` -> :func:`read_csv_imu`;
+    HDF5 (by extension or signature) -> :class:`ImuFileError` (read by the results layer);
+    any other name: PSINS if the first non-blank line is a ``%`` comment, else CSV.
+    `ts` is passed to the CSV reader only (PSINS files carry their own interval).
+    """
+    name = os.fspath(path)
+    p = Path(name)
+    suffix = p.suffix.lower()
+    if suffix in (".h5", ".hdf5", ".hdf"):
+        raise ImuFileError(
+            f"{name}: HDF5 IMU files (from `gcalign simulate`) are read by the results "
+            "module, not by read_imu_file; expected a PSINS .imu or a .csv/.txt file"
+        )
+    if suffix == ".imu":
+        return read_psins_imu(p)
+    if suffix in (".csv", ".txt"):
+        return read_csv_imu(p, ts=ts)
+    if p.is_file():
+        with open(p, "rb") as fh:
+            head = fh.read(4096)
+        if head.startswith(_HDF5_MAGIC):
+            raise ImuFileError(
+                f"{name}: is an HDF5 file; HDF5 IMU data is read by the results module, "
+                "expected a PSINS .imu or a .csv/.txt file"
+            )
+        first = next(
+            (ln.strip() for ln in head.decode("utf-8", "replace").splitlines() if ln.strip()), ""
+        )
+        if first.startswith("%"):
+            return read_psins_imu(p)
+    return read_csv_imu(p, ts=ts)

@@ -1,0 +1,202 @@
+"""Scenario models: site, IMU grade, motion of the base (YAML keys carry their units)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import BeforeValidator, Field, field_validator, model_validator
+
+from gcalign import units as u
+from gcalign.io.scenario.align import AlignConfig
+from gcalign.io.scenario.base import Model, NonNegVec3, PosVec3, Vec3
+from gcalign.io.scenario.northfind import NorthfindConfig
+from gcalign.sim.imu import ImuErrors, SensorErrors
+from gcalign.sim.motions import Motion, Segment
+
+
+def _broadcast_scalar(x):
+    if isinstance(x, (int, float)) and not isinstance(x, bool):
+        if x < 0:
+            raise ValueError(f"must be ≥ 0 (one number, or one per axis), got {x}")
+        return [x, x, x]
+    return x
+
+
+# A noise density: one number for all three axes, or one per axis.
+Noise = Annotated[NonNegVec3, BeforeValidator(_broadcast_scalar)]
+
+
+def _vec(x) -> np.ndarray:
+    return np.broadcast_to(np.asarray(x, dtype=float), (3,)).copy()
+
+
+def _misalignment(m) -> np.ndarray:
+    return np.asarray(m, dtype=float) * u.ARCSEC
+
+
+def _check_misalignment(m):
+    if m is None:
+        return m
+    a = np.asarray(m, dtype=float)
+    if a.shape != (3, 3):
+        raise ValueError(f"must be a 3x3 matrix of arc-seconds, got shape {a.shape}")
+    if np.any(np.diag(a) != 0):
+        raise ValueError("the diagonal must be zero (scale errors go in scale_ppm)")
+    return m
+
+
+class Site(Model):
+    lat_deg: float = Field(description="geodetic latitude, deg, within (-90, 90)")
+    lon_deg: float = Field(ge=-180, le=360, description="longitude, deg")
+    height_m: float = Field(0.0, ge=-1000, le=1e5, description="height above the ellipsoid, m")
+
+    @field_validator("lat_deg")
+    @classmethod
+    def _not_a_pole(cls, v):
+        if not -90 < v < 90:
+            raise ValueError(f"must be within (-90, 90) deg (the ENU frame is undefined at "
+                             f"the poles), got {v}")
+        return v
+
+    def to_si(self) -> np.ndarray:
+        """``[lat (rad), lon (rad), h (m)]``."""
+        return np.array([self.lat_deg * u.DEG, self.lon_deg * u.DEG, self.height_m])
+
+
+class Gyro(Model):
+    bias_dph: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    arw_dprh: Noise = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    scale_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    misalignment_arcsec: list[list[float]] | None = None
+    quantum_arcsec: float = Field(0.0, ge=0)
+
+    _check = field_validator("misalignment_arcsec")(_check_misalignment)
+
+    def to_si(self) -> SensorErrors:
+        return SensorErrors(
+            bias=_vec(self.bias_dph) * u.DPH,
+            noise=_vec(self.arw_dprh) * u.DPSH,
+            scale=_vec(self.scale_ppm) * u.PPM,
+            misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
+            quantum=self.quantum_arcsec * u.ARCSEC,
+        )
+
+
+class Accel(Model):
+    bias_ug: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    vrw_ugrhz: Noise = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    scale_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    misalignment_arcsec: list[list[float]] | None = None
+    quantum_ugs: float = Field(0.0, ge=0, description="velocity quantum, µg·s (PSINS header unit)")
+
+    _check = field_validator("misalignment_arcsec")(_check_misalignment)
+
+    def to_si(self) -> SensorErrors:
+        return SensorErrors(
+            bias=_vec(self.bias_ug) * u.UG,
+            noise=_vec(self.vrw_ugrhz) * u.UGPSHZ,
+            scale=_vec(self.scale_ppm) * u.PPM,
+            misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
+            quantum=self.quantum_ugs * u.UG,
+        )
+
+
+class Imu(Model):
+    rate_hz: float = Field(100.0, gt=0, le=1e5)
+    seed: int = Field(1, ge=0)
+    gyro: Gyro = Field(default_factory=Gyro)
+    accel: Accel = Field(default_factory=Accel)
+
+    @property
+    def ts(self) -> float:
+        return 1.0 / self.rate_hz
+
+    def errors(self) -> ImuErrors:
+        return ImuErrors(gyro=self.gyro.to_si(), accel=self.accel.to_si())
+
+
+class Swing(Model):
+    amplitude_deg: NonNegVec3 = Field(default_factory=lambda: [2.0, 3.0, 4.0])
+    period_s: PosVec3 = Field(default_factory=lambda: [10.0, 10.0, 20.0])
+    phase_deg: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+class SegmentModel(Model):
+    duration_s: float = Field(gt=0)
+    accel_mps2: float = 0.0
+    rate_dps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+class MotionModel(Model):
+    kind: Literal["static", "swing", "moving"]
+    attitude_deg: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    duration_s: float = Field(gt=0, le=1e6)
+    swing: Swing | None = None
+    segments: list[SegmentModel] | None = None
+
+    @field_validator("attitude_deg")
+    @classmethod
+    def _pitch_range(cls, v):
+        if not -90 < v[0] < 90:
+            raise ValueError(f"pitch must be within (-90, 90) deg, got {v[0]}")
+        return v
+
+    @model_validator(mode="after")
+    def _kind_fields(self):
+        if self.kind == "moving" and not self.segments:
+            raise ValueError("segments: missing; kind 'moving' needs a non-empty list of segments")
+        if self.kind != "moving" and self.segments:
+            raise ValueError(f"segments: only kind 'moving' takes segments, got kind {self.kind!r}")
+        if self.kind != "swing" and self.swing is not None:
+            raise ValueError(f"swing: only kind 'swing' takes a swing, got kind {self.kind!r}")
+        return self
+
+    def to_motion(self) -> Motion:
+        swing = self.swing or Swing()
+        return Motion(
+            kind=self.kind,
+            att0=tuple(np.asarray(self.attitude_deg) * u.DEG),
+            duration=self.duration_s,
+            amplitude=tuple(np.asarray(swing.amplitude_deg) * u.DEG),
+            period=(swing.period_s[0], swing.period_s[1], swing.period_s[2]),
+            phase=tuple(np.asarray(swing.phase_deg) * u.DEG),
+            segments=tuple(
+                Segment(s.duration_s, s.accel_mps2, tuple(np.asarray(s.rate_dps) * u.DEG))
+                for s in self.segments or ()
+            ),
+        )
+
+
+class Scenario(Model):
+    """A whole scenario file. Either `motion` (simulated data) or `imu_file` (recorded data)."""
+
+    name: str = Field("scenario", min_length=1, pattern=r"^[A-Za-z0-9_.+-]+$")
+    site: Site | None = None
+    imu: Imu = Field(default_factory=Imu)
+    motion: MotionModel | None = None
+    imu_file: Path | None = None
+    align: AlignConfig | None = None
+    northfind: NorthfindConfig | None = None
+
+    @model_validator(mode="after")
+    def _source(self):
+        if self.motion is not None and self.imu_file is not None:
+            raise ValueError("imu_file: give either 'motion' (simulated) or 'imu_file' (recorded)")
+        if self.motion is not None and self.site is None:
+            raise ValueError("site: missing; a simulated scenario needs a site")
+        if self.motion is not None and self.motion.segments:
+            for i, s in enumerate(self.motion.segments):
+                n = s.duration_s * self.imu.rate_hz
+                if abs(n - round(n)) > 1e-6:
+                    raise ValueError(
+                        f"motion.segments.{i}.duration_s: {s.duration_s} s is not a whole "
+                        f"number of IMU samples at {self.imu.rate_hz} Hz"
+                    )
+        if self.motion is not None:
+            n = self.motion.duration_s * self.imu.rate_hz
+            if round(n) < 2:
+                raise ValueError(f"motion.duration_s: {self.motion.duration_s} s holds fewer "
+                                 f"than 2 samples at {self.imu.rate_hz} Hz")
+        return self

@@ -1,0 +1,326 @@
+"""The `northfind` section of a scenario (seed 001; DESIGN.md "North-finding").
+
+A multi-position strapdown gyro north-finder on an indexing turntable::
+
+    name: seed001-simulation
+    site: {lat_deg: 40, lon_deg: 116, height_m: 0}
+    imu:
+      rate_hz: 100
+      seed: 1
+      gyro:  {bias_dph: 0.02, arw_dprh: 0.0026}
+      accel: {bias_ug: 20, vrw_ugrhz: 155}
+    northfind:
+      positions: 24              # n >= 3 equally spaced table positions per turn
+      dwell_s: 60                # dwell per position (> 0)
+      azimuth_deg: 48.0          # true azimuth of the reference axis, clockwise from north
+      # sweep: {start_deg: 0, stop_deg: 355, step_deg: 5}   # instead of azimuth_deg
+      tilt_deg: 10               # angle between the table normal and the vertical, [0, 90)
+      tilt_direction_deg: 0      # azimuth toward which the table surface descends
+      tilt_reference: table      # north: ζ is a true azimuth; table: ζ from the reference axis
+      # pitch_deg / roll_deg     # instead of tilt_deg / tilt_direction_deg (implies table)
+      methods: [coordinate, vector, naive, none]  # or vector_literal (eq. 10 as printed)
+      repeats: 1                 # independent determinations per azimuth (seed Table 1: 7)
+      index_error_arcsec: 0      # 1σ table indexing error (truth only)
+      samples: false             # true: simulate every sample, not the exact dwell means
+
+Rules
+-----
+* Exactly one of ``azimuth_deg`` and ``sweep``. A sweep runs from ``start_deg`` to
+  ``stop_deg`` *inclusive* in steps of ``step_deg > 0``, except that a stop equal to
+  ``start_deg + 360`` is excluded (it is the start again): ``{0, 360, 30}`` gives 12 azimuths,
+  ``{0, 355, 5}`` 72. A stop below the start is an empty sweep (an error).
+* ``site`` is required; ``|site.lat_deg| < 90`` (north is undefined at the poles).
+  ``site.height_m`` sets gravity; ``imu.rate_hz`` the sampling rate; ``imu.seed`` (or
+  ``--seed``) the random stream.
+* IMU errors — one rule: the table frame is the IMU body frame at table position 1
+  (x right, y = the north-finder's reference axis, z = table normal). The single in-plane
+  gyro is the **body-y gyro**: ``imu.gyro.bias_dph[1]``, ``arw_dprh[1]``, ``scale_ppm[1]``.
+  The two accelerometers are **body x and y**: ``imu.accel.bias_ug[0:2]`` and
+  ``vrw_ugrhz`` (x and y must be equal; the simulator has one density for both). The
+  z-axis values are unused. A constant bias cancels (it is the R of seed eq. 4); the
+  scatter of the azimuth comes from the white noise, whose dwell mean has the standard
+  deviation ``arw/√dwell`` (gyro) and ``vrw/√dwell`` (accelerometers). Terms the
+  north-finder model does not have (misalignment, quantisation, accelerometer scale) must
+  be zero: a non-zero value is an error rather than silently ignored.
+
+Converted once to :class:`gcalign.northfind.NorthfindSetup` (SI, radians) by
+:meth:`NorthfindConfig.to_setup`.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from pydantic import Field, field_validator, model_validator
+
+from gcalign import units as u
+from gcalign.errors import ScenarioError
+from gcalign.io.scenario.base import Model
+from gcalign.northfind import NorthfindSetup, tilt_from_pitch_roll
+
+MethodName = Literal["coordinate", "vector", "naive", "none", "vector_literal"]
+DEFAULT_METHODS: list[MethodName] = ["coordinate", "vector", "naive", "none"]
+MAX_AZIMUTHS = 100_000
+MAX_READINGS = 2_000_000  # azimuths × repeats × positions (memory of the result arrays)
+MAX_SAMPLES = 200_000_000  # with samples: true, simulated samples per sensor
+_TOL = 1e-9
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.6g}"
+
+
+def axis(value, i: int) -> float:
+    """Component `i` of an IMU per-axis value (a scalar default stands for all three axes)."""
+    return float(np.broadcast_to(np.asarray(value, dtype=float), (3,))[i])
+
+
+class Sweep(Model):
+    """True azimuths ``start_deg, start_deg + step_deg, …`` up to ``stop_deg`` (see module)."""
+
+    start_deg: float = Field(0.0, allow_inf_nan=False)
+    stop_deg: float = Field(360.0, allow_inf_nan=False)
+    step_deg: float = Field(allow_inf_nan=False, gt=0, le=360)
+
+    @model_validator(mode="after")
+    def _not_empty(self):
+        if self.stop_deg < self.start_deg:
+            raise ValueError(
+                f"stop_deg: empty sweep, stop_deg {_fmt(self.stop_deg)} is below start_deg "
+                f"{_fmt(self.start_deg)}; allowed: stop_deg >= start_deg"
+            )
+        count = int(np.floor((self.stop_deg - self.start_deg) / self.step_deg + _TOL)) + 1
+        if count > MAX_AZIMUTHS:
+            raise ValueError(
+                f"step_deg: the sweep would hold {count} azimuths, at most {MAX_AZIMUTHS} "
+                f"allowed; got step_deg {_fmt(self.step_deg)}"
+            )
+        return self
+
+    def azimuths_deg(self) -> np.ndarray:
+        """The swept azimuths (deg), shape (M,), M >= 1."""
+        count = int(np.floor((self.stop_deg - self.start_deg) / self.step_deg + _TOL)) + 1
+        az = self.start_deg + self.step_deg * np.arange(count)
+        full_turn = abs(self.stop_deg - self.start_deg - 360.0) < _TOL
+        if full_turn and count > 1 and abs(az[-1] - self.stop_deg) < 1e-6:
+            az = az[:-1]  # stop = start + 360 is the start again
+        return az
+
+    def label(self) -> str:
+        return f"{_fmt(self.start_deg)}:{_fmt(self.stop_deg)}:{_fmt(self.step_deg)}"
+
+
+class NorthfindConfig(Model):
+    """Multi-position north-finding (seed 001); see the module docstring for the rules."""
+
+    positions: int = Field(24, ge=3, le=100_000, description="table positions per turn")
+    dwell_s: float = Field(60.0, gt=0, le=1e6, allow_inf_nan=False, description="dwell, s")
+    azimuth_deg: float | None = Field(
+        None, allow_inf_nan=False, description="true azimuth of the reference axis, deg"
+    )
+    sweep: Sweep | None = None
+    tilt_deg: float | None = Field(
+        None, allow_inf_nan=False, description="table normal from the vertical, deg; default 0"
+    )
+    tilt_direction_deg: float | None = Field(
+        None, allow_inf_nan=False, description="azimuth of descent, deg; default 0"
+    )
+    tilt_reference: Literal["north", "table"] | None = Field(
+        None, description="north (fixed to the earth, default) or table (fixed to the table)"
+    )
+    pitch_deg: float | None = Field(
+        None, gt=-90, lt=90, allow_inf_nan=False, description="PSINS pitch of the table"
+    )
+    roll_deg: float | None = Field(
+        None, gt=-90, lt=90, allow_inf_nan=False, description="PSINS roll of the table"
+    )
+    methods: list[MethodName] = Field(default_factory=lambda: list(DEFAULT_METHODS), min_length=1)
+    repeats: int = Field(1, ge=1, le=1_000_000, description="independent determinations")
+    index_error_arcsec: float = Field(0.0, ge=0, allow_inf_nan=False)
+    samples: bool = False
+
+    @field_validator("tilt_deg")
+    @classmethod
+    def _tilt_range(cls, v):
+        if v is not None and not 0.0 <= v < 90.0:
+            raise ValueError(
+                f"the angle between the table normal and the vertical must satisfy "
+                f"0 <= tilt_deg < 90, got {_fmt(v)}"
+            )
+        return v
+
+    @field_validator("methods")
+    @classmethod
+    def _unique(cls, v):
+        dup = sorted({m for m in v if v.count(m) > 1})
+        if dup:
+            raise ValueError(f"each method at most once, got {dup[0]!r} twice")
+        return v
+
+    @model_validator(mode="after")
+    def _choices(self):
+        if self.azimuth_deg is None and self.sweep is None:
+            raise ValueError(
+                "azimuth_deg: missing; give the true azimuth (azimuth_deg) or a sweep "
+                "({start_deg, stop_deg, step_deg})"
+            )
+        if self.azimuth_deg is not None and self.sweep is not None:
+            raise ValueError(
+                f"sweep: give either azimuth_deg or sweep, not both (got azimuth_deg "
+                f"{_fmt(self.azimuth_deg)} and sweep {self.sweep.label()})"
+            )
+        attitude = self.pitch_deg is not None or self.roll_deg is not None
+        if attitude and (self.tilt_deg is not None or self.tilt_direction_deg is not None):
+            raise ValueError(
+                "pitch_deg: give the tilt either as tilt_deg/tilt_direction_deg or as "
+                "pitch_deg/roll_deg, not both"
+            )
+        if attitude and self.tilt_reference == "north":
+            raise ValueError(
+                "tilt_reference: pitch_deg/roll_deg describe the table itself (tilt fixed to "
+                "the table); allowed: 'table' or omit it, got 'north'"
+            )
+        return self
+
+    # ---------------------------------------------------------------- resolved values
+
+    @property
+    def reference(self) -> str:
+        """Effective tilt reference: 'table' with pitch/roll, else as given (default north)."""
+        if self.pitch_deg is not None or self.roll_deg is not None:
+            return "table"
+        return self.tilt_reference or "north"
+
+    def tilt_rad(self) -> tuple[float, float]:
+        """``(tilt ε, tilt direction ζ)`` in rad; ζ relative to `reference`."""
+        if self.pitch_deg is not None or self.roll_deg is not None:
+            eps, zeta = tilt_from_pitch_roll((self.pitch_deg or 0.0) * u.DEG,
+                                             (self.roll_deg or 0.0) * u.DEG)
+            return float(eps), float(zeta)
+        return (self.tilt_deg or 0.0) * u.DEG, (self.tilt_direction_deg or 0.0) * u.DEG
+
+    def azimuths_deg(self) -> np.ndarray:
+        """True azimuths (deg), shape (M,)."""
+        if self.sweep is not None:
+            return self.sweep.azimuths_deg()
+        assert self.azimuth_deg is not None  # the model validator requires one of the two
+        return np.array([float(self.azimuth_deg)])
+
+    def check(self, sc) -> None:
+        """Checks that need the rest of the scenario; ScenarioError naming the field."""
+        if sc.site is None:
+            raise ScenarioError("site: missing; north-finding needs the site latitude "
+                                "(site: {lat_deg, lon_deg, height_m})")
+        lat = sc.site.lat_deg
+        if abs(lat) >= 90.0:
+            raise ScenarioError(
+                f"site.lat_deg: north is undefined at the poles (the horizontal earth rate "
+                f"vanishes); north-finding needs -90 < lat_deg < 90, got {_fmt(lat)}"
+            )
+        if sc.imu_file is not None:
+            raise ScenarioError(
+                f"imu_file: northfind simulates the turntable; recorded data is not supported, "
+                f"got {str(sc.imu_file)!r} (remove imu_file)"
+            )
+        n = round(self.dwell_s * sc.imu.rate_hz)
+        readings = self.azimuths_deg().size * self.repeats * self.positions
+        if readings > MAX_READINGS:
+            raise ScenarioError(
+                f"northfind.repeats: azimuths × repeats × positions = {readings} dwell readings, "
+                f"at most {MAX_READINGS} allowed; got repeats {self.repeats}"
+            )
+        if self.samples and readings * n > MAX_SAMPLES:
+            raise ScenarioError(
+                f"northfind.samples: true would simulate {readings * n} samples per sensor, at "
+                f"most {MAX_SAMPLES} allowed; use samples: false (exact dwell means, "
+                f"statistically identical), got true"
+            )
+        if n < 1:
+            raise ScenarioError(
+                f"northfind.dwell_s: {_fmt(self.dwell_s)} s holds no sample at imu.rate_hz "
+                f"{_fmt(sc.imu.rate_hz)} Hz; allowed: dwell_s >= 1/rate_hz"
+            )
+        g, a = sc.imu.gyro, sc.imu.accel
+        vrw = [axis(a.vrw_ugrhz, i) for i in range(3)]
+        if vrw[0] != vrw[1]:
+            raise ScenarioError(
+                f"imu.accel.vrw_ugrhz: the north-finder's x and y accelerometers share one noise "
+                f"density; x and y must be equal, got {vrw}"
+            )
+        unsupported = [
+            ("imu.gyro.misalignment_arcsec", g.misalignment_arcsec is not None
+             and np.any(np.asarray(g.misalignment_arcsec, float) != 0), g.misalignment_arcsec),
+            ("imu.gyro.quantum_arcsec", g.quantum_arcsec != 0, g.quantum_arcsec),
+            ("imu.accel.misalignment_arcsec", a.misalignment_arcsec is not None
+             and np.any(np.asarray(a.misalignment_arcsec, float) != 0), a.misalignment_arcsec),
+            ("imu.accel.scale_ppm", axis(a.scale_ppm, 0) != 0 or axis(a.scale_ppm, 1) != 0,
+             a.scale_ppm),
+            ("imu.accel.quantum_ugs", a.quantum_ugs != 0, a.quantum_ugs),
+        ]
+        for field, bad, value in unsupported:
+            if bad:
+                raise ScenarioError(
+                    f"{field}: not modelled by the north-finder (one in-plane gyro, two "
+                    f"accelerometers with bias and white noise); allowed: 0, got {value}"
+                )
+
+    def to_setup(self, sc) -> NorthfindSetup:
+        """The SI setup for :func:`gcalign.northfind.run_northfind` (runs :meth:`check`)."""
+        self.check(sc)
+        g, a = sc.imu.gyro, sc.imu.accel
+        tilt, direction = self.tilt_rad()
+        try:
+            return NorthfindSetup(
+                azimuths=self.azimuths_deg() * u.DEG,
+                lat=sc.site.lat_deg * u.DEG,
+                positions=self.positions,
+                dwell_s=self.dwell_s,
+                rate_hz=sc.imu.rate_hz,
+                tilt=tilt,
+                tilt_direction=direction,
+                tilt_direction_ref=self.reference,
+                repeats=self.repeats,
+                height=sc.site.height_m,
+                gyro_bias=axis(g.bias_dph, 1) * u.DPH,  # the in-plane gyro is body y
+                gyro_arw=axis(g.arw_dprh, 1) * u.DPSH,
+                gyro_scale=axis(g.scale_ppm, 1) * u.PPM,
+                accel_bias=np.array([axis(a.bias_ug, 0), axis(a.bias_ug, 1)]) * u.UG,  # x, y
+                accel_vrw=axis(a.vrw_ugrhz, 0) * u.UGPSHZ,
+                index_error=self.index_error_arcsec * u.ARCSEC,
+            )
+        except ValueError as err:  # a combination the checks above did not foresee
+            raise ScenarioError(f"northfind: {err}") from None
+
+    def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
+        """Rows for `gcalign validate` (runs the cross-section checks too)."""
+        setup = self.to_setup(sc)
+        az = self.azimuths_deg()
+        if self.sweep is not None:
+            az_text = f"sweep {self.sweep.label()} °: {az.size} azimuths"
+        else:
+            az_text = f"{_fmt(az[0])} °"
+        tilt, direction = self.tilt_rad()
+        dwell_sigma = setup.gyro_arw / np.sqrt(setup.n_samples / setup.rate_hz)
+        accel_sigma = setup.accel_vrw / np.sqrt(setup.n_samples / setup.rate_hz)
+        return [
+            ("northfind.positions", str(self.positions),
+             f"θ_i = (i-1)·{_fmt(360.0 / self.positions)} °"),
+            ("northfind.dwell_s", f"{_fmt(self.dwell_s)} s", f"{setup.n_samples} samples"),
+            ("northfind.azimuth", az_text, f"{az.size} × {self.repeats} determinations"),
+            ("northfind.tilt", f"{_fmt(np.degrees(tilt))} ° toward {_fmt(np.degrees(direction))} °"
+             f" ({self.reference})", f"{_fmt(tilt)} rad, {_fmt(direction)} rad"),
+            ("northfind.methods", ", ".join(self.methods), ""),
+            ("northfind.gyro (body y)",
+             f"bias {_fmt(axis(sc.imu.gyro.bias_dph, 1))} °/h, "
+             f"ARW {_fmt(axis(sc.imu.gyro.arw_dprh, 1))} °/√h",
+             f"dwell-mean σ {_fmt(dwell_sigma / u.DPH)} °/h"),
+            ("northfind.accel (body x, y)",
+             f"bias {_fmt(axis(sc.imu.accel.bias_ug, 0))}, "
+             f"{_fmt(axis(sc.imu.accel.bias_ug, 1))} µg, "
+             f"VRW {_fmt(axis(sc.imu.accel.vrw_ugrhz, 0))} µg/√Hz",
+             f"dwell-mean σ {_fmt(accel_sigma / u.UG)} µg"),
+            ("northfind.index_error_arcsec", f"{_fmt(self.index_error_arcsec)} ″",
+             f"{_fmt(setup.index_error)} rad"),
+            ("northfind.samples", "every sample" if self.samples else "exact dwell means", ""),
+        ]

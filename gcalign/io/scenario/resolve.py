@@ -1,0 +1,91 @@
+"""The resolved values of a scenario, in user units and in SI, for `gcalign validate`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gcalign.io.scenario.models import Scenario
+
+
+def _v(x, digits=6) -> str:
+    a = np.atleast_1d(np.asarray(x, dtype=float))
+    text = ", ".join(f"{v:.{digits}g}" for v in a.ravel())
+    return text if a.size == 1 else f"[{text}]"
+
+
+def resolved_rows(sc: Scenario) -> list[tuple[str, str, str]]:
+    """``(field, value in user units, value in SI)`` for every setting the run will use."""
+    rows: list[tuple[str, str, str]] = [("name", sc.name, "")]
+    if sc.site is not None:
+        si = sc.site.to_si()
+        rows += [
+            ("site.lat_deg", _v(sc.site.lat_deg) + " °", _v(si[0], 10) + " rad"),
+            ("site.lon_deg", _v(sc.site.lon_deg) + " °", _v(si[1], 10) + " rad"),
+            ("site.height_m", _v(sc.site.height_m) + " m", _v(si[2]) + " m"),
+        ]
+    if sc.imu_file is not None:
+        rows.append(("imu_file", str(sc.imu_file), "(recorded data; imu errors not applied)"))
+    else:
+        imu, err = sc.imu, sc.imu.errors()
+        rows += [
+            ("imu.rate_hz", _v(imu.rate_hz) + " Hz", _v(imu.ts) + " s"),
+            ("imu.seed", str(imu.seed), ""),
+            ("imu.gyro.bias_dph", _v(imu.gyro.bias_dph) + " °/h", _v(err.gyro.bias) + " rad/s"),
+            ("imu.gyro.arw_dprh", _v(imu.gyro.arw_dprh) + " °/√h", _v(err.gyro.noise) + " rad/√s"),
+            ("imu.gyro.scale_ppm", _v(imu.gyro.scale_ppm) + " ppm", _v(err.gyro.scale)),
+            ("imu.accel.bias_ug", _v(imu.accel.bias_ug) + " µg", _v(err.accel.bias) + " m/s²"),
+            (
+                "imu.accel.vrw_ugrhz",
+                _v(imu.accel.vrw_ugrhz) + " µg/√Hz",
+                _v(err.accel.noise) + " m/s/√s",
+            ),
+            ("imu.accel.scale_ppm", _v(imu.accel.scale_ppm) + " ppm", _v(err.accel.scale)),
+        ]
+        for name, sensor, m in (("gyro", imu.gyro, err.gyro), ("accel", imu.accel, err.accel)):
+            if sensor.misalignment_arcsec is not None:
+                rows.append(
+                    (
+                        f"imu.{name}.misalignment_arcsec",
+                        _v(sensor.misalignment_arcsec) + " ″",
+                        _v(m.misalignment) + " rad",
+                    )
+                )
+            if m.quantum:
+                unit = "rad" if name == "gyro" else "m/s"
+                rows.append((f"imu.{name}.quantum", "", _v(m.quantum) + f" {unit}"))
+    if sc.motion is not None:
+        mo = sc.motion
+        n = int(round(mo.duration_s * sc.imu.rate_hz))
+        rows += [
+            ("motion.kind", mo.kind, ""),
+            (
+                "motion.attitude_deg",
+                _v(mo.attitude_deg) + " °",
+                _v(np.radians(mo.attitude_deg)) + " rad",
+            ),
+            ("motion.duration_s", _v(mo.duration_s) + " s", f"{n} samples"),
+        ]
+        if mo.kind == "swing":
+            sw = mo.to_motion()
+            rows += [
+                (
+                    "motion.swing.amplitude_deg",
+                    _v(mo.swing.amplitude_deg if mo.swing else []) + " °",
+                    _v(sw.amplitude) + " rad",
+                ),
+                ("motion.swing.period_s", _v(sw.period) + " s", ""),
+                ("motion.swing.phase_deg", "", _v(sw.phase) + " rad"),
+            ]
+        for i, s in enumerate(mo.segments or []):
+            rows.append(
+                (
+                    f"motion.segments.{i}",
+                    f"{s.duration_s:g} s, {s.accel_mps2:g} m/s², {_v(s.rate_dps)} °/s",
+                    _v(np.radians(s.rate_dps)) + " rad/s",
+                )
+            )
+    for section in ("align", "northfind"):
+        model = getattr(sc, section, None)
+        if model is not None and hasattr(model, "resolved_rows"):
+            rows += model.resolved_rows(sc)
+    return rows
