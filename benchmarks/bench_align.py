@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from gcalign.align import kernel as K
-from gcalign.align.cycles import Stage, loop_gains
+from gcalign.align.cycles import loop_gains
+from gcalign.align.stages import Stage
 from gcalign.app.align.run import run_alignment
 from gcalign.app.data import scenario_data
 from gcalign.cli.align import BUILTIN

@@ -10,8 +10,9 @@ import pytest
 
 from gcalign import units as u
 from gcalign.align import kernel as K
-from gcalign.align.cycles import Stage, loop_gains
+from gcalign.align.cycles import loop_gains
 from gcalign.align.gains import azimuth_gains
+from gcalign.align.stages import Stage
 from gcalign.app.align.run import run_alignment
 from gcalign.app.data import scenario_data
 from gcalign.io.scenario import parse_scenario

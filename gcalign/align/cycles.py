@@ -16,19 +16,10 @@ import numpy as np
 
 from gcalign.align import kernel as K
 from gcalign.align.gains import azimuth_gains, level_gains
+from gcalign.align.stages import Stage, stage_of_passes
 from gcalign.nav import earth
 
 MODES = ("conventional", "full-cycle", "half-cycle")
-
-
-@dataclass(frozen=True)
-class Stage:
-    """Loop parameters for `passes` passes (None: all remaining). Periods in s."""
-
-    t_xy: float
-    t_z: float
-    xi: float
-    passes: int | None = None
 
 
 @dataclass(frozen=True)
@@ -74,15 +65,6 @@ def pass_plan(mode: str, passes: int) -> list[tuple[str, str]]:
         else:
             plan.append(("reverse", "compass" if mode == "full-cycle" else "attitude"))
     return plan
-
-
-def stage_of_passes(stages: list[Stage], passes: int) -> list[int]:
-    """Stage index of each pass; the last stage without a count covers the rest."""
-    out: list[int] = []
-    for i, st in enumerate(stages):
-        n = passes - len(out) if st.passes is None else st.passes
-        out += [i] * n
-    return (out + [len(stages) - 1] * passes)[:passes]
 
 
 def loop_gains(stage: Stage, lat: float, h: float, azimuth_poles: str) -> np.ndarray:

@@ -8,11 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from gcalign.errors import ScenarioError
+from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario import Scenario
 from gcalign.sim.imu import ImuData, apply_errors, ideal_imu
 from gcalign.sim.motions import Truth
-
-HDF5_SUFFIXES = {".h5", ".hdf5", ".hdf"}
 
 
 @dataclass(frozen=True)
@@ -41,11 +40,16 @@ def read_data_file(path: Path) -> tuple[ImuData, Truth | None]:
         raise ScenarioError(f"imu_file: {err}") from None
 
 
-def scenario_data(scenario: Scenario, seed: int | None = None) -> RunData:
+def scenario_data(scenario: Scenario, seed: int | None = None,
+                  cache_key: str | None = None) -> RunData:
     """Simulate the scenario's motion with its IMU errors, or read its recorded IMU file.
 
     `seed` overrides ``imu.seed``; the same scenario and seed give the same numbers.
+    `cache_key` (a batch variant) lets successive seeds share the noise-free simulation:
+    it is computed once per key in this process (see :func:`cached_noise_free`).
     """
+    if cache_key is not None and scenario.imu_file is None:
+        return with_errors(scenario, cached_noise_free(scenario, cache_key), seed)
     if scenario.imu_file is not None:
         imu, truth = read_data_file(scenario.imu_file)
         if scenario.site is not None:
@@ -76,3 +80,24 @@ def with_errors(scenario: Scenario, ideal: RunData, seed: int | None = None) -> 
     seed = scenario.imu.seed if seed is None else seed
     imu = apply_errors(ideal.imu, scenario.imu.errors(), np.random.default_rng(seed))
     return RunData(imu=imu, truth=ideal.truth, site=ideal.site.copy(), seed=seed)
+
+
+_NOISE_FREE: dict[str, RunData] = {}  # cache key -> noise-free data, in this process
+
+
+def cached_noise_free(scenario: Scenario, key: str) -> RunData:
+    """:func:`noise_free` computed once per key (a batch variant: truth and ideal increments
+    are about 2/3 of a seed 000 run; only the sensor errors depend on the seed). Same
+    numbers, bit for bit (tested). The cached arrays are read-only, so code that would
+    modify them fails loudly. At most four variants are kept.
+    """
+    hit = _NOISE_FREE.get(key)
+    if hit is None:
+        if len(_NOISE_FREE) >= 4:
+            _NOISE_FREE.pop(next(iter(_NOISE_FREE)))
+        hit = _NOISE_FREE[key] = noise_free(scenario)
+        for obj in (hit.truth, hit.imu):
+            for value in vars(obj).values():
+                if isinstance(value, np.ndarray):
+                    value.flags.writeable = False
+    return hit

@@ -3,21 +3,17 @@
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import typer
 
-from gcalign.app import report
-from gcalign.app.align.run import alignment_summary, run_alignment
-from gcalign.app.data import scenario_data
-from gcalign.cli import app, default_output, user_errors
-from gcalign.cli.common import builtin_text, load_with_overrides, save_and_show
+from gcalign.app.registry import COMMANDS
+from gcalign.cli import app, user_errors
+from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
 from gcalign.cli.data import JSON_HELP, OUT_HELP
 from gcalign.errors import ScenarioError
-from gcalign.io import results
 
-BUILTIN = "seed000_moving_full_cycle.yaml"
+BUILTIN = COMMANDS["align"].builtin or ""
 
 
 def builtin_scenario_text() -> str:
@@ -65,20 +61,4 @@ def align(
         "t3_s": _t3(t3),
     }
     sc, text, _ = load_with_overrides(scenario, BUILTIN, "align", overrides)
-    data = scenario_data(sc, seed)
-    run = run_alignment(sc, data)
-    summary = alignment_summary(run, data, sc.name)
-    for line in summary["warnings"]:
-        sys.stderr.write(f"warning: {line}\n")
-    out = output or default_output(sc.name, "align", data.seed)
-    save_and_show(
-        out,
-        "align",
-        text,
-        data.seed,
-        summary,
-        report.align_table,
-        as_json,
-        lambda f: results.write_alignment(f, run),
-        data.truth,
-    )
+    run_and_show("align", sc, text, seed, output, as_json)

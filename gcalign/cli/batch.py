@@ -13,7 +13,6 @@ from pathlib import Path
 import typer
 
 from gcalign.app import batch as engine
-from gcalign.app import report
 from gcalign.cli import app, consoles, default_output, emit_json, user_errors
 from gcalign.cli.data import JSON_HELP
 from gcalign.errors import ScenarioError
@@ -111,7 +110,7 @@ def batch(
         if bar is not None:
             bar.stop()
     summary = result.summary
-    consoles(as_json).print(report.batch_table(summary))
+    consoles(as_json).print(engine.table(summary))
     if as_json:
         emit_json(summary)
     if summary["failed"]:

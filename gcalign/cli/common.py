@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
 
 import yaml
 
+from gcalign.app.registry import Outcome, command
 from gcalign.cli import consoles, emit_json
 from gcalign.errors import ScenarioError
 from gcalign.io import results
@@ -56,28 +58,32 @@ def load_with_overrides(
     return sc, text, source
 
 
-def save_and_show(
-    out: Path,
-    kind: str,
-    text: str,
-    seed,
-    summary: dict,
-    table,
-    as_json: bool,
-    write: Callable,
-    truth=None,
-) -> None:
-    """Write the results file atomically (header, truth, then `write(f)`), print the table
-    built by `table(summary)`, and the JSON summary under --json."""
+def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: Path | None,
+                 as_json: bool) -> None:
+    """Run command `name` on a loaded scenario through its room, write the results file
+    (default name from the scenario, command and seed) and show its table."""
+    from gcalign.cli import default_output
+
+    outcome = command(name).load().execute(sc, seed)
+    for line in outcome.warnings:
+        sys.stderr.write(f"warning: {line}\n")
+    out = output or default_output(sc.name, name, outcome.seed)
+    save_and_show(out, name, text, outcome, as_json)
+
+
+def save_and_show(out: Path, kind: str, text: str, outcome: Outcome, as_json: bool) -> None:
+    """Write the results file atomically (header, truth, then the command's groups), print
+    the command's table, and the JSON summary under --json."""
+    summary = outcome.summary
     summary["output"] = str(out)
     try:
         with results.atomic_h5(out) as f:
-            results.write_header(f, kind, text, seed, summary)
-            if truth is not None:
-                results.write_truth(f, truth)
-            write(f)
+            results.write_header(f, kind, text, outcome.seed, summary)
+            if outcome.truth is not None:
+                results.write_truth(f, outcome.truth)
+            outcome.write(f)
     except OSError as err:
         raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
-    consoles(as_json).print(table(summary))
+    consoles(as_json).print(command(kind).load().table(summary))
     if as_json:
         emit_json(summary)

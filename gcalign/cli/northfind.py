@@ -6,15 +6,13 @@ from pathlib import Path
 
 import typer
 
-from gcalign.app import report
-from gcalign.app.northfind.run import northfind_summary, run_northfind
-from gcalign.cli import app, default_output, user_errors
-from gcalign.cli.common import builtin_text, load_with_overrides, save_and_show
+from gcalign.app.registry import COMMANDS
+from gcalign.cli import app, user_errors
+from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
 from gcalign.cli.data import JSON_HELP, OUT_HELP
 from gcalign.errors import ScenarioError
-from gcalign.io import results
 
-BUILTIN = "seed001_simulation.yaml"
+BUILTIN = COMMANDS["northfind"].builtin or ""
 
 
 def builtin_scenario_text() -> str:
@@ -98,16 +96,4 @@ def northfind(
         "repeats": repeats,
     }
     sc, text = load_northfind(scenario, overrides)
-    run = run_northfind(sc, seed)
-    summary = northfind_summary(run, sc)
-    out = output or default_output(sc.name, "northfind", run.seed)
-    save_and_show(
-        out,
-        "northfind",
-        text,
-        run.seed,
-        summary,
-        report.northfind_table,
-        as_json,
-        lambda f: results.write_northfind(f, run),
-    )
+    run_and_show("northfind", sc, text, seed, output, as_json)

@@ -94,9 +94,6 @@ from gcalign.northfind.run import NorthfindResult, run_northfind
 from gcalign.northfind.simulate import (
     NorthfindSetup,
     TableData,
-    # in this namespace for `gcalign.app.batch.kernel_cache_stats`, which counts the cache
-    # hits of the numba dispatchers it finds in `gcalign.northfind`
-    _dwell_means_kernel,  # noqa: F401
     simulate_table,
 )
 from gcalign.northfind.theory import (

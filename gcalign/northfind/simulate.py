@@ -3,14 +3,13 @@
 :class:`NorthfindSetup` holds and validates the plain parameters of a run (truth, timing,
 sensor errors; SI and radians); :func:`simulate_table` draws the dwell means of the gyro
 and the two accelerometers (:class:`TableData`), either directly from their exact law or
-sample by sample in the numba kernel ``_dwell_means_kernel``.
+sample by sample in the numba kernel :func:`gcalign.northfind._kernel.dwell_means`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 
 from gcalign.nav import earth
@@ -221,24 +220,6 @@ class TableData:
     gravity: float
 
 
-@numba.njit(cache=True)
-def _dwell_means_kernel(rng, ideal, bias, sigma, n_samples):  # pragma: no cover - numba
-    """Sample-level dwell means: every sample ``ideal + bias + sigma * w``, then averaged.
-
-    ``ideal`` (K, n, S); draws are consumed in the C order of (K, n, S, n_samples).
-    """
-    K, n, S = ideal.shape
-    out = np.empty_like(ideal)
-    for k in range(K):
-        for i in range(n):
-            for s in range(S):
-                acc = 0.0
-                for _ in range(n_samples):
-                    acc += ideal[k, i, s] + bias[s] + sigma[s] * rng.standard_normal()
-                out[k, i, s] = acc / n_samples
-    return out
-
-
 def simulate_table(setup: NorthfindSetup, rng: np.random.Generator, *, samples: bool = False):
     """Simulate the dwell means of the gyro and accelerometers for every azimuth and repeat.
 
@@ -283,7 +264,9 @@ def simulate_table(setup: NorthfindSetup, rng: np.random.Generator, *, samples: 
     )  # per-sample standard deviation, rad/s and m/s²
     if samples:
         flat = np.ascontiguousarray(ideal.reshape(m * r, n, 3))
-        means = _dwell_means_kernel(rng, flat, bias, sigma, N).reshape(m, r, n, 3)
+        from gcalign.northfind._kernel import dwell_means  # numba: only for this path
+
+        means = dwell_means(rng, flat, bias, sigma, N).reshape(m, r, n, 3)
     else:
         # dwell mean of N white samples ~ N(0, σ_s²/N), drawn directly
         means = ideal + bias + (sigma / np.sqrt(N)) * rng.standard_normal((m, r, n, 3))

@@ -17,7 +17,8 @@ from gcalign.align import coarse as coarse_mod
 from gcalign.align import kernel as K
 from gcalign.align.compensate import compensate
 from gcalign.align.cycles import Block, PassRecord, run_passes
-from gcalign.app.data import RunData
+from gcalign.app.data import RunData, scenario_data
+from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import AlignConfig
@@ -333,3 +334,13 @@ def alignment_summary(run: AlignRun, data: RunData, name: str) -> dict:
         "compute_s": run.compute_s,
         "warnings": list(run.warnings),
     }
+
+
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Outcome:
+    """Simulate (or read) the data, align, summarise; the registry's entry point."""
+    from gcalign.app.align.hdf5 import write_alignment
+
+    data = scenario_data(sc, seed, cache_key)
+    run = run_alignment(sc, data)
+    return Outcome(alignment_summary(run, data, sc.name), lambda f: write_alignment(f, run),
+                   data.truth, data.seed, run.warnings)

@@ -23,7 +23,6 @@ Modules
 """
 
 from gcalign.app.batch.aggregate import (
-    ATT_COMPONENTS,
     STATS,
     aggregate,
     batch_summary,
@@ -54,7 +53,6 @@ from gcalign.app.batch.runs import (
     kernel_cache_stats,
     metric_value,
     run_chunk,
-    run_data,
     run_summary,
     run_task,
     warm_up,
@@ -79,8 +77,21 @@ from gcalign.app.batch.sweep import (
     sweep_from_mapping,
 )
 
+
+def table(summary: dict):
+    """The batch table (the registry's interface, as for every command's room)."""
+    from gcalign.app.batch.tables import batch_table
+
+    return batch_table(summary)
+
+
+def figures(f, name: str) -> dict:
+    from gcalign.app.batch.plots import figures as batch_figures
+
+    return batch_figures(f, name)
+
+
 __all__ = [
-    "ATT_COMPONENTS",
     "COMMANDS",
     "DEFAULT_METRICS",
     "JOURNAL_SUFFIX",
@@ -116,11 +127,12 @@ __all__ = [
     "read_runs_h5",
     "run_batch",
     "run_chunk",
-    "run_data",
     "run_summary",
     "run_task",
     "stats_of",
     "sweep_from_mapping",
     "warm_up",
+    "table",
+    "figures",
     "write_batch_h5",
 ]

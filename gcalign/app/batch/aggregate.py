@@ -14,7 +14,6 @@ import numpy as np
 from gcalign.app.batch.sweep import Sweep
 
 STATS = ("mean", "std", "rms", "median", "p05", "p95")
-ATT_COMPONENTS = ("pitch", "roll", "yaw")
 
 
 def _finite(x):
@@ -25,10 +24,15 @@ def _finite(x):
 
 
 def components(command: str, metric: str, k: int | None) -> list[str] | None:
+    """Names of a vector metric's components: the command's room says (attitude triples
+    are pitch, roll, yaw in align), else their indices."""
     if k is None:
         return None
-    if command == "align" and k == 3 and metric.endswith("_deg"):
-        return list(ATT_COMPONENTS)
+    from gcalign.app.registry import COMMANDS
+
+    room = COMMANDS[command].load() if command in COMMANDS else None
+    if room is not None and hasattr(room, "components"):
+        return room.components(metric, k)
     return [str(i) for i in range(k)]
 
 

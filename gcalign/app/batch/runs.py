@@ -14,8 +14,6 @@ import sys
 import time
 from typing import Any
 
-import numpy as np
-
 from gcalign.errors import GcalignError
 
 
@@ -38,48 +36,18 @@ def _scenario(task: dict):
     return sc
 
 
-_NOISE_FREE: dict = {}  # cache key -> noise-free RunData (truth, ideal IMU) in this worker
-
-
-def run_data(sc, seed: int, cache_key: str | None = None):
-    """:func:`gcalign.app.data.scenario_data` with the noise-free simulation (truth
-    and ideal increments: about 2/3 of a seed 000 run) computed once per variant in each
-    worker; only the sensor errors depend on the seed. Same numbers, bit for bit (tested).
-    The cached arrays are made read-only, so code that would modify them fails loudly.
-    """
-    from gcalign.app.data import noise_free, scenario_data, with_errors
-
-    if cache_key is None or sc.imu_file is not None or sc.motion is None or sc.site is None:
-        return scenario_data(sc, seed)
-    hit = _NOISE_FREE.get(cache_key)
-    if hit is None:
-        if len(_NOISE_FREE) >= 4:
-            _NOISE_FREE.pop(next(iter(_NOISE_FREE)))
-        hit = _NOISE_FREE[cache_key] = noise_free(sc)
-        for obj in (hit.truth, hit.imu):
-            for value in vars(obj).values():
-                if isinstance(value, np.ndarray):
-                    value.flags.writeable = False
-    return with_errors(sc, hit, seed)
-
-
 def run_summary(command: str, sc, seed: int, cache_key: str | None = None) -> dict:
-    """The summary dict a single ``gcalign align`` / ``gcalign northfind`` run would print.
+    """The summary dict a single run of `command` would print (through its room).
 
     `cache_key` (the variant) lets successive seeds share the noise-free simulation.
     """
-    if command == "align":
-        from gcalign.app.align.run import alignment_summary, run_alignment
+    from gcalign.app.registry import command as lookup
 
-        data = run_data(sc, seed, cache_key)
-        return alignment_summary(run_alignment(sc, data), data, sc.name)
-    if command == "northfind":
-        try:
-            from gcalign.app.northfind.run import northfind_summary, run_northfind
-        except ImportError as err:  # pragma: no cover - until the pipeline lands
-            raise GcalignError(f"northfind pipeline not available: {err}") from None
-        return northfind_summary(run_northfind(sc, seed), sc)
-    raise GcalignError(f"unknown command {command!r}")
+    try:
+        room = lookup(command).load()
+    except KeyError as err:
+        raise GcalignError(str(err.args[0])) from None
+    return room.execute(sc, seed, cache_key).summary
 
 
 def metric_value(summary: dict, path: str):
@@ -144,7 +112,7 @@ def kernel_cache_stats() -> dict:
     A miss means the kernel was compiled here instead of loaded from the on-disk cache.
     """
     hits = misses = 0
-    for name in ("gcalign.nav._kernels", "gcalign.align.kernel", "gcalign.northfind"):
+    for name in ("gcalign.nav._kernels", "gcalign.align.kernel", "gcalign.northfind._kernel"):
         mod = sys.modules.get(name)
         for obj in vars(mod).values() if mod else ():
             stats = getattr(obj, "stats", None)

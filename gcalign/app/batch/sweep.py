@@ -20,13 +20,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from gcalign.app.batch.overrides import apply_override
+from gcalign.app.registry import batchable
 from gcalign.errors import ScenarioError
 
-COMMANDS = ("align", "northfind")
-DEFAULT_METRICS = {
-    "align": ("error_t3_deg",),
-    "northfind": ("methods.coordinate.rms_error_deg",),
-}
+COMMANDS = tuple(batchable())
+DEFAULT_METRICS = {name: c.batch_metrics for name, c in batchable().items()}
 SWEEP_KEYS = ("name", "base", "command", "grid", "seeds", "seed_start", "metrics")
 
 

@@ -7,7 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gcalign.app.data import RunData
+from gcalign.app.data import RunData, scenario_data
+from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.nav import earth
 from gcalign.nav.rotation import attitude_error
@@ -100,3 +101,13 @@ def navigation_summary(run: NavRun, data: RunData, name: str) -> dict:
         out["final_error"] = {k: v[-1].tolist() for k, v in errors.items()}
         out["max_error"] = {k: np.abs(v).max(axis=0).tolist() for k, v in errors.items()}
     return out
+
+
+def execute(sc, seed: int | None = None, cache_key: str | None = None) -> Outcome:
+    """Simulate (or read) the data, navigate, summarise; the registry's entry point."""
+    from gcalign.app.navigate.hdf5 import write_navigation
+
+    data = scenario_data(sc, seed, cache_key)
+    run = run_navigation(data)
+    return Outcome(navigation_summary(run, data, sc.name), lambda f: write_navigation(f, run),
+                   data.truth, data.seed)

@@ -20,6 +20,7 @@ import numpy as np
 
 from gcalign import northfind as nf
 from gcalign import units as u
+from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.northfind import NorthfindConfig, axis
@@ -169,3 +170,11 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
         "methods": methods,
         "compute_s": run.compute_s,
     }
+
+
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Outcome:
+    """Simulate the turntable, estimate, summarise; the registry's entry point."""
+    from gcalign.app.northfind.hdf5 import write_northfind
+
+    run = run_northfind(sc, seed)
+    return Outcome(northfind_summary(run, sc), lambda f: write_northfind(f, run), None, run.seed)

@@ -7,7 +7,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gcalign.align.cycles import Stage, stage_of_passes
+from gcalign.align.stages import Stage, stage_of_passes
 from gcalign.io.scenario.base import Model, Vec3
 
 

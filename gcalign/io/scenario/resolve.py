@@ -84,7 +84,7 @@ def resolved_rows(sc: Scenario) -> list[tuple[str, str, str]]:
                     _v(np.radians(s.rate_dps)) + " rad/s",
                 )
             )
-    for section in ("align", "northfind"):
+    for section in type(sc).model_fields:  # every command section that can explain itself
         model = getattr(sc, section, None)
         if model is not None and hasattr(model, "resolved_rows"):
             rows += model.resolved_rows(sc)

@@ -1,0 +1,105 @@
+"""North-finding figures (seed 001 figs. 3-5): the azimuth error against the true azimuth,
+one subplot per method (mean over repeats, ±1σ band with repeats, the noise-free closed
+form where there is one); the difference coordinate − vector."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from gcalign.app.plots import _s, new_figure
+
+METHOD_ORDER = ("coordinate", "vector", "naive", "none")
+
+
+
+
+def _methods_in_order(names) -> list[str]:
+    names = list(names)
+    return [m for m in METHOD_ORDER if m in names] + [m for m in names if m not in METHOD_ORDER]
+
+
+def northfind_error_figure(azimuth_true: np.ndarray, errors: dict[str, np.ndarray],
+                           error_pred: dict[str, np.ndarray] | None = None,
+                           title: str = "north-finding error") -> Figure:
+    """Azimuth error (deg) against true azimuth (deg), one subplot per method.
+
+    errors : method -> (M,) or (repeats, M) rad. error_pred : method -> (M,) rad (closed
+    form, NaN where there is none).
+    """
+    methods = _methods_in_order(errors)
+    az = np.degrees(np.asarray(azimuth_true, float))
+    order = np.argsort(az)
+    fig, axes = new_figure(len(methods), height=2.2 * len(methods) + 1.0)
+    for ax, m in zip(axes, methods, strict=True):
+        e = np.degrees(np.atleast_2d(errors[m]))[:, order]
+        r = e.shape[0]
+        mean = e.mean(0)
+        ax.plot(az[order], mean, marker="." if az.size < 100 else None, linewidth=1.0,
+                label="error" if r == 1 else f"mean of {r} repeats")
+        if r > 1:
+            sd = e.std(0, ddof=1)
+            ax.fill_between(az[order], mean - sd, mean + sd, alpha=0.25, label="±1σ")
+        pred = None if error_pred is None else error_pred.get(m)
+        if pred is not None and np.any(np.isfinite(pred)):
+            ax.plot(az[order], np.degrees(np.asarray(pred))[order], color="black",
+                    linestyle="--", linewidth=0.8, label="closed form (noise-free)")
+        ax.set_ylabel(f"{m}\nerror (deg)")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize="small")
+    axes[-1].set_xlabel("true azimuth (deg, clockwise from north)")
+    axes[-1].set_xlim(0, 360)
+    axes[-1].set_xticks(np.arange(0, 361, 45))
+    fig.suptitle(title)
+    return fig
+
+
+def northfind_difference_figure(azimuth_true: np.ndarray, a: np.ndarray, b: np.ndarray,
+                                names: tuple[str, str] = ("coordinate", "vector"),
+                                title: str = "difference of the two compensation methods"
+                                ) -> Figure:
+    """Seed 001 fig. 5: estimate difference of two methods (arc-seconds) against true
+    azimuth; a, b are errors (M,) or (repeats, M) rad."""
+    az = np.degrees(np.asarray(azimuth_true, float))
+    order = np.argsort(az)
+    d = (np.degrees(np.atleast_2d(a) - np.atleast_2d(b)) * 3600.0)[:, order]
+    fig, axes = new_figure(1, height=3.6)
+    ax = axes[0]
+    ax.plot(az[order], d.mean(0), marker="." if az.size < 100 else None, linewidth=1.0,
+            label=f"{names[0]} − {names[1]}" + (f" (mean of {d.shape[0]})" if len(d) > 1 else ""))
+    ax.set_xlabel("true azimuth (deg, clockwise from north)")
+    ax.set_ylabel("difference (arcsec)")
+    ax.set_xlim(0, 360)
+    ax.set_xticks(np.arange(0, 361, 45))
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper right", fontsize="small")
+    fig.suptitle(title)
+    return fig
+
+
+def read_northfind(f) -> tuple[np.ndarray, dict, dict]:
+    g = f["northfind"]
+    names = _s(g.attrs.get("methods", "")).split(",") if "methods" in g.attrs else []
+    import h5py
+
+    names = [n for n in names if n in g] or [k for k in g if isinstance(g[k], h5py.Group)
+                                             and "error" in g[k]]
+    errors = {m: g[m]["error"][()] for m in names}
+    pred = {m: g[m]["error_pred"][()] for m in names if "error_pred" in g[m]}
+    return g["azimuth_true"][()], errors, pred
+
+
+def figures(f, name: str) -> dict[str, Figure]:
+    """The figures of a northfind results file."""
+    figs: dict[str, Figure] = {}
+    if "northfind" not in f:
+        return figs
+    az, errors, pred = read_northfind(f)
+    head = f"{name}: {len(az)} azimuth(s)"
+    figs["northfind_error"] = northfind_error_figure(
+        az, errors, pred, title=f"{head} — azimuth error per method")
+    if "coordinate" in errors and "vector" in errors:
+        figs["northfind_difference"] = northfind_difference_figure(
+            az, errors["coordinate"], errors["vector"],
+            title=f"{head} — coordinate − vector (seed 001 fig. 5)")
+    return figs

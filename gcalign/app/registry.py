@@ -1,0 +1,81 @@
+"""The command registry: one line per command; adding a capability is new files plus a line.
+
+Each command's room is a subpackage of :mod:`gcalign.app` whose ``__init__`` offers, as
+plain functions that import their heavy parts only when called (so ``gcalign show`` and
+``gcalign validate`` never load numba):
+
+* ``execute(sc, seed=None, cache_key=None) -> Outcome`` -- run a scenario (not ``batch``);
+* ``table(summary) -> rich.table.Table`` -- the table the command prints (and ``show``);
+* ``figures(f, name) -> dict[str, Figure]`` -- the figures of its results file (``plot``);
+* optionally ``components(metric, k)`` -- names of a batch metric's vector components.
+
+The registry itself imports nothing of them; :meth:`Command.room` loads the subpackage.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from types import ModuleType
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What one run of a command produced, ready to be written and shown.
+
+    summary : plain numbers (degrees, seconds, ...): the JSON contract and ``summary_json``.
+    write : writes the command's groups into an open results file (h5py.File).
+    truth : the simulated truth to store under ``/truth``, if any.
+    seed : the random seed the run used (None for recorded data).
+    warnings : one line each, shown on stderr and kept in the summary.
+    """
+
+    summary: dict
+    write: Callable[[Any], None]
+    truth: Any = None
+    seed: int | None = None
+    warnings: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Command:
+    """A command: its name (also the ``kind`` of its results file) and its room."""
+
+    name: str
+    room: str  # subpackage of gcalign.app
+    help: str
+    section: str | None = None  # the scenario section it reads
+    builtin: str | None = None  # built-in scenario (package data gcalign/scenarios)
+    batch_metrics: tuple[str, ...] = field(default=())  # default metrics; () = not batchable
+
+    def load(self) -> ModuleType:
+        return importlib.import_module(f"gcalign.app.{self.room}")
+
+
+COMMANDS: dict[str, Command] = {
+    c.name: c
+    for c in (
+        Command("simulate", "simulate", "Simulate truth and IMU data."),
+        Command("navigate", "navigate", "Strapdown navigation of simulated or recorded data."),
+        Command("align", "align", "Gyrocompass alignment (seed 000).", "align",
+                "seed000_moving_full_cycle.yaml", ("error_t3_deg",)),
+        Command("northfind", "northfind", "Multi-position north-finding (seed 001).",
+                "northfind", "seed001_simulation.yaml", ("methods.coordinate.rms_error_deg",)),
+        Command("batch", "batch", "Sweeps and Monte Carlo over any batchable command."),
+    )
+}
+
+
+def command(name: str) -> Command:
+    """The registered command `name`; KeyError names the ones that exist."""
+    try:
+        return COMMANDS[name]
+    except KeyError:
+        raise KeyError(f"unknown command {name!r}; commands: {', '.join(COMMANDS)}") from None
+
+
+def batchable() -> dict[str, Command]:
+    """Commands a sweep can run, with their default metrics."""
+    return {n: c for n, c in COMMANDS.items() if c.batch_metrics}

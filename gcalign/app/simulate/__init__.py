@@ -1,0 +1,25 @@
+"""`gcalign simulate`: truth and IMU data of a scenario.
+
+The room's interface for the registry (:mod:`gcalign.app.registry`); each function imports
+its module when called, so tables and figures never load the numerical kernels.
+"""
+
+from __future__ import annotations
+
+from gcalign.app.registry import Outcome
+
+
+def execute(sc, seed: int | None = None, cache_key: str | None = None) -> Outcome:
+    from gcalign.app.simulate.run import execute as run
+
+    return run(sc, seed, cache_key)
+
+
+def table(summary: dict):
+    from gcalign.app.simulate.tables import simulate_table
+
+    return simulate_table(summary)
+
+
+def figures(f, name: str) -> dict:
+    return {}  # the truth figure, which every file with /truth gets
