@@ -17,8 +17,9 @@ The functions take latitude in radians and height in metres, broadcast over arra
 default to WGS-84. The same formulas run inside the numba kernels from
 :meth:`EarthModel.params` (:func:`gcalign.nav._kernels.earth_at`); a test keeps them in step.
 
->>> r_m, r_n = SEED004.radii(np.radians(45.7796))
->>> round(float(r_m), 1), round(float(r_n), 1), round(float(SEED004.gravity(np.radians(45.7796))), 6)
+>>> lat = np.radians(45.7796)
+>>> r_m, r_n = SEED004.radii(lat)
+>>> round(float(r_m), 1), round(float(r_n), 1), round(float(SEED004.gravity(lat)), 6)
 (6368531.5, 6389423.2, 9.806998)
 """
 
