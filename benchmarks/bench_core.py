@@ -41,7 +41,7 @@ from gcalign.nav._kernels import empty_states, strapdown_block
 from gcalign.nav.rotation import euler_to_quat, quat_to_dcm
 from gcalign.nav.strapdown import NavState, navigate
 from gcalign.sim.imu import ImuErrors, SensorErrors, apply_errors, ideal_imu
-from gcalign.sim.motions import Motion, Segment
+from gcalign.sim.motions import Moving, Segment, Swing
 from gcalign.units import DEG, DPH, DPSH, UG, UGPSHZ
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -78,7 +78,7 @@ motion:
 """
 
 
-def moving_motion() -> Motion:
+def moving_motion() -> Moving:
     right, left = (0.0, 0.0, -DEG), (0.0, 0.0, DEG)
     segments = (
         Segment(10.0),
@@ -89,13 +89,11 @@ def moving_motion() -> Motion:
         Segment(10.0, rate=right),
         Segment(10.0),
     )
-    return Motion("moving", (0.0, 0.0, 30.0 * DEG), 400.0, segments=segments)
+    return Moving((0.0, 0.0, 30.0 * DEG), 400.0, segments)
 
 
-def swing_motion() -> Motion:
-    return Motion(
-        "swing",
-        (0.0, 0.0, 30.0 * DEG),
+def swing_motion() -> Swing:
+    return Swing((0.0, 0.0, 30.0 * DEG),
         400.0,
         amplitude=(2 * DEG, 3 * DEG, 4 * DEG),
         period=(10.0, 10.0, 20.0),

@@ -17,9 +17,10 @@ from gcalign.app.align.run import run_alignment
 from gcalign.app.data import scenario_data
 from gcalign.io.scenario import parse_scenario
 from gcalign.nav import earth
+from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import euler_to_dcm, misalignment, quat_mult, quat_to_dcm, rotvec_to_quat
 from gcalign.sim.imu import ideal_imu
-from gcalign.sim.motions import Motion
+from gcalign.sim.motions import Swing
 
 SITE = {"lat_deg": 45.7796, "lon_deg": 126.6705, "height_m": 0.0}
 LAT = np.radians(SITE["lat_deg"])
@@ -61,9 +62,14 @@ def reference_block(state, dtheta, dv, vref, body, ts, sign, gains, mode):
         q = quat_mult(rotvec_to_quat(-w_in * ts), quat_mult(q, rotvec_to_quat(dtheta[k])))
         q = q / np.linalg.norm(q)
         nxt = ref_n(k + 1, q)
-        lat_new = lat + 0.5 * (r[1] + nxt[1]) * ts / (r_m + h)
-        lon = lon + 0.5 * (r[0] + nxt[0]) * ts / ((r_n + h) * np.cos(lat))
-        h = h + 0.5 * (r[2] + nxt[2]) * ts
+        # position along the reference velocity: trapezoid, radii at mid-interval
+        u = 0.5 * (r + nxt)
+        h_mid = h + 0.5 * u[2] * ts
+        lat_mid = lat + 0.5 * u[1] * ts / (r_m + h_mid)
+        rm_mid, rn_mid = earth.radii(lat_mid)
+        lat_new = lat + u[1] * ts / (rm_mid + h_mid)
+        lon = lon + u[0] * ts / ((rn_mid + h_mid) * np.cos(lat_mid))
+        h_new = h + u[2] * ts
         if mode != K.ATTITUDE:
             frame = 2 * w_ie + w_en + (w_c if body else 0.0)
             a = -np.cross(frame, 0.5 * (r + nxt))
@@ -83,7 +89,7 @@ def reference_block(state, dtheta, dv, vref, body, ts, sign, gains, mode):
                 wce = -dvn * (1 + ku2) / rmh
         else:
             ve, vn = nxt[0], nxt[1]
-        lat, r = lat_new, nxt
+        lat, h, r = lat_new, h_new, nxt
         out.append(q.copy())
     final = np.concatenate([q, [ve, vn, ie, inn, wcu, lat, lon, h]])
     return final, np.array(out)
@@ -93,9 +99,7 @@ def reference_block(state, dtheta, dv, vref, body, ts, sign, gains, mode):
 @pytest.mark.parametrize("sign", [1.0, -1.0])
 @pytest.mark.parametrize("body", [False, True])
 def test_kernel_matches_numpy_reference(mode, sign, body):
-    motion = Motion(
-        "swing",
-        tuple(np.radians([1, 2, 30])),
+    motion = Swing(tuple(np.radians([1, 2, 30])),
         15.0,
         amplitude=tuple(np.radians([2, 3, 4])),
         period=(10, 10, 20),
@@ -117,7 +121,8 @@ def test_kernel_matches_numpy_reference(mode, sign, body):
     state[6:9] = [1e-4, -2e-4, 3e-6]
     expected, q_ref = reference_block(state.copy(), dtheta, dv, vref, body, 0.01, sign, gains, mode)
     q_out = np.empty((n + 1, 4))
-    K.gyrocompass_block(state, dtheta, dv, vref, body, 0.01, sign, gains, mode, q_out)
+    K.gyrocompass_block(state, dtheta, dv, vref, body, 0.01, sign, WGS84.params(), gains, mode,
+                        q_out)
     np.testing.assert_allclose(q_out, q_ref, rtol=0, atol=1e-12)
     scale = np.maximum(np.abs(expected), 1e-300)
     assert np.max(np.abs(state - expected) / scale) < 1e-9 or np.allclose(

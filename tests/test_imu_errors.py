@@ -18,7 +18,7 @@ import pytest
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import parse_scenario
 from gcalign.sim.imu import ImuData, ImuErrors, SensorErrors, apply_errors, ideal_imu
-from gcalign.sim.motions import Motion
+from gcalign.sim.motions import Swing
 
 TS = 0.01
 DEG = math.pi / 180.0
@@ -52,9 +52,7 @@ def tumbling_block() -> ImuData:
     incommensurate periods): every gyro and accelerometer axis sees large positive and
     negative inputs, so the 3x3 error matrix is observable from all nine entries."""
     if "imu" not in _TUMBLE:
-        motion = Motion(
-            "swing",
-            (0.0, 0.0, 0.0),
+        motion = Swing((0.0, 0.0, 0.0),
             300.0,
             amplitude=(60 * DEG, 80 * DEG, 180 * DEG),
             period=(7.0, 11.0, 13.0),

@@ -20,11 +20,13 @@ import numpy as np
 import pytest
 
 from gcalign.nav import earth
-from gcalign.nav._kernels import earth_at, empty_states, strapdown_block, transport_rate
+from gcalign.nav import _kernels as K
+from gcalign.nav._kernels import earth_at, transport_rate
+from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import euler_to_dcm, misalignment, quat_to_dcm
 from gcalign.nav.strapdown import NavState, navigate, reverse_data
 from gcalign.sim.imu import ideal_imu
-from gcalign.sim.motions import Motion, Segment
+from gcalign.sim.motions import Moving, Segment, Static, Swing
 from gcalign.units import DEG
 
 TS = 0.01
@@ -32,15 +34,13 @@ SITE = np.array([45.7796 * DEG, 126.6705 * DEG, 0.0])  # seed 000 (Harbin)
 EPS = np.finfo(float).eps
 
 
-def seed_motion(kind: str, duration: float = 400.0) -> Motion:
+def seed_motion(kind: str, duration: float = 400.0):
     """The seed 000 motions: static, §5.2 swing, §5.3 moving base (initial yaw 30°)."""
     att0 = (0.0, 0.0, 30.0 * DEG)
     if kind == "static":
-        return Motion("static", att0, duration)
+        return Static(att0, duration)
     if kind == "swing":
-        return Motion(
-            "swing",
-            att0,
+        return Swing(att0,
             duration,
             amplitude=(2 * DEG, 3 * DEG, 4 * DEG),
             period=(10.0, 10.0, 20.0),
@@ -56,7 +56,7 @@ def seed_motion(kind: str, duration: float = 400.0) -> Motion:
         Segment(10.0, rate=right),
         Segment(10.0),  # cruise (held to the end)
     )
-    return Motion("moving", att0, duration, segments=segments)
+    return Moving(att0, duration, segments)
 
 
 _CACHE: dict = {}
@@ -227,20 +227,14 @@ def reference_block(q0, v0, p0, dtheta, dv, ts, earth_sign):
 
 
 def kernel_block(q0, v0, p0, dtheta, dv, ts, earth_sign):
-    q, v, p = empty_states(len(dtheta))
-    strapdown_block(
-        np.asarray(q0, float),
-        np.asarray(v0, float),
-        np.asarray(p0, float),
-        np.ascontiguousarray(dtheta),
-        np.ascontiguousarray(dv),
-        ts,
-        earth_sign,
-        q,
-        v,
-        p,
-    )
-    return q, v, p
+    """The block kernel on the state vector (free vertical channel, every step kept)."""
+    state = np.zeros(K.NAV_STATE)
+    state[K.Q], state[K.V], state[K.P] = q0, v0, p0
+    out = np.empty((len(dtheta), K.NAV_STATE))
+    K.strapdown_block(state, np.ascontiguousarray(dtheta), np.ascontiguousarray(dv), ts,
+                      earth_sign, WGS84.params(), np.zeros(4), np.zeros(1), 1, out)
+    rows = np.vstack([np.concatenate([q0, v0, p0, [0.0]]), out])
+    return rows[:, K.Q], rows[:, K.V], rows[:, K.P]
 
 
 def relative_errors(kernel, reference, p0, ts):
@@ -368,7 +362,7 @@ def test_static_increments_closed_form(att_deg):
     40000 Δθ is exact to 1e-10 relative (about 3e-12 rad).
     """
     att = np.radians(att_deg)
-    motion = Motion("static", tuple(att), 400.0)
+    motion = Static(tuple(att), 400.0)
     truth, imu = ideal_imu(motion, SITE, TS)
     lat, _, h = SITE
     C_bn = euler_to_dcm(att).T
@@ -387,10 +381,11 @@ def test_static_increments_closed_form(att_deg):
 
 @pytest.mark.parametrize("h", [0.0, 380.0, -500.0, 12_000.0])
 def test_scalar_earth_helpers_match_vectorised(h):
+    E = WGS84.params()
     lats = np.radians(np.linspace(-89.9, 89.9, 37))
     v_n = np.array([3.0, -7.0, 0.5])
     for lat in lats:
-        r_m, r_n, g, sl, cl = earth_at(lat, h)
+        r_m, r_n, g, sl, cl = earth_at(E, lat, h)
         ref_m, ref_n = earth.radii(lat)
         assert r_m == pytest.approx(ref_m, rel=1e-15, abs=0)
         assert r_n == pytest.approx(ref_n, rel=1e-15, abs=0)
@@ -406,13 +401,14 @@ def test_scalar_earth_helpers_match_vectorised(h):
 def test_earth_values_by_hand():
     """WGS-84 anchors: R_N(0) = a, R_M(0) = a (1 - e²), R_M(90°) = R_N(90°) = a / sqrt(1 - e²);
     normal gravity at the equator is GE, at the pole GE (1 + c1 + c2)."""
+    E = WGS84.params()
     a, e2 = 6378137.0, (2 - 1 / 298.257223563) / 298.257223563
-    r_m, r_n, g, _, _ = earth_at(0.0, 0.0)
+    r_m, r_n, g, _, _ = earth_at(E, 0.0, 0.0)
     assert r_n == pytest.approx(a, rel=1e-15)
     assert r_m == pytest.approx(a * (1 - e2), rel=1e-15)
     assert g == pytest.approx(9.7803267715, rel=1e-15)
-    r_m, r_n, g, _, _ = earth_at(np.pi / 2, 0.0)
+    r_m, r_n, g, _, _ = earth_at(E, np.pi / 2, 0.0)
     assert r_m == pytest.approx(a / np.sqrt(1 - e2), rel=1e-14)
     assert r_n == pytest.approx(a / np.sqrt(1 - e2), rel=1e-14)
     assert g == pytest.approx(9.7803267715 * (1 + 5.27094e-3 + 2.32718e-5), rel=1e-15)
-    assert earth_at(0.0, 1000.0)[2] == pytest.approx(9.7803267715 - 3.086e-3, rel=1e-15)
+    assert earth_at(E, 0.0, 1000.0)[2] == pytest.approx(9.7803267715 - 3.086e-3, rel=1e-15)

@@ -36,7 +36,8 @@ import math
 
 import numpy as np
 
-from gcalign.nav import earth, rotation
+from gcalign.nav import rotation
+from gcalign.nav.earth import WGS84, EarthModel
 
 COARSE_EPOCHS = ("end", "start")
 """Allowed values of ``at`` in :func:`inertial_frame_coarse`."""
@@ -87,7 +88,7 @@ def _double_vector(a1, a2, b1, b2):
     return rot.as_matrix()
 
 
-def analytic_coarse(dtheta, dv, ts, lat):
+def analytic_coarse(dtheta, dv, ts, lat, earth: EarthModel = WGS84):
     """Static-base analytic (double-vector) coarse alignment.
 
     Parameters
@@ -138,7 +139,7 @@ def _cumulative_quat(dq):
     return q
 
 
-def _gravity_velocity_in0(t, lat, g):
+def _gravity_velocity_in0(t, lat, g, w):
     """Velocity ∫_0^t C_n^in0(τ) [0, 0, g] dτ (m/s) of a point at rest, in in0, shape (N, 3).
 
     ``C_n^in0(τ)`` is the rotation by ``ω_ie τ`` about the earth axis ``e = [0, cos L, sin L]``
@@ -148,7 +149,6 @@ def _gravity_velocity_in0(t, lat, g):
 
     ``1 − cos ωt`` is evaluated as ``2 sin²(ωt/2)`` (ωt is ~1e-3: no cancellation).
     """
-    w = earth.OMEGA_IE
     sl, cl = math.sin(lat), math.cos(lat)
     e = np.array([0.0, cl, sl])
     u_perp = np.array([0.0, 0.0, 1.0]) - sl * e
@@ -161,7 +161,8 @@ def _gravity_velocity_in0(t, lat, g):
     return g * v
 
 
-def inertial_frame_coarse(dtheta, dv, ts, lat, lon=0.0, h=0.0, at="end"):
+def inertial_frame_coarse(dtheta, dv, ts, lat, lon=0.0, h=0.0, at="end",
+                          earth: EarthModel = WGS84):
     """Inertial-frame coarse alignment on a static, swinging or disturbed base.
 
     Parameters
@@ -226,7 +227,7 @@ def inertial_frame_coarse(dtheta, dv, ts, lat, lon=0.0, h=0.0, at="end"):
     v_ib0 = np.cumsum(np.einsum("kij,kj->ki", C_prev, dv_comp), axis=0)
     # 3. v^in0(t_k) of a point at rest, analytic
     t = ts * np.arange(1, n + 1)
-    v_in0 = _gravity_velocity_in0(t, lat, float(earth.gravity(lat, h)))
+    v_in0 = _gravity_velocity_in0(t, lat, float(earth.gravity(lat, h)), earth.omega_ie)
     # 4. Wahba: v^in0 = C_ib0^in0 v^ib0 over all epochs
     from scipy.spatial.transform import Rotation
 

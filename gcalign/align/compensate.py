@@ -16,23 +16,24 @@ from __future__ import annotations
 import numpy as np
 
 from gcalign.align import kernel as K
-from gcalign.align.cycles import Block
-from gcalign.nav import earth
+from gcalign.align.cycles import Block, run_block
+from gcalign.nav.earth import WGS84, C_en, EarthModel
 from gcalign.nav.rotation import dcm_to_quat, quat_to_dcm
+from gcalign.nav.strapdown import integrate_attitude
 
 METHODS = ("none", "one-off", "continued")
 
 
-def _C_ni(pos, tau):
+def _C_in(pos, tau, earth: EarthModel):
     """C_n^i at elapsed times tau (s) since T2 and positions [lat, lon, h]: Rz(ω τ) C_n^e."""
-    a = earth.OMEGA_IE * np.asarray(tau, float)
+    a = earth.omega_ie * np.asarray(tau, float)
     c, s = np.cos(a), np.sin(a)
     z, o = np.zeros_like(a), np.ones_like(a)
     R = np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
-    return R @ earth.C_en(pos[..., 0], pos[..., 1])
+    return R @ C_en(pos[..., 0], pos[..., 1])
 
 
-def _track(pos0, t, v_n):
+def _track(pos0, t, v_n, earth: EarthModel):
     """Latitude/longitude/height along ENU velocity samples (trapezoid rule)."""
     dt = np.diff(t)[:, None]
     r_m, r_n = earth.radii(pos0[0])
@@ -45,63 +46,40 @@ def _track(pos0, t, v_n):
     )
 
 
-def one_off(state_t2: np.ndarray, after: Block) -> np.ndarray:
+def one_off(state_t2: np.ndarray, after: Block, earth: EarthModel = WGS84) -> np.ndarray:
     """q_nb at the end of `after` by seed eqs. 14-18 (see module docstring)."""
-    n = len(after.dtheta)
-    q_b_ib0 = np.empty((n + 1, 4))
-    pure = K.new_state(np.array([1.0, 0.0, 0.0, 0.0]), np.zeros(3), state_t2[9:12])
-    # Earth rate off and zero reference velocity: the kernel integrates the gyro alone (eq. 18).
-    K.gyrocompass_block(
-        pure,
-        after.dtheta,
-        after.dv,
-        np.zeros((n + 1, 3)),
-        False,
-        after.ts,
-        0.0,
-        np.zeros(K.GAINS_SIZE),
-        K.ATTITUDE,
-        q_b_ib0,
-    )
-    pos_t2 = state_t2[9:12]
-    C_ib0_i = _C_ni(pos_t2, 0.0) @ quat_to_dcm(state_t2[0:4])  # eq. 14 at T2
+    # eq. 18: pure gyro quaternion integration from the body inertial frame frozen at T2
+    q_ib0_b = integrate_attitude(np.array([1.0, 0.0, 0.0, 0.0]), after.dtheta, after.ts)
+    pos_t2 = state_t2[K.POS]
+    C_i_ib0 = _C_in(pos_t2, 0.0, earth) @ quat_to_dcm(state_t2[K.ATT])  # eq. 14 at T2
     tau = after.t - after.t[0]
-    C_b_ib0 = quat_to_dcm(q_b_ib0)
+    C_ib0_b = quat_to_dcm(q_ib0_b)
+    n = len(after.dtheta)
     pos = np.broadcast_to(pos_t2, (n + 1, 3))
     # The position at T3 needs the velocity, which (odometer) needs the attitude: two rounds.
     for _ in range(2):
-        C_nb = np.swapaxes(_C_ni(pos, tau), -1, -2) @ C_ib0_i @ C_b_ib0  # eqs. 14-17
+        C_nb = np.swapaxes(_C_in(pos, tau, earth), -1, -2) @ C_i_ib0 @ C_ib0_b  # eqs. 14-17
         v_n = np.einsum("kij,kj->ki", C_nb, after.vref) if after.vref_body else after.vref
-        pos = _track(pos_t2, after.t, v_n)
+        pos = _track(pos_t2, after.t, v_n, earth)
     return dcm_to_quat(C_nb[-1])
 
 
-def continued(state_t2: np.ndarray, after: Block) -> np.ndarray:
+def continued(state_t2: np.ndarray, after: Block, earth: EarthModel = WGS84) -> np.ndarray:
     """q_nb at the end of `after` by a plain strapdown attitude update from T2."""
-    n = len(after.dtheta)
     state = state_t2.copy()
-    q_out = np.empty((n + 1, 4))
-    K.gyrocompass_block(
-        state,
-        after.dtheta,
-        after.dv,
-        after.vref,
-        after.vref_body,
-        after.ts,
-        1.0,
-        np.zeros(K.GAINS_SIZE),
-        K.ATTITUDE,
-        q_out,
-    )
+    q_out = np.empty((len(after.dtheta) + 1, 4))
+    run_block(state, after, 0, len(after.dtheta), False, np.zeros(K.GAINS_SIZE), K.ATTITUDE,
+              q_out, earth)
     return q_out[-1]
 
 
-def compensate(method: str, state_t2: np.ndarray, after: Block) -> np.ndarray:
+def compensate(method: str, state_t2: np.ndarray, after: Block,
+               earth: EarthModel = WGS84) -> np.ndarray:
     """q_nb at T3 from the kernel state at T2 and the data stored after T2."""
     if method == "none" or len(after.dtheta) == 0:
-        return state_t2[0:4].copy()
+        return state_t2[K.ATT].copy()
     if method == "one-off":
-        return one_off(state_t2, after)
+        return one_off(state_t2, after, earth)
     if method == "continued":
-        return continued(state_t2, after)
+        return continued(state_t2, after, earth)
     raise ValueError(f"compensation: got {method!r}, allowed: {', '.join(METHODS)}")

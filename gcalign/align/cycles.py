@@ -17,7 +17,7 @@ import numpy as np
 from gcalign.align import kernel as K
 from gcalign.align.gains import azimuth_gains, level_gains
 from gcalign.align.stages import Stage, stage_of_passes
-from gcalign.nav import earth
+from gcalign.nav.earth import WGS84, EarthModel
 
 MODES = ("conventional", "full-cycle", "half-cycle")
 
@@ -67,7 +67,8 @@ def pass_plan(mode: str, passes: int) -> list[tuple[str, str]]:
     return plan
 
 
-def loop_gains(stage: Stage, lat: float, h: float, azimuth_poles: str) -> np.ndarray:
+def loop_gains(stage: Stage, lat: float, h: float, azimuth_poles: str,
+               earth: EarthModel = WGS84) -> np.ndarray:
     """Gains vector of the kernel for a stage at the site (east loop with R_N, north with R_M)."""
     r_m, r_n = earth.radii(lat)
     g = float(earth.gravity(lat, h))
@@ -79,24 +80,16 @@ def loop_gains(stage: Stage, lat: float, h: float, azimuth_poles: str) -> np.nda
     )
 
 
-def _run(state, block: Block, lo: int, hi: int, reverse: bool, gains, mode, q_out):
+def run_block(state, block: Block, lo: int, hi: int, reverse: bool, gains, mode, q_out,
+              earth: EarthModel = WGS84) -> None:
     """Kernel over increments lo..hi-1 of the block (forward) or hi-1..lo (reverse)."""
     dth, dv, vref = block.dtheta[lo:hi], block.dv[lo:hi], block.vref[lo : hi + 1]
     sign = 1.0
     if reverse:
         dth, dv, vref, sign = -dth[::-1], dv[::-1], -vref[::-1], -1.0
-    K.gyrocompass_block(
-        state,
-        np.ascontiguousarray(dth),
-        np.ascontiguousarray(dv),
-        np.ascontiguousarray(vref),
-        block.vref_body,
-        block.ts,
-        sign,
-        gains,
-        mode,
-        q_out,
-    )
+    K.gyrocompass_block(state, np.ascontiguousarray(dth), np.ascontiguousarray(dv),
+                        np.ascontiguousarray(vref), block.vref_body, block.ts, sign,
+                        earth.params(), gains, mode, q_out)
 
 
 def run_passes(
@@ -107,6 +100,7 @@ def run_passes(
     stages: list[Stage],
     azimuth_poles: str,
     level_s: float,
+    earth: EarthModel = WGS84,
 ) -> tuple[np.ndarray, list[PassRecord]]:
     """Run the passes of a mode over the block from the kernel state at its start.
 
@@ -118,8 +112,8 @@ def run_passes(
     state = state0.copy()
     n = len(block.dtheta)
     stage_idx = stage_of_passes(stages, passes)
-    lat, h = state[9], state[11]
-    gains_by_stage = [loop_gains(st, lat, h, azimuth_poles) for st in stages]
+    lat, h = state[K.POS][0], state[K.POS][2]
+    gains_by_stage = [loop_gains(st, lat, h, azimuth_poles, earth) for st in stages]
     records = []
     direction_prev = "forward"
     for i, (direction, kind) in enumerate(pass_plan(mode, passes)):
@@ -130,13 +124,13 @@ def run_passes(
         gains = gains_by_stage[stage_idx[i]]
         q_out = np.empty((n + 1, 4))
         if kind == "attitude":
-            _run(state, block, 0, n, reverse, gains, K.ATTITUDE, q_out)
+            run_block(state, block, 0, n, reverse, gains, K.ATTITUDE, q_out, earth)
         elif i == 0 and level_s > 0:
             n_level = min(int(round(level_s / block.ts)), n)
-            _run(state, block, 0, n_level, False, gains, K.LEVEL, q_out[: n_level + 1])
-            _run(state, block, n_level, n, False, gains, K.COMPASS, q_out[n_level:])
+            run_block(state, block, 0, n_level, False, gains, K.LEVEL, q_out[: n_level + 1], earth)
+            run_block(state, block, n_level, n, False, gains, K.COMPASS, q_out[n_level:], earth)
         else:
-            _run(state, block, 0, n, reverse, gains, K.COMPASS, q_out)
+            run_block(state, block, 0, n, reverse, gains, K.COMPASS, q_out, earth)
         t = block.t[::-1] if reverse else block.t
         records.append(PassRecord(i, direction, kind, stage_idx[i], gains, t, q_out))
     if direction_prev == "reverse":

@@ -8,6 +8,7 @@ Per step (data already transformed for a reverse pass: gyro negated, velocity ne
 ``earth_sign = -1``, so Ω = earth_sign·ω_ie·cos L changes sign with the data):
 
 - attitude ``q ← q(−ω_in T) ⊗ q ⊗ q(Δθ)`` with ``ω_in = ω_ie + ω_en(v_R) + ω_c``;
+- position along v_R by the trapezoid rule, radii at mid-interval (the strapdown step's);
 - horizontal velocity ``v ← v + C_nb Δv − ((2ω_ie + ω_en [+ ω_c]) × v_R,mid) T − K1 δv T``
   (eqs. 11-13; the Coriolis and frame-rate terms are those of the reference velocity v_R;
   ω_c is included for an odometer reference, which is resolved with the computed attitude
@@ -24,16 +25,25 @@ of the T2→T3 update), ``LEVEL`` (both level loops, azimuth free) and ``COMPASS
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
-from gcalign.nav._kernels import earth_at, qmul, qrot, rotate_small, rv2q, transport_rate
-from gcalign.nav.earth import OMEGA_IE
+from gcalign.nav._kernels import (
+    attitude_update,
+    earth_at,
+    position_update,
+    qrot,
+    specific_force_increment,
+    transport_rate,
+)
 
 ATTITUDE, LEVEL, COMPASS = 0, 1, 2
 STATE_SIZE = 12
+ATT = slice(0, 4)  #: q_nb
+VEL = slice(4, 6)  #: v_E, v_N (m/s)
+INTEGRALS = slice(6, 8)  #: ∫δv_E, ∫δv_N (m)
+WCU = 8  #: ω_cU (rad/s)
+POS = slice(9, 12)  #: lat, lon (rad), h (m)
 # Loop states that are velocities or rates: they change sign with the data at a change
 # of pass direction (DESIGN.md); the attitude and the position are kept.
 FLIP = slice(4, 9)
@@ -42,13 +52,15 @@ GAINS_SIZE = 10
 
 
 @njit(cache=True)
-def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains, mode, q_out):
+def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, E, gains, mode,
+                      q_out):
     """Run the loops over N increments, updating `state` (12,) in place.
 
     dtheta, dv : (N, 3) body increments (rad, m/s), in processing order.
     vref : (N+1, 3) reference velocity at the start (row 0) and at the end of each step
         (m/s); ENU, or body frame (odometer) if `vref_body`, then resolved with the
         computed attitude.
+    E : earth model vector (:meth:`gcalign.nav.earth.EarthModel.params`).
     gains : (10,) loop gains; mode : ATTITUDE, LEVEL or COMPASS.
     q_out : (N+1, 4) attitude after each step, row 0 = start (preallocated).
     """
@@ -66,7 +78,7 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains,
     if vref_body:
         re, rn, ru = qrot(q0, q1, q2, q3, re, rn, ru)
     wce = wcn = 0.0
-    r_m, r_n, g, sl, cl = earth_at(lat, h)
+    r_m, r_n, g, sl, cl = earth_at(E, lat, h)
     if mode != ATTITUDE:
         # Control rates of the incoming state.
         dve, dvn = ve - re, vn - rn
@@ -76,9 +88,9 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains,
         else:
             wce = -dvn * (1.0 + ku2) / (r_m + h)
     for k in range(dtheta.shape[0]):
-        r_m, r_n, g, sl, cl = earth_at(lat, h)
+        r_m, r_n, g, sl, cl = earth_at(E, lat, h)
         rmh, rnh = r_m + h, r_n + h  # radii at the start of the step
-        wie = earth_sign * OMEGA_IE
+        wie = earth_sign * E[3]
         wie_n, wie_u = wie * cl, wie * sl
         te, tn, tu = transport_rate(re, rn, r_m, r_n, h, sl, cl)
         cu = wcu if mode == COMPASS else 0.0
@@ -86,28 +98,23 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains,
         wy = (wie_n + tn + wcn) * ts
         wz = (wie_u + tu + cu) * ts
 
-        # Specific-force increment at mid-interval, as in the strapdown step.
-        bx, by, bz = rotate_small(
-            0.5 * dtheta[k, 0], 0.5 * dtheta[k, 1], 0.5 * dtheta[k, 2], dv[k, 0], dv[k, 1], dv[k, 2]
+        # Specific-force increment at mid-interval, and the attitude update with the
+        # platform rate including the control rates: the pieces of the strapdown step.
+        fx, fy, fz = specific_force_increment(
+            q0, q1, q2, q3, dtheta[k, 0], dtheta[k, 1], dtheta[k, 2], dv[k, 0], dv[k, 1],
+            dv[k, 2], wx, wy, wz,
         )
-        fx, fy, fz = qrot(q0, q1, q2, q3, bx, by, bz)
-        fx, fy, fz = rotate_small(-0.5 * wx, -0.5 * wy, -0.5 * wz, fx, fy, fz)
-
-        # Attitude update with the platform rate including the control rates.
-        aw, ax, ay, az = rv2q(dtheta[k, 0], dtheta[k, 1], dtheta[k, 2])
-        nw, nx, ny, nz = rv2q(-wx, -wy, -wz)
-        p0, p1, p2, p3 = qmul(q0, q1, q2, q3, aw, ax, ay, az)
-        p0, p1, p2, p3 = qmul(nw, nx, ny, nz, p0, p1, p2, p3)
-        nq = 1.0 / math.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
-        q0, q1, q2, q3 = p0 * nq, p1 * nq, p2 * nq, p3 * nq
+        q0, q1, q2, q3 = attitude_update(
+            q0, q1, q2, q3, dtheta[k, 0], dtheta[k, 1], dtheta[k, 2], wx, wy, wz
+        )
 
         # Reference velocity at the end of the step, and position along it.
         ne, nn, nu = vref[k + 1, 0], vref[k + 1, 1], vref[k + 1, 2]
         if vref_body:
             ne, nn, nu = qrot(q0, q1, q2, q3, ne, nn, nu)
-        lat_new = lat + 0.5 * (rn + nn) * ts / (r_m + h)
-        lon = lon + 0.5 * (re + ne) * ts / ((r_n + h) * cl)
-        h = h + 0.5 * (ru + nu) * ts
+        lat_new, lon, h_new = position_update(
+            E, lat, lon, h, 0.5 * (re + ne), 0.5 * (rn + nn), 0.5 * (ru + nu), ts
+        )
 
         if mode != ATTITUDE:
             # Coriolis and frame-rate acceleration of the reference velocity (seed §1). With
@@ -137,7 +144,7 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains,
                 wce = -dvn * (1.0 + ku2) / rmh
         else:
             ve, vn = ne, nn
-        lat = lat_new
+        lat, h = lat_new, h_new
         re, rn, ru = ne, nn, nu
         q_out[k + 1, 0], q_out[k + 1, 1], q_out[k + 1, 2], q_out[k + 1, 3] = q0, q1, q2, q3
 
@@ -149,7 +156,7 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, gains,
 def new_state(q_nb, v_n, pos) -> np.ndarray:
     """Loop state vector from attitude, horizontal velocity and position; loop states zero."""
     s = np.zeros(STATE_SIZE)
-    s[0:4] = q_nb
-    s[4:6] = np.asarray(v_n, float)[:2]
-    s[9:12] = pos
+    s[ATT] = q_nb
+    s[VEL] = np.asarray(v_n, float)[:2]
+    s[POS] = pos
     return s

@@ -1,8 +1,18 @@
-"""The IMU data and truth of a scenario: simulated from `motion`, or read from `imu_file`."""
+"""The IMU data and truth of a scenario: simulated from `motion`, or read from `imu_file`.
+
+Two views of the same data:
+
+* :class:`Stream` -- blocks of measured increments with the truth at their end times,
+  generated on the fly (simulation: truth → ideal increments → sensor errors), so that a
+  72 h run never holds more than a block; what ``simulate`` and ``navigate`` use.
+* :class:`RunData` -- the whole run as arrays (alignment passes need the stored block).
+  :func:`scenario_data` builds it from the stream into preallocated arrays.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -10,18 +20,63 @@ import numpy as np
 from gcalign.errors import ScenarioError
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario import Scenario
-from gcalign.sim.imu import ImuData, apply_errors, ideal_imu
-from gcalign.sim.motions import Truth
+from gcalign.nav.earth import WGS84, EarthModel
+from gcalign.sim.errors import ErrorStream
+from gcalign.sim.imu import ImuData
+from gcalign.sim.motions import Truth, sample_count
 
 
 @dataclass(frozen=True)
 class RunData:
-    """What every pipeline starts from: IMU increments, truth if known, site, seed."""
+    """What every pipeline starts from: IMU increments, truth if known, site, seed, earth."""
 
     imu: ImuData
     truth: Truth | None
     site: np.ndarray
     seed: int | None
+    earth: EarthModel = WGS84
+
+
+@dataclass(frozen=True)
+class DataBlock:
+    """Measured increments k0 .. k0+n-1 (sensor frame) and, if known, the truth at their end
+    times t: att, v_n, pos (n, 3), segment (n,); q_bs (n, 4) mechanism angles or None."""
+
+    k0: int
+    t: np.ndarray
+    dtheta: np.ndarray
+    dv: np.ndarray
+    att: np.ndarray | None = None
+    v_n: np.ndarray | None = None
+    pos: np.ndarray | None = None
+    segment: np.ndarray | None = None
+    q_bs: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Stream:
+    """A run's data as blocks (see the module docstring). `truth0` is the truth at the time
+    before the first increment (None for recorded data); `header` the recorded file's own
+    ImuData (its att0, v0_n, site, meta) without the arrays."""
+
+    ts: float
+    samples: int
+    site: np.ndarray
+    earth: EarthModel
+    seed: int | None
+    source: str
+    truth0: Truth | None
+    make_blocks: Callable[[], Iterator[DataBlock]] = field(repr=False)
+    header: ImuData | None = None
+    has_mechanism: bool = False
+
+    def blocks(self) -> Iterator[DataBlock]:
+        return self.make_blocks()
+
+    @property
+    def t0(self) -> float:
+        """Time before the first increment (s)."""
+        return 0.0 if self.header is None else float(self.header.t[0] - self.ts)
 
 
 def read_data_file(path: Path) -> tuple[ImuData, Truth | None]:
@@ -40,6 +95,109 @@ def read_data_file(path: Path) -> tuple[ImuData, Truth | None]:
         raise ScenarioError(f"imu_file: {err}") from None
 
 
+def _recorded(scenario: Scenario) -> RunData:
+    assert scenario.imu_file is not None
+    imu, truth = read_data_file(scenario.imu_file)
+    if scenario.site is not None:
+        site = scenario.site.to_si()
+    elif imu.site is not None:
+        site = np.asarray(imu.site, float)
+    else:
+        raise ScenarioError(
+            f"site: missing; {scenario.imu_file} does not give the site, so the scenario must"
+        )
+    return RunData(imu=imu, truth=truth, site=site, seed=None, earth=scenario.earth_model)
+
+
+def _simulation(scenario: Scenario):
+    if scenario.motion is None:
+        raise ScenarioError("motion: missing; the scenario needs 'motion' or 'imu_file'")
+    assert scenario.site is not None  # the model requires a site with a motion
+    motion = scenario.motion.to_motion()
+    mech = None
+    if scenario.mechanism is not None:
+        mech = scenario.mechanism.to_mechanism(scenario.motion.attitude_deg)
+    return motion, mech, scenario.site.to_si()
+
+
+def scenario_stream(scenario: Scenario, seed: int | None = None,
+                    block: int | None = None) -> Stream:
+    """The scenario's data as blocks (simulated with its sensor errors, or recorded)."""
+    from gcalign.sim.ideal import BLOCK, ideal_blocks, initial_truth
+
+    earth = scenario.earth_model
+    if scenario.imu_file is not None:
+        data = _recorded(scenario)
+        imu, truth = data.imu, data.truth
+        size = block or BLOCK
+
+        def recorded_blocks() -> Iterator[DataBlock]:
+            for k0 in range(0, len(imu), size):
+                sl = slice(k0, k0 + size)
+                tr = {} if truth is None else {
+                    "att": truth.att[1:][sl], "v_n": truth.v_n[1:][sl], "pos": truth.pos[1:][sl],
+                    "segment": None if truth.segment is None else truth.segment[1:][sl]}
+                yield DataBlock(k0, imu.t[sl], imu.dtheta[sl], imu.dv[sl],
+                                q_bs=None if imu.q_bs is None else imu.q_bs[sl], **tr)
+
+        t0 = None if truth is None else Truth(truth.t[:1], truth.att[:1], truth.v_n[:1],
+                                              truth.pos[:1], None if truth.segment is None
+                                              else truth.segment[:1])
+        header = replace(imu, t=imu.t[:1], dtheta=imu.dtheta[:0], dv=imu.dv[:0],
+                         q_bs=None if imu.q_bs is None else imu.q_bs[:0])
+        return Stream(imu.ts, len(imu), data.site, earth, None, imu.source, t0,
+                      recorded_blocks, header, imu.q_bs is not None)
+
+    motion, mech, site = _simulation(scenario)
+    seed = scenario.imu.seed if seed is None else seed
+    ts = scenario.imu.ts
+    n = sample_count(motion.duration, ts)
+    errors = scenario.imu.errors()
+
+    def simulated_blocks() -> Iterator[DataBlock]:
+        stream = ErrorStream(errors, ts, np.random.default_rng(seed), n)
+        for b in ideal_blocks(motion, site, ts, earth, mech, block=block or BLOCK):
+            dtheta, dv = stream.apply(b.dtheta, b.dv)
+            yield DataBlock(b.k0, b.t, dtheta, dv, b.att, b.v_n, b.pos, b.segment, b.q_bs)
+
+    return Stream(ts, n, site, earth, seed, "simulated", initial_truth(motion, site, earth),
+                  simulated_blocks, has_mechanism=mech is not None)
+
+
+def gather(stream: Stream) -> RunData:
+    """The whole run as arrays (preallocated; one block of temporaries at a time)."""
+    n = stream.samples
+    t = np.empty(n)
+    dtheta, dv = np.empty((n, 3)), np.empty((n, 3))
+    with_truth = stream.truth0 is not None
+    att, v, pos = (np.empty((n + 1, 3)) for _ in range(3)) if with_truth else (None,) * 3
+    seg = np.empty(n + 1, np.int64) if with_truth else None
+    q_bs = np.empty((n, 4)) if stream.has_mechanism else None
+    if with_truth:
+        assert stream.truth0 is not None and att is not None and v is not None
+        assert pos is not None and seg is not None
+        att[0], v[0], pos[0] = stream.truth0.att[0], stream.truth0.v_n[0], stream.truth0.pos[0]
+        seg[0] = 0 if stream.truth0.segment is None else stream.truth0.segment[0]
+    for b in stream.blocks():
+        sl = slice(b.k0, b.k0 + len(b.t))
+        t[sl], dtheta[sl], dv[sl] = b.t, b.dtheta, b.dv
+        if with_truth and b.att is not None:
+            s1 = slice(b.k0 + 1, b.k0 + 1 + len(b.t))
+            att[s1], v[s1], pos[s1] = b.att, b.v_n, b.pos  # type: ignore[index]
+            seg[s1] = 0 if b.segment is None else b.segment  # type: ignore[index]
+        if q_bs is not None and b.q_bs is not None:
+            q_bs[sl] = b.q_bs
+    truth = None
+    if with_truth:
+        assert att is not None and v is not None and pos is not None
+        truth = Truth(np.concatenate([[stream.t0], t]), att, v, pos, seg)
+    if stream.header is not None:
+        imu = replace(stream.header, t=t, dtheta=dtheta, dv=dv, q_bs=q_bs)
+    else:
+        imu = ImuData(t=t, dtheta=dtheta, dv=dv, ts=stream.ts, site=stream.site, q_bs=q_bs)
+    return RunData(imu=imu, truth=truth, site=stream.site, seed=stream.seed, earth=stream.earth)
+
+
 def scenario_data(scenario: Scenario, seed: int | None = None,
                   cache_key: str | None = None) -> RunData:
     """Simulate the scenario's motion with its IMU errors, or read its recorded IMU file.
@@ -48,38 +206,32 @@ def scenario_data(scenario: Scenario, seed: int | None = None,
     `cache_key` (a batch variant) lets successive seeds share the noise-free simulation:
     it is computed once per key in this process (see :func:`cached_noise_free`).
     """
-    if cache_key is not None and scenario.imu_file is None:
-        return with_errors(scenario, cached_noise_free(scenario, cache_key), seed)
     if scenario.imu_file is not None:
-        imu, truth = read_data_file(scenario.imu_file)
-        if scenario.site is not None:
-            site = scenario.site.to_si()
-        elif imu.site is not None:
-            site = np.asarray(imu.site, float)
-        else:
-            raise ScenarioError(
-                f"site: missing; {scenario.imu_file} does not give the site, so the scenario must"
-            )
-        return RunData(imu=imu, truth=truth, site=site, seed=None)
-    return with_errors(scenario, noise_free(scenario), seed)
+        return _recorded(scenario)
+    if cache_key is not None:
+        return with_errors(scenario, cached_noise_free(scenario, cache_key), seed)
+    return gather(scenario_stream(scenario, seed))
 
 
 def noise_free(scenario: Scenario) -> RunData:
     """Truth and ideal increments of a simulated scenario: the part that no seed changes
     (a batch computes it once per variant)."""
-    if scenario.motion is None:
-        raise ScenarioError("motion: missing; the scenario needs 'motion' or 'imu_file'")
-    assert scenario.site is not None  # the model requires a site with a motion
-    site = scenario.site.to_si()
-    truth, ideal = ideal_imu(scenario.motion.to_motion(), site, scenario.imu.ts)
-    return RunData(imu=ideal, truth=truth, site=site, seed=None)
+    from gcalign.sim.imu import ideal_imu
+
+    motion, mech, site = _simulation(scenario)
+    truth, ideal = ideal_imu(motion, site, scenario.imu.ts, earth=scenario.earth_model,
+                             mechanism=mech)
+    return RunData(imu=ideal, truth=truth, site=site, seed=None, earth=scenario.earth_model)
 
 
 def with_errors(scenario: Scenario, ideal: RunData, seed: int | None = None) -> RunData:
     """The scenario's sensor errors applied to noise-free data; `seed` overrides imu.seed."""
     seed = scenario.imu.seed if seed is None else seed
-    imu = apply_errors(ideal.imu, scenario.imu.errors(), np.random.default_rng(seed))
-    return RunData(imu=imu, truth=ideal.truth, site=ideal.site.copy(), seed=seed)
+    stream = ErrorStream(scenario.imu.errors(), ideal.imu.ts, np.random.default_rng(seed),
+                         len(ideal.imu))
+    dtheta, dv = stream.apply(ideal.imu.dtheta, ideal.imu.dv)
+    return RunData(imu=replace(ideal.imu, dtheta=dtheta, dv=dv), truth=ideal.truth,
+                   site=ideal.site.copy(), seed=seed, earth=ideal.earth)
 
 
 _NOISE_FREE: dict[str, RunData] = {}  # cache key -> noise-free data, in this process

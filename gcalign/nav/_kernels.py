@@ -1,13 +1,26 @@
-"""Numba kernels: the strapdown update over whole blocks (the hot loop).
+"""Numba kernels: the one strapdown update, its pieces, and the block kernels over them.
 
-Scalar helpers here are inlined into the kernels by LLVM; they repeat the vectorised
-formulas of :mod:`gcalign.nav.earth` and :mod:`gcalign.nav.rotation`, and
-``tests/test_strapdown.py`` holds the two in step (kernel vs slow NumPy reference, 1e-12).
+Private: the public functions are in :mod:`gcalign.nav.strapdown`. Scalar helpers here are
+inlined into every kernel by LLVM (the gyrocompass of :mod:`gcalign.align.kernel` uses the
+same pieces); they repeat the vectorised formulas of :mod:`gcalign.nav.earth` and
+:mod:`gcalign.nav.rotation`, and ``tests/test_strapdown.py`` holds the two in step (kernel
+vs slow NumPy reference, 1e-12).
+
+Earth models are values: every kernel takes the float64 vector of
+:meth:`gcalign.nav.earth.EarthModel.params` (``[form, a, e2|f, ω_ie, g0, g1, g2, g3]``).
+
+The navigation state is one float64 vector with named slices (:data:`Q`, :data:`V`,
+:data:`P`, :data:`DA`): ``q_nb (4) | v_n ENU (3) | lat, lon, h (3) | vertical loop
+acceleration (1)``, so that a stream of blocks hands it on.
 
 One update serves both directions (DESIGN.md "Reverse navigation"): a reverse pass feeds
 time-reversed data with negated gyro increments, negated velocity and ``earth_sign = -1``.
-Every approximation in the step is evaluated at the middle of the interval, so the
-reverse step undoes the forward step to second order in the step size.
+Every approximation in the step is evaluated at the middle of the interval, so the reverse
+step undoes the forward step to second order in the step size.
+
+Vertical channel (``vertical = [mode, k1, k2, k3]``): ``FREE`` integrates it (unstable,
+time constant √(R/2g) ≈ 570 s); ``HOLD`` keeps h at the reference height and v_U = 0
+(PSINS's height hold); ``DAMPED`` is the third-order loop of :func:`vertical_gains`.
 """
 
 from __future__ import annotations
@@ -17,20 +30,49 @@ import math
 import numpy as np
 from numba import njit
 
-from gcalign.nav.earth import E2, G_C1, G_C2, G_C3, GE, OMEGA_IE
-from gcalign.nav.earth import A as EARTH_A
+Q = slice(0, 4)  #: q_nb in the state vector
+V = slice(4, 7)  #: v_n, ENU, m/s
+P = slice(7, 10)  #: lat, lon (rad), h (m)
+DA = 10  #: vertical-loop acceleration estimate (m/s²), DAMPED only
+NAV_STATE = 11
+FREE, HOLD, DAMPED = 0, 1, 2
+
+# PSINS cone factors (Savage's polynomial-rate optimum, cross product with the last
+# sub-increment): φ = Σθ_i + (Σ_{i<n} c_i θ_i) × θ_n.
+CONE = np.zeros((6, 5))
+CONE[2, :1] = [2.0 / 3.0]
+CONE[3, :2] = [9.0 / 20.0, 27.0 / 20.0]
+CONE[4, :3] = [54.0 / 105.0, 92.0 / 105.0, 214.0 / 105.0]
+CONE[5, :4] = [250.0 / 504.0, 525.0 / 504.0, 650.0 / 504.0, 1375.0 / 504.0]
+
+
+def vertical_gains(tau: float, gravity_gradient: float) -> np.ndarray:
+    """Gains ``[DAMPED, k1, k2, k3]`` of the third-order height loop with a triple pole at −1/τ.
+
+    Loop (δh = h − h_ref):  ḣ = v_U − k1 δh;  v̇_U = f_U − g − k2 δh − a;  ȧ = k3 δh.
+    Its error equations, with the positive gravity feedback ∂g/∂h = −g3 (≈ 2g/R), have the
+    characteristic polynomial ``s³ + k1 s² + (k2 − g3) s + k3``; matching ``(s + 1/τ)³``
+    gives ``k1 = 3/τ``, ``k2 = 3/τ² + g3``, ``k3 = 1/τ³``.
+    """
+    return np.array([DAMPED, 3.0 / tau, 3.0 / tau**2 + gravity_gradient, 1.0 / tau**3])
 
 
 @njit(cache=True, inline="always")
-def earth_at(lat, h):
-    """R_M, R_N (m), normal gravity g (m/s²), sin L, cos L at latitude `lat`, height `h`."""
+def earth_at(E, lat, h):
+    """R_M, R_N (m), normal gravity g (m/s²), sin L, cos L of earth model `E` at (lat, h)."""
     sl = math.sin(lat)
     cl = math.cos(lat)
     s2 = sl * sl
-    w = 1.0 - E2 * s2
-    r_n = EARTH_A / math.sqrt(w)
-    r_m = r_n * (1.0 - E2) / w
-    g = GE * (1.0 + G_C1 * s2 + G_C2 * s2 * s2) - G_C3 * h
+    if E[0] == 0.0:  # exact ellipsoid radii
+        e2 = E[2]
+        w = 1.0 - e2 * s2
+        r_n = E[1] / math.sqrt(w)
+        r_m = r_n * (1.0 - e2) / w
+    else:  # first order in the flattening
+        f = E[2]
+        r_m = E[1] * (1.0 - 2.0 * f + 3.0 * f * s2)
+        r_n = E[1] * (1.0 + f * s2)
+    g = E[4] * (1.0 + E[5] * s2 + E[6] * s2 * s2) - E[7] * h
     return r_m, r_n, g, sl, cl
 
 
@@ -96,74 +138,145 @@ def transport_rate(ve, vn, r_m, r_n, h, sl, cl):
 
 
 @njit(cache=True, inline="always")
-def strapdown_step(q, v, p, dth, dvb, ts, earth_sign):
-    """One strapdown update in place: q (4,) q_nb, v (3,) ENU m/s, p (3,) [lat, lon, h].
+def specific_force_increment(q0, q1, q2, q3, bx, by, bz, dx, dy, dz, wx, wy, wz):
+    """Specific-force increment resolved at mid-interval: ``R(-ω_in T/2) C_nb R(Δθ/2) Δv``.
+
+    (bx, by, bz) = Δθ, (dx, dy, dz) = Δv (body), (wx, wy, wz) = ω_in^n T.
+    """
+    ux, uy, uz = rotate_small(0.5 * bx, 0.5 * by, 0.5 * bz, dx, dy, dz)
+    fx, fy, fz = qrot(q0, q1, q2, q3, ux, uy, uz)
+    return rotate_small(-0.5 * wx, -0.5 * wy, -0.5 * wz, fx, fy, fz)
+
+
+@njit(cache=True, inline="always")
+def attitude_update(q0, q1, q2, q3, bx, by, bz, wx, wy, wz):
+    """``q ← q(−ω_in T) ⊗ q ⊗ q(Δθ)``, renormalised: body rotation on the right,
+    navigation-frame rotation (wx, wy, wz) = ω_in^n T on the left."""
+    aw, ax, ay, az = rv2q(bx, by, bz)
+    nw, nx, ny, nz = rv2q(-wx, -wy, -wz)
+    p0, p1, p2, p3 = qmul(q0, q1, q2, q3, aw, ax, ay, az)
+    p0, p1, p2, p3 = qmul(nw, nx, ny, nz, p0, p1, p2, p3)
+    nq = 1.0 / math.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
+    return p0 * nq, p1 * nq, p2 * nq, p3 * nq
+
+
+@njit(cache=True, inline="always")
+def position_update(E, lat, lon, h, ue, un, uu, ts):
+    """Position after `ts` at mean ENU velocity (ue, un, uu) (trapezoid rule); radii at the
+    mid-interval latitude and height."""
+    h_mid = h + 0.5 * uu * ts
+    r_m, _, _, _, _ = earth_at(E, lat, h)
+    lat_mid = lat + 0.5 * un * ts / (r_m + h_mid)
+    r_m, r_n, _, _, cl = earth_at(E, lat_mid, h_mid)
+    return lat + un * ts / (r_m + h_mid), lon + ue * ts / ((r_n + h_mid) * cl), h + uu * ts
+
+
+@njit(cache=True, inline="always")
+def strapdown_step(s, dth, dvb, ts, earth_sign, E, vertical, h_ref):
+    """One strapdown update of the state vector `s` in place (see the module docstring).
 
     Velocity:  v_k = v_{k-1} + R(-ω_in T/2) C_nb(k-1) R(Δθ/2) Δv + (g_n - (2ω_ie + ω_en) × v_mid) T
                (the specific-force increment resolved at mid-interval; Coriolis at a
                predicted mid-interval velocity)
     Attitude:  q_k = q(-ω_in T) ⊗ q_{k-1} ⊗ q(Δθ_k),  ω_in = ω_ie + ω_en(v_mid)
     Position:  trapezoid in velocity, radii at the mid-interval latitude.
+    Vertical:  HOLD: h = h_ref, v_U = 0; DAMPED: v_U −= (k2 δh + a) T, h −= k1 δh T,
+               a += k3 δh T with δh = h − h_ref at the start of the step.
     """
-    lat, h = p[0], p[2]
-    r_m, r_n, g, sl, cl = earth_at(lat, h)
-    wie = earth_sign * OMEGA_IE
+    lat, lon, h = s[7], s[8], s[9]
+    r_m, r_n, g, sl, cl = earth_at(E, lat, h)
+    wie = earth_sign * E[3]
     wie_n, wie_u = wie * cl, wie * sl
-    ve, vn, vu = v[0], v[1], v[2]
+    ve, vn, vu = s[4], s[5], s[6]
+    mode = vertical[0]
 
-    # Specific-force increment at mid-interval: body half-rotation, then nav half-rotation.
-    bx, by, bz = rotate_small(0.5 * dth[0], 0.5 * dth[1], 0.5 * dth[2], dvb[0], dvb[1], dvb[2])
-    fx, fy, fz = qrot(q[0], q[1], q[2], q[3], bx, by, bz)
     tx, ty, tz = transport_rate(ve, vn, r_m, r_n, h, sl, cl)
-    wx, wy, wz = tx * ts, (wie_n + ty) * ts, (wie_u + tz) * ts
-    fx, fy, fz = rotate_small(-0.5 * wx, -0.5 * wy, -0.5 * wz, fx, fy, fz)
+    fx, fy, fz = specific_force_increment(
+        s[0], s[1], s[2], s[3], dth[0], dth[1], dth[2], dvb[0], dvb[1], dvb[2],
+        tx * ts, (wie_n + ty) * ts, (wie_u + tz) * ts,
+    )
 
     # Predict the mid-interval velocity, then Coriolis/transport and gravity there.
     me = ve + 0.5 * fx
     mn = vn + 0.5 * fy
-    mu = vu + 0.5 * (fz - g * ts)
+    mu = 0.0 if mode == HOLD else vu + 0.5 * (fz - g * ts)
     tx, ty, tz = transport_rate(me, mn, r_m, r_n, h, sl, cl)
     cx, cy, cz = tx, 2.0 * wie_n + ty, 2.0 * wie_u + tz
-    ae = -(cy * mu - cz * mn)
-    an = -(cz * me - cx * mu)
-    au = -(cx * mn - cy * me) - g
-    v[0] = ve + fx + ae * ts
-    v[1] = vn + fy + an * ts
-    v[2] = vu + fz + au * ts
+    ve1 = ve + fx - (cy * mu - cz * mn) * ts
+    vn1 = vn + fy - (cz * me - cx * mu) * ts
+    vu1 = vu + fz - ((cx * mn - cy * me) + g) * ts
 
-    # Attitude: body rotation on the right, navigation-frame rotation on the left.
-    aw, ax, ay, az = rv2q(dth[0], dth[1], dth[2])
-    nw, nx, ny, nz = rv2q(-tx * ts, -(wie_n + ty) * ts, -(wie_u + tz) * ts)
-    q0, q1, q2, q3 = qmul(q[0], q[1], q[2], q[3], aw, ax, ay, az)
-    q0, q1, q2, q3 = qmul(nw, nx, ny, nz, q0, q1, q2, q3)
-    nq = 1.0 / math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
-    q[0], q[1], q[2], q[3] = q0 * nq, q1 * nq, q2 * nq, q3 * nq
+    s[0], s[1], s[2], s[3] = attitude_update(
+        s[0], s[1], s[2], s[3], dth[0], dth[1], dth[2], tx * ts, (wie_n + ty) * ts,
+        (wie_u + tz) * ts,
+    )
 
-    # Position by the trapezoid rule in velocity; radii at the mid-interval latitude.
-    ue, un, uu = 0.5 * (ve + v[0]), 0.5 * (vn + v[1]), 0.5 * (vu + v[2])
-    h_mid = h + 0.5 * uu * ts
-    lat_mid = lat + 0.5 * un * ts / (r_m + h_mid)
-    r_m, r_n, g, sl, cl = earth_at(lat_mid, h_mid)
-    p[0] = lat + un * ts / (r_m + h_mid)
-    p[1] = p[1] + ue * ts / ((r_n + h_mid) * cl)
-    p[2] = h + uu * ts
+    dh = h - h_ref
+    if mode == HOLD:
+        vu, vu1 = 0.0, 0.0
+    elif mode == DAMPED:
+        vu1 -= (vertical[2] * dh + s[DA]) * ts
+        s[DA] += vertical[3] * dh * ts
+    lat1, lon1, h1 = position_update(
+        E, lat, lon, h, 0.5 * (ve + ve1), 0.5 * (vn + vn1), 0.5 * (vu + vu1), ts
+    )
+    if mode == HOLD:
+        h1 = h_ref
+    elif mode == DAMPED:
+        h1 -= vertical[1] * dh * ts
+    s[4], s[5], s[6] = ve1, vn1, vu1
+    s[7], s[8], s[9] = lat1, lon1, h1
 
 
 @njit(cache=True)
-def strapdown_block(q0, v0, p0, dtheta, dv, ts, earth_sign, q_out, v_out, p_out):
-    """Integrate N increments from the state (q0, v0, p0); write N+1 states (row 0 = start).
+def strapdown_block(s, dtheta, dv, ts, earth_sign, E, vertical, h_ref, stride, out):
+    """Integrate N increments from the state `s` (updated in place); after every `stride`
+    steps write the state into the next row of `out` ((N // stride, NAV_STATE)).
 
-    q_out (N+1, 4), v_out (N+1, 3), p_out (N+1, 3) are preallocated by the caller.
+    h_ref : (N,) reference height at the start of each step, or (1,) for a constant one.
     """
-    q = q0.copy()
-    v = v0.copy()
-    p = p0.copy()
-    q_out[0], v_out[0], p_out[0] = q, v, p
+    nref = h_ref.shape[0]
+    row = 0
     for k in range(dtheta.shape[0]):
-        strapdown_step(q, v, p, dtheta[k], dv[k], ts, earth_sign)
-        q_out[k + 1], v_out[k + 1], p_out[k + 1] = q, v, p
+        strapdown_step(s, dtheta[k], dv[k], ts, earth_sign, E, vertical,
+                       h_ref[k if k < nref else nref - 1])
+        if (k + 1) % stride == 0:
+            out[row, :] = s
+            row += 1
 
 
-def empty_states(n: int):
-    """Preallocated (q, v, p) outputs for n increments: (n+1, 4), (n+1, 3), (n+1, 3)."""
-    return np.empty((n + 1, 4)), np.empty((n + 1, 3)), np.empty((n + 1, 3))
+@njit(cache=True)
+def attitude_block(q, dtheta, ts, w_in, subsamples, stride, out):
+    """Attitude-only strapdown over N increments in groups of `subsamples` (N a multiple):
+    each group is one update over ``subsamples·ts`` with the coning-corrected rotation
+    vector ``φ = Σθ_i + (Σ_{i<n} c_i θ_i) × θ_n`` (:data:`CONE`), and
+    ``q ← q(−ω_in T) ⊗ q ⊗ q(φ)`` with the constant navigation-frame rate `w_in` (3,) (rad/s;
+    zeros integrates the gyros alone). `q` (4,) is updated in place; after every `stride`
+    updates it is written into the next row of `out` ((N // subsamples // stride, 4)).
+    """
+    n = subsamples
+    T = n * ts
+    wx, wy, wz = w_in[0] * T, w_in[1] * T, w_in[2] * T
+    row = 0
+    for k in range(dtheta.shape[0] // n):
+        i0 = k * n
+        sx = sy = sz = 0.0
+        cxs = cys = czs = 0.0
+        for i in range(n):
+            sx += dtheta[i0 + i, 0]
+            sy += dtheta[i0 + i, 1]
+            sz += dtheta[i0 + i, 2]
+            if i < n - 1:
+                c = CONE[n, i]
+                cxs += c * dtheta[i0 + i, 0]
+                cys += c * dtheta[i0 + i, 1]
+                czs += c * dtheta[i0 + i, 2]
+        lx, ly, lz = dtheta[i0 + n - 1, 0], dtheta[i0 + n - 1, 1], dtheta[i0 + n - 1, 2]
+        px = sx + cys * lz - czs * ly
+        py = sy + czs * lx - cxs * lz
+        pz = sz + cxs * ly - cys * lx
+        q[0], q[1], q[2], q[3] = attitude_update(q[0], q[1], q[2], q[3], px, py, pz,
+                                                 wx, wy, wz)
+        if (k + 1) % stride == 0:
+            out[row, 0], out[row, 1], out[row, 2], out[row, 3] = q[0], q[1], q[2], q[3]
+            row += 1

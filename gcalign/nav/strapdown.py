@@ -1,9 +1,21 @@
-"""Free strapdown navigation over a block of IMU data, forward or in reverse.
+"""Strapdown navigation over blocks or streams of IMU increments, forward or in reverse.
+
+Public face of the private kernels (:mod:`gcalign.nav._kernels`):
+
+* :func:`navigate` -- one block, every state kept (alignment passes, tests);
+* :class:`Navigator` -- a stream of blocks with the state carried from one to the next, so
+  that a 72 h run never holds more than a block (what ``gcalign navigate`` uses);
+* :func:`integrate_attitude` -- attitude only, with coning correction over sub-samples.
 
 Reverse navigation (seed 000 §3, after Yan Gongmin; DESIGN.md "Reverse navigation") runs
 the forward kernel on transformed data: time reversed, gyro increments negated, velocity
 increments unchanged, earth rate negated, velocity negated. With ω_en linear in v the
 transformed equations are exactly the forward ones, so one kernel serves both.
+
+The vertical channel (:class:`Vertical`): ``free`` (pure inertial: unstable, time constant
+√(R/2g) ≈ 570 s), ``hold`` (height held at a reference, v_U = 0: PSINS's choice for ground
+and long static runs) or ``damped`` (third-order loop to a reference height with a triple
+pole at −1/τ).
 """
 
 from __future__ import annotations
@@ -12,8 +24,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gcalign.nav._kernels import empty_states, strapdown_block
+from gcalign.nav import _kernels as K
+from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import euler_to_quat, quat_to_euler
+
+VERTICAL_MODES = ("free", "hold", "damped")
 
 
 @dataclass(frozen=True)
@@ -31,6 +46,37 @@ class NavState:
     @property
     def att(self) -> np.ndarray:
         return quat_to_euler(self.q_nb)
+
+    def vector(self) -> np.ndarray:
+        """The kernel's state vector (:data:`gcalign.nav._kernels.NAV_STATE` floats)."""
+        s = np.zeros(K.NAV_STATE)
+        s[K.Q], s[K.V], s[K.P] = self.q_nb, self.v_n, self.pos
+        return s
+
+
+@dataclass(frozen=True)
+class Vertical:
+    """Vertical-channel treatment: mode ``free | hold | damped``; `tau` (s) is the damped
+    loop's time constant (triple pole at −1/τ). The reference height comes with the data
+    (:meth:`Navigator.run`) or is the start height."""
+
+    mode: str = "free"
+    tau: float = 30.0
+
+    def __post_init__(self):
+        if self.mode not in VERTICAL_MODES:
+            raise ValueError(f"vertical: got {self.mode!r}, allowed: {', '.join(VERTICAL_MODES)}")
+        if not self.tau > 0:
+            raise ValueError(f"vertical tau: must be > 0 s, got {self.tau}")
+
+    def params(self, earth: EarthModel) -> np.ndarray:
+        """``[mode, k1, k2, k3]`` for the kernels."""
+        if self.mode == "damped":
+            return K.vertical_gains(self.tau, earth.g3)
+        return np.array([K.FREE if self.mode == "free" else K.HOLD, 0.0, 0.0, 0.0])
+
+
+FREE = Vertical("free")
 
 
 @dataclass(frozen=True)
@@ -59,31 +105,100 @@ def reverse_data(dtheta, dv):
     return np.ascontiguousarray(-dtheta[::-1]), np.ascontiguousarray(dv[::-1])
 
 
-def navigate(t, dtheta, dv, ts: float, start: NavState, reverse: bool = False) -> NavSolution:
+class Navigator:
+    """Streamed strapdown navigation: :meth:`run` integrates one block after another,
+    carrying the state (and the vertical loop) across blocks; the result of any split of
+    the data into blocks is the same, bit for bit.
+
+    Parameters
+    ----------
+    start : NavState at the time before the first increment.
+    ts : sample interval, s.
+    earth : earth model. vertical : vertical-channel treatment.
+    reverse : feed the data in reverse time order already transformed? No: pass the blocks
+        in *forward* order of the reverse pass (latest first) and ``reverse=True``; each
+        block is reversed and negated here.
+    """
+
+    def __init__(self, start: NavState, ts: float, earth: EarthModel = WGS84,
+                 vertical: Vertical = FREE, reverse: bool = False):
+        self.ts = float(ts)
+        self.earth = earth
+        self.vertical = vertical
+        self.reverse = reverse
+        self._E = earth.params()
+        self._vert = vertical.params(earth)
+        self._sign = -1.0 if reverse else 1.0
+        s = start.vector()
+        if reverse:
+            s[K.V] *= -1.0
+        self._s = s
+        self._h0 = float(start.pos[2])
+
+    @property
+    def state(self) -> NavState:
+        """The current state (velocity in the forward-time sense)."""
+        s = self._s
+        return NavState(s[K.Q].copy(), self._sign * s[K.V], s[K.P].copy())
+
+    def run(self, dtheta, dv, h_ref=None, stride: int = 1) -> np.ndarray:
+        """Integrate a block of increments (N, 3); the states after every `stride` steps,
+        (N // stride, NAV_STATE) with the named slices of :mod:`gcalign.nav._kernels`
+        (velocity in the forward-time sense). `h_ref` (N,) or a number: the reference
+        height of ``hold``/``damped`` at the start of each step (default: the start height).
+        """
+        dtheta = np.ascontiguousarray(dtheta, dtype=float)
+        dv = np.ascontiguousarray(dv, dtype=float)
+        if self.reverse:
+            dtheta, dv = reverse_data(dtheta, dv)
+        href = np.atleast_1d(np.asarray(self._h0 if h_ref is None else h_ref, dtype=float))
+        if href.size > 1 and self.reverse:
+            href = np.ascontiguousarray(href[::-1])
+        out = np.empty((len(dtheta) // stride, K.NAV_STATE))
+        K.strapdown_block(self._s, dtheta, dv, self.ts, self._sign, self._E, self._vert,
+                          href, int(stride), out)
+        if self.reverse:
+            out[:, K.V] *= -1.0
+        return out
+
+
+def navigate(t, dtheta, dv, ts: float, start: NavState, reverse: bool = False, *,
+             earth: EarthModel = WGS84, vertical: Vertical = FREE, h_ref=None) -> NavSolution:
     """Strapdown navigation over increments (N, 3) ending at times `t` (N,).
 
     Forward: `start` is the state at ``t[0] - ts``. Reverse: `start` is the state at
     ``t[-1]`` and the pass ends at ``t[0] - ts``.
     """
-    dtheta = np.ascontiguousarray(dtheta, dtype=float)
-    dv = np.ascontiguousarray(dv, dtype=float)
     times = np.concatenate([[t[0] - ts], t])
-    sign = 1.0
-    v0 = np.asarray(start.v_n, float)
+    nav = Navigator(start, ts, earth, vertical, reverse)
+    states = nav.run(dtheta, dv, h_ref)
+    q = np.concatenate([[np.asarray(start.q_nb, float)], states[:, K.Q]])
+    v = np.concatenate([[np.asarray(start.v_n, float)], states[:, K.V]])
+    p = np.concatenate([[np.asarray(start.pos, float)], states[:, K.P]])
     if reverse:
-        dtheta, dv = reverse_data(dtheta, dv)
-        times, sign, v0 = times[::-1], -1.0, -v0
-    q, v, p = empty_states(len(dtheta))
-    strapdown_block(
-        np.asarray(start.q_nb, float),
-        v0,
-        np.asarray(start.pos, float),
-        dtheta,
-        dv,
-        float(ts),
-        sign,
-        q,
-        v,
-        p,
-    )
-    return NavSolution(t=times, q_nb=q, v_n=sign * v, pos=p)
+        times = times[::-1]
+    return NavSolution(t=times, q_nb=q, v_n=v, pos=p)
+
+
+def integrate_attitude(q0, dtheta, ts: float, w_in_n=None, subsamples: int = 1,
+                       stride: int = 1) -> np.ndarray:
+    """Attitude-only strapdown: ``q ← q(−ω_in T) ⊗ q ⊗ q(φ)`` every `subsamples` increments
+    (T = subsamples·ts), φ the coning-corrected rotation vector of the group (PSINS cone
+    factors, exact to the order of a polynomial rate of degree subsamples − 1).
+
+    q0 (4,); dtheta (N, 3) rad with N a multiple of `subsamples` (at most 5); w_in_n (3,)
+    rad/s, constant (default zero: the gyros alone). Returns the attitude at the start and
+    after every `stride` updates, (1 + N // subsamples // stride, 4).
+    """
+    if not 1 <= subsamples <= 5:
+        raise ValueError(f"subsamples: 1 to 5 sub-increments per update, got {subsamples}")
+    dtheta = np.ascontiguousarray(dtheta, dtype=float)
+    if len(dtheta) % subsamples:
+        raise ValueError(f"dtheta: {len(dtheta)} increments is not a multiple of "
+                         f"subsamples = {subsamples}")
+    q = np.array(q0, dtype=float)
+    out = np.empty((len(dtheta) // subsamples // stride + 1, 4))
+    out[0] = q
+    w = np.zeros(3) if w_in_n is None else np.asarray(w_in_n, dtype=float)
+    K.attitude_block(q, dtheta, float(ts), w, int(subsamples), int(stride), out[1:])
+    return out

@@ -1,159 +1,392 @@
-"""Truth trajectories: static, swing and moving (by segments) bases.
+"""Motions of the base as types, each giving its truth at any time (not only at samples).
 
-A motion is a function of time giving the Euler angles, their rates, and the forward
-speed along the body y axis (DESIGN.md "Truth and IMU simulation"; seed 000 §5.2, §5.3).
-:func:`generate` samples it at the IMU rate and integrates the position; the exact
-ideal increments are built from it in :mod:`gcalign.sim.imu`.
+Kinds (DESIGN.md "Truth and IMU simulation"; seed 000 §5.2-5.3, seed 002 §3, seed 003 §4):
+
+* :class:`Static` -- fixed attitude and position.
+* :class:`Swing` -- ``att(t) = att0 + A sin(2π t/T + φ)`` per Euler angle, fixed position.
+* :class:`Moving` -- segments of constant forward acceleration (along body y) and constant
+  Euler-angle rates; the velocity is along the body's forward axis (so pitch is the flight
+  path angle and height changes with it). :func:`flight` builds one from aircraft segments
+  with targets (accelerate to a speed, pitch/roll/yaw at a rate to an angle, turns).
+* :class:`Turntable` -- a :class:`~gcalign.sim.schedule.Schedule` turning the body about its
+  own axes (``C_nb(t) = C_nb0 · S(t)``), fixed position (seed 003; indexing tables).
+
+Every motion answers :meth:`kinematics` at arbitrary times: attitude, C_nb, angular rate of
+the body relative to the navigation frame resolved in the body (ω_nb^b), ENU velocity and
+its time derivative, and the position. Positions of a moving base are integrated on the
+motion's own grid (nodes at most :data:`NODE_S` apart, split at segment boundaries,
+Gauss–Legendre between nodes), so the truth at a time does not depend on how anybody
+samples it. The earth model enters only through the radii.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
-from gcalign.nav import earth
-from gcalign.nav.rotation import euler_to_dcm
+from gcalign.nav.earth import WGS84, EarthModel
+from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm, quat_to_dcm
+from gcalign.sim.schedule import Schedule
+
+NODE_S = 1.0  #: largest spacing of the position nodes of a moving base (s)
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(6)  # exact to degree 11 between nodes
 
 
 @dataclass(frozen=True)
-class Segment:
-    """One piece of a moving-base motion (SI): duration (s), forward acceleration along
-    body y (m/s²), Euler-angle rates ``[pitch, roll, yaw]`` (rad/s)."""
+class Kinematics:
+    """Truth at times t (N,), SI: att (N, 3) [pitch, roll, yaw]; C_nb (N, 3, 3);
+    omega_nb_b (N, 3) rad/s; v_n, a_n (N, 3) ENU m/s, m/s²; pos (N, 3) [lat, lon, h];
+    segment (N,) index of the motion segment (0 where a motion has none)."""
 
-    duration: float
-    accel: float = 0.0
-    rate: tuple[float, float, float] = (0.0, 0.0, 0.0)
-
-
-@dataclass(frozen=True)
-class Motion:
-    """Motion of the base (SI, radians).
-
-    kind : "static" | "swing" | "moving".
-    att0 : (3,) initial (static, moving) or mean (swing) attitude ``[pitch, roll, yaw]``.
-    amplitude, period, phase : (3,) swing per Euler angle: ``att0 + A sin(2π t/T + phase)``.
-    segments : moving only; the last segment is held until `duration`.
-    """
-
-    kind: str
-    att0: tuple[float, float, float]
-    duration: float
-    amplitude: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    period: tuple[float, float, float] = (1.0, 1.0, 1.0)
-    phase: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    segments: tuple[Segment, ...] = ()
-
-    def evaluate(self, t, t_segment=None):
-        """Attitude, attitude rate, forward speed and its rate at times `t` (s), shape (N,).
-
-        `t_segment` (N,), optional, picks the segment of a moving base by another time: the
-        IMU simulation evaluates every sub-point of a sample with the segment of the
-        sample's midpoint, so a boundary on a sample time takes the left or right limit
-        as the integral over that sample needs.
-
-        Returns ``att (N, 3) rad, att_dot (N, 3) rad/s, speed (N,) m/s, speed_dot (N,) m/s²``.
-        """
-        t = np.asarray(t, dtype=float)
-        att0 = np.asarray(self.att0, dtype=float)
-        zeros = np.zeros_like(t)
-        if self.kind == "static":
-            att = np.broadcast_to(att0, t.shape + (3,)).copy()
-            return att, np.zeros_like(att), zeros, zeros
-        if self.kind == "swing":
-            w = 2.0 * np.pi / np.asarray(self.period, dtype=float)
-            arg = t[:, None] * w + np.asarray(self.phase, dtype=float)
-            amp = np.asarray(self.amplitude, dtype=float)
-            return att0 + amp * np.sin(arg), amp * w * np.cos(arg), zeros, zeros
-        if self.kind == "moving":
-            return self._evaluate_segments(t, t if t_segment is None else t_segment)
-        raise ValueError(f"motion.kind: got {self.kind!r}, allowed: static, swing, moving")
-
-    def _evaluate_segments(self, t, t_segment):
-        durations = np.array([s.duration for s in self.segments], dtype=float)
-        accel = np.array([s.accel for s in self.segments], dtype=float)
-        rate = np.array([s.rate for s in self.segments], dtype=float).reshape(-1, 3)
-        starts = np.concatenate([[0.0], np.cumsum(durations)[:-1]])
-        # State at the start of each segment (attitude and speed are continuous).
-        att_start = np.asarray(self.att0, dtype=float) + np.concatenate(
-            [np.zeros((1, 3)), np.cumsum(rate[:-1] * durations[:-1, None], axis=0)]
-        )
-        speed_start = np.concatenate([[0.0], np.cumsum(accel[:-1] * durations[:-1])])
-        # A time exactly on a boundary belongs to the later segment; the last one is held.
-        j = np.clip(np.searchsorted(starts, t_segment, side="right") - 1, 0, len(starts) - 1)
-        dt = t - starts[j]
-        att = att_start[j] + rate[j] * dt[:, None]
-        speed = speed_start[j] + accel[j] * dt
-        return att, rate[j], speed, accel[j]
+    t: np.ndarray
+    att: np.ndarray
+    C_nb: np.ndarray
+    omega_nb_b: np.ndarray
+    v_n: np.ndarray
+    a_n: np.ndarray
+    pos: np.ndarray
+    segment: np.ndarray
 
 
 @dataclass(frozen=True)
 class Truth:
     """Sampled truth (SI): times (N+1,), attitude (N+1, 3), ENU velocity (N+1, 3),
-    position ``[lat, lon, h]`` (N+1, 3) in rad, rad, m."""
+    position ``[lat, lon, h]`` (N+1, 3) in rad, rad, m; segment index (N+1,) or None."""
 
     t: np.ndarray
     att: np.ndarray
     v_n: np.ndarray
     pos: np.ndarray
+    segment: np.ndarray | None = None
 
 
-def kinematics(motion: Motion, t, t_segment=None):
-    """Attitude, DCM, ENU velocity and its time derivative at times `t` (vectorised).
+def _fixed(t, att0, site, C=None, omega=None) -> Kinematics:
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    n = t.shape[0]
+    att0 = np.asarray(att0, dtype=float)
+    C_nb = np.broadcast_to(euler_to_dcm(att0), (n, 3, 3)) if C is None else C
+    att = np.broadcast_to(att0, (n, 3)) if C is None else dcm_to_euler(C)
+    zeros = np.zeros((n, 3))
+    return Kinematics(t, att, C_nb, zeros if omega is None else omega, zeros, zeros,
+                      np.broadcast_to(np.asarray(site, float), (n, 3)), np.zeros(n, np.int64))
 
-    ``v_n = C_nb [0, s, 0]`` is the body-forward speed s resolved in ENU; its derivative
-    is ``ṡ c + s ċ`` with c the second column of C_nb (d/dt by the chain rule on the
-    Euler angles).
+
+def _euler_rate_to_body(att, att_dot):
+    """ω_nb^b from Euler angles and their rates, C_nb = Rz(y) Rx(p) Ry(r):
+    ω = Ry(r)ᵀ [ṗ, 0, 0] + Ry(r)ᵀ Rx(p)ᵀ [0, 0, ẏ] + [0, ṙ, 0]."""
+    p, r = att[:, 0], att[:, 1]
+    pd, rd, yd = att_dot[:, 0], att_dot[:, 1], att_dot[:, 2]
+    cp, sp, cr, sr = np.cos(p), np.sin(p), np.cos(r), np.sin(r)
+    return np.stack([pd * cr - yd * cp * sr, rd + yd * sp, pd * sr + yd * cp * cr], -1)
+
+
+@dataclass(frozen=True)
+class Static:
+    """Fixed attitude ``att0`` (rad) at the site, for `duration` s."""
+
+    att0: tuple[float, float, float]
+    duration: float
+    kind: str = field(default="static", init=False)
+
+    def kinematics(self, t, site, earth: EarthModel = WGS84) -> Kinematics:
+        return _fixed(t, self.att0, site)
+
+
+@dataclass(frozen=True)
+class Swing:
+    """``att(t) = att0 + amplitude sin(2π t / period + phase)`` per Euler angle (rad, s)."""
+
+    att0: tuple[float, float, float]
+    duration: float
+    amplitude: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    period: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    phase: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    kind: str = field(default="swing", init=False)
+
+    def euler(self, t):
+        """Euler angles and their rates at times t."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        w = 2.0 * np.pi / np.asarray(self.period, dtype=float)
+        arg = t[:, None] * w + np.asarray(self.phase, dtype=float)
+        amp = np.asarray(self.amplitude, dtype=float)
+        return np.asarray(self.att0, float) + amp * np.sin(arg), amp * w * np.cos(arg)
+
+    def kinematics(self, t, site, earth: EarthModel = WGS84) -> Kinematics:
+        att, att_dot = self.euler(t)
+        k = _fixed(t, self.att0, site, C=euler_to_dcm(att))
+        return Kinematics(k.t, att, k.C_nb, _euler_rate_to_body(att, att_dot), k.v_n, k.a_n,
+                          k.pos, k.segment)
+
+
+@dataclass(frozen=True)
+class Turntable:
+    """The body turned by `schedule` about its own axes from ``att0``: C_nb = C_nb0 · S(t)."""
+
+    att0: tuple[float, float, float]
+    duration: float
+    schedule: Schedule
+    kind: str = field(default="turntable", init=False)
+
+    def kinematics(self, t, site, earth: EarthModel = WGS84) -> Kinematics:
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        C = euler_to_dcm(np.asarray(self.att0, float)) @ quat_to_dcm(self.schedule.quat(t))
+        return _fixed(t, self.att0, site, C=C, omega=self.schedule.rate(t))
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One piece of a moving-base motion (SI): duration (s), forward acceleration along
+    body y (m/s²), Euler-angle rates ``[pitch, roll, yaw]`` (rad/s), and a name."""
+
+    duration: float
+    accel: float = 0.0
+    rate: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class Moving:
+    """Segments of constant forward acceleration and Euler-angle rates from ``att0`` and
+    forward speed ``speed0``; the last segment is held until `duration`.
+
+    The velocity is ``v_n = s C_nb[:, 1]`` (along the body's forward axis), its derivative
+    ``ṡ c + s ċ`` with c the second column of C_nb (chain rule on the Euler angles).
     """
-    att, att_dot, s, s_dot = motion.evaluate(t, t_segment)
-    C = euler_to_dcm(att)
-    p, y = att[:, 0], att[:, 2]
-    pd, yd = att_dot[:, 0], att_dot[:, 2]
-    c = C[:, :, 1]  # [-sin y cos p, cos y cos p, sin p]
-    c_dot = np.stack(
-        [
+
+    att0: tuple[float, float, float]
+    duration: float
+    segments: tuple[Segment, ...]
+    speed0: float = 0.0
+    kind: str = field(default="moving", init=False)
+    _nodes: dict = field(init=False, repr=False, compare=False, default_factory=dict)
+
+    def __post_init__(self):
+        if not self.segments:
+            raise ValueError("segments: a moving base needs at least one segment")
+
+    # ------------------------------------------------------------------ segments
+
+    def _tables(self):
+        d = np.array([s.duration for s in self.segments], dtype=float)
+        accel = np.array([s.accel for s in self.segments], dtype=float)
+        rate = np.array([s.rate for s in self.segments], dtype=float).reshape(-1, 3)
+        starts = np.concatenate([[0.0], np.cumsum(d)[:-1]])
+        att_start = np.asarray(self.att0, dtype=float) + np.concatenate(
+            [np.zeros((1, 3)), np.cumsum(rate[:-1] * d[:-1, None], axis=0)])
+        speed_start = self.speed0 + np.concatenate([[0.0], np.cumsum(accel[:-1] * d[:-1])])
+        return starts, accel, rate, att_start, speed_start
+
+    def segment_index(self, t, side: Literal["left", "right"] = "right") -> np.ndarray:
+        """Segment of each time; a time on a boundary belongs to the later segment
+        (``side="right"``) or the earlier one (``"left"``); the last one is held."""
+        starts = self._tables()[0]
+        j = np.searchsorted(starts, np.atleast_1d(np.asarray(t, float)), side=side) - 1
+        return np.clip(j, 0, len(starts) - 1)
+
+    def euler(self, t, segment=None):
+        """Euler angles, their rates, forward speed and its rate at times t; `segment`
+        (optional) picks the segment of each time (a sample's integral over a boundary
+        takes the limits of its own side)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        starts, accel, rate, att_start, speed_start = self._tables()
+        j = self.segment_index(t) if segment is None else segment
+        dt = t - starts[j]
+        return (att_start[j] + rate[j] * dt[:, None], rate[j], speed_start[j] + accel[j] * dt,
+                accel[j])
+
+    def velocity(self, t, segment=None):
+        """ENU velocity and acceleration (m/s, m/s²), attitude and C_nb at times t."""
+        att, att_dot, s, s_dot = self.euler(t, segment)
+        C = euler_to_dcm(att)
+        p, y = att[:, 0], att[:, 2]
+        pd, yd = att_dot[:, 0], att_dot[:, 2]
+        c = C[:, :, 1]  # [-sin y cos p, cos y cos p, sin p]
+        c_dot = np.stack([
             -np.cos(y) * np.cos(p) * yd + np.sin(y) * np.sin(p) * pd,
             -np.sin(y) * np.cos(p) * yd - np.cos(y) * np.sin(p) * pd,
             np.cos(p) * pd,
-        ],
-        -1,
-    )
-    v_n = s[:, None] * c
-    a_n = s_dot[:, None] * c + s[:, None] * c_dot
-    return att, C, v_n, a_n
+        ], -1)
+        return s[:, None] * c, s_dot[:, None] * c + s[:, None] * c_dot, att, att_dot, C
 
+    # ------------------------------------------------------------------ position
 
-def integrate_position(t, v_n, pos0, iterations: int = 3):
-    """Latitude, longitude, height along a finely sampled ENU velocity (trapezoid rule).
+    def _node_grid(self) -> np.ndarray:
+        starts = list(self._tables()[0]) + [self.duration]
+        grid = []
+        for a, b in zip(starts[:-1], starts[1:], strict=True):
+            b = min(b, self.duration) if a < self.duration else a
+            n = max(1, math.ceil((b - a) / NODE_S - 1e-9))
+            grid.append(a + (b - a) * np.arange(n) / n)
+        last = self.duration
+        return np.unique(np.concatenate(grid + [np.array([last])]))
 
-    The radii depend on the latitude being integrated; a few fixed-point passes settle it
-    (each pass changes R_M by the latitude change times dR_M/dL, ~1e-5 relative).
-    """
-    pos0 = np.asarray(pos0, dtype=float)
-    dt = np.diff(t)
-    h = pos0[2] + np.concatenate([[0.0], np.cumsum(0.5 * (v_n[1:, 2] + v_n[:-1, 2]) * dt)])
-    lat = np.full_like(t, pos0[0])
-    for _ in range(iterations):
+    def _rate_of_position(self, t, seg, lat, h, earth):
+        v, *_ = self.velocity(t, seg)
         r_m, r_n = earth.radii(lat)
-        lat_rate = v_n[:, 1] / (r_m + h)
-        lat = pos0[0] + np.concatenate(
-            [[0.0], np.cumsum(0.5 * (lat_rate[1:] + lat_rate[:-1]) * dt)]
-        )
-    r_m, r_n = earth.radii(lat)
-    lon_rate = v_n[:, 0] / ((r_n + h) * np.cos(lat))
-    lon = pos0[1] + np.concatenate([[0.0], np.cumsum(0.5 * (lon_rate[1:] + lon_rate[:-1]) * dt)])
-    return np.stack([lat, lon, h], -1)
+        return np.stack([v[:, 1] / (r_m + h), v[:, 0] / ((r_n + h) * np.cos(lat)), v[:, 2]],
+                        -1)
+
+    def _gl(self, a, b, seg, pos_a, pos_b, earth):
+        """∫_a^b of the position rate (Gauss–Legendre, 6 points per interval); latitude and
+        height at the nodes interpolated between the interval's ends (their nonlinearity
+        changes the radii by < 1e-9 relative here)."""
+        half = 0.5 * (b - a)
+        tt = (0.5 * (a + b))[:, None] + half[:, None] * _GL_X
+        frac = 0.5 * (1.0 + _GL_X)
+        lat = pos_a[:, None, 0] + frac * (pos_b[:, None, 0] - pos_a[:, None, 0])
+        h = pos_a[:, None, 2] + frac * (pos_b[:, None, 2] - pos_a[:, None, 2])
+        k = tt.shape[1]
+        rate = self._rate_of_position(tt.ravel(), np.repeat(seg, k), lat.ravel(), h.ravel(),
+                                      earth).reshape(-1, k, 3)
+        return np.einsum("k,nkc->nc", _GL_W, rate) * half[:, None]
+
+    def nodes(self, site, earth: EarthModel = WGS84):
+        """Node times and positions (cached per site and earth model)."""
+        key = (tuple(np.asarray(site, float)), earth.name)
+        hit = self._nodes.get(key)
+        if hit is not None:
+            return hit
+        tn = self._node_grid()
+        seg = self.segment_index(0.5 * (tn[:-1] + tn[1:]))
+        site = np.asarray(site, float)
+        pos = np.tile(site, (len(tn), 1))
+        for _ in range(3):  # fixed point: each pass improves the radii along the track
+            inc = self._gl(tn[:-1], tn[1:], seg, pos[:-1], pos[1:], earth)
+            pos = site + np.concatenate([np.zeros((1, 3)), np.cumsum(inc, axis=0)])
+        self._nodes.clear()
+        self._nodes[key] = (tn, pos)
+        return tn, pos
+
+    def position(self, t, site, earth: EarthModel = WGS84) -> np.ndarray:
+        """``[lat, lon, h]`` at times t: the node before t plus the integral from it."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        tn, pn = self.nodes(site, earth)
+        i = np.clip(np.searchsorted(tn, t, side="right") - 1, 0, len(tn) - 2)
+        seg = self.segment_index(0.5 * (tn[i] + tn[i + 1]))
+        # the end of the partial interval, for the radii: linear between the nodes
+        frac = ((t - tn[i]) / (tn[i + 1] - tn[i]))[:, None]
+        p_end = pn[i] + frac * (pn[i + 1] - pn[i])
+        return pn[i] + self._gl(tn[i], t, seg, pn[i], p_end, earth)
+
+    def kinematics(self, t, site, earth: EarthModel = WGS84, segment=None) -> Kinematics:
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        seg = self.segment_index(t) if segment is None else segment
+        v, a, att, att_dot, C = self.velocity(t, seg)
+        return Kinematics(t, att, C, _euler_rate_to_body(att, att_dot), v, a,
+                          self.position(t, site, earth), seg)
 
 
-def sample_grid(n: int, ts: float, substeps: int):
-    """Sub-point times of each of n samples, (n, substeps + 1), and the samples' midpoints (n,).
+MotionType = Static | Swing | Moving | Turntable
 
-    Neighbouring rows share their end points; times are built from integers so that a
-    boundary is the same number in both rows.
+
+# ---------------------------------------------------------------------- flight
+
+
+@dataclass(frozen=True)
+class FlightSegment:
+    """An aircraft manoeuvre with a target (SI, rad). Kinds and what they take:
+
+    ``hold``: duration. ``accelerate``: accel (m/s², signed) to `speed` (m/s); duration
+    optional (then it must allow reaching the speed; the rest is held). ``pitch`` /
+    ``roll`` / ``yaw``: `rate` (rad/s, > 0) to the target `angle` (rad); duration optional.
+    ``turn``: a level turn through `angle` (rad, + left, − right) at `rate` (rad/s, > 0).
+    ``coordinated_turn``: the yaw rate of a coordinated turn at the current bank,
+    ψ̇ = −g tan φ / V, for `duration` or through `angle`.
     """
-    k = np.arange(n)[:, None] * substeps + np.arange(substeps + 1)
-    h = ts / substeps
-    return k * h, (np.arange(n) + 0.5) * ts
+
+    kind: str
+    duration: float | None = None
+    accel: float | None = None
+    speed: float | None = None
+    rate: float | None = None
+    angle: float | None = None
+    name: str = ""
+
+
+FLIGHT_KINDS = ("hold", "accelerate", "pitch", "roll", "yaw", "turn", "coordinated_turn")
+_AXIS = {"pitch": 0, "roll": 1, "yaw": 2}
+
+
+def flight(att0, segments, speed0: float = 0.0, g: float = 9.80665) -> Moving:
+    """A :class:`Moving` motion from aircraft segments with targets (seed 002 §3), each
+    resolved from the state its predecessor leaves: the duration a target needs, or a
+    ValueError naming the segment when the target cannot be reached in the given time.
+
+    The total duration is the sum of the segment durations.
+    """
+    att = np.array(att0, dtype=float)
+    speed = float(speed0)
+    out: list[Segment] = []
+    for i, fs in enumerate(segments):
+        label = fs.name or f"{i}:{fs.kind}"
+        where = f"segment {i} ({fs.kind})"
+        if fs.kind not in FLIGHT_KINDS:
+            raise ValueError(f"{where}: unknown kind; allowed: {', '.join(FLIGHT_KINDS)}")
+        rate = np.zeros(3)
+        accel = 0.0
+        if fs.kind == "hold":
+            need = None
+        elif fs.kind == "accelerate":
+            if fs.accel is None or fs.speed is None or fs.accel == 0:
+                raise ValueError(f"{where}: needs a non-zero accel and a target speed")
+            need = (fs.speed - speed) / fs.accel
+            if need < 0:
+                raise ValueError(f"{where}: accel {fs.accel:g} m/s² moves away from the "
+                                 f"target speed {fs.speed:g} m/s (speed is {speed:g} m/s)")
+            accel = fs.accel
+        elif fs.kind in _AXIS:
+            if fs.rate is None or fs.rate <= 0 or fs.angle is None:
+                raise ValueError(f"{where}: needs a rate > 0 and a target angle")
+            k = _AXIS[fs.kind]
+            delta = fs.angle - att[k]
+            need = abs(delta) / fs.rate
+            rate[k] = math.copysign(fs.rate, delta)
+        elif fs.kind == "turn":
+            if fs.rate is None or fs.rate <= 0 or fs.angle is None:
+                raise ValueError(f"{where}: needs a rate > 0 and an angle")
+            need = abs(fs.angle) / fs.rate
+            rate[2] = math.copysign(fs.rate, fs.angle)
+        else:  # coordinated turn at the current bank and speed
+            if speed <= 0:
+                raise ValueError(f"{where}: needs forward speed, got {speed:g} m/s")
+            rate[2] = -g * math.tan(att[1]) / speed
+            if fs.angle is not None:
+                if rate[2] == 0 or np.sign(rate[2]) != np.sign(fs.angle):
+                    raise ValueError(f"{where}: the bank {math.degrees(att[1]):g}° turns the "
+                                     f"other way (or not at all) for angle {fs.angle:g} rad")
+                need = fs.angle / rate[2]
+            else:
+                need = None
+        if need is None:
+            if fs.duration is None:
+                raise ValueError(f"{where}: needs a duration")
+            duration = fs.duration
+        elif fs.duration is None:
+            duration = need
+        else:
+            if need > fs.duration * (1 + 1e-12):
+                raise ValueError(f"{where}: the target needs {need:g} s at the given rate, "
+                                 f"more than its duration {fs.duration:g} s")
+            duration = fs.duration
+        if duration <= 0:
+            raise ValueError(f"{where}: duration must be > 0, got {duration:g} s")
+        active = duration if need is None else need  # time spent changing the state
+        out.append(Segment(active, accel, (float(rate[0]), float(rate[1]), float(rate[2])),
+                           label))
+        if active < duration:  # the target is reached early: hold it for the rest
+            out.append(Segment(duration - active, 0.0, (0.0, 0.0, 0.0), label + " (held)"))
+        att = att + rate * active
+        speed += accel * active
+        if speed < -1e-9:
+            raise ValueError(f"{where}: forward speed would become negative ({speed:g} m/s)")
+    total = float(sum(s.duration for s in out))
+    return Moving(tuple(att0), total, tuple(out), speed0)
+
+
+# ---------------------------------------------------------------------- sampling
 
 
 def sample_count(duration: float, ts: float) -> int:

@@ -22,6 +22,7 @@ from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import AlignConfig
+from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import (
     attitude_error,
     euler_to_dcm,
@@ -155,8 +156,9 @@ def coarse_attitude(data: RunData, cfg: AlignConfig, i0: int, i1: int):
     dth, dv, ts, site = data.imu.dtheta[lo:i1], data.imu.dv[lo:i1], data.imu.ts, data.site
     try:
         if c.method == "analytic":
-            return coarse_mod.analytic_coarse(dth, dv, ts, site[0]) + offset
-        return coarse_mod.inertial_frame_coarse(dth, dv, ts, site[0], site[1], site[2]) + offset
+            return coarse_mod.analytic_coarse(dth, dv, ts, site[0], data.earth) + offset
+        return coarse_mod.inertial_frame_coarse(dth, dv, ts, site[0], site[1], site[2],
+                                                earth=data.earth) + offset
     except ValueError as err:  # too short a window
         raise ScenarioError(
             f"align.coarse.duration_s: the coarse window [{(lo - i0) * ts:g}, "
@@ -180,18 +182,9 @@ def _block(data: RunData, vref, body: bool, lo: int, hi: int) -> Block:
 def warm_up() -> None:
     """Load the compiled kernel (numba cache) before the computation is timed."""
     state = K.new_state(np.array([1.0, 0.0, 0.0, 0.0]), np.zeros(3), np.array([0.7, 0.0, 0.0]))
-    K.gyrocompass_block(
-        state,
-        np.zeros((1, 3)),
-        np.zeros((1, 3)),
-        np.zeros((2, 3)),
-        False,
-        0.01,
-        1.0,
-        np.zeros(K.GAINS_SIZE),
-        K.ATTITUDE,
-        np.empty((2, 4)),
-    )
+    K.gyrocompass_block(state, np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((2, 3)), False,
+                        0.01, 1.0, WGS84.params(), np.zeros(K.GAINS_SIZE), K.ATTITUDE,
+                        np.empty((2, 4)))
 
 
 def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
@@ -239,10 +232,11 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
         [s.to_stage() for s in cfg.stages],
         poles,
         cfg.level_phase_s,
+        data.earth,
     )
     compute = time.perf_counter() - t_start
     if realtime:
-        q2, q3 = records[0].q_nb[i2 - i1], state_end[0:4].copy()
+        q2, q3 = records[0].q_nb[i2 - i1], state_end[K.ATT].copy()
         equivalent = (i3 - i0) * ts
     else:
         if cfg.t3_s == "measured":
@@ -251,8 +245,8 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
                 raise ScenarioError("align.t3_s: 'measured' latency runs past the end of the data")
         else:
             i3 = _index(data, cfg, cfg.t3_s, "t3_s")
-        q2 = state_end[0:4].copy()
-        q3 = compensate(cfg.compensation, state_end, _block(data, vref, body, i2, i3))
+        q2 = state_end[K.ATT].copy()
+        q3 = compensate(cfg.compensation, state_end, _block(data, vref, body, i2, i3), data.earth)
         equivalent = (i1 - i0) * ts + cfg.pass_count * (i2 - i1) * ts
 
     truth = data.truth

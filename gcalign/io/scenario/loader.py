@@ -10,14 +10,17 @@ from pydantic import ValidationError
 
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.models import Scenario
+from gcalign.io.scenario.motion import MOTION_KINDS
 
 # Model-level checks name their field at the start of the message ("segments: ..."),
 # since pydantic gives them the model's location only.
 _FIELD_PREFIX = re.compile(r"^([a-z_0-9]+(?:\.[a-z_0-9]+)*): ")
 
 
-# Location parts that name a member of a union type, not a key the user wrote.
-_UNION_TAG = re.compile(r"^(float|int|str|bool|constrained-\w+|\w+\[.*\])$")
+# Location parts that name a member of a union type, not a key the user wrote (also the
+# tags of the discriminated motion union).
+_UNION_TAG = re.compile(r"^(float|int|str|bool|constrained-\w+|\w+\[.*\]|"
+                        + "|".join(MOTION_KINDS) + r")$")
 
 
 def scenario_errors(err: ValidationError, source: str = "") -> str:
@@ -38,6 +41,18 @@ def scenario_errors(err: ValidationError, source: str = "") -> str:
         where = ".".join(loc) or "scenario"
         if e["type"] == "extra_forbidden":
             msg = "unknown key (check the spelling; see README 'Scenario format')"
+        elif e["type"] in ("union_tag_invalid", "union_tag_not_found"):
+            ctx = e.get("ctx", {})
+            key = str(ctx.get("discriminator", "kind")).strip("'")
+            where = ".".join([*loc, key])
+            allowed = str(ctx.get("expected_tags", "")).replace("'", "") or ", ".join(
+                MOTION_KINDS)
+            msg = (f"allowed: {allowed}, got {ctx['tag']!r}" if "tag" in ctx
+                   else f"missing; allowed: {allowed}")
+            by_field.setdefault(where, [])
+            if msg not in by_field[where]:
+                by_field[where].append(msg)
+            continue
         elif e["type"] not in {"missing", "model_type", "value_error"}:
             got_of[where] = f", got {e.get('input')!r}"
         by_field.setdefault(where, [])

@@ -10,10 +10,12 @@ from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from gcalign import units as u
 from gcalign.io.scenario.align import AlignConfig
-from gcalign.io.scenario.base import Model, NonNegVec3, PosVec3, Vec3
+from gcalign.io.scenario.base import Model, NonNegVec3, Vec3
+from gcalign.io.scenario.motion import MotionModel
+from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
-from gcalign.sim.imu import ImuErrors, SensorErrors
-from gcalign.sim.motions import Motion, Segment
+from gcalign.nav.earth import MODELS, EarthModel
+from gcalign.sim.errors import ImuErrors, SensorErrors
 
 
 def _broadcast_scalar(x):
@@ -71,6 +73,8 @@ class Gyro(Model):
     scale_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     misalignment_arcsec: list[list[float]] | None = None
     quantum_arcsec: float = Field(0.0, ge=0)
+    asym_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0],
+                           description="asymmetric scale factor: + for positive input, − negative")
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
@@ -81,6 +85,7 @@ class Gyro(Model):
             scale=_vec(self.scale_ppm) * u.PPM,
             misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
             quantum=self.quantum_arcsec * u.ARCSEC,
+            asym=_vec(self.asym_ppm) * u.PPM,
         )
 
 
@@ -90,6 +95,8 @@ class Accel(Model):
     scale_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     misalignment_arcsec: list[list[float]] | None = None
     quantum_ugs: float = Field(0.0, ge=0, description="velocity quantum, µg·s (PSINS header unit)")
+    asym_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0],
+                           description="asymmetric scale factor: + for positive input, − negative")
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
@@ -100,6 +107,7 @@ class Accel(Model):
             scale=_vec(self.scale_ppm) * u.PPM,
             misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
             quantum=self.quantum_ugs * u.UG,
+            asym=_vec(self.asym_ppm) * u.PPM,
         )
 
 
@@ -117,68 +125,24 @@ class Imu(Model):
         return ImuErrors(gyro=self.gyro.to_si(), accel=self.accel.to_si())
 
 
-class Swing(Model):
-    amplitude_deg: NonNegVec3 = Field(default_factory=lambda: [2.0, 3.0, 4.0])
-    period_s: PosVec3 = Field(default_factory=lambda: [10.0, 10.0, 20.0])
-    phase_deg: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-
-class SegmentModel(Model):
-    duration_s: float = Field(gt=0)
-    accel_mps2: float = 0.0
-    rate_dps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-
-class MotionModel(Model):
-    kind: Literal["static", "swing", "moving"]
-    attitude_deg: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    duration_s: float = Field(gt=0, le=1e6)
-    swing: Swing | None = None
-    segments: list[SegmentModel] | None = None
-
-    @field_validator("attitude_deg")
-    @classmethod
-    def _pitch_range(cls, v):
-        if not -90 < v[0] < 90:
-            raise ValueError(f"pitch must be within (-90, 90) deg, got {v[0]}")
-        return v
-
-    @model_validator(mode="after")
-    def _kind_fields(self):
-        if self.kind == "moving" and not self.segments:
-            raise ValueError("segments: missing; kind 'moving' needs a non-empty list of segments")
-        if self.kind != "moving" and self.segments:
-            raise ValueError(f"segments: only kind 'moving' takes segments, got kind {self.kind!r}")
-        if self.kind != "swing" and self.swing is not None:
-            raise ValueError(f"swing: only kind 'swing' takes a swing, got kind {self.kind!r}")
-        return self
-
-    def to_motion(self) -> Motion:
-        swing = self.swing or Swing()
-        return Motion(
-            kind=self.kind,
-            att0=tuple(np.asarray(self.attitude_deg) * u.DEG),
-            duration=self.duration_s,
-            amplitude=tuple(np.asarray(swing.amplitude_deg) * u.DEG),
-            period=(swing.period_s[0], swing.period_s[1], swing.period_s[2]),
-            phase=tuple(np.asarray(swing.phase_deg) * u.DEG),
-            segments=tuple(
-                Segment(s.duration_s, s.accel_mps2, tuple(np.asarray(s.rate_dps) * u.DEG))
-                for s in self.segments or ()
-            ),
-        )
-
-
 class Scenario(Model):
     """A whole scenario file. Either `motion` (simulated data) or `imu_file` (recorded data)."""
 
     name: str = Field("scenario", min_length=1, pattern=r"^[A-Za-z0-9_.+-]+$")
     site: Site | None = None
+    earth: Literal["wgs84", "seed004"] = "wgs84"
     imu: Imu = Field(default_factory=Imu)
     motion: MotionModel | None = None
+    mechanism: MechanismConfig | None = None
     imu_file: Path | None = None
+    navigation: NavigationConfig | None = None
+    output: OutputConfig = Field(default_factory=OutputConfig)
     align: AlignConfig | None = None
     northfind: NorthfindConfig | None = None
+
+    @property
+    def earth_model(self) -> EarthModel:
+        return MODELS[self.earth]
 
     @model_validator(mode="after")
     def _source(self):
@@ -186,17 +150,12 @@ class Scenario(Model):
             raise ValueError("imu_file: give either 'motion' (simulated) or 'imu_file' (recorded)")
         if self.motion is not None and self.site is None:
             raise ValueError("site: missing; a simulated scenario needs a site")
-        if self.motion is not None and self.motion.segments:
-            for i, s in enumerate(self.motion.segments):
-                n = s.duration_s * self.imu.rate_hz
-                if abs(n - round(n)) > 1e-6:
-                    raise ValueError(
-                        f"motion.segments.{i}.duration_s: {s.duration_s} s is not a whole "
-                        f"number of IMU samples at {self.imu.rate_hz} Hz"
-                    )
         if self.motion is not None:
-            n = self.motion.duration_s * self.imu.rate_hz
+            n = self.motion.duration() * self.imu.rate_hz
             if round(n) < 2:
-                raise ValueError(f"motion.duration_s: {self.motion.duration_s} s holds fewer "
+                raise ValueError(f"motion.duration_s: {self.motion.duration():g} s holds fewer "
                                  f"than 2 samples at {self.imu.rate_hz} Hz")
+        if self.mechanism is not None and self.imu_file is not None:
+            raise ValueError("mechanism: recorded data carry their own sensor frame; a "
+                             "mechanism applies to simulated motion only (remove it)")
         return self

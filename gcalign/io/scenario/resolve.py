@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from gcalign.io.scenario.models import Scenario
+from gcalign.io.scenario.motion import SwingModel
+from gcalign.sim.motions import Swing, Turntable
 
 
 def _v(x, digits=6) -> str:
@@ -54,38 +56,41 @@ def resolved_rows(sc: Scenario) -> list[tuple[str, str, str]]:
                 unit = "rad" if name == "gyro" else "m/s"
                 rows.append((f"imu.{name}.quantum", "", _v(m.quantum) + f" {unit}"))
     if sc.motion is not None:
-        mo = sc.motion
-        n = int(round(mo.duration_s * sc.imu.rate_hz))
-        rows += [
-            ("motion.kind", mo.kind, ""),
-            (
-                "motion.attitude_deg",
-                _v(mo.attitude_deg) + " °",
-                _v(np.radians(mo.attitude_deg)) + " rad",
-            ),
-            ("motion.duration_s", _v(mo.duration_s) + " s", f"{n} samples"),
-        ]
-        if mo.kind == "swing":
-            sw = mo.to_motion()
-            rows += [
-                (
-                    "motion.swing.amplitude_deg",
-                    _v(mo.swing.amplitude_deg if mo.swing else []) + " °",
-                    _v(sw.amplitude) + " rad",
-                ),
-                ("motion.swing.period_s", _v(sw.period) + " s", ""),
-                ("motion.swing.phase_deg", "", _v(sw.phase) + " rad"),
-            ]
-        for i, s in enumerate(mo.segments or []):
-            rows.append(
-                (
-                    f"motion.segments.{i}",
-                    f"{s.duration_s:g} s, {s.accel_mps2:g} m/s², {_v(s.rate_dps)} °/s",
-                    _v(np.radians(s.rate_dps)) + " rad/s",
-                )
-            )
+        rows += motion_rows(sc)
+    rows.append(("earth", sc.earth, ""))
     for section in type(sc).model_fields:  # every command section that can explain itself
         model = getattr(sc, section, None)
         if model is not None and hasattr(model, "resolved_rows"):
             rows += model.resolved_rows(sc)
+    return rows
+
+
+def motion_rows(sc: Scenario) -> list[tuple[str, str, str]]:
+    """The motion as the run will see it: kind, start, duration and its pieces."""
+    mo = sc.motion
+    assert mo is not None
+    motion = mo.to_motion()
+    n = int(round(motion.duration * sc.imu.rate_hz))
+    rows = [
+        ("motion.kind", mo.kind, ""),
+        ("motion.attitude_deg", _v(mo.attitude_deg) + " °",
+         _v(np.radians(mo.attitude_deg)) + " rad"),
+        ("motion.duration_s", _v(motion.duration) + " s", f"{n} samples"),
+    ]
+    if isinstance(motion, Swing) and isinstance(mo, SwingModel):
+        rows += [
+            ("motion.swing.amplitude_deg", _v(mo.swing.amplitude_deg) + " °",
+             _v(motion.amplitude) + " rad"),
+            ("motion.swing.period_s", _v(motion.period) + " s", ""),
+            ("motion.swing.phase_deg", _v(mo.swing.phase_deg) + " °", _v(motion.phase) + " rad"),
+        ]
+    for i, seg in enumerate(getattr(motion, "segments", ())):
+        rows.append((f"motion.segments.{i}" + (f" ({seg.name})" if seg.name else ""),
+                     f"{seg.duration:g} s, {seg.accel:g} m/s², {_v(np.degrees(seg.rate))} °/s",
+                     _v(seg.rate) + " rad/s"))
+    if isinstance(motion, Turntable):
+        for i, st in enumerate(motion.schedule.steps):
+            rows.append((f"motion.steps.{i}", f"axis {_v(st.axis)}, "
+                         f"{np.degrees(st.profile.angle):g}° in {st.profile.duration:g} s, "
+                         f"dwell {st.dwell:g} s", f"{st.profile.angle:.9g} rad"))
     return rows
