@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gcalign.nav import earth
 from gcalign.nav import _kernels as K
+from gcalign.nav import earth
 from gcalign.nav._kernels import earth_at, transport_rate
 from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import euler_to_dcm, misalignment, quat_to_dcm
