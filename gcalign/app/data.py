@@ -21,9 +21,10 @@ from gcalign.errors import ScenarioError
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario import Scenario
 from gcalign.nav.earth import WGS84, EarthModel
+from gcalign.nav.rotation import dcm_to_quat
 from gcalign.sim.errors import ErrorStream
 from gcalign.sim.imu import ImuData
-from gcalign.sim.motions import Truth, sample_count
+from gcalign.sim.motions import Moving, Truth, sample_count
 
 
 @dataclass(frozen=True)
@@ -69,9 +70,19 @@ class Stream:
     make_blocks: Callable[[], Iterator[DataBlock]] = field(repr=False)
     header: ImuData | None = None
     has_mechanism: bool = False
+    at: Callable[[int], tuple] | None = field(default=None, repr=False)
 
     def blocks(self) -> Iterator[DataBlock]:
         return self.make_blocks()
+
+    def truth_at(self, k: int):
+        """(att, v_n, pos) of the truth at sample k (the end of increment k − 1; k = 0 the
+        start), or None without truth."""
+        return None if self.at is None else self.at(k)[:3]
+
+    def q_bs_at(self, k: int):
+        """Mechanism angles q_bs at sample k, or None without a mechanism."""
+        return None if self.at is None or not self.has_mechanism else self.at(k)[3]
 
     @property
     def t0(self) -> float:
@@ -145,8 +156,17 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
                                               else truth.segment[:1])
         header = replace(imu, t=imu.t[:1], dtheta=imu.dtheta[:0], dv=imu.dv[:0],
                          q_bs=None if imu.q_bs is None else imu.q_bs[:0])
+        q_bs0 = imu.meta.get("q_bs0")
+
+        def recorded_at(k: int):
+            q = None if imu.q_bs is None else (q_bs0 if k == 0 else imu.q_bs[k - 1])
+            if truth is None:
+                return None, None, None, q
+            return truth.att[k], truth.v_n[k], truth.pos[k], q
+
+        at = recorded_at if truth is not None or imu.q_bs is not None else None
         return Stream(imu.ts, len(imu), data.site, earth, None, imu.source, t0,
-                      recorded_blocks, header, imu.q_bs is not None)
+                      recorded_blocks, header, imu.q_bs is not None, at)
 
     motion, mech, site = _simulation(scenario)
     seed = scenario.imu.seed if seed is None else seed
@@ -160,8 +180,21 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
             dtheta, dv = stream.apply(b.dtheta, b.dv)
             yield DataBlock(b.k0, b.t, dtheta, dv, b.att, b.v_n, b.pos, b.segment, b.q_bs)
 
+    def simulated_at(k: int):
+        """Truth at sample k from the motion itself (truth at any time)."""
+        t = np.array([k * ts])
+        seg = None
+        if isinstance(motion, Moving):  # the end of increment k − 1: its own segment
+            seg = motion.segment_index(t, side="left")
+        kin = (motion.kinematics(t, site, earth, segment=seg) if seg is not None
+               else motion.kinematics(t, site, earth))
+        q_bs = None
+        if mech is not None:
+            q_bs = mech.q_bs(t, dcm_to_quat(kin.C_nb))[0]
+        return kin.att[0].copy(), kin.v_n[0].copy(), kin.pos[0].copy(), q_bs
+
     return Stream(ts, n, site, earth, seed, "simulated", initial_truth(motion, site, earth),
-                  simulated_blocks, has_mechanism=mech is not None)
+                  simulated_blocks, has_mechanism=mech is not None, at=simulated_at)
 
 
 def gather(stream: Stream) -> RunData:

@@ -49,6 +49,7 @@ class Command:
     section: str | None = None  # the scenario section it reads
     builtin: str | None = None  # built-in scenario (package data gcalign/scenarios)
     batch_metrics: tuple[str, ...] = field(default=())  # default metrics; () = not batchable
+    streams: bool = False  # execute() writes its series into an open results file (sink=)
 
     def load(self) -> ModuleType:
         return importlib.import_module(f"gcalign.app.{self.room}")
@@ -57,8 +58,9 @@ class Command:
 COMMANDS: dict[str, Command] = {
     c.name: c
     for c in (
-        Command("simulate", "simulate", "Simulate truth and IMU data."),
-        Command("navigate", "navigate", "Strapdown navigation of simulated or recorded data."),
+        Command("simulate", "simulate", "Simulate truth and IMU data.", streams=True),
+        Command("navigate", "navigate", "Strapdown navigation of simulated or recorded data.",
+                "navigation", streams=True),
         Command("align", "align", "Gyrocompass alignment (seed 000).", "align",
                 "seed000_moving_full_cycle.yaml", ("error_t3_deg",)),
         Command("northfind", "northfind", "Multi-position north-finding (seed 001).",

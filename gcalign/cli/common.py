@@ -9,7 +9,7 @@ from pathlib import Path
 
 import yaml
 
-from gcalign.app.registry import Outcome, command
+from gcalign.app.registry import command
 from gcalign.cli import consoles, emit_json
 from gcalign.errors import ScenarioError
 from gcalign.io import results
@@ -28,18 +28,25 @@ def load_with_overrides(
     section: str,
     overrides: dict,
     adjust: Callable[[dict, dict], None] | None = None,
+    data: dict | None = None,
+    text: str | None = None,
 ) -> tuple[Scenario, str, str]:
-    """Scenario (the file, or the built-in one), its text and its source name, with the
-    options that were given written into `section` before validation, so that a bad
-    option is reported like a bad key in the file. `adjust(section, given)` may drop keys
-    that a given option replaces. The text stored in results files records the overrides.
+    """Scenario (the file, the built-in one, or a given mapping `data` with its `text`),
+    its text and its source name, with the options that were given written into `section`
+    before validation, so that a bad option is reported like a bad key in the file.
+    `adjust(section, given)` may drop keys that a given option replaces. The text stored in
+    results files records the overrides.
     """
-    if path is None:
+    if data is not None:
+        source = str(path)
+        text = text or yaml.safe_dump(data, sort_keys=False)
+    elif path is None:
         text, source = builtin_text(builtin), f"<built-in {builtin}>"
         data = yaml.safe_load(text)
     else:
         data, source = read_yaml(path), str(path)
         text = Path(path).read_text(encoding="utf-8")
+    assert text is not None
     given = {k: v for k, v in overrides.items() if v is not None}
     if isinstance(data, dict) and given:
         current = data.get(section)
@@ -59,31 +66,38 @@ def load_with_overrides(
 
 
 def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: Path | None,
-                 as_json: bool) -> None:
+                 as_json: bool, **options) -> None:
     """Run command `name` on a loaded scenario through its room, write the results file
-    (default name from the scenario, command and seed) and show its table."""
+    (default name from the scenario, command and seed) and show its table. A streaming
+    command writes its series into the (temporary) file while it runs; `options` go to its
+    ``execute``."""
     from gcalign.cli import default_output
 
-    outcome = command(name).load().execute(sc, seed)
-    for line in outcome.warnings:
-        sys.stderr.write(f"warning: {line}\n")
-    out = output or default_output(sc.name, name, outcome.seed)
-    save_and_show(out, name, text, outcome, as_json)
-
-
-def save_and_show(out: Path, kind: str, text: str, outcome: Outcome, as_json: bool) -> None:
-    """Write the results file atomically (header, truth, then the command's groups), print
-    the command's table, and the JSON summary under --json."""
-    summary = outcome.summary
-    summary["output"] = str(out)
+    cmd = command(name)
+    room = cmd.load()
+    run_seed = None if sc.imu_file is not None else (sc.imu.seed if seed is None else seed)
+    out = output or default_output(sc.name, name, run_seed)
     try:
         with results.atomic_h5(out) as f:
-            results.write_header(f, kind, text, outcome.seed, summary)
+            if cmd.streams:
+                outcome = room.execute(sc, seed, sink=f, **options)
+            else:
+                outcome = room.execute(sc, seed, **options)
+            for line in outcome.warnings:
+                sys.stderr.write(f"warning: {line}\n")
+            summary = outcome.summary
+            summary["output"] = str(out)
+            results.write_header(f, name, text, outcome.seed, summary)
             if outcome.truth is not None:
                 results.write_truth(f, outcome.truth)
             outcome.write(f)
     except OSError as err:
         raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
+    show(name, summary, as_json)
+
+
+def show(kind: str, summary: dict, as_json: bool) -> None:
+    """Print a command's table (stderr under --json) and, under --json, the summary."""
     consoles(as_json).print(command(kind).load().table(summary))
     if as_json:
         emit_json(summary)

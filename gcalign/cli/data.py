@@ -10,10 +10,10 @@ import yaml
 
 from gcalign.app.report import kv_table, summary_table
 from gcalign.cli import app, consoles, emit_json, user_errors
-from gcalign.cli.common import run_and_show
+from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.io import results
 from gcalign.io.results import HDF5_SUFFIXES
-from gcalign.io.scenario import load_scenario, parse_scenario
+from gcalign.io.scenario import load_scenario
 from gcalign.io.scenario.resolve import resolved_rows
 
 DATA_SUFFIXES = {".imu", ".csv", ".txt"}
@@ -40,16 +40,27 @@ def navigate(
     source: Path = typer.Argument(
         ..., help="Scenario YAML, a results file with /imu, or a PSINS .imu / CSV data file."
     ),
+    init: str | None = typer.Option(
+        None, "--init", help="Start from: truth | header | an alignment results file (its "
+        "attitude at T3, at T3's data time). Default: truth, or the header of recorded data."),
+    vertical: str | None = typer.Option(
+        None, "--vertical", help="Vertical channel: auto | free | hold | damped."),
+    start: float | None = typer.Option(None, "--start", help="Data time to start at (s)."),
+    duration: float | None = typer.Option(None, "--duration", help="How long to navigate (s)."),
     output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
     seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
     as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ):
-    """Free inertial navigation from the true initial state; errors against truth.
+    """Strapdown navigation, streamed block by block; errors against truth at every sample.
 
-    Recorded data have no truth: the run starts from the file header's state and the
-    table shows the final state instead of errors (`final_error` is null in the JSON).
+    The vertical channel is held for bases whose height cannot change and for recorded
+    data, damped to the true height on moving bases (navigation.vertical, --vertical).
+    Recorded data have no truth: the table shows the final state and its drift from the
+    start (`final_error` is null in the JSON).
     """
+    overrides = {"vertical": vertical, "start_s": start, "duration_s": duration}
     suffix = source.suffix.lower()
+    data = text = None
     if suffix in DATA_SUFFIXES | HDF5_SUFFIXES:
         # A bare data file stands for the scenario `imu_file: SOURCE`; our own results
         # file keeps the name and text of the scenario that made it.
@@ -57,12 +68,14 @@ def navigate(
         stored = yaml.safe_load(text) if text else None
         name = stored.get("name") if isinstance(stored, dict) else None
         name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.stem) or "data"
-        scenario = {"name": name, "imu_file": str(source.resolve())}
-        text = text or yaml.safe_dump(scenario)
-        sc = parse_scenario(scenario, str(source))
-    else:
-        sc, text = load_scenario(source)
-    run_and_show("navigate", sc, text, seed, output, as_json)
+        data = {"name": name, "imu_file": str(source.resolve())}
+        if isinstance(stored, dict):
+            for key in ("earth", "navigation", "output"):
+                if key in stored:
+                    data[key] = stored[key]
+        text = text or yaml.safe_dump(data)
+    sc, text, _ = load_with_overrides(source, "", "navigation", overrides, data=data, text=text)
+    run_and_show("navigate", sc, text, seed, output, as_json, init=init)
 
 
 @app.command()

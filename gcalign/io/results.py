@@ -60,6 +60,35 @@ def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None
     return ds
 
 
+class Series:
+    """Datasets that grow block by block: chunked, compressed (gzip + shuffle), resizable
+    along axis 0, each with its units (and frame) attribute. ``append(name=array, …)``
+    adds rows to every named dataset; the file never holds a run's series in memory."""
+
+    def __init__(self, group: h5py.Group, spec: dict[str, tuple[int | None, str, str | None]],
+                 chunk_rows: int = 4096, **attrs):
+        self.group = group
+        for name, (width, units, frame) in spec.items():
+            shape = (0,) if width is None else (0, width)
+            ds = group.create_dataset(
+                name, shape=shape, maxshape=(None,) + shape[1:], dtype="f8",
+                chunks=(chunk_rows,) + shape[1:], compression="gzip", compression_opts=4,
+                shuffle=True)
+            ds.attrs["units"] = units
+            if frame:
+                ds.attrs["frame"] = frame
+        for k, v in attrs.items():
+            group.attrs[k] = v
+
+    def append(self, **arrays) -> None:
+        for name, a in arrays.items():
+            ds = self.group[name]
+            a = np.asarray(a, dtype=float)
+            n = ds.shape[0]
+            ds.resize(n + a.shape[0], axis=0)
+            ds[n:] = a
+
+
 def write_header(f: h5py.File, kind: str, scenario_yaml: str, seed: int | None, summary: dict):
     f.attrs["gcalign_version"] = __version__
     f.attrs["kind"] = kind
@@ -120,7 +149,9 @@ def read_truth(path: Path) -> Truth | None:
         if "truth" not in f:
             return None
         g = f["truth"]
-        return Truth(t=g["t"][()], att=g["att"][()], v_n=g["v_n"][()], pos=g["pos"][()])
+        seg = g["segment"][()].astype(np.int64) if "segment" in g else None
+        return Truth(t=g["t"][()], att=g["att"][()], v_n=g["v_n"][()], pos=g["pos"][()],
+                     segment=seg)
 
 
 def read_imu(path: Path) -> ImuData:
@@ -129,6 +160,11 @@ def read_imu(path: Path) -> ImuData:
         if "imu" not in f:
             raise ScenarioError(f"{path}: holds no /imu group (write one with 'gcalign simulate')")
         g = f["imu"]
+        if "summed_from_ts" in g.attrs:
+            raise ScenarioError(
+                f"{path}: /imu holds increments summed to {1 / float(g.attrs['ts']):g} Hz "
+                f"(output.rate_hz); navigation needs every sample (coning and sculling are "
+                f"lost in sums): simulate again with output: {{rate_hz: full}}")
         extra: dict = {k: np.asarray(g.attrs[k]) for k in ("site", "att0", "v0_n") if k in g.attrs}
         scenario = yaml.safe_load(str(f.attrs.get("scenario_yaml", ""))) or {}
         motion = scenario.get("motion") if isinstance(scenario, dict) else None
@@ -139,7 +175,9 @@ def read_imu(path: Path) -> ImuData:
             dv=g["dv"][()],
             ts=float(g.attrs["ts"]),
             source=str(path),
-            meta={"motion_kind": kind} if kind else {},
+            meta=({"motion_kind": kind} if kind else {})
+            | ({"q_bs0": np.asarray(g.attrs["q_bs0"])} if "q_bs0" in g.attrs else {}),
+            q_bs=g["q_bs"][()] if "q_bs" in g else None,
             **extra,
         )
 

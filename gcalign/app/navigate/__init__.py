@@ -9,10 +9,10 @@ from __future__ import annotations
 from gcalign.app.registry import Outcome
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None) -> Outcome:
+def execute(sc, seed: int | None = None, cache_key: str | None = None, **options) -> Outcome:
     from gcalign.app.navigate.run import execute as run
 
-    return run(sc, seed, cache_key)
+    return run(sc, seed, cache_key, **options)
 
 
 def table(summary: dict):

@@ -1,36 +1,39 @@
-"""Free inertial navigation from the initial state, with errors against truth."""
+"""Strapdown navigation of a scenario's data, streamed block by block, with errors against truth.
+
+The data come as a :class:`gcalign.app.data.Stream` (simulated on the fly, or recorded);
+each block is integrated by :class:`gcalign.nav.strapdown.Navigator`, compared with the
+truth at every sample (final and largest errors use every sample), decimated to the output
+rate and appended to the results file, so memory does not grow with a run's duration.
+
+On a turning IMU (a mechanism) the navigation integrates the sensor frame and reports the
+body attitude through the mechanism angles the data carry, ``q_nb = q_ns ⊗ q_bs*``.
+
+Where navigation starts (``--init``): the truth (simulated data), the file header (recorded
+data), or an alignment results file, whose attitude at T3 is taken at T3's data time.
+"""
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-from gcalign.app.data import RunData, scenario_data
+from gcalign.app.data import Stream, scenario_stream
 from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
-from gcalign.nav import earth
-from gcalign.nav.rotation import attitude_error
-from gcalign.nav.strapdown import NavSolution, NavState, navigate
+from gcalign.io.scenario import Scenario
+from gcalign.io.scenario.navigation import NavigationConfig
+from gcalign.nav import _kernels as K
+from gcalign.nav.earth import WGS84, EarthModel
+from gcalign.nav.rotation import attitude_error, quat_to_euler
+from gcalign.nav.strapdown import Navigator, NavState, Vertical
+from gcalign.sim.mechanism import body_attitude
 
 
-@dataclass(frozen=True)
-class NavRun:
-    """A free-navigation run. Errors are None without truth.
-
-    att_error (N+1, 3) rad as Euler differences; vel_error (N+1, 3) m/s ENU;
-    pos_error (N+1, 3) m ENU (east, north, up).
-    """
-
-    solution: NavSolution
-    att_error: np.ndarray | None
-    vel_error: np.ndarray | None
-    pos_error: np.ndarray | None
-    compute_s: float
-
-
-def position_error_enu(pos, pos_true):
+def position_error_enu(pos, pos_true, earth: EarthModel = WGS84):
     """ENU metres between two ``[lat, lon, h]`` tracks, (N, 3), radii at the true latitude."""
     r_m, r_n = earth.radii(pos_true[:, 0])
     h = pos_true[:, 2]
@@ -44,70 +47,260 @@ def position_error_enu(pos, pos_true):
     )
 
 
-def initial_state(data: RunData) -> NavState:
-    """The true initial state, or the one in the IMU file's header for recorded data."""
-    if data.truth is not None:
-        tr = data.truth
-        return NavState.from_euler(tr.att[0], tr.v_n[0], tr.pos[0])
-    if data.imu.att0 is None:
-        raise ScenarioError(
-            f"imu_file: {data.imu.source} gives no initial attitude and there is no truth"
-        )
-    v0 = data.imu.v0_n if data.imu.v0_n is not None else np.zeros(3)
-    return NavState.from_euler(data.imu.att0, v0, data.site)
+@dataclass(frozen=True)
+class Start:
+    """Where navigation starts: sample index k (the state is at the end of increment k − 1),
+    the body state there, and where it came from."""
+
+    k: int
+    state: NavState
+    source: str  # "truth" | "header" | "alignment FILE"
 
 
-def run_navigation(data: RunData) -> NavRun:
-    imu = data.imu
-    start = initial_state(data)
+def alignment_start(path: Path, stream: Stream, truth_at) -> Start:
+    """The attitude at T3 of an alignment results file, at T3's data time."""
+    from gcalign.io import results
+
+    kind, summary, _ = results.read_summary(path)
+    if kind != "align":
+        raise ScenarioError(f"--init: {path} is a {kind!r} results file; it must come from "
+                            "'gcalign align'")
+    if summary.get("source") != stream.source:
+        raise ScenarioError(f"--init: {path} aligned {summary.get('source')!r}, but this run "
+                            f"navigates {stream.source!r}; align the same data")
+    t_data = float(summary.get("start_s", 0.0)) + float(summary["t3_s"])
+    k = int(round(t_data / stream.ts))
+    att = np.radians(summary["attitude_t3_deg"])
+    tr = truth_at(k)
+    v = np.zeros(3) if tr is None else tr[1]
+    pos = stream.site if tr is None else tr[2]
+    return Start(k, NavState.from_euler(att, v, pos), f"alignment {path} (T3 = {t_data:g} s)")
+
+
+def vertical_of(cfg: NavigationConfig, sc: Scenario, motion_kind: str | None = None) -> Vertical:
+    """The vertical channel: as configured, or ``auto``: hold for bases whose height cannot
+    change (static, swing, turntable) and for recorded data (parked or unknown), damped to
+    the true height for moving bases and flights."""
+    mode = cfg.vertical
+    if mode == "auto":
+        kind = sc.motion.kind if sc.motion is not None else motion_kind
+        mode = "damped" if kind in ("moving", "flight") else "hold"
+    return Vertical(mode, cfg.tau_s)
+
+
+@dataclass
+class _Stats:
+    """Final and largest errors over every sample."""
+
+    final: dict
+    peak: dict
+    horizontal_max: float = 0.0
+
+    @classmethod
+    def empty(cls) -> _Stats:
+        z = np.zeros(3)
+        return cls({k: z for k in ("att", "v_n", "pos")}, {k: z for k in ("att", "v_n", "pos")})
+
+    def add(self, err: dict) -> None:
+        """Fold in the errors of one block (dict of (n, 3) arrays)."""
+        for k, e in err.items():
+            self.final[k] = e[-1]
+            self.peak[k] = np.maximum(self.peak[k], np.abs(e).max(axis=0))
+        self.horizontal_max = max(self.horizontal_max,
+                                  float(np.hypot(err["pos"][:, 0], err["pos"][:, 1]).max()))
+
+
+def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
+                    duration_s: float | None = None, sink=None) -> dict:
+    """Navigate from `start` to the end of the data (or for `duration_s`), compare with the
+    truth at every sample, write every `stride`-th row to `sink` (an h5py group), and
+    return the plain-number pieces of the summary (SI, radians)."""
+    from gcalign.io.results import ATT_FRAME, Series
+
+    ts, earth = stream.ts, stream.earth
+    k_end = stream.samples if duration_s is None else min(
+        stream.samples, start.k + int(round(duration_s / ts)))
+    if k_end <= start.k:
+        raise ScenarioError(f"navigation: nothing to navigate: start at sample {start.k} of "
+                            f"{stream.samples} ({start.k * ts:g} s of {stream.samples * ts:g} s)")
+    has_truth = stream.truth0 is not None
+    series = None
+    if sink is not None:
+        spec = {"t": (None, "s", None), "att": (3, "rad", ATT_FRAME), "v_n": (3, "m/s", "ENU"),
+                "pos": (3, "rad, rad, m", "[latitude, longitude, height]")}
+        if has_truth:
+            spec |= {"error/att": (3, "rad", "Euler differences est - true, yaw wrapped"),
+                     "error/v_n": (3, "m/s", "ENU"),
+                     "error/pos": (3, "m", "ENU (east, north, up)")}
+        series = Series(sink, spec, stride=stride, rate_hz=1.0 / (stride * ts),
+                        vertical=vertical.mode)
+    state = start.state
+    h_last = float(state.pos[2])
+    drift_max = 0.0
+    nav = None
+    stats = _Stats.empty()
     t0 = time.perf_counter()
-    sol = navigate(imu.t, imu.dtheta, imu.dv, imu.ts, start)
-    compute = time.perf_counter() - t0
-    if data.truth is None:
-        return NavRun(sol, None, None, None, compute)
-    tr = data.truth
-    return NavRun(
-        solution=sol,
-        att_error=attitude_error(sol.att, tr.att),
-        vel_error=sol.v_n - tr.v_n,
-        pos_error=position_error_enu(sol.pos, tr.pos),
-        compute_s=compute,
-    )
+    compute = 0.0
+    first = True
+    for b in stream.blocks():
+        lo, hi = max(start.k - b.k0, 0), min(k_end - b.k0, len(b.t))
+        if hi <= lo:
+            if b.k0 >= k_end:
+                break
+            continue
+        q_bs = None if b.q_bs is None else b.q_bs[lo:hi]
+        if nav is None:
+            q_bs0 = stream.q_bs_at(start.k)
+            q_ns0 = state.q_nb if q_bs0 is None else _qmul(state.q_nb, q_bs0)
+            nav = Navigator(NavState(q_ns0, state.v_n, state.pos), ts, earth, vertical)
+        h_ref = None
+        if has_truth and b.pos is not None:  # the true height at the start of each step
+            prev = b.pos[lo - 1, 2] if lo > 0 else h_last
+            h_ref = np.concatenate([[prev], b.pos[lo:hi - 1, 2]])
+            h_last = b.pos[hi - 1, 2]
+        c0 = time.perf_counter()
+        out = nav.run(b.dtheta[lo:hi], b.dv[lo:hi], h_ref)
+        compute += time.perf_counter() - c0
+        q = out[:, K.Q] if q_bs is None else body_attitude(out[:, K.Q], q_bs)
+        att, v, pos = quat_to_euler(q), out[:, K.V], out[:, K.P]
+        disp = position_error_enu(pos, np.broadcast_to(start.state.pos, pos.shape), earth)
+        drift_max = max(drift_max, float(np.hypot(disp[:, 0], disp[:, 1]).max()))
+        err = None
+        if has_truth and b.att is not None:
+            err = {"att": attitude_error(att, b.att[lo:hi]), "v_n": v - b.v_n[lo:hi],
+                   "pos": position_error_enu(pos, b.pos[lo:hi], earth)}
+            stats.add(err)
+        if series is not None:
+            if first:  # the start row
+                row0 = {"t": [start.k * ts + stream.t0], "att": [start.state.att],
+                        "v_n": [start.state.v_n], "pos": [start.state.pos]}
+                if err is not None:
+                    row0 |= {"error/att": np.zeros((1, 3)), "error/v_n": np.zeros((1, 3)),
+                             "error/pos": np.zeros((1, 3))}
+                series.append(**row0)
+            # rows whose sample count from the start is a multiple of the stride
+            k = b.k0 + np.arange(lo, hi) + 1 - start.k
+            keep = (k % stride) == 0
+            rows = {"t": b.t[lo:hi][keep], "att": att[keep], "v_n": v[keep], "pos": pos[keep]}
+            if err is not None:
+                rows |= {f"error/{n}": e[keep] for n, e in err.items()}
+            series.append(**rows)
+        first = False
+        final_att, final_v, final_pos = att[-1], v[-1], pos[-1]
+    assert nav is not None
+    return {
+        "samples": k_end - start.k,
+        "duration_s": (k_end - start.k) * ts,
+        "start_s": start.k * ts,
+        "final_state": (final_att, final_v, final_pos),
+        "displacement": disp[-1],
+        "max_horizontal_displacement": drift_max,
+        "stats": stats if has_truth else None,
+        "compute_s": compute,
+        "wall_s": time.perf_counter() - t0,
+    }
 
 
-def navigation_summary(run: NavRun, data: RunData, name: str) -> dict:
-    """Plain-number summary (degrees, m/s, m) for tables, JSON and the results file."""
-    sol = run.solution
+def _qmul(a, b):
+    from gcalign.nav.rotation import quat_mult
+
+    return quat_mult(np.asarray(a, float), np.asarray(b, float))
+
+
+def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | None = None,
+                   sink=None) -> tuple[dict, Stream]:
+    """Navigate a scenario's data; the summary (plain numbers, degrees/m) and the stream."""
+    cfg = sc.navigation or NavigationConfig()
+    stream = scenario_stream(sc, seed)
+    kind = None if stream.header is None else stream.header.meta.get("motion_kind")
+    vertical = vertical_of(cfg, sc, kind)
+    stride = _stride(sc, stream)
+
+    def truth_at(k: int):
+        """(att, v_n, pos) at the end of increment k − 1 (k = 0: the start), or None."""
+        return stream.truth_at(k)
+
+    if init is not None and init not in ("truth", "header"):
+        if cfg.start_s:
+            raise ScenarioError(f"navigation.start_s: {cfg.start_s:g} s cannot matter with "
+                                f"--init {init} (it starts at the alignment's T3); remove one")
+        start = alignment_start(Path(init), stream, truth_at)
+    else:
+        k = int(round(cfg.start_s / stream.ts))
+        if k >= stream.samples:
+            raise ScenarioError(f"navigation.start_s: {cfg.start_s:g} s is past the end of the "
+                                f"data ({stream.samples * stream.ts:g} s)")
+        source = init or ("truth" if stream.truth0 is not None else "header")
+        tr = truth_at(k) if source == "truth" else None
+        if source == "truth" and tr is None:
+            raise ScenarioError("--init: truth: recorded data have no truth; use 'header' or "
+                                "an alignment results file")
+        if source == "truth":
+            state = NavState.from_euler(*tr)
+        else:
+            hd = stream.header
+            if hd is None or hd.att0 is None:
+                raise ScenarioError(f"--init: header: {stream.source} gives no initial "
+                                    "attitude; use an alignment results file")
+            if k:
+                raise ScenarioError("navigation.start_s: the file header's state is at the "
+                                    "first sample; start_s must be 0 with --init header")
+            v0 = hd.v0_n if hd.v0_n is not None else np.zeros(3)
+            state = NavState.from_euler(hd.att0, v0, stream.site)
+        start = Start(k, state, source)
+    part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink)
+    return _summary(sc, stream, start, vertical, stride, part), stream
+
+
+def _stride(sc: Scenario, stream: Stream) -> int:
+    try:
+        return sc.output.stride(1.0 / stream.ts, stream.samples * stream.ts)
+    except ValueError as err:
+        raise ScenarioError(str(err)) from None
+
+
+def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, stride: int,
+             part: dict) -> dict:
+    att, v, pos = part["final_state"]
     out = {
-        "scenario": name,
-        "source": data.imu.source,
-        "samples": len(data.imu),
-        "duration_s": float(sol.t[-1] - sol.t[0]),
-        "compute_s": run.compute_s,
+        "scenario": sc.name,
+        "source": stream.source,
+        "seed": stream.seed,
+        "earth": stream.earth.name,
+        "samples": part["samples"],
+        "start_s": part["start_s"],
+        "duration_s": part["duration_s"],
+        "init": start.source,
+        "vertical": vertical.mode,
+        "vertical_tau_s": vertical.tau if vertical.mode == "damped" else None,
+        "mechanism": stream.has_mechanism,
+        "output_rate_hz": 1.0 / (stride * stream.ts),
+        "compute_s": part["compute_s"],
         "final_state": {
-            "attitude_deg": np.degrees(sol.att[-1]).tolist(),
-            "velocity_mps": sol.v_n[-1].tolist(),
-            "position_deg_m": [*np.degrees(sol.pos[-1, :2]).tolist(), float(sol.pos[-1, 2])],
+            "attitude_deg": np.degrees(att).tolist(),
+            "velocity_mps": v.tolist(),
+            "position_deg_m": [*np.degrees(pos[:2]).tolist(), float(pos[2])],
         },
+        "displacement_m": part["displacement"].tolist(),
+        "max_horizontal_displacement_m": part["max_horizontal_displacement"],
         "final_error": None,
         "max_error": None,
+        "max_horizontal_error_m": None,
     }
-    if run.att_error is not None:
-        errors = {
-            "attitude_deg": np.degrees(run.att_error),
-            "velocity_mps": run.vel_error,
-            "position_m": run.pos_error,
-        }
-        out["final_error"] = {k: v[-1].tolist() for k, v in errors.items()}
-        out["max_error"] = {k: np.abs(v).max(axis=0).tolist() for k, v in errors.items()}
+    st = part["stats"]
+    if st is not None:
+        deg = {"att": math.degrees(1.0), "v_n": 1.0, "pos": 1.0}
+        names = {"att": "attitude_deg", "v_n": "velocity_mps", "pos": "position_m"}
+        out["final_error"] = {names[k]: (st.final[k] * deg[k]).tolist() for k in names}
+        out["max_error"] = {names[k]: (st.peak[k] * deg[k]).tolist() for k in names}
+        out["max_horizontal_error_m"] = st.horizontal_max
     return out
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None) -> Outcome:
-    """Simulate (or read) the data, navigate, summarise; the registry's entry point."""
-    from gcalign.app.navigate.hdf5 import write_navigation
-
-    data = scenario_data(sc, seed, cache_key)
-    run = run_navigation(data)
-    return Outcome(navigation_summary(run, data, sc.name), lambda f: write_navigation(f, run),
-                   data.truth, data.seed)
+def execute(sc, seed: int | None = None, cache_key: str | None = None, sink=None,
+            init: str | Path | None = None) -> Outcome:
+    """Navigate (streamed); the registry's entry point. With `sink` (an open results file)
+    the decimated series go into its /navigate group as they are computed."""
+    group = None if sink is None else sink.create_group("navigate")
+    summary, stream = run_navigation(sc, seed, init, group)
+    return Outcome(summary, lambda f: None, None, stream.seed)

@@ -1,4 +1,10 @@
-"""Simulate a scenario's truth and IMU data; the summary `gcalign simulate` prints."""
+"""Simulate a scenario's truth and IMU data, streamed; the summary `gcalign simulate` prints.
+
+Series are stored at the output rate (``output.rate_hz``; every sample for runs up to an
+hour by default). At full rate ``/imu`` holds the increments themselves; decimated, it
+holds their exact sums over each output interval (attribute ``summed_from_ts``), which are
+fine for plots and statistics but not for navigation (coning and sculling are lost).
+"""
 
 from __future__ import annotations
 
@@ -6,41 +12,108 @@ import time
 
 import numpy as np
 
-from gcalign.app.data import RunData, scenario_data
+from gcalign.app.data import scenario_stream
 from gcalign.app.registry import Outcome
+from gcalign.errors import ScenarioError
+from gcalign.io.scenario import Scenario
+
+BODY = "body: x right, y forward, z up"
+SENSOR = "sensor frame s (turned by the mechanism; C_s^b in q_bs)"
 
 
-def simulation_summary(data: RunData, name: str, compute_s: float) -> dict:
-    imu = data.imu
-    s = {
-        "scenario": name,
-        "seed": data.seed,
-        "samples": len(imu),
-        "rate_hz": 1.0 / imu.ts,
-        "duration_s": float(len(imu) * imu.ts),
-        "compute_s": compute_s,
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+            sink=None) -> Outcome:
+    """Simulate block by block; with `sink` (an open results file) write /truth and /imu."""
+    from gcalign.io.results import ATT_FRAME, Series
+
+    t_start = time.perf_counter()
+    stream = scenario_stream(sc, seed)
+    ts = stream.ts
+    try:
+        stride = sc.output.stride(1.0 / ts, stream.samples * ts)
+    except ValueError as err:
+        raise ScenarioError(str(err)) from None
+    frame = SENSOR if stream.has_mechanism else BODY
+    truth = imu = None
+    tr0 = stream.truth0
+    if sink is not None and tr0 is not None:
+        truth = Series(sink.create_group("truth"), {
+            "t": (None, "s", None), "att": (3, "rad", ATT_FRAME), "v_n": (3, "m/s", "ENU"),
+            "pos": (3, "rad, rad, m", "[latitude, longitude, height]"),
+            "segment": (None, "", "index of the motion segment")}, stride=stride)
+        truth.append(t=[0.0], att=tr0.att, v_n=tr0.v_n, pos=tr0.pos, segment=[0])
+    if sink is not None:
+        spec = {"t": (None, "s", None), "dtheta": (3, "rad", frame), "dv": (3, "m/s", frame)}
+        if stream.has_mechanism:
+            spec["q_bs"] = (4, "", "mechanism angles: quaternion of C_s^b at t")
+        attrs = {"ts": ts * stride, "source": stream.source, "site": stream.site}
+        if stride > 1:
+            attrs["summed_from_ts"] = ts
+        imu = Series(sink.create_group("imu"), spec, **attrs)
+        if stream.has_mechanism:
+            imu.group.attrs["q_bs0"] = stream.q_bs_at(0)
+    distance = 0.0
+    v_prev = None if tr0 is None else tr0.v_n[0]
+    pos0 = None if tr0 is None else tr0.pos[0]
+    h_max = h_min = None if tr0 is None else float(tr0.pos[0, 2])
+    last = None
+    carry = {"dtheta": np.zeros(3), "dv": np.zeros(3)}
+    for b in stream.blocks():
+        if b.v_n is not None and v_prev is not None:
+            v = np.vstack([v_prev[None], b.v_n])
+            distance += float(np.linalg.norm(0.5 * (v[1:] + v[:-1]), axis=1).sum() * ts)
+            v_prev = b.v_n[-1]
+            h_max = max(h_max, float(b.pos[:, 2].max()))  # type: ignore[arg-type]
+            h_min = min(h_min, float(b.pos[:, 2].min()))  # type: ignore[arg-type]
+        k = b.k0 + np.arange(1, len(b.t) + 1)
+        keep = (k % stride) == 0
+        if truth is not None and b.att is not None:
+            truth.append(t=b.t[keep], att=b.att[keep], v_n=b.v_n[keep], pos=b.pos[keep],
+                         segment=b.segment[keep])
+        if imu is not None:
+            ends = np.flatnonzero(keep)
+            if stride == 1:
+                rows = {"dtheta": b.dtheta, "dv": b.dv}
+            else:  # sums over each output interval, the remainder carried to the next block
+                rows = {}
+                for name, inc in (("dtheta", b.dtheta), ("dv", b.dv)):
+                    P = np.cumsum(inc, axis=0)
+                    if len(ends):
+                        rows[name] = P[ends] - np.vstack([-carry[name][None], P[ends[:-1]]])
+                        carry[name] = P[-1] - P[ends[-1]]
+                    else:
+                        rows[name] = np.empty((0, 3))
+                        carry[name] = carry[name] + P[-1]
+            extra = {} if b.q_bs is None else {"q_bs": b.q_bs[keep]}
+            imu.append(t=b.t[keep], **rows, **extra)
+        last = b
+    summary = {
+        "scenario": sc.name,
+        "seed": stream.seed,
+        "earth": stream.earth.name,
+        "samples": stream.samples,
+        "rate_hz": 1.0 / ts,
+        "duration_s": float(stream.samples * ts),
+        "output_rate_hz": 1.0 / (stride * ts),
+        "mechanism": stream.has_mechanism,
+        "compute_s": time.perf_counter() - t_start,
         "initial_attitude_deg": None,
         "final_attitude_deg": None,
         "final_velocity_mps": None,
         "distance_m": None,
+        "height_range_m": None,
+        "final_displacement_m": None,
     }
-    if data.truth is not None:
-        tr = data.truth
-        step = np.linalg.norm(np.diff(tr.t)[:, None] * 0.5 * (tr.v_n[1:] + tr.v_n[:-1]), axis=1)
-        s.update(
-            initial_attitude_deg=np.degrees(tr.att[0]).tolist(),
-            final_attitude_deg=np.degrees(tr.att[-1]).tolist(),
-            final_velocity_mps=tr.v_n[-1].tolist(),
-            distance_m=float(step.sum()),
+    if tr0 is not None and last is not None and last.att is not None:
+        from gcalign.app.navigate.run import position_error_enu
+
+        d = position_error_enu(last.pos[-1:], pos0[None], stream.earth)[0]  # type: ignore
+        summary.update(
+            initial_attitude_deg=np.degrees(tr0.att[0]).tolist(),
+            final_attitude_deg=np.degrees(last.att[-1]).tolist(),
+            final_velocity_mps=last.v_n[-1].tolist(),
+            distance_m=distance,
+            height_range_m=[h_min, h_max],
+            final_displacement_m=d.tolist(),
         )
-    return s
-
-
-def execute(sc, seed: int | None = None, cache_key: str | None = None) -> Outcome:
-    """Simulate (or read) the data and summarise; the registry's entry point."""
-    from gcalign.io.results import write_imu
-
-    t0 = time.perf_counter()
-    data = scenario_data(sc, seed, cache_key)
-    summary = simulation_summary(data, sc.name, time.perf_counter() - t0)
-    return Outcome(summary, lambda f: write_imu(f, data.imu), data.truth, data.seed)
+    return Outcome(summary, lambda f: None, None, stream.seed)
