@@ -39,18 +39,26 @@ class RunData:
 
 
 @dataclass(frozen=True)
+class BlockTruth:
+    """The truth at the end times of a block's increments: att, v_n, pos (n, 3) and the
+    motion segment of each increment (n,)."""
+
+    att: np.ndarray
+    v_n: np.ndarray
+    pos: np.ndarray
+    segment: np.ndarray
+
+
+@dataclass(frozen=True)
 class DataBlock:
-    """Measured increments k0 .. k0+n-1 (sensor frame) and, if known, the truth at their end
-    times t: att, v_n, pos (n, 3), segment (n,); q_bs (n, 4) mechanism angles or None."""
+    """Measured increments k0 .. k0+n-1 (sensor frame) at end times t (n,), the truth there
+    if known, and the mechanism angles q_bs (n, 4) if the IMU turns."""
 
     k0: int
     t: np.ndarray
     dtheta: np.ndarray
     dv: np.ndarray
-    att: np.ndarray | None = None
-    v_n: np.ndarray | None = None
-    pos: np.ndarray | None = None
-    segment: np.ndarray | None = None
+    truth: BlockTruth | None = None
     q_bs: np.ndarray | None = None
 
 
@@ -145,11 +153,13 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
         def recorded_blocks() -> Iterator[DataBlock]:
             for k0 in range(0, len(imu), size):
                 sl = slice(k0, k0 + size)
-                tr = {} if truth is None else {
-                    "att": truth.att[1:][sl], "v_n": truth.v_n[1:][sl], "pos": truth.pos[1:][sl],
-                    "segment": None if truth.segment is None else truth.segment[1:][sl]}
-                yield DataBlock(k0, imu.t[sl], imu.dtheta[sl], imu.dv[sl],
-                                q_bs=None if imu.q_bs is None else imu.q_bs[sl], **tr)
+                tr = None
+                if truth is not None:
+                    seg = (np.zeros(len(imu.t[sl]), np.int64) if truth.segment is None
+                           else truth.segment[1:][sl])
+                    tr = BlockTruth(truth.att[1:][sl], truth.v_n[1:][sl], truth.pos[1:][sl], seg)
+                yield DataBlock(k0, imu.t[sl], imu.dtheta[sl], imu.dv[sl], tr,
+                                None if imu.q_bs is None else imu.q_bs[sl])
 
         t0 = None if truth is None else Truth(truth.t[:1], truth.att[:1], truth.v_n[:1],
                                               truth.pos[:1], None if truth.segment is None
@@ -178,7 +188,8 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
         stream = ErrorStream(errors, ts, np.random.default_rng(seed), n)
         for b in ideal_blocks(motion, site, ts, earth, mech, block=block or BLOCK):
             dtheta, dv = stream.apply(b.dtheta, b.dv)
-            yield DataBlock(b.k0, b.t, dtheta, dv, b.att, b.v_n, b.pos, b.segment, b.q_bs)
+            yield DataBlock(b.k0, b.t, dtheta, dv, BlockTruth(b.att, b.v_n, b.pos, b.segment),
+                            b.q_bs)
 
     def simulated_at(k: int):
         """Truth at sample k from the motion itself (truth at any time)."""
@@ -214,10 +225,10 @@ def gather(stream: Stream) -> RunData:
     for b in stream.blocks():
         sl = slice(b.k0, b.k0 + len(b.t))
         t[sl], dtheta[sl], dv[sl] = b.t, b.dtheta, b.dv
-        if with_truth and b.att is not None:
+        if b.truth is not None:
             s1 = slice(b.k0 + 1, b.k0 + 1 + len(b.t))
-            att[s1], v[s1], pos[s1] = b.att, b.v_n, b.pos  # type: ignore[index]
-            seg[s1] = 0 if b.segment is None else b.segment  # type: ignore[index]
+            att[s1], v[s1], pos[s1] = b.truth.att, b.truth.v_n, b.truth.pos  # type: ignore
+            seg[s1] = b.truth.segment  # type: ignore[index]
         if q_bs is not None and b.q_bs is not None:
             q_bs[sl] = b.q_bs
     truth = None

@@ -57,7 +57,7 @@ class Start:
     source: str  # "truth" | "header" | "alignment FILE"
 
 
-def alignment_start(path: Path, stream: Stream, truth_at) -> Start:
+def alignment_start(path: Path, stream: Stream) -> Start:
     """The attitude at T3 of an alignment results file, at T3's data time."""
     from gcalign.io import results
 
@@ -71,9 +71,10 @@ def alignment_start(path: Path, stream: Stream, truth_at) -> Start:
     t_data = float(summary.get("start_s", 0.0)) + float(summary["t3_s"])
     k = int(round(t_data / stream.ts))
     att = np.radians(summary["attitude_t3_deg"])
-    tr = truth_at(k)
-    v = np.zeros(3) if tr is None else tr[1]
-    pos = stream.site if tr is None else tr[2]
+    tr = stream.truth_at(k)
+    known = tr is not None and tr[0] is not None
+    v = tr[1] if known else np.zeros(3)  # type: ignore[index]
+    pos = tr[2] if known else stream.site  # type: ignore[index]
     return Start(k, NavState.from_euler(att, v, pos), f"alignment {path} (T3 = {t_data:g} s)")
 
 
@@ -154,10 +155,11 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
             q_ns0 = state.q_nb if q_bs0 is None else _qmul(state.q_nb, q_bs0)
             nav = Navigator(NavState(q_ns0, state.v_n, state.pos), ts, earth, vertical)
         h_ref = None
-        if has_truth and b.pos is not None:  # the true height at the start of each step
-            prev = b.pos[lo - 1, 2] if lo > 0 else h_last
-            h_ref = np.concatenate([[prev], b.pos[lo:hi - 1, 2]])
-            h_last = b.pos[hi - 1, 2]
+        tr = b.truth
+        if tr is not None:  # the true height at the start of each step
+            prev = tr.pos[lo - 1, 2] if lo > 0 else h_last
+            h_ref = np.concatenate([[prev], tr.pos[lo:hi - 1, 2]])
+            h_last = tr.pos[hi - 1, 2]
         c0 = time.perf_counter()
         out = nav.run(b.dtheta[lo:hi], b.dv[lo:hi], h_ref)
         compute += time.perf_counter() - c0
@@ -166,9 +168,9 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         disp = position_error_enu(pos, np.broadcast_to(start.state.pos, pos.shape), earth)
         drift_max = max(drift_max, float(np.hypot(disp[:, 0], disp[:, 1]).max()))
         err = None
-        if has_truth and b.att is not None:
-            err = {"att": attitude_error(att, b.att[lo:hi]), "v_n": v - b.v_n[lo:hi],
-                   "pos": position_error_enu(pos, b.pos[lo:hi], earth)}
+        if tr is not None:
+            err = {"att": attitude_error(att, tr.att[lo:hi]), "v_n": v - tr.v_n[lo:hi],
+                   "pos": position_error_enu(pos, tr.pos[lo:hi], earth)}
             stats.add(err)
         if series is not None:
             if first:  # the start row
@@ -216,27 +218,23 @@ def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | Non
     vertical = vertical_of(cfg, sc, kind)
     stride = _stride(sc, stream)
 
-    def truth_at(k: int):
-        """(att, v_n, pos) at the end of increment k − 1 (k = 0: the start), or None."""
-        return stream.truth_at(k)
-
     if init is not None and init not in ("truth", "header"):
         if cfg.start_s:
             raise ScenarioError(f"navigation.start_s: {cfg.start_s:g} s cannot matter with "
                                 f"--init {init} (it starts at the alignment's T3); remove one")
-        start = alignment_start(Path(init), stream, truth_at)
+        start = alignment_start(Path(init), stream)
     else:
         k = int(round(cfg.start_s / stream.ts))
         if k >= stream.samples:
             raise ScenarioError(f"navigation.start_s: {cfg.start_s:g} s is past the end of the "
                                 f"data ({stream.samples * stream.ts:g} s)")
         source = init or ("truth" if stream.truth0 is not None else "header")
-        tr = truth_at(k) if source == "truth" else None
-        if source == "truth" and tr is None:
-            raise ScenarioError("--init: truth: recorded data have no truth; use 'header' or "
-                                "an alignment results file")
+        tr = stream.truth_at(k) if source == "truth" else None
         if source == "truth":
-            state = NavState.from_euler(*tr)
+            if tr is None or tr[0] is None:
+                raise ScenarioError("--init: truth: recorded data have no truth; use 'header' "
+                                    "or an alignment results file")
+            state = NavState.from_euler(tr[0], tr[1], tr[2])
         else:
             hd = stream.header
             if hd is None or hd.att0 is None:

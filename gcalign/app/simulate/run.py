@@ -46,30 +46,31 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
         spec = {"t": (None, "s", None), "dtheta": (3, "rad", frame), "dv": (3, "m/s", frame)}
         if stream.has_mechanism:
             spec["q_bs"] = (4, "", "mechanism angles: quaternion of C_s^b at t")
-        attrs = {"ts": ts * stride, "source": stream.source, "site": stream.site}
+        imu = Series(sink.create_group("imu"), spec, ts=ts * stride, source=stream.source,
+                     site=stream.site)
         if stride > 1:
-            attrs["summed_from_ts"] = ts
-        imu = Series(sink.create_group("imu"), spec, **attrs)
+            imu.group.attrs["summed_from_ts"] = ts
         if stream.has_mechanism:
             imu.group.attrs["q_bs0"] = stream.q_bs_at(0)
     distance = 0.0
-    v_prev = None if tr0 is None else tr0.v_n[0]
-    pos0 = None if tr0 is None else tr0.pos[0]
-    h_max = h_min = None if tr0 is None else float(tr0.pos[0, 2])
+    v_prev = np.zeros(3) if tr0 is None else tr0.v_n[0]
+    h0 = 0.0 if tr0 is None else float(tr0.pos[0, 2])
+    h_range = (h0, h0)
     last = None
     carry = {"dtheta": np.zeros(3), "dv": np.zeros(3)}
     for b in stream.blocks():
-        if b.v_n is not None and v_prev is not None:
-            v = np.vstack([v_prev[None], b.v_n])
+        tr = b.truth
+        if tr is not None:
+            v = np.vstack([v_prev[None], tr.v_n])
             distance += float(np.linalg.norm(0.5 * (v[1:] + v[:-1]), axis=1).sum() * ts)
-            v_prev = b.v_n[-1]
-            h_max = max(h_max, float(b.pos[:, 2].max()))  # type: ignore[arg-type]
-            h_min = min(h_min, float(b.pos[:, 2].min()))  # type: ignore[arg-type]
+            v_prev = tr.v_n[-1]
+            h_range = (min(h_range[0], float(tr.pos[:, 2].min())),
+                       max(h_range[1], float(tr.pos[:, 2].max())))
         k = b.k0 + np.arange(1, len(b.t) + 1)
         keep = (k % stride) == 0
-        if truth is not None and b.att is not None:
-            truth.append(t=b.t[keep], att=b.att[keep], v_n=b.v_n[keep], pos=b.pos[keep],
-                         segment=b.segment[keep])
+        if truth is not None and tr is not None:
+            truth.append(t=b.t[keep], att=tr.att[keep], v_n=tr.v_n[keep], pos=tr.pos[keep],
+                         segment=tr.segment[keep])
         if imu is not None:
             ends = np.flatnonzero(keep)
             if stride == 1:
@@ -87,7 +88,7 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             extra = {} if b.q_bs is None else {"q_bs": b.q_bs[keep]}
             imu.append(t=b.t[keep], **rows, **extra)
         last = b
-    summary = {
+    summary: dict = {
         "scenario": sc.name,
         "seed": stream.seed,
         "earth": stream.earth.name,
@@ -104,16 +105,17 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
         "height_range_m": None,
         "final_displacement_m": None,
     }
-    if tr0 is not None and last is not None and last.att is not None:
+    end = None if last is None else last.truth
+    if tr0 is not None and end is not None:
         from gcalign.app.navigate.run import position_error_enu
 
-        d = position_error_enu(last.pos[-1:], pos0[None], stream.earth)[0]  # type: ignore
+        d = position_error_enu(end.pos[-1:], tr0.pos[:1], stream.earth)[0]
         summary.update(
             initial_attitude_deg=np.degrees(tr0.att[0]).tolist(),
-            final_attitude_deg=np.degrees(last.att[-1]).tolist(),
-            final_velocity_mps=last.v_n[-1].tolist(),
+            final_attitude_deg=np.degrees(end.att[-1]).tolist(),
+            final_velocity_mps=end.v_n[-1].tolist(),
             distance_m=distance,
-            height_range_m=[h_min, h_max],
+            height_range_m=list(h_range),
             final_displacement_m=d.tolist(),
         )
     return Outcome(summary, lambda f: None, None, stream.seed)
