@@ -280,3 +280,73 @@ def attitude_block(q, dtheta, ts, w_in, subsamples, stride, out):
         if (k + 1) % stride == 0:
             out[row, 0], out[row, 1], out[row, 2], out[row, 3] = q[0], q[1], q[2], q[3]
             row += 1
+
+
+@njit(cache=True, inline="always")
+def euler_of(q0, q1, q2, q3):
+    """[pitch, roll, yaw] of q_nb (C_nb = Rz(yaw) Rx(pitch) Ry(roll)), as rotation.quat_to_euler."""
+    c21 = 2.0 * (q2 * q3 + q0 * q1)
+    c20 = 2.0 * (q1 * q3 - q0 * q2)
+    c22 = q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3
+    c01 = 2.0 * (q1 * q2 - q0 * q3)
+    c11 = q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3
+    return math.asin(min(max(c21, -1.0), 1.0)), math.atan2(-c20, c22), math.atan2(-c01, c11)
+
+
+@njit(cache=True)
+def error_block(states, q_bs, has_qbs, att_t, v_t, pos_t, has_truth, E, pos0, k_first,
+                stride, acc, out):
+    """Errors of a block of navigation states against the truth at every sample, folded
+    into `acc`, and every `stride`-th sample written as a row of `out`.
+
+    states (n, NAV_STATE) (q is q_ns when `has_qbs`: the body attitude is q_ns ⊗ q_bs*);
+    att_t, v_t, pos_t (n or 1, 3) truth; pos0 (3,) start position (for the drift);
+    k_first: samples from the start to the first state of the block minus one;
+    acc (7, 3): rows |att err| max, |v err| max, |pos err| max, [horizontal error max,
+    horizontal displacement max, 0], then the last sample's att, v and pos errors;
+    out (≥ rows, 18): att, v, pos, att err, v err, pos err.
+    Returns the number of rows written. Euler errors est − true, yaw wrapped to ±π.
+    """
+    n = states.shape[0]
+    nt = att_t.shape[0]
+    r_m0, r_n0, _, _, cl0 = earth_at(E, pos0[0], pos0[2])
+    rows = 0
+    e = np.zeros(9)
+    for i in range(n):
+        q0, q1, q2, q3 = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
+        if has_qbs:
+            q0, q1, q2, q3 = qmul(q0, q1, q2, q3, q_bs[i, 0], -q_bs[i, 1], -q_bs[i, 2],
+                                  -q_bs[i, 3])
+        p, r, y = euler_of(q0, q1, q2, q3)
+        lat, lon, h = states[i, 7], states[i, 8], states[i, 9]
+        de = (lon - pos0[1]) * (r_n0 + pos0[2]) * cl0
+        dn = (lat - pos0[0]) * (r_m0 + pos0[2])
+        acc[3, 1] = max(acc[3, 1], math.sqrt(de * de + dn * dn))
+        j = i if i < nt else nt - 1
+        if has_truth:
+            e[0] = p - att_t[j, 0]
+            e[1] = r - att_t[j, 1]
+            e[2] = (y - att_t[j, 2] + math.pi) % (2.0 * math.pi) - math.pi
+            for c in range(3):
+                e[3 + c] = states[i, 4 + c] - v_t[j, c]
+            r_m, r_n, _, _, cl = earth_at(E, pos_t[j, 0], pos_t[j, 2])
+            e[6] = (lon - pos_t[j, 1]) * (r_n + pos_t[j, 2]) * cl
+            e[7] = (lat - pos_t[j, 0]) * (r_m + pos_t[j, 2])
+            e[8] = h - pos_t[j, 2]
+            for c in range(9):
+                a = abs(e[c])
+                if a > acc[c // 3, c % 3]:
+                    acc[c // 3, c % 3] = a
+            acc[3, 0] = max(acc[3, 0], math.sqrt(e[6] * e[6] + e[7] * e[7]))
+            if i == n - 1:
+                for c in range(9):
+                    acc[4 + c // 3, c % 3] = e[c]
+        if (k_first + i + 1) % stride == 0:
+            out[rows, 0], out[rows, 1], out[rows, 2] = p, r, y
+            for c in range(3):
+                out[rows, 3 + c] = states[i, 4 + c]
+                out[rows, 6 + c] = states[i, 7 + c]
+            for c in range(9):
+                out[rows, 9 + c] = e[c]
+            rows += 1
+    return rows

@@ -63,15 +63,19 @@ class _Channel:
     def __init__(self, err: SensorErrors, ts: float, rng: np.random.Generator | None):
         self.err, self.ts, self.rng = err, ts, rng
         self.M = err.matrix().T
+        self.unit = bool(np.all(self.M == np.eye(3)))  # no scale factor or misalignment
+        self.bias_ts = np.asarray(err.bias, dtype=float) * ts
+        self.asym = np.asarray(err.asym, dtype=float) if np.any(np.asarray(err.asym) != 0) \
+            else None
         self.sigma = np.asarray(err.noise, dtype=float) * np.sqrt(ts)
         self.running = np.zeros(3)  # unquantised running sum
         self.total = np.zeros(3)  # quantised running sum already output
 
     def apply(self, ideal: np.ndarray) -> np.ndarray:
         err = self.err
-        out = ideal @ self.M + np.asarray(err.bias) * self.ts
-        if np.any(np.asarray(err.asym) != 0):
-            out = out + np.asarray(err.asym) * np.abs(ideal)
+        out = ideal + self.bias_ts if self.unit else ideal @ self.M + self.bias_ts
+        if self.asym is not None:
+            out = out + self.asym * np.abs(ideal)
         if self.rng is not None:
             out = out + self.rng.standard_normal(ideal.shape) * self.sigma
         if err.quantum > 0:

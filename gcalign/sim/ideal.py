@@ -21,9 +21,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from gcalign.nav.earth import WGS84, C_en, EarthModel
-from gcalign.nav.rotation import dcm_to_quat, quat_conj, quat_mult, quat_to_rotvec
+from gcalign.nav.rotation import (
+    dcm_to_quat,
+    euler_to_quat,
+    quat_conj,
+    quat_mult,
+    quat_to_euler,
+    quat_to_rotvec,
+)
 from gcalign.sim.mechanism import Mechanism
-from gcalign.sim.motions import MotionType, Moving, Static, Truth, sample_count
+from gcalign.sim.motions import MotionType, Moving, Static, Truth, Turntable, sample_count
+from gcalign.sim.schedule import AngleProfile, Schedule, Step
 
 BLOCK = 1 << 16  #: samples per block
 
@@ -75,6 +83,9 @@ def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
     weights[1:-1:2], weights[2:-1:2] = 4.0, 2.0
     weights *= h / 3.0
     site = np.asarray(site, dtype=float)
+    if isinstance(motion, Static | Turntable):
+        yield from _fixed_site_blocks(motion, site, ts, earth, mechanism, block, m, n_total)
+        return
     static = isinstance(motion, Static)
     for k0 in range(0, n_total, block):
         n = min(block, n_total - k0)
@@ -165,3 +176,34 @@ def _split_at_boundaries(dv, motion: Moving, mechanism, site, earth, k0, n, ts, 
             total += (w * (c - a) / (3.0 * m)) @ _specific_force_s(motion, mechanism, site,
                                                                     earth, tt, seg)
         dv[k - k0] = total
+
+
+_IDENTITY = Schedule((Step((0.0, 0.0, 1.0), AngleProfile.rest(1.0)),))
+
+
+def _fixed_site_blocks(motion: Static | Turntable, site, ts, earth, mechanism, block, m,
+                       n_total) -> Iterator[SimBlock]:
+    """The numba route for a base at a fixed site (:func:`fixed_site_block`)."""
+    from gcalign.sim._kernels import fixed_site_block
+
+    q_nb0 = euler_to_quat(np.asarray(motion.att0, float))
+    body = motion.schedule if isinstance(motion, Turntable) else None
+    # at rest: v_n = 0 and a_n = 0, so f_n is the normal gravity, up
+    f_n = np.array([0.0, 0.0, float(earth.gravity(site[0], site[2]))])
+    q_en = dcm_to_quat(C_en(site[0], site[1]))
+    body_tab = (body or _IDENTITY).kernel_tables()
+    mech_tab = (mechanism.schedule if mechanism is not None else _IDENTITY).kernel_tables()
+    mech_nav = mechanism is not None and mechanism.reference == "navigation"
+    for k0 in range(0, n_total, block):
+        n = min(block, n_total - k0)
+        dtheta, dv = np.empty((n, 3)), np.empty((n, 3))
+        q_nb, q_bs = np.empty((n, 4)), np.empty((n, 4))
+        fixed_site_block(k0, n, ts, m, earth.omega_ie, q_en, f_n, q_nb0, body_tab,
+                         body is not None, mech_tab, mechanism is not None, mech_nav,
+                         dtheta, dv, q_nb, q_bs)
+        t = (k0 + 1 + np.arange(n)) * ts
+        att = np.broadcast_to(np.asarray(motion.att0, float), (n, 3)) if body is None else \
+            quat_to_euler(q_nb)
+        yield SimBlock(k0=k0, t=t, dtheta=dtheta, dv=dv, att=np.array(att),
+                       v_n=np.zeros((n, 3)), pos=np.tile(site, (n, 1)),
+                       segment=np.zeros(n, np.int64), q_bs=q_bs if mechanism is not None else None)

@@ -285,6 +285,14 @@ class Schedule:
         )
         return self._tables
 
+    def kernel_tables(self) -> tuple:
+        """The tables as the tuple the numba kernels take (:mod:`gcalign.sim._kernels`)."""
+        tb = self.tables()
+        return (tb["t0"], tb["kind"], np.ascontiguousarray(tb["coef"]), tb["step"],
+                tb["theta0"], np.ascontiguousarray(tb["axis"]),
+                np.ascontiguousarray(tb["before"]), np.asarray(tb["cycle_rotvec"], float),
+                tb["q0"], float(tb["period"]), bool(tb["repeat"]))
+
     @property
     def cycle_rotation(self) -> np.ndarray:
         """Quaternion of the rotation over one pass through the steps (identity for a

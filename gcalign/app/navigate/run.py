@@ -28,7 +28,7 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.navigation import NavigationConfig
 from gcalign.nav import _kernels as K
 from gcalign.nav.earth import WGS84, EarthModel
-from gcalign.nav.rotation import attitude_error, quat_to_euler
+from gcalign.nav.rotation import quat_to_euler
 from gcalign.nav.strapdown import Navigator, NavState, Vertical
 from gcalign.sim.mechanism import body_attitude
 
@@ -89,36 +89,16 @@ def vertical_of(cfg: NavigationConfig, sc: Scenario, motion_kind: str | None = N
     return Vertical(mode, cfg.tau_s)
 
 
-@dataclass
-class _Stats:
-    """Final and largest errors over every sample."""
-
-    final: dict
-    peak: dict
-    horizontal_max: float = 0.0
-
-    @classmethod
-    def empty(cls) -> _Stats:
-        z = np.zeros(3)
-        return cls({k: z for k in ("att", "v_n", "pos")}, {k: z for k in ("att", "v_n", "pos")})
-
-    def add(self, err: dict) -> None:
-        """Fold in the errors of one block (dict of (n, 3) arrays)."""
-        for k, e in err.items():
-            self.final[k] = e[-1]
-            self.peak[k] = np.maximum(self.peak[k], np.abs(e).max(axis=0))
-        self.horizontal_max = max(self.horizontal_max,
-                                  float(np.hypot(err["pos"][:, 0], err["pos"][:, 1]).max()))
-
-
 def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
                     duration_s: float | None = None, sink=None) -> dict:
     """Navigate from `start` to the end of the data (or for `duration_s`), compare with the
-    truth at every sample, write every `stride`-th row to `sink` (an h5py group), and
-    return the plain-number pieces of the summary (SI, radians)."""
+    truth at every sample (:func:`gcalign.nav._kernels.error_block`), write every
+    `stride`-th row to `sink` (an h5py group), and return the plain-number pieces of the
+    summary (SI, radians)."""
     from gcalign.io.results import ATT_FRAME, Series
 
     ts, earth = stream.ts, stream.earth
+    E = earth.params()
     k_end = stream.samples if duration_s is None else min(
         stream.samples, start.k + int(round(duration_s / ts)))
     if k_end <= start.k:
@@ -135,69 +115,68 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
                      "error/pos": (3, "m", "ENU (east, north, up)")}
         series = Series(sink, spec, stride=stride, rate_hz=1.0 / (stride * ts),
                         vertical=vertical.mode)
+        row0 = {"t": [start.k * ts + stream.t0], "att": [start.state.att],
+                "v_n": [start.state.v_n], "pos": [start.state.pos]}
+        if has_truth:
+            row0 |= {f"error/{n}": np.zeros((1, 3)) for n in ("att", "v_n", "pos")}
+        series.append(**row0)
     state = start.state
-    h_last = float(state.pos[2])
-    drift_max = 0.0
-    nav = None
-    stats = _Stats.empty()
-    t0 = time.perf_counter()
+    pos0 = np.asarray(state.pos, dtype=float)
+    h_last = float(pos0[2])
+    q_bs0 = stream.q_bs_at(start.k)
+    q_ns0 = state.q_nb if q_bs0 is None else _qmul(state.q_nb, q_bs0)
+    nav = Navigator(NavState(q_ns0, state.v_n, pos0), ts, earth, vertical)
+    acc = np.zeros((7, 3))
+    none = np.zeros((1, 3))
+    last = None
     compute = 0.0
-    first = True
+    t0 = time.perf_counter()
     for b in stream.blocks():
         lo, hi = max(start.k - b.k0, 0), min(k_end - b.k0, len(b.t))
         if hi <= lo:
             if b.k0 >= k_end:
                 break
             continue
-        q_bs = None if b.q_bs is None else b.q_bs[lo:hi]
-        if nav is None:
-            q_bs0 = stream.q_bs_at(start.k)
-            q_ns0 = state.q_nb if q_bs0 is None else _qmul(state.q_nb, q_bs0)
-            nav = Navigator(NavState(q_ns0, state.v_n, state.pos), ts, earth, vertical)
-        h_ref = None
         tr = b.truth
+        h_ref = None
         if tr is not None:  # the true height at the start of each step
             prev = tr.pos[lo - 1, 2] if lo > 0 else h_last
             h_ref = np.concatenate([[prev], tr.pos[lo:hi - 1, 2]])
             h_last = tr.pos[hi - 1, 2]
         c0 = time.perf_counter()
-        out = nav.run(b.dtheta[lo:hi], b.dv[lo:hi], h_ref)
+        states = nav.run(b.dtheta[lo:hi], b.dv[lo:hi], h_ref)
         compute += time.perf_counter() - c0
-        q = out[:, K.Q] if q_bs is None else body_attitude(out[:, K.Q], q_bs)
-        att, v, pos = quat_to_euler(q), out[:, K.V], out[:, K.P]
-        disp = position_error_enu(pos, np.broadcast_to(start.state.pos, pos.shape), earth)
-        drift_max = max(drift_max, float(np.hypot(disp[:, 0], disp[:, 1]).max()))
-        err = None
-        if tr is not None:
-            err = {"att": attitude_error(att, tr.att[lo:hi]), "v_n": v - tr.v_n[lo:hi],
-                   "pos": position_error_enu(pos, tr.pos[lo:hi], earth)}
-            stats.add(err)
-        if series is not None:
-            if first:  # the start row
-                row0 = {"t": [start.k * ts + stream.t0], "att": [start.state.att],
-                        "v_n": [start.state.v_n], "pos": [start.state.pos]}
-                if err is not None:
-                    row0 |= {"error/att": np.zeros((1, 3)), "error/v_n": np.zeros((1, 3)),
-                             "error/pos": np.zeros((1, 3))}
-                series.append(**row0)
-            # rows whose sample count from the start is a multiple of the stride
-            k = b.k0 + np.arange(lo, hi) + 1 - start.k
-            keep = (k % stride) == 0
-            rows = {"t": b.t[lo:hi][keep], "att": att[keep], "v_n": v[keep], "pos": pos[keep]}
-            if err is not None:
-                rows |= {f"error/{n}": e[keep] for n, e in err.items()}
-            series.append(**rows)
-        first = False
-        final_att, final_v, final_pos = att[-1], v[-1], pos[-1]
-    assert nav is not None
+        q_bs = np.zeros((1, 4)) if b.q_bs is None else np.ascontiguousarray(b.q_bs[lo:hi])
+        out = np.empty((len(states) // stride + 1, 18))
+        rows = K.error_block(states, q_bs, b.q_bs is not None,
+                             none if tr is None else np.ascontiguousarray(tr.att[lo:hi]),
+                             none if tr is None else np.ascontiguousarray(tr.v_n[lo:hi]),
+                             none if tr is None else np.ascontiguousarray(tr.pos[lo:hi]),
+                             tr is not None, E, pos0, b.k0 + lo - start.k, stride, acc, out)
+        if series is not None and rows:
+            keep = np.flatnonzero((b.k0 + np.arange(lo, hi) + 1 - start.k) % stride == 0)
+            r = out[:rows]
+            data = {"t": b.t[lo:hi][keep], "att": r[:, 0:3], "v_n": r[:, 3:6],
+                    "pos": r[:, 6:9]}
+            if has_truth:
+                data |= {"error/att": r[:, 9:12], "error/v_n": r[:, 12:15],
+                         "error/pos": r[:, 15:18]}
+            series.append(**data)
+        last = (states[-1], None if b.q_bs is None else b.q_bs[hi - 1])
+    assert last is not None
+    s_end, qbs_end = last
+    q_end = s_end[K.Q] if qbs_end is None else body_attitude(s_end[K.Q][None], qbs_end[None])[0]
+    pos_end = s_end[K.P]
     return {
         "samples": k_end - start.k,
         "duration_s": (k_end - start.k) * ts,
         "start_s": start.k * ts,
-        "final_state": (final_att, final_v, final_pos),
-        "displacement": disp[-1],
-        "max_horizontal_displacement": drift_max,
-        "stats": stats if has_truth else None,
+        "final_state": (quat_to_euler(q_end), s_end[K.V].copy(), pos_end.copy()),
+        "displacement": position_error_enu(pos_end[None], pos0[None], earth)[0],
+        "max_horizontal_displacement": float(acc[3, 1]),
+        "peak": acc[0:3] if has_truth else None,
+        "final_error": acc[4:7] if has_truth else None,
+        "max_horizontal_error": float(acc[3, 0]) if has_truth else None,
         "compute_s": compute,
         "wall_s": time.perf_counter() - t0,
     }
@@ -285,13 +264,12 @@ def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, str
         "max_error": None,
         "max_horizontal_error_m": None,
     }
-    st = part["stats"]
-    if st is not None:
-        deg = {"att": math.degrees(1.0), "v_n": 1.0, "pos": 1.0}
-        names = {"att": "attitude_deg", "v_n": "velocity_mps", "pos": "position_m"}
-        out["final_error"] = {names[k]: (st.final[k] * deg[k]).tolist() for k in names}
-        out["max_error"] = {names[k]: (st.peak[k] * deg[k]).tolist() for k in names}
-        out["max_horizontal_error_m"] = st.horizontal_max
+    if part["peak"] is not None:
+        scale = np.array([[math.degrees(1.0)], [1.0], [1.0]])
+        names = ("attitude_deg", "velocity_mps", "position_m")
+        out["final_error"] = dict(zip(names, (part["final_error"] * scale).tolist(), strict=True))
+        out["max_error"] = dict(zip(names, (part["peak"] * scale).tolist(), strict=True))
+        out["max_horizontal_error_m"] = part["max_horizontal_error"]
     return out
 
 

@@ -1,0 +1,121 @@
+"""Numba kernels of the simulation: rotation schedules and the ideal increments of a base at a
+fixed site (static or on a turntable), with or without a mechanism turning the IMU.
+
+The vectorised NumPy route (:func:`gcalign.sim.ideal.ideal_blocks`) serves every motion; this
+one serves the long runs (72 h on a mechanism, 5 kHz turntables) where a NumPy temporary per
+operation costs more than the arithmetic. ``tests/test_ideal.py`` holds the two equal.
+
+A schedule enters as the tuple :meth:`gcalign.sim.schedule.Schedule.kernel_tables`:
+``(t0, kind, coef, step, theta0, axis, before, cycle_rotvec, q0, period, repeat)``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from gcalign.nav._kernels import qmul, qrot, rv2q
+
+
+@njit(cache=True, inline="always")
+def schedule_quat(tab, t):
+    """Quaternion of the schedule's rotation at time t (see :class:`Schedule`)."""
+    t0, kind, coef, step, theta0, axis, before, cyc, q0, period, repeat = tab
+    if repeat:
+        k = math.floor(t / period)
+        tau = t - k * period
+    else:
+        k = 0.0
+        tau = min(max(t, 0.0), period)
+    lo, hi = 0, t0.shape[0] - 1
+    while lo < hi:  # last piece with t0 <= tau
+        mid = (lo + hi + 1) // 2
+        if t0[mid] <= tau:
+            lo = mid
+        else:
+            hi = mid - 1
+    j = lo
+    x = tau - t0[j]
+    c0, c1, c2 = coef[j, 0], coef[j, 1], coef[j, 2]
+    if kind[j] == 1:
+        th = theta0[j] + c0 * (math.sin(c1 * x + c2) - math.sin(c2))
+    else:
+        th = theta0[j] + c0 * x + 0.5 * c1 * x * x + c2 * x * x * x / 6.0
+    s = step[j]
+    aw, ax, ay, az = rv2q(axis[s, 0] * th, axis[s, 1] * th, axis[s, 2] * th)
+    bw, bx, by, bz = qmul(before[s, 0], before[s, 1], before[s, 2], before[s, 3],
+                          aw, ax, ay, az)
+    if repeat and k != 0.0:
+        cw, cx, cy, cz = rv2q(k * cyc[0], k * cyc[1], k * cyc[2])
+        bw, bx, by, bz = qmul(cw, cx, cy, cz, bw, bx, by, bz)
+    return qmul(q0[0], q0[1], q0[2], q0[3], bw, bx, by, bz)
+
+
+@njit(cache=True, inline="always")
+def _sensor(q_nb0, body, has_body, mech, has_mech, mech_nav, t):
+    """q_nb and q_ns at time t."""
+    bw, bx, by, bz = q_nb0[0], q_nb0[1], q_nb0[2], q_nb0[3]
+    if has_body:
+        sw, sx, sy, sz = schedule_quat(body, t)
+        bw, bx, by, bz = qmul(bw, bx, by, bz, sw, sx, sy, sz)
+    if not has_mech:
+        return bw, bx, by, bz, bw, bx, by, bz
+    mw, mx, my, mz = schedule_quat(mech, t)
+    if mech_nav:
+        return bw, bx, by, bz, mw, mx, my, mz
+    nw, nx, ny, nz = qmul(bw, bx, by, bz, mw, mx, my, mz)
+    return bw, bx, by, bz, nw, nx, ny, nz
+
+
+@njit(cache=True)
+def fixed_site_block(k0, n, ts, m, omega_ie, q_en, f_n, q_nb0, body, has_body, mech, has_mech,
+                     mech_nav, dtheta, dv, q_nb_out, q_bs_out):
+    """Ideal increments k0 .. k0+n-1 of a base at a fixed site whose body attitude is q_nb0
+    (times the schedule `body` if `has_body`), the IMU turned by `mech` (body- or, with
+    `mech_nav`, navigation-referenced) if `has_mech`.
+
+    Gyro: rotvec(q_is(k-1)* q_is(k)), q_is = q_ie(t - t_block) ⊗ q_en ⊗ q_ns.
+    Accelerometer: Simpson over `m` (even) sub-intervals of f_s = C_sn f_n (f_n constant).
+    Writes dtheta, dv (n, 3), and at each end time q_nb (n, 4) and q_bs = q_nb* ⊗ q_ns.
+    """
+    h = ts / m
+    t_ref = k0 * ts
+    pw = px = py = pz = 0.0  # q_is at the start of the sample
+    gx = gy = gz = 0.0  # f_s at the start of the sample
+    for i in range(n):
+        k = k0 + i
+        j0 = 0 if i == 0 else 1  # a sample starts where the previous one ended
+        ax, ay, az = gx, gy, gz
+        for j in range(j0, m + 1):
+            t = (k * m + j) * h
+            bw, bx, by, bz, sw, sx, sy, sz = _sensor(q_nb0, body, has_body, mech, has_mech,
+                                                     mech_nav, t)
+            fx, fy, fz = qrot(sw, -sx, -sy, -sz, f_n[0], f_n[1], f_n[2])
+            wgt = 1.0 if (j == 0 or j == m) else (4.0 if j % 2 == 1 else 2.0)
+            ax += wgt * fx
+            ay += wgt * fy
+            az += wgt * fz
+            if j == 0 or j == m:
+                half = 0.5 * omega_ie * (t - t_ref)
+                ew, ez = math.cos(half), math.sin(half)
+                # q_is = q_ie ⊗ q_en ⊗ q_ns (q_ie about z)
+                uw, ux, uy, uz = qmul(ew, 0.0, 0.0, ez, q_en[0], q_en[1], q_en[2], q_en[3])
+                cw, cx, cy, cz = qmul(uw, ux, uy, uz, sw, sx, sy, sz)
+                if j == m:
+                    # Δθ = rotvec(conj(q_is(start)) ⊗ q_is(end))
+                    dw, dx, dy, dz = qmul(pw, -px, -py, -pz, cw, cx, cy, cz)
+                    if dw < 0.0:
+                        dw, dx, dy, dz = -dw, -dx, -dy, -dz
+                    nrm = math.sqrt(dx * dx + dy * dy + dz * dz)
+                    r = 2.0 * math.atan2(nrm, dw) / nrm if nrm > 1e-12 else 2.0 / dw
+                    dtheta[i, 0], dtheta[i, 1], dtheta[i, 2] = dx * r, dy * r, dz * r
+                    q_nb_out[i, 0], q_nb_out[i, 1] = bw, bx
+                    q_nb_out[i, 2], q_nb_out[i, 3] = by, bz
+                    qw, qx, qy, qz = qmul(bw, -bx, -by, -bz, sw, sx, sy, sz)
+                    q_bs_out[i, 0], q_bs_out[i, 1] = qw, qx
+                    q_bs_out[i, 2], q_bs_out[i, 3] = qy, qz
+                    gx, gy, gz = fx, fy, fz
+                pw, px, py, pz = cw, cx, cy, cz
+        c = h / 3.0
+        dv[i, 0], dv[i, 1], dv[i, 2] = ax * c, ay * c, az * c
