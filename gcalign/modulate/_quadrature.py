@@ -61,9 +61,10 @@ class CycleGrid:
         return np.einsum("mn,mn...->m...", self.w, v)
 
 
-def split_count(span: float, duration: float, max_len: float | None) -> int:
+def split_count(span: float, duration: float, max_len: float | None,
+                max_span: float = MAX_SPAN) -> int:
     """Sub-intervals for a piece turning through `span` rad in `duration` s."""
-    k = max(1, math.ceil(span / MAX_SPAN - 1e-12))
+    k = max(1, math.ceil(span / max_span - 1e-12))
     if max_len is not None:
         k = max(k, math.ceil(duration / max_len - 1e-12))
     return k
@@ -77,10 +78,10 @@ def gauss_legendre(a: np.ndarray, b: np.ndarray, n: int = N_NODES):
 
 
 def cycle_grid(schedule: Schedule, n: int = N_NODES, max_len: float | None = 60.0,
-               split_constant: bool = False) -> CycleGrid:
-    """The quadrature grid of one cycle. Turning pieces are split by angle and `max_len`
-    (s); resting pieces are one sub-interval unless `split_constant` (for integrands that
-    vary in time on them, such as e^{-iωt})."""
+               split_constant: bool = False, max_span: float = MAX_SPAN) -> CycleGrid:
+    """The quadrature grid of one cycle. Turning pieces are split by angle (`max_span`,
+    rad) and `max_len` (s); resting pieces are one sub-interval unless `split_constant`
+    (for integrands that vary in time on them, such as e^{-iωt})."""
     p = pieces(schedule)
     a, b, idx, const = [], [], [], []
     for j in range(len(p.t0)):
@@ -89,7 +90,7 @@ def cycle_grid(schedule: Schedule, n: int = N_NODES, max_len: float | None = 60.
         if p.constant[j] and not split_constant:
             k = 1
         else:
-            k = split_count(float(p.span[j]), float(p.duration[j]), max_len)
+            k = split_count(float(p.span[j]), float(p.duration[j]), max_len, max_span)
         e = p.t0[j] + p.duration[j] * np.arange(k + 1) / k
         a.append(e[:-1])
         b.append(e[1:])

@@ -16,6 +16,13 @@ enters the reference frame as follows (open loop: no earth rate, no navigation l
   the net over the seed's 12 steps is ``Σ ±π δk_u C_before u = 0`` (its ccw and cw halves
   cancel), and within the cycle it reaches 2π·δk on each axis.
 
+A term that returns to zero every cycle still has a cycle mean (``*_offset``): the
+computed attitude is off by −m(t), on average by −m̄, a standing tilt and heading error
+that the navigation loops see as if it were an initial attitude error (it starts the
+Schuler and earth-rate oscillations). For the seed's scheme m̄ = π δk (−1, 1, 1)
+(6.5″ per 10 ppm); a scheme whose second half repeats the first with every turn reversed
+(``single-4``, ``four-position-24``) has m̄ = 0.
+
 The literal seed-12 scheme (spec §2): over any symmetric turn profile ``∫cos θ dt = 0`` and
 the sine terms cancel in pairs, so ``∫_cycle C dt = 4(Ts + Tz)·diag(−1, 1, 1)`` exactly,
 ``C̄ = diag(−1, 1, 1)/3`` — at each of the three equally weighted positions every sensor
@@ -29,8 +36,9 @@ only by ``ω_s² / |ω_m² − ω_s²|``. We warn when a harmonic k of C(t) with
 itself; dual-16 with the seed's timing: 83.2 min against 84.46 min).
 
 Integrals are Gauss–Legendre on the schedule's pieces (:mod:`._quadrature`), exact to
-round-off for these profiles; peaks are taken at every piece end and every 45° of turn
-(exact for turns about sensor axes, where each term is monotonic within a step).
+round-off for these profiles; peaks are taken at every piece end and every 5.6° of turn
+(exact for turns about sensor axes, where each term is monotonic or, for ∫C dt, linear in
+the turning column; within a few 1e-5 otherwise).
 
 >>> from gcalign.modulate.schemes import builtin_scheme
 >>> r = invariant_report(builtin_scheme("seed-12"))
@@ -53,6 +61,7 @@ from gcalign.sim.schedule import Schedule
 
 SCHULER_BAND = 0.2  # warn when a harmonic's period is within ±20 % of Schuler's
 HARMONIC_FLOOR = 0.01  # ... and its amplitude per unit bias exceeds 1 %
+PEAK_SPAN = math.pi / 32  # rad of turn between the samples where peaks are taken
 
 
 @dataclass(frozen=True)
@@ -80,9 +89,11 @@ class InvariantReport:
     errors : the :class:`ErrorTerms` the vectors below are for.
     residual_gyro_bias : (3,) rad/s, C̄ ε.  residual_accel_bias : (3,) m/s², C̄ ∇.
     gyro_bias_excursion : (3,) rad, per axis max |∫_0^t (C − C̄) ε dt| over the cycle.
-    scale_factor_net, scale_factor_peak : (3,) rad, the scale-factor term m(T) and per axis
-        max |m(t)| over the cycle.
-    misalignment_net, misalignment_peak : (3,) rad, the same for the misalignment term.
+    gyro_bias_offset : (3,) rad, the cycle mean of ∫_0^t (C − C̄) ε dt.
+    scale_factor_net, scale_factor_peak, scale_factor_offset : (3,) rad, the scale-factor
+        term m(T), per axis max |m(t)|, and the cycle mean of m(t).
+    misalignment_net, misalignment_peak, misalignment_offset : (3,) rad, the same for the
+        misalignment term.
     schuler_period : s, 2π/ω_s at the site.
     harmonics : the harmonics of C(t) within ±20 % of the Schuler period (any amplitude).
     warnings : human-readable warnings (Schuler resonance).
@@ -101,10 +112,13 @@ class InvariantReport:
     residual_gyro_bias: np.ndarray
     residual_accel_bias: np.ndarray
     gyro_bias_excursion: np.ndarray
+    gyro_bias_offset: np.ndarray
     scale_factor_net: np.ndarray
     scale_factor_peak: np.ndarray
+    scale_factor_offset: np.ndarray
     misalignment_net: np.ndarray
     misalignment_peak: np.ndarray
+    misalignment_offset: np.ndarray
     schuler_period: float
     harmonics: tuple[Harmonic, ...]
     warnings: tuple[str, ...]
@@ -123,18 +137,37 @@ class InvariantReport:
         return np.einsum("aii->ai", self.rate_tensor)
 
 
-def running_integrals(schedule: Schedule, grid: CycleGrid | None = None):
-    """Running ∫_0^t C dt (K, 3, 3) and W(t) (K, 3, 3, 3) at the grid's sub-interval ends,
-    with the times (K,) (t = 0 first)."""
-    g = grid if grid is not None else cycle_grid(schedule)
+@dataclass(frozen=True)
+class Running:
+    """Running integrals over one cycle at the quadrature grid's sub-interval ends.
+
+    t : (K,) s (0 first, T last). C : (K, 3, 3) s, ∫_0^t C ds. W : (K, 3, 3, 3) rad, the
+    rate tensor W(t). mean_C : (3, 3) s and mean_W : (3, 3, 3) rad, their cycle means
+    (1/T)∫_0^T (·)(t) dt = (1/T)∫_0^T (T − s) (integrand)(s) ds (by parts, exact).
+    """
+
+    t: np.ndarray
+    C: np.ndarray
+    W: np.ndarray
+    mean_C: np.ndarray
+    mean_W: np.ndarray
+
+
+def running_integrals(schedule: Schedule, grid: CycleGrid | None = None) -> Running:
+    """:class:`Running` of `schedule` (Gauss–Legendre on `grid`; by default the cycle grid
+    with sub-intervals of ≤ 360°/64 of turn, where the peaks are sampled)."""
+    g = grid if grid is not None else cycle_grid(schedule, max_span=PEAK_SPAN)
     tt = g.t.ravel()
+    T = schedule.period
     C = schedule.dcm(tt)
-    w = schedule.rate(tt)
-    dC = g.integrals(C)
-    dW = g.integrals(np.einsum("nai,nj->naij", C, w))
+    CW = np.einsum("nai,nj->naij", C, schedule.rate(tt))
+    dC, dW = g.integrals(C), g.integrals(CW)
+    lever = (T - tt) / T
     zero = np.zeros((1,) + dC.shape[1:]), np.zeros((1,) + dW.shape[1:])
-    return (np.append(0.0, g.b), np.concatenate([zero[0], np.cumsum(dC, 0)]),
-            np.concatenate([zero[1], np.cumsum(dW, 0)]))
+    return Running(np.append(0.0, g.b), np.concatenate([zero[0], np.cumsum(dC, 0)]),
+                   np.concatenate([zero[1], np.cumsum(dW, 0)]),
+                   g.integrals(C * lever[:, None, None]).sum(0),
+                   g.integrals(CW * lever[:, None, None, None]).sum(0))
 
 
 def modulation_harmonic(schedule: Schedule, k: int) -> np.ndarray:
@@ -156,7 +189,8 @@ def schuler_harmonics(schedule: Schedule, omega_s: float) -> tuple[Harmonic, ...
         c = modulation_harmonic(schedule, k)
         amp = 2.0 * float(np.linalg.norm(c, axis=0).max())
         w = 2.0 * math.pi * k / T
-        out.append(Harmonic(k, T / k, amp, omega_s**2 / abs(w * w - omega_s**2)))
+        gap = abs(w * w - omega_s**2)
+        out.append(Harmonic(k, T / k, amp, omega_s**2 / gap if gap > 0 else math.inf))
     return tuple(out)
 
 
@@ -173,7 +207,8 @@ def invariant_report(scheme: Scheme | Schedule, errors: ErrorTerms | None = None
     if errors is None:
         errors = ErrorTerms.seed004(gyro_scale=np.full(3, 10e-6))
     T = schedule.period
-    t, run_C, run_W = running_integrals(schedule)
+    run = running_integrals(schedule)
+    t, run_C, run_W = run.t, run.C, run.W
     integral_C, W = run_C[-1], run_W[-1]
     mean_C = integral_C / T
     eps = errors.gyro_bias
@@ -182,6 +217,8 @@ def invariant_report(scheme: Scheme | Schedule, errors: ErrorTerms | None = None
     M = errors.gyro_misalignment
     m_sf = np.einsum("kaij,ij->ka", run_W, K)
     m_mis = np.einsum("kaij,ij->ka", run_W, M)
+    # cycle mean of ∫_0^t (C − C̄) ε ds: (1/T)∫(T − s) C ds ε − (T/2) C̄ ε
+    offset = run.mean_C @ eps - 0.5 * T * (mean_C @ eps)
     omega_s = earth.schuler_rate(lat)
     harmonics = schuler_harmonics(schedule, omega_s)
     warnings = tuple(
@@ -193,7 +230,10 @@ def invariant_report(scheme: Scheme | Schedule, errors: ErrorTerms | None = None
         scheme=name, reference=reference, period=T, integral_C=integral_C, mean_C=mean_C,
         rate_tensor=W, peak_integral_C=np.linalg.norm(run_C, axis=1).max(0), errors=errors,
         residual_gyro_bias=mean_C @ eps, residual_accel_bias=mean_C @ errors.accel_bias,
-        gyro_bias_excursion=excursion, scale_factor_net=m_sf[-1],
-        scale_factor_peak=np.abs(m_sf).max(0), misalignment_net=m_mis[-1],
-        misalignment_peak=np.abs(m_mis).max(0), schuler_period=2 * math.pi / omega_s,
+        gyro_bias_excursion=excursion, gyro_bias_offset=offset, scale_factor_net=m_sf[-1],
+        scale_factor_peak=np.abs(m_sf).max(0),
+        scale_factor_offset=np.einsum("aij,ij->a", run.mean_W, K), misalignment_net=m_mis[-1],
+        misalignment_peak=np.abs(m_mis).max(0),
+        misalignment_offset=np.einsum("aij,ij->a", run.mean_W, M),
+        schuler_period=2 * math.pi / omega_s,
         harmonics=harmonics, warnings=warnings, t=t, running_C=run_C, running_rate=run_W)

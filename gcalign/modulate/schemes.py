@@ -32,6 +32,10 @@ dwell Ts = 300 s):
     our 12-step scheme over four positions A, B, C, D = Rx(π), all turns +180° (spec 004
     §2 [P]): A→B (z), B→C (x), C→A (y), A→D (x), D→B (y), B→A (z), A→C (y), C→B (x),
     B→D (y), D→C (z), C→D (z), D→A (x). Mean C = 0 and net scale-factor term 0.
+``four-position-24``
+    ``four-position-12``, then the same twelve turns with the signs reversed (spec 004 §2:
+    the forward/reverse version, 124.8 min, that avoids cable wind-up). The scale-factor
+    term then also has a zero cycle mean (see :mod:`.invariants`).
 ``continuous``
     constant rate about one axis (z, 6 °/s by default), one turn per cycle.
 
@@ -304,6 +308,7 @@ DUAL_16 = _DUAL_8 + [(a, -ang) for a, ang in _DUAL_8]
 DUAL_16_IMPROVED = DUAL_16[:8] + [DUAL_16[k - 1] for k in (10, 9, 12, 11, 14, 13, 16, 15)]
 SEED_12 = [(a, 180.0) for a in "zxyyxz"] + [(a, -180.0) for a in "zxyyxz"]
 FOUR_POSITION_12 = [(a, 180.0) for a in "zxyxyzyxyzzx"]
+FOUR_POSITION_24 = FOUR_POSITION_12 + [(a, -ang) for a, ang in FOUR_POSITION_12]
 
 _DESCRIPTIONS = {
     "fixed": "no rotation",
@@ -312,6 +317,7 @@ _DESCRIPTIONS = {
     "dual-16-improved": "dual axis improved 16-step (rows 9-16 swapped in pairs)",
     "seed-12": "seed 004 literal three-position 12-step (leaves diag(-1,1,1)/3 of each bias)",
     "four-position-12": "four positions A,B,C,D=Rx(pi), 12 turns of +180 deg (cancels)",
+    "four-position-24": "four-position-12, then the same 12 turns reversed (no wind-up)",
     "continuous": "constant rate about one axis",
 }
 BUILTIN_NAMES = tuple(_DESCRIPTIONS)
@@ -338,7 +344,8 @@ def builtin_rows(name: str, *, dwell: float | None = None, turn: Turn = SEED_TUR
             raise ScenarioError(f"scheme rate_dps: must be > 0, got {rate / DEG!r}")
         return (Row(AXES[axis], 2.0 * math.pi, 0.0 if dwell is None else dwell, rate=rate),)
     table = {"single-4": SINGLE_4, "dual-16": DUAL_16, "dual-16-improved": DUAL_16_IMPROVED,
-             "seed-12": SEED_12, "four-position-12": FOUR_POSITION_12}[name]
+             "seed-12": SEED_12, "four-position-12": FOUR_POSITION_12,
+             "four-position-24": FOUR_POSITION_24}[name]
     return tuple(_turn_rows(table, turn, SEED_DWELL if dwell is None else dwell))
 
 
@@ -347,9 +354,10 @@ def builtin_scheme(name: str, *, dwell: float | None = None, turn: Turn = SEED_T
     """Built-in scheme `name` as a :class:`Scheme` (arguments as :func:`builtin_rows`).
 
     ``seed-12`` and ``four-position-12`` are navigation-referenced (the three-axis
-    mechanism isolates the carrier, spec 004 §2); the others are body-referenced.
+    mechanism isolates the carrier, spec 004 §2), and so are the ``four-position`` schemes;
+    the others are body-referenced.
     """
     rows = builtin_rows(name, dwell=dwell, turn=turn, rate=rate, axis=axis)
-    reference = "navigation" if name in ("seed-12", "four-position-12") else "body"
+    reference = "navigation" if name.startswith(("seed-12", "four-position")) else "body"
     return scheme_from_rows(rows, name=name, reference=reference,
                             description=_DESCRIPTIONS[name])
