@@ -42,7 +42,7 @@ the turning column; within a few 1e-5 otherwise).
 
 >>> from gcalign.modulate.schemes import builtin_scheme
 >>> r = invariant_report(builtin_scheme("seed-12"))
->>> np.round(3 * r.mean_C, 12).tolist()
+>>> (np.round(3 * r.mean_C, 12) + 0.0).tolist()
 [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
 """
 

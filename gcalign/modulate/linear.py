@@ -41,6 +41,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
 from gcalign.estimation.kalman import van_loan
 from gcalign.modulate._quadrature import gauss_legendre, pieces, split_count
 from gcalign.modulate.schemes import Scheme
@@ -341,7 +342,8 @@ def linear_errors(scheme: Scheme | Schedule, errors: ErrorTerms, *,
             Q, L = prop.q_d(b - a)
             P = Phi @ P @ Phi.T + Q
             if n_paths:
-                x[:, 1:] += L @ rng.standard_normal((7, n_paths))  # type: ignore[union-attr]
+                assert rng is not None  # checked above
+                x[:, 1:] += L @ rng.standard_normal((7, n_paths))
         m = is_out[i + 1]
         if m >= 0:
             X[m] = x[:, 0]

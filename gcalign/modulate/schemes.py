@@ -58,6 +58,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -276,12 +277,13 @@ def scheme_from_rows(rows: Sequence[Row] | Sequence[Mapping], *, name: str = "us
     if reference not in REFERENCES:
         raise ScenarioError(f"scheme reference: got {reference!r}; allowed: "
                             f"{', '.join(REFERENCES)}")
-    if rows and isinstance(rows[0], Mapping):
-        rows = rows_from_dicts(rows)  # type: ignore[arg-type]
-    rows = tuple(rows)  # type: ignore[arg-type]
     if not rows:
         raise ScenarioError("scheme rows: the table is empty; give at least one row")
-    steps = [_checked_step(i, r) for i, r in enumerate(rows)]  # type: ignore[arg-type]
+    if isinstance(rows[0], Mapping):
+        si = rows_from_dicts(cast(Sequence[Mapping], rows))
+    else:
+        si = tuple(cast(Sequence[Row], rows))
+    steps = [_checked_step(i, r) for i, r in enumerate(si)]
     schedule = Schedule(tuple(steps), repeat=True, q0=q0)
     rv = quat_to_rotvec(schedule.cycle_rotation)
     ang = float(np.linalg.norm(rv))
@@ -290,7 +292,7 @@ def scheme_from_rows(rows: Sequence[Row] | Sequence[Mapping], *, name: str = "us
             f"scheme rows: the table does not return the IMU to its start: after the last row "
             f"it is turned by {ang / DEG:.6g} deg about {np.round(rv / ang, 6).tolist()}; add "
             "rows that bring it back")
-    return Scheme(name, rows, schedule, reference, description)  # type: ignore[arg-type]
+    return Scheme(name, si, schedule, reference, description)
 
 
 # ---------------------------------------------------------------------------- built-ins
