@@ -167,6 +167,8 @@ def test_bad_si_rows_and_builtins_are_named():
         scheme_from_rows([good, Row((0.0, 0.0, 1.0), -math.pi, -2.0, rate=1.0)])
     with pytest.raises(ScenarioError, match=r"row 1: axis: .*unit vector"):
         scheme_from_rows([Row((0.0, 0.0, 2.0), 0.0, 10.0)])
+    with pytest.raises(ScenarioError, match=r"row 1: angle: a turn of .* needs a profile"):
+        scheme_from_rows([Row((0.0, 0.0, 1.0), math.pi, 10.0)])
     with pytest.raises(ScenarioError, match=r"unknown scheme 'seed-13'; built-in: fixed, "):
         builtin_scheme("seed-13")
     with pytest.raises(ScenarioError, match=r"dwell_s: must be ≥ 0"):

@@ -93,7 +93,7 @@ class Row:
     signed, ccw +) with one profile, then dwell `dwell` (s).
 
     Profile, by which fields are set: ``t_accel``, ``t_const``, ``t_decel`` (trapezoid by
-    times); ``rate`` and ``accel`` (trapezoid by rate, rad/s, and acceleration, rad/s²);
+    times; ``t_const`` 0 and ``t_decel = t_accel`` when not set); ``rate`` and ``accel`` (trapezoid by rate, rad/s, and acceleration, rad/s²);
     ``rate`` alone (constant rate, starts at speed); none (``angle`` 0: a pure dwell).
     """
 
@@ -106,23 +106,25 @@ class Row:
     rate: float | None = None
     accel: float | None = None
 
-    def profile(self) -> AngleProfile:
-        """The row's angle profile (without the dwell)."""
-        if self.t_accel is not None and self.t_decel is not None:
-            return AngleProfile.trapezoid(self.angle, t_accel=self.t_accel,
-                                          t_const=self.t_const or 0.0, t_decel=self.t_decel)
-        if self.rate is not None and self.accel is not None:
-            return AngleProfile.trapezoid_rate(self.angle, rate=self.rate, accel=self.accel)
-        if self.rate is not None:
-            return AngleProfile.constant_rate(math.copysign(self.rate, self.angle),
-                                              abs(self.angle) / self.rate)
-        return AngleProfile.rest(self.dwell)
+    @property
+    def turns(self) -> bool:
+        """Whether the row has a turn profile (otherwise it is a pure dwell)."""
+        return self.t_accel is not None or self.rate is not None
 
     def step(self) -> Step:
         """The :class:`Step` of this row (a pure dwell is one rest piece)."""
-        if self.angle == 0.0 and self.t_accel is None and self.rate is None:
+        if self.t_accel is not None:
+            profile = AngleProfile.trapezoid(
+                self.angle, t_accel=self.t_accel, t_const=self.t_const or 0.0,
+                t_decel=self.t_accel if self.t_decel is None else self.t_decel)
+        elif self.rate is not None and self.accel is not None:
+            profile = AngleProfile.trapezoid_rate(self.angle, rate=self.rate, accel=self.accel)
+        elif self.rate is not None:
+            profile = AngleProfile.constant_rate(math.copysign(self.rate, self.angle),
+                                                 abs(self.angle) / self.rate)
+        else:
             return Step(self.axis, AngleProfile.rest(self.dwell))
-        return Step(self.axis, self.profile(), dwell=self.dwell)
+        return Step(self.axis, profile, dwell=self.dwell)
 
 
 @dataclass(frozen=True)
@@ -255,6 +257,11 @@ def _checked_step(i: int, r: Row) -> Step:
             raise _row_error(i, f"{name}", f"must be > 0, got {v!r}")
     if r.t_const is not None and not r.t_const >= 0:
         raise _row_error(i, "t_const", f"must be ≥ 0, got {r.t_const!r}")
+    if not r.turns and r.angle != 0.0:
+        raise _row_error(i, "angle", f"a turn of {r.angle!r} rad needs a profile (t_accel… "
+                         "or rate)")
+    if r.turns and r.angle == 0.0:
+        raise _row_error(i, "angle", "a turn profile needs a non-zero angle")
     try:
         step = r.step()
     except ValueError as e:
