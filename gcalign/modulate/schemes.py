@@ -93,8 +93,9 @@ class Row:
     signed, ccw +) with one profile, then dwell `dwell` (s).
 
     Profile, by which fields are set: ``t_accel``, ``t_const``, ``t_decel`` (trapezoid by
-    times; ``t_const`` 0 and ``t_decel = t_accel`` when not set); ``rate`` and ``accel`` (trapezoid by rate, rad/s, and acceleration, rad/s²);
-    ``rate`` alone (constant rate, starts at speed); none (``angle`` 0: a pure dwell).
+    times; ``t_const`` 0 and ``t_decel = t_accel`` when not set); ``rate`` and ``accel``
+    (trapezoid by rate, rad/s, and acceleration, rad/s²); ``rate`` alone (constant rate,
+    starts at speed); none (``angle`` 0: a pure dwell).
     """
 
     axis: tuple[float, float, float]
