@@ -30,7 +30,8 @@ thousand 7×7 matrix–vector products.
 Noise: ARW and VRW are the same on every axis, so ``C(t) w`` has the law of w whatever
 the mechanism does — the noise enters independently of the scheme, with the Van Loan
 covariance ``Q_d(h)`` of ``blockdiag(arw² I₃, vrw² I₂, 0, 0)``. The covariance P(t) is
-propagated alongside; sample paths (``rng``, ``n_paths``) add ``chol(Q_d) z`` per interval.
+propagated alongside; sample paths (``rng``, ``n_paths``) add ``L z`` per interval, with
+L Lᵀ = Q_d (eigen-decomposition: Q_d is only semi-definite) and z ~ N(0, I).
 
 Outputs: north ``R_M δL``, east ``R_N cos L δλ`` and horizontal error (m), φ (rad).
 """
