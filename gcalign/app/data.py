@@ -21,7 +21,7 @@ from gcalign.errors import ScenarioError
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario import Scenario
 from gcalign.nav.earth import WGS84, EarthModel
-from gcalign.nav.rotation import dcm_to_quat
+from gcalign.nav.rotation import dcm_to_quat, euler_to_quat
 from gcalign.sim.errors import ErrorStream
 from gcalign.sim.imu import ImuData
 from gcalign.sim.motions import Moving, Truth, sample_count
@@ -40,10 +40,11 @@ class RunData:
 
 @dataclass(frozen=True)
 class BlockTruth:
-    """The truth at the end times of a block's increments: att, v_n, pos (n, 3) and the
-    motion segment of each increment (n,)."""
+    """The truth at the end times of a block's increments: att (n, 3), q_nb (n, 4), v_n,
+    pos (n, 3) and the motion segment of each increment (n,)."""
 
     att: np.ndarray
+    q_nb: np.ndarray
     v_n: np.ndarray
     pos: np.ndarray
     segment: np.ndarray
@@ -157,7 +158,9 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
                 if truth is not None:
                     seg = (np.zeros(len(imu.t[sl]), np.int64) if truth.segment is None
                            else truth.segment[1:][sl])
-                    tr = BlockTruth(truth.att[1:][sl], truth.v_n[1:][sl], truth.pos[1:][sl], seg)
+                    att = truth.att[1:][sl]
+                    tr = BlockTruth(att, euler_to_quat(att), truth.v_n[1:][sl],
+                                    truth.pos[1:][sl], seg)
                 yield DataBlock(k0, imu.t[sl], imu.dtheta[sl], imu.dv[sl], tr,
                                 None if imu.q_bs is None else imu.q_bs[sl])
 
@@ -188,8 +191,8 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
         stream = ErrorStream(errors, ts, np.random.default_rng(seed), n)
         for b in ideal_blocks(motion, site, ts, earth, mech, block=block or BLOCK):
             dtheta, dv = stream.apply(b.dtheta, b.dv)
-            yield DataBlock(b.k0, b.t, dtheta, dv, BlockTruth(b.att, b.v_n, b.pos, b.segment),
-                            b.q_bs)
+            yield DataBlock(b.k0, b.t, dtheta, dv,
+                            BlockTruth(b.att, b.q_nb, b.v_n, b.pos, b.segment), b.q_bs)
 
     def simulated_at(k: int):
         """Truth at sample k from the motion itself (truth at any time)."""

@@ -294,24 +294,28 @@ def euler_of(q0, q1, q2, q3):
 
 
 @njit(cache=True)
-def error_block(states, q_bs, has_qbs, att_t, v_t, pos_t, has_truth, E, pos0, k_first,
+def error_block(states, q_bs, has_qbs, att_t, q_t, v_t, pos_t, has_truth, E, pos0, k_first,
                 stride, acc, out):
     """Errors of a block of navigation states against the truth at every sample, folded
     into `acc`, and every `stride`-th sample written as a row of `out`.
 
     states (n, NAV_STATE) (q is q_ns when `has_qbs`: the body attitude is q_ns ⊗ q_bs*);
-    att_t, v_t, pos_t (n or 1, 3) truth; pos0 (3,) start position (for the drift);
+    att_t, q_t (quaternion), v_t, pos_t (n or 1, 3 or 4) truth; pos0 (3,) start position;
     k_first: samples from the start to the first state of the block minus one;
-    acc (7, 3): rows |att err| max, |v err| max, |pos err| max, [horizontal error max,
-    horizontal displacement max, 0], then the last sample's att, v and pos errors;
-    out (≥ rows, 18): att, v, pos, att err, v err, pos err.
-    Returns the number of rows written. Euler errors est − true, yaw wrapped to ±π.
+    acc (9, 3): rows |att err| max, |v err| max, |pos err| max, [horizontal error max,
+    horizontal displacement max, 0], |φ| max, then the last sample's att, v, pos and φ
+    errors; out (≥ rows, 21): att, v, pos, att err, v err, pos err, φ.
+    Attitude errors: Euler differences est − true with roll and yaw wrapped to ±π (the
+    seeds' convention; ill-defined near pitch ±90°) and the misalignment φ (ENU) from
+    C_est C_trueᵀ = exp(−[φ×]), which always is defined.
+    Returns the number of rows written.
     """
     n = states.shape[0]
     nt = att_t.shape[0]
     r_m0, r_n0, _, _, cl0 = earth_at(E, pos0[0], pos0[2])
     rows = 0
-    e = np.zeros(9)
+    e = np.zeros(12)
+    two_pi = 2.0 * math.pi
     for i in range(n):
         q0, q1, q2, q3 = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
         if has_qbs:
@@ -325,28 +329,37 @@ def error_block(states, q_bs, has_qbs, att_t, v_t, pos_t, has_truth, E, pos0, k_
         j = i if i < nt else nt - 1
         if has_truth:
             e[0] = p - att_t[j, 0]
-            e[1] = r - att_t[j, 1]
-            e[2] = (y - att_t[j, 2] + math.pi) % (2.0 * math.pi) - math.pi
+            e[1] = (r - att_t[j, 1] + math.pi) % two_pi - math.pi
+            e[2] = (y - att_t[j, 2] + math.pi) % two_pi - math.pi
             for c in range(3):
                 e[3 + c] = states[i, 4 + c] - v_t[j, c]
             r_m, r_n, _, _, cl = earth_at(E, pos_t[j, 0], pos_t[j, 2])
             e[6] = (lon - pos_t[j, 1]) * (r_n + pos_t[j, 2]) * cl
             e[7] = (lat - pos_t[j, 0]) * (r_m + pos_t[j, 2])
             e[8] = h - pos_t[j, 2]
+            # φ = −rotvec(q_est ⊗ q_true*)
+            dw, dx, dy, dz = qmul(q0, q1, q2, q3, q_t[j, 0], -q_t[j, 1], -q_t[j, 2], -q_t[j, 3])
+            if dw < 0.0:
+                dw, dx, dy, dz = -dw, -dx, -dy, -dz
+            nrm = math.sqrt(dx * dx + dy * dy + dz * dz)
+            k = -2.0 * math.atan2(nrm, dw) / nrm if nrm > 1e-12 else -2.0 / dw
+            e[9], e[10], e[11] = k * dx, k * dy, k * dz
             for c in range(9):
                 a = abs(e[c])
                 if a > acc[c // 3, c % 3]:
                     acc[c // 3, c % 3] = a
+            for c in range(3):
+                acc[4, c] = max(acc[4, c], abs(e[9 + c]))
             acc[3, 0] = max(acc[3, 0], math.sqrt(e[6] * e[6] + e[7] * e[7]))
             if i == n - 1:
-                for c in range(9):
-                    acc[4 + c // 3, c % 3] = e[c]
+                for c in range(12):
+                    acc[5 + c // 3, c % 3] = e[c]
         if (k_first + i + 1) % stride == 0:
             out[rows, 0], out[rows, 1], out[rows, 2] = p, r, y
             for c in range(3):
                 out[rows, 3 + c] = states[i, 4 + c]
                 out[rows, 6 + c] = states[i, 7 + c]
-            for c in range(9):
+            for c in range(12):
                 out[rows, 9 + c] = e[c]
             rows += 1
     return rows

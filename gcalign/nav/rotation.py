@@ -154,9 +154,9 @@ def wrap_pi(a):
 
 
 def attitude_error(att_est, att_true):
-    """Euler-angle error ``est - true`` (rad), yaw wrapped to ±π, shape (..., 3)."""
+    """Euler-angle error ``est - true`` (rad), roll and yaw wrapped to ±π, shape (..., 3)."""
     d = np.asarray(att_est, dtype=float) - np.asarray(att_true, dtype=float)
-    return np.concatenate([d[..., :2], wrap_pi(d[..., 2:])], -1)
+    return np.concatenate([d[..., :1], wrap_pi(d[..., 1:])], -1)
 
 
 def misalignment(C_nb_est, C_nb_true):

@@ -40,9 +40,9 @@ BLOCK = 1 << 16  #: samples per block
 class SimBlock:
     """Increments k0 .. k0+n-1 and the truth at their end times (SI).
 
-    t (n,) end times; dtheta, dv (n, 3) sensor frame; att (n, 3), v_n (n, 3), pos (n, 3)
-    body truth at t; segment (n,) motion segment of each increment; q_bs (n, 4) mechanism
-    angles at t (None without a mechanism).
+    t (n,) end times; dtheta, dv (n, 3) sensor frame; att (n, 3), q_nb (n, 4), v_n (n, 3),
+    pos (n, 3) body truth at t; segment (n,) motion segment of each increment; q_bs (n, 4)
+    mechanism angles at t (None without a mechanism).
     """
 
     k0: int
@@ -50,6 +50,7 @@ class SimBlock:
     dtheta: np.ndarray
     dv: np.ndarray
     att: np.ndarray
+    q_nb: np.ndarray
     v_n: np.ndarray
     pos: np.ndarray
     segment: np.ndarray
@@ -142,7 +143,8 @@ def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
         if mechanism is not None:
             q_bs = mechanism.q_bs(grid.ravel()[ends], q_nb[ends])
         yield SimBlock(k0=k0, t=grid.ravel()[ends], dtheta=dtheta, dv=dv,
-                       att=np.array(kin.att[ends]), v_n=np.array(kin.v_n[ends]),
+                       att=np.array(kin.att[ends]), q_nb=np.array(q_nb[ends]),
+                       v_n=np.array(kin.v_n[ends]),
                        pos=np.array(kin.pos[ends]),
                        segment=(np.zeros(n, np.int64) if seg is None else seg[ends]),
                        q_bs=q_bs)
@@ -204,6 +206,6 @@ def _fixed_site_blocks(motion: Static | Turntable, site, ts, earth, mechanism, b
         t = (k0 + 1 + np.arange(n)) * ts
         att = np.broadcast_to(np.asarray(motion.att0, float), (n, 3)) if body is None else \
             quat_to_euler(q_nb)
-        yield SimBlock(k0=k0, t=t, dtheta=dtheta, dv=dv, att=np.array(att),
+        yield SimBlock(k0=k0, t=t, dtheta=dtheta, dv=dv, att=np.array(att), q_nb=q_nb,
                        v_n=np.zeros((n, 3)), pos=np.tile(site, (n, 1)),
                        segment=np.zeros(n, np.int64), q_bs=q_bs if mechanism is not None else None)

@@ -31,7 +31,7 @@ from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm, quat_to_dcm
 from gcalign.sim.schedule import Schedule
 
-NODE_S = 1.0  #: largest spacing of the position nodes of a moving base (s)
+NODE_S = 0.25  #: largest spacing of the position nodes of a moving base (s)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(6)  # exact to degree 11 between nodes
 
 
@@ -231,8 +231,9 @@ class Moving:
 
     def _gl(self, a, b, seg, pos_a, pos_b, earth):
         """∫_a^b of the position rate (Gauss–Legendre, 6 points per interval); latitude and
-        height at the nodes interpolated between the interval's ends (their nonlinearity
-        changes the radii by < 1e-9 relative here)."""
+        height at the nodes interpolated between the interval's ends: in a 9 °/s turn at
+        165 m/s latitude departs from the line by ~3e-8 rad within 0.25 s, which moves
+        cos L and the radii by ~3e-8 relative (a few µm per second of flight)."""
         half = 0.5 * (b - a)
         tt = (0.5 * (a + b))[:, None] + half[:, None] * _GL_X
         frac = 0.5 * (1.0 + _GL_X)

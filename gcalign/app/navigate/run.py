@@ -95,7 +95,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
     truth at every sample (:func:`gcalign.nav._kernels.error_block`), write every
     `stride`-th row to `sink` (an h5py group), and return the plain-number pieces of the
     summary (SI, radians)."""
-    from gcalign.io.results import ATT_FRAME, Series
+    from gcalign.io.results import ATT_FRAME, PHI_FRAME, Series
 
     ts, earth = stream.ts, stream.earth
     E = earth.params()
@@ -110,15 +110,17 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         spec = {"t": (None, "s", None), "att": (3, "rad", ATT_FRAME), "v_n": (3, "m/s", "ENU"),
                 "pos": (3, "rad, rad, m", "[latitude, longitude, height]")}
         if has_truth:
-            spec |= {"error/att": (3, "rad", "Euler differences est - true, yaw wrapped"),
+            spec |= {"error/att": (3, "rad", "Euler differences est - true, roll and yaw "
+                                              "wrapped"),
                      "error/v_n": (3, "m/s", "ENU"),
-                     "error/pos": (3, "m", "ENU (east, north, up)")}
+                     "error/pos": (3, "m", "ENU (east, north, up)"),
+                     "error/phi": (3, "rad", PHI_FRAME)}
         series = Series(sink, spec, stride=stride, rate_hz=1.0 / (stride * ts),
                         vertical=vertical.mode)
         row0 = {"t": [start.k * ts + stream.t0], "att": [start.state.att],
                 "v_n": [start.state.v_n], "pos": [start.state.pos]}
         if has_truth:
-            row0 |= {f"error/{n}": np.zeros((1, 3)) for n in ("att", "v_n", "pos")}
+            row0 |= {f"error/{n}": np.zeros((1, 3)) for n in ("att", "v_n", "pos", "phi")}
         series.append(**row0)
     state = start.state
     pos0 = np.asarray(state.pos, dtype=float)
@@ -126,8 +128,8 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
     q_bs0 = stream.q_bs_at(start.k)
     q_ns0 = state.q_nb if q_bs0 is None else _qmul(state.q_nb, q_bs0)
     nav = Navigator(NavState(q_ns0, state.v_n, pos0), ts, earth, vertical)
-    acc = np.zeros((7, 3))
-    none = np.zeros((1, 3))
+    acc = np.zeros((9, 3))
+    none, q_none = np.zeros((1, 3)), np.zeros((1, 4))
     last = None
     compute = 0.0
     t0 = time.perf_counter()
@@ -147,9 +149,10 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         states = nav.run(b.dtheta[lo:hi], b.dv[lo:hi], h_ref)
         compute += time.perf_counter() - c0
         q_bs = np.zeros((1, 4)) if b.q_bs is None else np.ascontiguousarray(b.q_bs[lo:hi])
-        out = np.empty((len(states) // stride + 1, 18))
+        out = np.empty((len(states) // stride + 1, 21))
         rows = K.error_block(states, q_bs, b.q_bs is not None,
                              none if tr is None else np.ascontiguousarray(tr.att[lo:hi]),
+                             q_none if tr is None else np.ascontiguousarray(tr.q_nb[lo:hi]),
                              none if tr is None else np.ascontiguousarray(tr.v_n[lo:hi]),
                              none if tr is None else np.ascontiguousarray(tr.pos[lo:hi]),
                              tr is not None, E, pos0, b.k0 + lo - start.k, stride, acc, out)
@@ -160,7 +163,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
                     "pos": r[:, 6:9]}
             if has_truth:
                 data |= {"error/att": r[:, 9:12], "error/v_n": r[:, 12:15],
-                         "error/pos": r[:, 15:18]}
+                         "error/pos": r[:, 15:18], "error/phi": r[:, 18:21]}
             series.append(**data)
         last = (states[-1], None if b.q_bs is None else b.q_bs[hi - 1])
     assert last is not None
@@ -174,8 +177,8 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         "final_state": (quat_to_euler(q_end), s_end[K.V].copy(), pos_end.copy()),
         "displacement": position_error_enu(pos_end[None], pos0[None], earth)[0],
         "max_horizontal_displacement": float(acc[3, 1]),
-        "peak": acc[0:3] if has_truth else None,
-        "final_error": acc[4:7] if has_truth else None,
+        "peak": acc[[0, 1, 2, 4]] if has_truth else None,
+        "final_error": acc[5:9] if has_truth else None,
         "max_horizontal_error": float(acc[3, 0]) if has_truth else None,
         "compute_s": compute,
         "wall_s": time.perf_counter() - t0,
@@ -265,8 +268,8 @@ def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, str
         "max_horizontal_error_m": None,
     }
     if part["peak"] is not None:
-        scale = np.array([[math.degrees(1.0)], [1.0], [1.0]])
-        names = ("attitude_deg", "velocity_mps", "position_m")
+        scale = np.array([[math.degrees(1.0)], [1.0], [1.0], [math.degrees(1.0)]])
+        names = ("attitude_deg", "velocity_mps", "position_m", "misalignment_deg")
         out["final_error"] = dict(zip(names, (part["final_error"] * scale).tolist(), strict=True))
         out["max_error"] = dict(zip(names, (part["peak"] * scale).tolist(), strict=True))
         out["max_horizontal_error_m"] = part["max_horizontal_error"]

@@ -35,6 +35,8 @@ def navigate_table(s: dict) -> Table:
         rows = [
             ("attitude error (pitch, roll, yaw) (deg)", fmt(fe["attitude_deg"]),
              fmt(me["attitude_deg"])),
+            ("misalignment φ ENU (deg)", fmt(fe["misalignment_deg"]),
+             fmt(me["misalignment_deg"])),
             ("velocity error ENU (m/s)", fmt(fe["velocity_mps"]), fmt(me["velocity_mps"])),
             ("position error ENU (m)", fmt(fe["position_m"]), fmt(me["position_m"])),
             ("horizontal position error (m)",
