@@ -164,8 +164,10 @@ def run_case(case: Case, settings: Settings, rng: np.random.Generator, *,
                       rotvec_to_quat(u_axis[None, :] * theta[:, None]))
         return quat_to_euler(q)
 
-    # solution 0: the aligned attitude at rest
-    theta_ins = float(axis_angle(schedule, np.array([0.0]))[0])
+    # solution 0: the aligned attitude at rest, plus what the filter leaves of the dither
+    # at t = 0 (alignment averages the dither; navigation sees its filtered residual)
+    theta_ins = float(axis_angle(schedule, np.array([0.0]))[0]) + gyro.dither_residual(
+        chain.response(np.array([settings.sensor.dither_hz]))[0], 0.0)
     att0 = attitude(np.array([theta_ins]))
     tracks = [track(att0[:, a], model, np.array([att0[0, a], 0.0, 0.0]), P0) for a in range(3)]
     x_carry = [tr.x_last for tr in tracks]

@@ -70,6 +70,13 @@ class GyroChannel:
         phase = rng.uniform(0.0, 2.0 * np.pi)
         return cls(sensor, float(rem), float(phase))
 
+    def dither_residual(self, response: complex, t: float) -> float:
+        """The dither angle after a filter of complex `response` at the dither frequency,
+        at time `t` (s), in steady state (rad): ``A_d Im(H e^{j(2π f_d t + φ_d)})``."""
+        s = self.sensor
+        return float(s.dither_amplitude * (response * np.exp(
+            1j * (2.0 * np.pi * s.dither_hz * t + self.dither_phase))).imag)
+
     def measure(self, t: np.ndarray, ideal: np.ndarray, dt: float,
                 rng: np.random.Generator) -> np.ndarray:
         """Counts (rad) for the ideal increments `ideal` (N,) ending at times `t` (N,) (s),

@@ -104,7 +104,8 @@ class FilterSettings:
 
 @dataclass(frozen=True, kw_only=True)
 class SensorSettings:
-    """The gyro channel along the turntable axis (spec 003 §4 [O] noise model).
+    """The gyro channel along the turntable axis (spec 003 §4 [O] noise model; the seed
+    gives no noise figures, so every default here is an assumption, stated in the results).
 
     Parameters
     ----------
@@ -112,16 +113,20 @@ class SensorSettings:
         Angle per count ([O] 0.1″); counts carry their remainder, so the quantised angle
         stays within one quantum of the sensed angle. 0: no quantisation.
     arw : float, rad/√s
-        Angle random walk (white rate noise), ≥ 0.
+        Angle random walk (white rate noise), ≥ 0; default 0.0005 °/√h (a 1″-class ring
+        laser gyro), a random walk of 0.1″ over a 12 s case.
     dither_amplitude : float, rad
-        Peak of the mechanical dither seen in the sensed angle, ≥ 0 (0: none).
+        Peak of the mechanical dither seen in the sensed angle, ≥ 0 (0: none); default
+        100″. A mechanically dithered RLG is what the notch is for, and the dither makes
+        the quantisation error white (without it, 5 °/s is exactly 36 counts per sample and
+        the quantisation error stands still).
     dither_hz : float, Hz
         Dither frequency (the notch is meant for it), > 0.
     """
 
     quantum: float = 0.1 * ARCSEC
     arw: float = 0.0005 * DEG / 60.0
-    dither_amplitude: float = 0.0
+    dither_amplitude: float = 100.0 * ARCSEC
     dither_hz: float = 400.0
 
     def __post_init__(self) -> None:
