@@ -237,3 +237,25 @@ def test_pulse_and_case_checks_run_before_anything():
     fast = Case(name="fast swing", kind="swing", amplitude=DEG, frequency=600.0)
     with pytest.raises(ValueError, match="swing frequency must be below the Nyquist"):
         run_case(fast, Settings(), np.random.default_rng(0))
+
+
+def test_a_finite_jerk_softens_the_ramp_corners():
+    """The corner transients come from the steps in α: with a jerk limit of 200 °/s³ the
+    20 °/s² ramp's corners shrink (noise-free), for both predictors, and the ramp still
+    ends at 15 °/s."""
+    s = Settings(sensor=QUIET)
+    soft = dataclasses.replace(ACCEL20, jerk=200 * DEG, name="accel 20°/s², jerk 200°/s³")
+    assert len(soft.corners(s.duration_s)) == 4
+    hard_res, soft_res = (run_case(c, s, np.random.default_rng(0)) for c in (ACCEL20, soft))
+    for p in ("kalman-ls", "taylor"):
+        corner = []
+        for res in (hard_res, soft_res):
+            t = res.pulses.t
+            near = np.zeros(len(t), dtype=bool)
+            for c in res.case.corners(s.duration_s):
+                near |= np.abs(t - c) <= s.corner_s
+            corner.append(np.max(np.abs(res.error(p)[near & (t >= 1.0), 2])))
+        assert corner[1] < 0.2 * corner[0], (p, corner)
+    t_end = soft.corners(s.duration_s)[-1]
+    assert soft.schedule(s.duration_s).angle_rate_accel(np.array([t_end + 1.0]))[1][0] == \
+        pytest.approx(15 * DEG, rel=1e-12)

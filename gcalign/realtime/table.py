@@ -41,8 +41,9 @@ class CaseSummary:
     before : dict metric → float
         rad for rate and swing (peak |error| of ``none``), rad/s for accel (slope).
     before_theory : dict metric → float
-        The closed form (:meth:`Case.before_theory`) with Tdelay = T_chain + mean Δt
-        (truth) or T + mean Δt (seed).
+        The closed form (:meth:`Case.before_theory`) with Tdelay = T_chain + Δt (truth) or
+        T + Δt (seed): the largest Δt for the peaks (rate, swing), the mean Δt for the
+        slope (accel); one value when the pulses sit at a fixed offset.
     stats : dict predictor → PredictorStats
     n_pulses : int
         Pulses evaluated (after the settle time).
@@ -78,8 +79,10 @@ def summarise(res: CaseResult) -> CaseSummary:
     """Table-1 row of one case result."""
     keep, corner = _masks(res)
     c = res.component
-    mean_dt = float(np.mean(res.pulses.dt_true[keep])) if keep.any() else 0.0
-    delays = {"truth": res.chain_delay + mean_dt, "seed": res.delay + mean_dt}
+    dt = res.pulses.dt_true[keep]
+    dt_peak = float(np.mean(dt) if res.case.kind == "accel" else np.max(dt)) if keep.any() \
+        else 0.0
+    delays = {"truth": res.chain_delay + dt_peak, "seed": res.delay + dt_peak}
     before, theory = {}, {}
     for m in METRICS:
         theory[m] = res.case.before_theory(delays[m])
