@@ -61,3 +61,10 @@ def test_each_case_draws_from_its_own_generator():
     rows = table1(s, np.random.default_rng(4), cases)
     alone = run_case(cases[2], s, np.random.default_rng(4).spawn(3)[2])
     np.testing.assert_array_equal(rows[2].predicted["kalman-ls"], alone.predicted["kalman-ls"])
+
+
+def test_summary_without_the_none_predictor_still_reports_before():
+    s = Settings(duration_s=3.0, predictors=("kalman-ls",))
+    row = summarise(run_case(TABLE1[1], s, np.random.default_rng(0)))
+    assert set(row.stats) == {"kalman-ls"}
+    assert row.before["truth"] == pytest.approx(row.before_theory["truth"], rel=0.01)

@@ -103,7 +103,9 @@ class CaseResult:
         if metric not in METRICS:
             raise ValueError(f"metric must be one of {METRICS}, got {metric!r}")
         ref = self.truth if metric == "truth" else self.ins_ref
-        return wrap_pi(self.predicted[predictor] - ref)
+        # ``none`` is the latched attitude, there whichever predictors ran
+        pred = self.latched if predictor == "none" else self.predicted[predictor]
+        return wrap_pi(pred - ref)
 
     @property
     def component(self) -> int:
@@ -224,8 +226,8 @@ def run_case(case: Case, settings: Settings, rng: np.random.Generator, *,
         hist_k0 = k1 + 1 - len(hist_att)
 
     horizon = (T + pulses.dt)[:, None]  # Tdelay = T + Δt (measured), per axis
-    predicted = {name: run_predictor(name, states, horizon, tau)
-                 for name in settings.predictors}
+    predicted = {name: latched.copy() if name == "none" else
+                 run_predictor(name, states, horizon, tau) for name in settings.predictors}
     truth = quat_to_euler(schedule.quat(pulses.t))
     out_series = None
     if keep_series:

@@ -24,7 +24,8 @@ Prediction over ``Tdelay = T + Δt`` (the seed's eq. 13 is lost; reconstructed [
 exact increment of a quadratic); for cubic θ with jerk j each step misses ``j s³/6``, so
 the error is ``j (nτ³ + r³)/6`` (= j·T·τ²/6 for Δt = 0), against ``j·Tdelay³/6`` for the
 plain Taylor step ``θ + ω Tdelay + ½ α Tdelay²`` (``taylor``; PSINS ``insextrap`` is its
-first-order version). ``none`` outputs the latched attitude.
+first-order version). ``none`` outputs the latched INS attitude itself (no tracker), and is
+handled where the latched attitude is (:mod:`gcalign.realtime.chain`).
 
 >>> import numpy as np
 >>> ls_weights(4.0).tolist()
@@ -55,7 +56,6 @@ __all__ = [
     "ls_fit",
     "ls_weights",
     "predict_kalman_ls",
-    "predict_none",
     "predict_taylor",
     "prediction_response",
     "run_predictor",
@@ -260,17 +260,13 @@ def predict_taylor(states: np.ndarray, horizon: np.ndarray | float, tau: float) 
     return s[..., 0] + s[..., 1] * h + 0.5 * s[..., 2] * h * h
 
 
-def predict_none(states: np.ndarray, horizon: np.ndarray | float, tau: float) -> np.ndarray:
-    """The latched attitude itself (before prediction)."""
-    return np.asarray(states, dtype=float)[..., 2, 0]
-
-
-_PREDICT = {"none": predict_none, "taylor": predict_taylor, "kalman-ls": predict_kalman_ls}
+#: predictors that extrapolate the tracker's states; ``none`` is the latched attitude itself
+_PREDICT = {"taylor": predict_taylor, "kalman-ls": predict_kalman_ls}
 
 
 def run_predictor(name: str, states: np.ndarray, horizon: np.ndarray | float,
                   tau: float) -> np.ndarray:
-    """Dispatch to a predictor of :data:`gcalign.realtime.settings.PREDICTORS` by name."""
+    """Dispatch to an extrapolating predictor by name (``taylor``, ``kalman-ls``)."""
     try:
         f = _PREDICT[name]
     except KeyError:
@@ -300,8 +296,8 @@ def prediction_response(freq_hz: np.ndarray, model: TrackerModel, horizon: float
         c[0, 0] = 1.0
     elif predictor == "taylor":
         c[0] = [1.0, horizon, 0.5 * horizon**2]
-    elif predictor == "none":
-        c[0, 0] = 1.0
+    elif predictor == "none":  # the observation itself, without the tracker
+        return np.ones(np.size(freq_hz), dtype=complex)
     else:
         raise ValueError(f"predictor must be one of {tuple(_PREDICT)}, got {predictor!r}")
     zinv = np.exp(-2j * np.pi * np.atleast_1d(np.asarray(freq_hz, dtype=float)) * tau)
