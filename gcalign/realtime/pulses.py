@@ -55,8 +55,12 @@ def latch(t: np.ndarray, solution_hz: float, resolution_s: float = 0.0
     # the 1e-9 guards edges that fall on an instant but are computed a hair early
     k = np.floor(t * solution_hz + 1e-9).astype(np.int64)
     dt_true = np.maximum(t - k * tau, 0.0)
-    dt = dt_true if resolution_s == 0 else np.round(dt_true / resolution_s) * resolution_s
-    return k, dt_true, dt
+    return k, dt_true, _count(dt_true, resolution_s)
+
+
+def _count(dt: np.ndarray, resolution_s: float) -> np.ndarray:
+    """Δt as a counter of `resolution_s` measures it (nearest count); exact when 0."""
+    return dt if resolution_s == 0 else np.round(dt / resolution_s) * resolution_s
 
 
 def make_pulses(p: PulseSettings, duration_s: float, solution_hz: float,
@@ -72,13 +76,10 @@ def make_pulses(p: PulseSettings, duration_s: float, solution_hz: float,
     if p.mode == "solution":
         m = round(solution_hz / p.rate_hz)
         k = np.arange(0, int(np.floor(duration_s * solution_hz + 1e-9)) + 1, m, dtype=np.int64)
-        offset = float(p.offset_s or 0.0)
-        dt_true = np.full(len(k), offset)
-        dt = dt_true if p.resolution_s == 0 else np.round(dt_true / p.resolution_s) * \
-            p.resolution_s
-        t = k * tau + offset
-        keep = t <= duration_s
-        return Pulses(t[keep], k[keep], dt_true[keep], dt[keep])
+        t = k * tau + float(p.offset_s or 0.0)
+        k = k[t <= duration_s]
+        dt_true = np.full(len(k), float(p.offset_s or 0.0))
+        return Pulses(k * tau + dt_true, k, dt_true, _count(dt_true, p.resolution_s))
     period = (1.0 + p.drift_ppm * 1e-6) / p.rate_hz
     offset = rng.uniform(0.0, 1.0 / p.rate_hz) if p.offset_s is None else p.offset_s
     n = int(np.floor((duration_s - offset) / period)) + 1 if offset <= duration_s else 0
