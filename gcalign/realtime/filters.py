@@ -1,0 +1,184 @@
+"""The composite digital filter of seed 003 §2 (spec 003 §2): design, group delay, streaming.
+
+Sensor increments at ``Fs`` = 5 kHz pass, during alignment, a linear-phase FIR low-pass of
+*order* 180 (181 taps); in navigation an IIR notch at the gyro dither frequency, then a FIR
+low-pass of order 40 (41 taps). Seed eq. (1): a linear-phase FIR of order N delays by
+``T = N / (2 Fs)`` — 18 ms and 4 ms. The notch "introduces almost no phase delay" [P]; its
+low-frequency group delay is ``1 − (a1 + 2 a2)/(1 + a1 + a2)`` samples (derivation in
+:func:`notch_dc_delay`), ≈ ``1/(2π f0 Q)`` s: 40.6 µs for 400 Hz, Q = 10 [O], which at
+20 °/s is 2.9″ — not negligible at the arc-second level, so the default delay T used by
+the predictors is the chain's real low-frequency group delay (:attr:`FilterChain.delay`).
+
+The cut-off frequencies, window, notch frequency and Q are not in the seed: they are
+settings (:class:`gcalign.realtime.settings.FilterSettings`) with the spec's [O] defaults.
+
+Streaming: :meth:`FilterChain.apply` filters one chunk and returns the carried state
+(``lfilter`` ``zi``), so a long run is filtered in pieces with the same numbers as in one
+piece (tested).
+
+>>> from gcalign.realtime.settings import FilterSettings
+>>> nav = navigation_chain(FilterSettings())
+>>> round(nav.fir_delay * 1e3, 9), round(nav.notch_delay * 1e6, 2), round(nav.delay * 1e3, 4)
+(4.0, 40.65, 4.0406)
+>>> round(alignment_chain(FilterSettings()).delay * 1e3, 9)
+18.0
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import signal
+
+from gcalign.realtime.settings import FilterSettings
+
+__all__ = [
+    "ChainState",
+    "FilterChain",
+    "alignment_chain",
+    "design_fir",
+    "design_notch",
+    "first_moment",
+    "navigation_chain",
+    "notch_dc_delay",
+]
+
+
+def design_fir(order: int, cutoff_hz: float, fs: float, window: str = "hamming") -> np.ndarray:
+    """Linear-phase FIR low-pass of `order` N (N + 1 taps), unit DC gain (``Σh = 1``).
+
+    ``scipy.signal.firwin(N + 1, cutoff, window, fs)`` (windowed sinc; scaled so the DC
+    gain is 1, which a rate or an increment stream needs to keep its mean). Shape (N + 1,).
+    """
+    h = signal.firwin(order + 1, cutoff_hz, window=window, fs=fs)
+    return h / h.sum()
+
+
+def design_notch(f0_hz: float, q: float, fs: float) -> tuple[np.ndarray, np.ndarray]:
+    """Second-order IIR notch at `f0_hz` with quality factor `q` (``scipy.signal.iirnotch``).
+
+    Returns ``(b, a)``, each shape (3,); ``b = g [1, −2 cos w0, 1]``, ``a = [1, a1, a2]``,
+    unit gain at DC.
+    """
+    b, a = signal.iirnotch(f0_hz, q, fs=fs)
+    return np.asarray(b, dtype=float), np.asarray(a, dtype=float)
+
+
+def first_moment(h: np.ndarray) -> float:
+    """Centre of mass ``Σ k h_k / Σ h_k`` of a FIR (samples): its exact DC group delay, and
+    its group delay at every frequency when ``h`` is symmetric (= N/2)."""
+    h = np.asarray(h, dtype=float)
+    return float(np.arange(len(h)) @ h / h.sum())
+
+
+def notch_dc_delay(b: np.ndarray, a: np.ndarray) -> float:
+    """Low-frequency group delay of ``H = B(z⁻¹)/A(z⁻¹)`` (samples), in closed form.
+
+    The group delay of a polynomial ``P(z⁻¹) = Σ p_k z⁻ᵏ`` at ω → 0 is its first moment
+    ``Σ k p_k / Σ p_k``, and that of a ratio is the difference. ``b`` of a notch is
+    symmetric (moment 1) and ``a = [1, a1, a2]`` has moment ``(a1 + 2 a2)/(1 + a1 + a2)``,
+    so ``τ(0) = 1 − (a1 + 2 a2)/(1 + a1 + a2)`` (spec 003 §2, test 2).
+    """
+    return first_moment(b) - first_moment(a)
+
+
+@dataclass(frozen=True)
+class ChainState:
+    """Carried filter state between chunks: notch ``zi`` (2, m) or None, FIR ``zi`` (N, m)."""
+
+    notch: np.ndarray | None
+    fir: np.ndarray
+
+
+@dataclass(frozen=True)
+class FilterChain:
+    """A notch (optional) followed by a linear-phase FIR, at the sample rate `fs` (Hz).
+
+    Attributes
+    ----------
+    fs : float, Hz
+    h : (N + 1,) float
+        FIR taps, ``Σh = 1``.
+    notch_ba : tuple of (3,) arrays, or None
+        ``(b, a)`` of the notch.
+    """
+
+    fs: float
+    h: np.ndarray
+    notch_ba: tuple[np.ndarray, np.ndarray] | None = None
+
+    @property
+    def order(self) -> int:
+        """FIR order N (taps − 1)."""
+        return len(self.h) - 1
+
+    @property
+    def fir_delay(self) -> float:
+        """FIR group delay ``N / (2 Fs)`` (s), seed eq. (1), from the taps' first moment."""
+        return first_moment(self.h) / self.fs
+
+    @property
+    def notch_delay(self) -> float:
+        """Notch low-frequency group delay (s); 0 without a notch."""
+        if self.notch_ba is None:
+            return 0.0
+        return notch_dc_delay(*self.notch_ba) / self.fs
+
+    @property
+    def delay(self) -> float:
+        """Low-frequency group delay of the whole chain (s): the T of spec 003 §1."""
+        return self.fir_delay + self.notch_delay
+
+    def group_delay(self, freqs_hz: np.ndarray) -> np.ndarray:
+        """Group delay of the chain (s) at `freqs_hz` (``scipy.signal.group_delay``), (F,)."""
+        f = np.asarray(freqs_hz, dtype=float)
+        _, gd = signal.group_delay((self.h, [1.0]), w=f, fs=self.fs)
+        if self.notch_ba is not None:
+            gd = gd + signal.group_delay(self.notch_ba, w=f, fs=self.fs)[1]
+        return gd / self.fs
+
+    def response(self, freqs_hz: np.ndarray) -> np.ndarray:
+        """Complex frequency response of the chain at `freqs_hz`, (F,)."""
+        f = np.asarray(freqs_hz, dtype=float)
+        H = signal.freqz(self.h, [1.0], worN=f, fs=self.fs)[1]
+        if self.notch_ba is not None:
+            H = H * signal.freqz(*self.notch_ba, worN=f, fs=self.fs)[1]
+        return H
+
+    def initial_state(self, channels: int = 1, x0: float | np.ndarray = 0.0) -> ChainState:
+        """State of a chain that has seen the constant input `x0` forever (zero: at rest).
+
+        ``lfilter_zi`` is the steady state for a unit step; each stage's input is the
+        previous stage's output, which for a constant equals it (unit DC gains).
+        """
+        x0 = np.broadcast_to(np.asarray(x0, dtype=float), (channels,))
+        notch = None
+        if self.notch_ba is not None:
+            notch = signal.lfilter_zi(*self.notch_ba)[:, None] * x0[None, :]
+        fir = signal.lfilter_zi(self.h, [1.0])[:, None] * x0[None, :]
+        return ChainState(notch=notch, fir=fir)
+
+    def apply(self, x: np.ndarray, state: ChainState) -> tuple[np.ndarray, ChainState]:
+        """Filter one chunk `x` (n, m) along axis 0 from `state`; returns ``(y, new_state)``."""
+        x = np.asarray(x, dtype=float)
+        zn = state.notch
+        if self.notch_ba is not None:
+            x, zn = signal.lfilter(*self.notch_ba, x, axis=0, zi=zn)
+        y, zf = signal.lfilter(self.h, [1.0], x, axis=0, zi=state.fir)
+        return y, ChainState(notch=zn, fir=zf)
+
+
+def navigation_chain(fs: FilterSettings) -> FilterChain:
+    """Navigation chain: notch at ``notch_hz`` (Q ``notch_q``; none if ``notch_hz`` is None),
+    then the FIR of order ``nav_order`` at ``nav_cutoff_hz`` (seed §2: 40, spec [O] 200 Hz)."""
+    notch = None if fs.notch_hz is None else design_notch(fs.notch_hz, fs.notch_q, fs.fs_hz)
+    return FilterChain(fs.fs_hz, design_fir(fs.nav_order, fs.nav_cutoff_hz, fs.fs_hz,
+                                            fs.window), notch)
+
+
+def alignment_chain(fs: FilterSettings) -> FilterChain:
+    """Alignment chain: the FIR of order ``align_order`` at ``align_cutoff_hz`` (seed §2: 180,
+    spec [O] 100 Hz), no notch."""
+    return FilterChain(fs.fs_hz, design_fir(fs.align_order, fs.align_cutoff_hz, fs.fs_hz,
+                                            fs.window))

@@ -1,0 +1,111 @@
+"""Our Table 1 of seed 003 (§3.2): errors before and after prediction, per case.
+
+For each case the reported component is the one the turn moves (heading for the seed's
+z turns). Metrics skip ``settle_s``; windows of ±``corner_s`` around the ramp corners (steps
+in α) are reported separately (spec 003 §4: the 3-point extrapolation has transients
+there). "Before" is the latched attitude's error: its peak for rate and swing cases, its
+slope during the acceleration phase for the acceleration cases (seed: "error grows
+72″/s"). Both metrics (truth, and the seed's INS-later reference) are given for every
+predictor.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from gcalign.realtime.cases import TABLE1, Case
+from gcalign.realtime.chain import METRICS, CaseResult, run_case
+from gcalign.realtime.settings import Settings
+
+__all__ = ["CaseSummary", "PredictorStats", "summarise", "table1"]
+
+
+@dataclass(frozen=True)
+class PredictorStats:
+    """Errors of one predictor on one case (rad): max |e| and rms away from corners, max |e|
+    within the corner windows (nan without corners), per metric (``truth``, ``seed``)."""
+
+    max: dict[str, float]
+    rms: dict[str, float]
+    corner_max: dict[str, float]
+
+
+@dataclass(frozen=True)
+class CaseSummary:
+    """One row of our Table 1.
+
+    before : dict metric → float
+        rad for rate and swing (peak |error| of ``none``), rad/s for accel (slope).
+    before_theory : dict metric → float
+        The closed form (:meth:`Case.before_theory`) with Tdelay = T_chain + Δt (truth) or
+        T + Δt (seed): the largest Δt for the peaks (rate, swing), the mean Δt for the
+        slope (accel); one value when the pulses sit at a fixed offset.
+    stats : dict predictor → PredictorStats
+    n_pulses : int
+        Pulses evaluated (after the settle time).
+    """
+
+    name: str
+    kind: str
+    before: dict[str, float]
+    before_theory: dict[str, float]
+    stats: dict[str, PredictorStats]
+    n_pulses: int
+
+
+def _masks(res: CaseResult) -> tuple[np.ndarray, np.ndarray]:
+    s = res.settings
+    t = res.pulses.t
+    window = t >= s.settle_s
+    corner = np.zeros(len(t), dtype=bool)
+    for c in res.case.corners(s.duration_s):
+        corner |= np.abs(t - c) <= s.corner_s
+    return window & ~corner, window & corner
+
+
+def _slope(res: CaseResult, metric: str, keep: np.ndarray) -> float:
+    a, b = res.case.accel_window(res.settings.duration_s)
+    t = res.pulses.t
+    sel = keep & (t > a) & (t < b)
+    e = res.error("none", metric)[sel, res.component]
+    return abs(float(np.polyfit(t[sel], e, 1)[0]))
+
+
+def summarise(res: CaseResult) -> CaseSummary:
+    """Table-1 row of one case result."""
+    keep, corner = _masks(res)
+    c = res.component
+    dt = res.pulses.dt_true[keep]
+    dt_peak = float(np.mean(dt) if res.case.kind == "accel" else np.max(dt)) if keep.any() \
+        else 0.0
+    delays = {"truth": res.chain_delay + dt_peak, "seed": res.delay + dt_peak}
+    before, theory = {}, {}
+    for m in METRICS:
+        theory[m] = res.case.before_theory(delays[m])
+        if res.case.kind == "accel":
+            before[m] = _slope(res, m, keep)
+        else:
+            before[m] = float(np.max(np.abs(res.error("none", m)[keep, c])))
+    stats = {}
+    for p in res.predicted:
+        mx, rms, cm = {}, {}, {}
+        for m in METRICS:
+            e = res.error(p, m)[:, c]
+            mx[m] = float(np.max(np.abs(e[keep])))
+            rms[m] = float(np.sqrt(np.mean(e[keep] ** 2)))
+            cm[m] = float(np.max(np.abs(e[corner]))) if corner.any() else math.nan
+        stats[p] = PredictorStats(max=mx, rms=rms, corner_max=cm)
+    return CaseSummary(name=res.case.name, kind=res.case.kind, before=before,
+                       before_theory=theory, stats=stats, n_pulses=int(keep.sum()))
+
+
+def table1(settings: Settings, rng: np.random.Generator,
+           cases: Sequence[Case] = TABLE1) -> list[CaseResult]:
+    """Run the seed's 12 cases (or `cases`) with `settings`; each case draws from its own
+    child generator (``rng.spawn``), so a case's numbers do not depend on the others."""
+    children = rng.spawn(len(cases))
+    return [run_case(c, settings, g) for c, g in zip(cases, children, strict=True)]

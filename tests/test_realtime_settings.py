@@ -1,0 +1,69 @@
+"""Bad settings of a real-time run are rejected with one line naming the setting
+(gcalign.realtime.settings, cases; must-show 7, the parts below the command line)."""
+
+from __future__ import annotations
+
+import pytest
+
+from gcalign.realtime import Case, FilterSettings, PulseSettings, Settings, TrackerSettings
+from gcalign.realtime.cases import check_case
+from gcalign.units import DEG
+
+
+def _swing(f):
+    return Case(name="s", kind="swing", amplitude=DEG, frequency=f)
+
+
+BAD = [
+    ("pulse rate above the solution rate", lambda: Settings(pulses=PulseSettings(rate_hz=2000.0)),
+     "pulses.rate_hz must be ≤ solution_hz = 1000 Hz"),
+    ("async pulse rate above the solution rate",
+     lambda: Settings(pulses=PulseSettings(mode="async", rate_hz=1500.0)),
+     "pulses.rate_hz must be ≤ solution_hz"),
+    ("filter order < 1", lambda: FilterSettings(nav_order=0),
+     "filter.nav_order must be an integer ≥ 1"),
+    ("alignment order < 1", lambda: FilterSettings(align_order=-3),
+     "filter.align_order must be an integer ≥ 1"),
+    ("notch at Nyquist", lambda: FilterSettings(notch_hz=2500.0),
+     "filter.notch_hz must be in (0, 2500) Hz"),
+    ("notch above Nyquist", lambda: FilterSettings(notch_hz=3000.0), "filter.notch_hz"),
+    ("sample rate not a multiple of the solution rate",
+     lambda: Settings(filter=FilterSettings(fs_hz=4800.0)),
+     "filter.fs_hz must be a whole multiple of solution_hz = 1000 Hz, got 4800 Hz"),
+    ("solution rate above the sample rate", lambda: Settings(solution_hz=10000.0),
+     "filter.fs_hz must be a whole multiple"),
+    ("Qc = 0", lambda: TrackerSettings(qc=0.0), "tracker.qc must be a finite number > 0"),
+    ("Qc < 0", lambda: TrackerSettings(qc=-1.0), "tracker.qc must be a finite number > 0"),
+    ("R = 0", lambda: TrackerSettings(r=0.0), "tracker.r must be a finite number > 0"),
+    ("R < 0", lambda: TrackerSettings(r=-1e-12), "tracker.r must be a finite number > 0"),
+    ("swing frequency above Nyquist", lambda: check_case(_swing(600.0), Settings()),
+     "swing frequency must be below the Nyquist frequency of the 1000 Hz attitude solution"),
+    ("swing frequency zero", lambda: _swing(0.0), "swing frequency must be > 0 Hz"),
+    ("cut-off above Nyquist", lambda: FilterSettings(nav_cutoff_hz=2600.0),
+     "filter.nav_cutoff_hz must be in (0, 2500) Hz"),
+    ("pulses not on solution instants", lambda: Settings(pulses=PulseSettings(rate_hz=300.0)),
+     "pulses.rate_hz must divide solution_hz"),
+    ("unknown predictor", lambda: Settings(predictors=("kalman",)), "predictors must be"),
+    ("ramp that cannot reach its rate",
+     lambda: check_case(Case(name="r", kind="accel", accel=0.1 * DEG, rate=15 * DEG),
+                        Settings()), "ramp: reaching"),
+]
+
+
+@pytest.mark.parametrize(("what", "make", "message"), BAD, ids=[b[0] for b in BAD])
+def test_bad_settings_raise_one_line_naming_the_setting(what, make, message):
+    with pytest.raises(ValueError) as info:
+        make()
+    text = str(info.value)
+    assert message in text
+    assert "\n" not in text
+
+
+def test_defaults_are_the_spec_proposals():
+    s = Settings()
+    assert (s.filter.fs_hz, s.solution_hz, s.samples_per_solution) == (5000.0, 1000.0, 5)
+    assert (s.filter.align_order, s.filter.nav_order) == (180, 40)
+    assert (s.filter.notch_hz, s.filter.notch_q) == (400.0, 10.0)
+    assert (s.filter.align_cutoff_hz, s.filter.nav_cutoff_hz) == (100.0, 200.0)
+    assert s.tracker.qc == 1.0
+    assert s.delay_s is None  # T from the chain
