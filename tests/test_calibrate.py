@@ -36,6 +36,7 @@ from gcalign.calibrate import (
 )
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
+from gcalign.nav.earth import WGS84
 from gcalign.sim.imu import ideal_imu
 from gcalign.units import DEG
 
@@ -318,6 +319,30 @@ def test_zero_velocity_alignment_on_lasergyro(start_s):
     gyrocompass = np.degrees(run_alignment(sc, scenario_data(sc)).att_t2)
     assert yaw == pytest.approx(gyrocompass[2], abs=0.05)
     np.testing.assert_allclose(np.degrees(r.att[-1, :2]), gyrocompass[:2], atol=0.01)
+
+
+def test_designed_trajectory_envelope():
+    """Spec §3 and §6 item 13 on the stand-in: 590 s in total, 90 m/s after the ground roll
+    (89.96 m/s after 13.84 s), a 60° climb at the end of the pitch-up, 165 m/s for the
+    roll and turns, a net heading change of a whole turn (left 180, right 90, left 90,
+    left 180), and the spec's envelope (independent check: 7987 m, 14.85 km)."""
+    data = _flight(designed_590)
+    tr, seg = data.truth, {sp.name: sp for sp in data.segments}
+    assert tr.t[-1] == pytest.approx(590.0)
+
+    def at(t):
+        return int(round(t / TS))
+
+    speed = np.linalg.norm(tr.v_n, axis=1)
+    assert speed[at(seg["ground roll"].end)] == pytest.approx(89.96, abs=1e-6)
+    assert np.degrees(tr.att[at(seg["pitch-up"].end), 0]) == pytest.approx(60.0, abs=1e-9)
+    assert speed[at(seg["roll left"].start)] == pytest.approx(164.96, abs=1e-6)
+    assert np.degrees(tr.att[-1, 2] - tr.att[0, 2]) == pytest.approx(360.0, abs=1e-9)
+    r_m, r_n = WGS84.radii(SITE[0])
+    north = (tr.pos[:, 0] - SITE[0]) * r_m
+    east = (tr.pos[:, 1] - SITE[1]) * r_n * np.cos(SITE[0])
+    assert tr.pos[:, 2].max() == pytest.approx(7987.0, rel=2e-3)
+    assert np.hypot(north, east).max() == pytest.approx(14850.0, rel=2e-2)
 
 
 def test_settings_are_frozen_values():

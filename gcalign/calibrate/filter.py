@@ -93,8 +93,10 @@ class Settings:
                                 f"{self.filter_rate!r}")
         ratio = rate / self.filter_rate
         if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
-            raise ScenarioError(f"filter_rate: must divide the navigation rate {rate:g} Hz "
-                                f"(e.g. {rate / max(1, round(ratio)):g}), got {self.filter_rate:g}")
+            divisors = [rate / n for n in range(1, int(rate) + 1) if (rate / n).is_integer()]
+            raise ScenarioError(f"filter_rate: must be the navigation rate {rate:g} Hz divided by "
+                                f"a whole number (e.g. {', '.join(f'{d:g}' for d in divisors)} Hz),"
+                                f" got {self.filter_rate:g}")
         return int(round(ratio))
 
     def covariances(self, pos):
@@ -204,12 +206,13 @@ def _scaled_solve(P: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 def _measurement(measure: str, v_n, pos, ref_v, ref_pos, noise) -> np.ndarray:
     """z = INS − reference − noise (seed eqs. 5–7); position in metres north, east."""
+    dv = v_n[:2] - ref_v[:2]
+    if measure == "velocity":
+        return dv - noise
     r_m, r_n = WGS84.radii(pos[0])
-    dp = [(pos[0] - ref_pos[0]) * (r_m + pos[2]),
-          (pos[1] - ref_pos[1]) * (r_n + pos[2]) * np.cos(pos[0])]
-    z = {"velocity": v_n[:2] - ref_v[:2], "position": np.array(dp),
-         "both": np.r_[v_n[:2] - ref_v[:2], dp]}[measure]
-    return z - noise
+    dp = np.array([(pos[0] - ref_pos[0]) * (r_m + pos[2]),
+                   (pos[1] - ref_pos[1]) * (r_n + pos[2]) * np.cos(pos[0])])
+    return (dp if measure == "position" else np.concatenate([dv, dp])) - noise
 
 
 def _noise_sigma(s: Settings) -> np.ndarray:
@@ -295,8 +298,8 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         sig[k + 1], P = np.sqrt(np.diag(u.P)), u.P
         est[k + 1, NAV] = u.x[NAV]
         if truth is not None and x_true is not None:
-            e = np.r_[_phi(q, q_true[k + 1]), v - truth.v_n[j], p - truth.pos[j],
-                      _imu_residual(x_true, imu)]
+            e = np.concatenate([_phi(q, q_true[k + 1]), v - truth.v_n[j], p - truth.pos[j],
+                                _imu_residual(x_true, imu)])
             nees[k + 1] = float((e - u.x) @ _scaled_solve(u.P, e - u.x))
             tru[k + 1, NAV], tru[k + 1, IMU] = e[NAV], x_true[IMU]
         if hist is not None:

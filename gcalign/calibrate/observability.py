@@ -121,7 +121,7 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
     # O_j = Q_j R_j: every stack of O_j (SOM) or O_j M (TOM) has the singular values and
     # right vectors of the same stack of R_j, half the rows
     O = ob.piece_matrix(pc.F, H)
-    Rp = np.linalg.qr(O, mode="r")
+    Rp = np.asarray(np.linalg.qr(O, mode="r"))
     Phi = np.array([expm(F * d) for F, d in zip(pc.F, pc.duration, strict=True)])
     # condition of seed eq. (12), in the coordinates the ranks are taken in (x = diag(sc) y)
     resid_piece = ob.null_space_residual(Rp * sc, pc.F * sc / sc[:, None], rtol)
