@@ -274,16 +274,17 @@ def test_section_41_covariance_degree_is_at_least_one():
 
 def test_calibration_time_590_s():
     """Must-show 6: one 590 s calibration (25 Hz navigation, 1 Hz filter, NEES against the
-    truth) within 0.5 s warm; asserted at 1.5 s for the best of three here (shared machine),
-    the benchmark prints the median (benchmarks/bench_calibrate.py)."""
+    truth) within 0.5 s warm; asserted here as at most 1 s of this process's CPU time, best
+    of three (the machine is shared); benchmarks/bench_calibrate.py prints the wall-clock
+    median."""
     data = _flight(designed_590, proposed_truth(), ie.ARW_DEFAULT, ie.VRW_DEFAULT)
     calibrate(data, Settings(), np.random.default_rng(0))
     best = np.inf
     for _ in range(3):
-        start = time.perf_counter()
+        start = time.process_time()
         calibrate(data, Settings(), np.random.default_rng(0))
-        best = min(best, time.perf_counter() - start)
-    assert best < 1.5
+        best = min(best, time.process_time() - start)
+    assert best < 1.0
 
 
 # --------------------------------------------------------------------------- real data

@@ -262,16 +262,38 @@ def test_bad_table_input():
 
 def test_table_time_on_the_590_s_trajectory():
     """Must-show 6: the observability table of the 590 s designed trajectory (21 segments,
-    590 pieces, SOM/TOM/null space, covariance degree) within 0.5 s warm (0.2 s with one
-    BLAS thread); asserted at 1.5 s for the best of three here because the machine is shared
-    (benchmarks/bench_calibrate.py prints the median against the target)."""
+    590 pieces, SOM/TOM/null space, covariance degree) within 0.5 s warm; asserted here as
+    at most 1 s of this process's CPU time, best of three, because the machine is shared
+    (benchmarks/bench_calibrate.py prints the wall-clock median against the target)."""
     motion, names = designed_590()
     data = simulate_flight(motion, SITE, TS, np.zeros(21), 0.0, 0.0, np.random.default_rng(0),
                            names)
     observability_table(data.truth, data.segments)
     best = np.inf
     for _ in range(3):
-        start = time.perf_counter()
+        start = time.process_time()
         observability_table(data.truth, data.segments)
-        best = min(best, time.perf_counter() - start)
-    assert best < 1.5
+        best = min(best, time.process_time() - start)
+    assert best < 1.0
+
+
+def test_expm_stack_and_r_factor_equal_the_lapack_routes():
+    """The observability table avoids LAPACK's tall and threaded paths (they collapse on a
+    shared machine); its matrix exponential and triangular factor agree with scipy's expm
+    and numpy's SVD to 1e-12 on the flight's own F (entries from 1e-13 to 26)."""
+    from scipy.linalg import expm
+
+    motion, names = section_41_set()
+    data = simulate_flight(motion, SITE, TS, np.zeros(21), 0.0, 0.0, np.random.default_rng(0),
+                           names)
+    pc = pieces(data.truth, data.segments)
+    E = ob.expm_stack(pc.F[::20] * pc.duration[::20, None, None])
+    for Fj, dj, Ej in zip(pc.F[::20], pc.duration[::20], E, strict=True):
+        ref = expm(Fj * dj)
+        np.testing.assert_allclose(Ej, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    A = ob.som(ob.piece_matrix(pc.F[:200], ie.measurement_matrix("velocity", SITE)))
+    R = ob.r_factor(A)
+    assert R.shape == (21, 21)
+    s_ref = np.linalg.svd(A, compute_uv=False)
+    np.testing.assert_allclose(np.linalg.svd(R, compute_uv=False), s_ref, rtol=1e-10,
+                               atol=1e-13 * s_ref[0])

@@ -10,7 +10,8 @@ Modules
 -------
 - :mod:`gcalign.calibrate.data` -- inputs as plain arrays (:class:`FlightData`,
   :class:`Trajectory`, :class:`Span`), simulation from a motion, zero-velocity data.
-- :mod:`gcalign.calibrate.filter` -- :func:`calibrate`, :func:`covariance_run`, :func:`rts`.
+- :mod:`gcalign.calibrate.filter` -- :func:`calibrate`, :func:`covariance_run` (the RTS
+  smoother is :func:`gcalign.estimation.kalman.rts`).
 - :mod:`gcalign.calibrate.observability` -- :func:`observability_table`.
 
 The error model is :mod:`gcalign.estimation.ins_error`, the Kalman steps
@@ -34,13 +35,12 @@ from gcalign.calibrate.filter import (
     Settings,
     calibrate,
     covariance_run,
-    rts,
 )
 from gcalign.calibrate.observability import ObservabilityTable, observability_table
 
 __all__ = [
     "CalibrationResult", "CovarianceRun", "FlightData", "ObservabilityTable", "Settings", "Span",
     "Trajectory", "calibrate", "covariance_run", "draw_truth", "flight_from_ideal",
-    "observability_table", "perturb", "proposed_truth", "rts",
+    "observability_table", "perturb", "proposed_truth",
     "simulate_flight", "zero_velocity_data",
 ]

@@ -35,7 +35,8 @@ from gcalign.calibrate.data import FlightData, Trajectory
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
 from gcalign.estimation.ins_error import DB, DKA, DKG, DP, DV, EB, IMU, N_STATES, NAV, PHI
-from gcalign.estimation.kalman import predict, update, van_loan
+from gcalign.estimation.kalman import nees as nees_of
+from gcalign.estimation.kalman import predict, rts, update, van_loan
 from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import (
     euler_to_quat,
@@ -197,13 +198,6 @@ def _phi(q_est: np.ndarray, q_true: np.ndarray) -> np.ndarray:
     return quat_to_rotvec(quat_mult(q_true, quat_conj(q_est)))
 
 
-def _scaled_solve(P: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """P⁻¹ B for a covariance whose diagonal spans many decades (solved in σ units)."""
-    d = np.sqrt(np.diag(P))
-    return np.linalg.solve(P / np.outer(d, d), B / (d[:, None] if B.ndim == 2 else d)) / (
-        d[:, None] if B.ndim == 2 else d)
-
-
 def _measurement(measure: str, v_n, pos, ref_v, ref_pos, noise) -> np.ndarray:
     """z = INS − reference − noise (seed eqs. 5–7); position in metres north, east."""
     dv = v_n[:2] - ref_v[:2]
@@ -279,7 +273,7 @@ def calibrate(data: FlightData, settings: Settings | None = None,
     if truth is not None and x_true is not None:
         q_true = euler_to_quat(truth.att[::S][: K + 1])
         tru[0] = x_true
-        nees[0] = float(x_true @ _scaled_solve(P0, x_true))
+        nees[0] = nees_of(x_true, P0)
 
     for k in range(K):
         blk = slice(k * S, (k + 1) * S)
@@ -300,7 +294,7 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         if truth is not None and x_true is not None:
             e = np.concatenate([_phi(q, q_true[k + 1]), v - truth.v_n[j], p - truth.pos[j],
                                 _imu_residual(x_true, imu)])
-            nees[k + 1] = float((e - u.x) @ _scaled_solve(u.P, e - u.x))
+            nees[k + 1] = nees_of(e - u.x, u.P)
             tru[k + 1, NAV], tru[k + 1, IMU] = e[NAV], x_true[IMU]
         if hist is not None:
             hist.Phi[k], hist.P_prior[k], hist.x_prior[k] = Phi, P_prior, x_prior
@@ -325,26 +319,6 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         nees=nees if known else None, innovation=innov, standardized=stdz, nis=nis,
         att=quat_to_euler(quat), v_n=vel, pos=posn,
         measure_names=ie.MEASUREMENT_NAMES[s.measure], settings=s, smoothed=smoothed)
-
-
-def rts(Phis, P_prior, x_prior, P_post, x_post):
-    """Rauch–Tung–Striebel smoother over K filter steps.
-
-    Phis (K, n, n): transition from epoch k to k+1; P_prior, x_prior (K, …): the prediction
-    at epoch k+1; P_post, x_post (K+1, …): the posterior at epoch k (epoch 0: the prior).
-    ``C_k = P⁺_k Φ_kᵀ (P⁻_{k+1})⁻¹``, ``x^s_k = x⁺_k + C_k (x^s_{k+1} − x⁻_{k+1})``,
-    ``P^s_k = P⁺_k + C_k (P^s_{k+1} − P⁻_{k+1}) C_kᵀ``. In closed loop x⁻ = 0 and the
-    recursion is unchanged: the feedback is a known input and cancels.
-    Returns ``(x_s (K+1, n), P_s (K+1, n, n))``.
-    """
-    K = len(Phis)
-    xs, Ps = x_post.copy(), P_post.copy()
-    for k in range(K - 1, -1, -1):
-        Ck = _scaled_solve(P_prior[k], Phis[k] @ P_post[k]).T
-        xs[k] = x_post[k] + Ck @ (xs[k + 1] - x_prior[k])
-        Pk = P_post[k] + Ck @ (Ps[k + 1] - P_prior[k]) @ Ck.T
-        Ps[k] = 0.5 * (Pk + Pk.T)
-    return xs, Ps
 
 
 def _smooth(h: _History, feedback: bool) -> Smoothed:

@@ -14,7 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.linalg import expm
 
 from gcalign.calibrate.data import Span, Trajectory
 from gcalign.calibrate.filter import Settings, covariance_run
@@ -89,8 +88,7 @@ def pieces(truth: Trajectory, segments, piece_s: float = 1.0) -> Pieces:
 
 def _stack_r(R: np.ndarray | None, rows: np.ndarray) -> np.ndarray:  # (≤ n, n)
     """Triangular factor of ``[R; rows]``: the SVD of a stack only needs it."""
-    A = rows if R is None else np.vstack([R, rows])
-    return np.asarray(np.linalg.qr(A, mode="r")) if A.shape[0] > A.shape[1] else A
+    return ob.r_factor(rows if R is None else np.vstack([R, rows]))
 
 
 def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: str = "velocity",
@@ -122,7 +120,7 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
     # right vectors of the same stack of R_j, half the rows
     O = ob.piece_matrix(pc.F, H)
     Rp = np.asarray(np.linalg.qr(O, mode="r"))
-    Phi = np.array([expm(F * d) for F, d in zip(pc.F, pc.duration, strict=True)])
+    Phi = ob.expm_stack(pc.F * pc.duration[:, None, None])
     # condition of seed eq. (12), in the coordinates the ranks are taken in (x = diag(sc) y)
     resid_piece = ob.null_space_residual(Rp * sc, pc.F * sc / sc[:, None], rtol)
 
