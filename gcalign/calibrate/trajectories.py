@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-from gcalign.sim.motions import Motion, Segment
+from gcalign.sim.motions import Moving, Segment
 
 Stage = tuple[str, float, float, tuple[float, float, float]]
 
@@ -67,10 +67,9 @@ DESIGNED: tuple[Stage, ...] = (
 CONVENTIONAL: tuple[Stage, ...] = DESIGNED[:6]
 
 
-def moving_motion(stages, yaw0: float = 0.0) -> tuple[Motion, list[str]]:
+def moving_motion(stages, yaw0: float = 0.0) -> tuple[Moving, list[str]]:
     """The ``moving`` motion of a stage table, and the stage names. `yaw0` in rad."""
     d = math.pi / 180.0
     segs = tuple(Segment(dur, acc, (p * d, r * d, y * d)) for _, dur, acc, (p, r, y) in stages)
-    return (Motion(kind="moving", att0=(0.0, 0.0, yaw0),
-                   duration=sum(s.duration for s in segs), segments=segs),
+    return (Moving((0.0, 0.0, yaw0), sum(s.duration for s in segs), segs),
             [name for name, *_ in stages])
