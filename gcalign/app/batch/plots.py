@@ -2,7 +2,8 @@
 
 - A grid with a numeric key (``align.stages.0.t_z_s: [100, 120, …]``): the median over
   seeds of |metric| against that key, one line per combination of the other grid values,
-  one column per case of the sweep, one row per vector component (:func:`sweep_figure`).
+  one column per case of the sweep (when other grid values draw the lines), one row per
+  vector component (:func:`sweep_figure`).
 - Otherwise: box plots of the distribution over seeds, one box per variant, one subplot per
   vector component (:func:`batch_figure`).
 """
@@ -19,12 +20,34 @@ from gcalign.app.batch.sweep import CASE_KEY
 from gcalign.app.plots import _s, new_figure
 
 
+def _short_keys(keys: list[str]) -> dict[str, str]:
+    """The last part of each dotted key where it is unique (``t_z_s``), else the key."""
+    tails = [k.rsplit(".", 1)[-1] for k in keys]
+    return {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
+
+
+def _pairs(overrides: dict, keys: list[str], sep: str) -> str:
+    """``key=value`` of the given override keys, short key names, floats as ``%g``."""
+    short = _short_keys(keys)
+    return sep.join(f"{short[k]}={overrides[k]:g}" if isinstance(overrides[k], float) else
+                    f"{short[k]}={overrides[k]}" for k in keys if k in overrides)
+
+
 def _variant_label(overrides: dict, grid_keys: list[str]) -> str:
-    tails = [k.rsplit(".", 1)[-1] for k in grid_keys]
-    short = {k: (t if tails.count(t) == 1 else k)
-             for k, t in zip(grid_keys, tails, strict=True)}
-    return "\n".join(f"{short.get(k, k)}={v:g}" if isinstance(v, float) else
-                     f"{short.get(k, k)}={v}" for k, v in overrides.items()) or "base"
+    return _pairs(overrides, [*grid_keys, *(k for k in overrides if k not in grid_keys)],
+                  "\n") or "base"
+
+
+def _values_and_components(values, components: list[str] | None):
+    """Values as (R, k) and the names of the panels: the components, or one pooled panel
+    for more than 3 of them."""
+    values = np.asarray(values, float)
+    if values.ndim == 1:
+        values = values[:, None]
+    k = values.shape[1]
+    if k > 3:
+        return values, ["all components pooled"], True
+    return values, components or ([""] if k == 1 else [str(i) for i in range(k)]), False
 
 
 def batch_figure(metric: str, values: np.ndarray, variant: np.ndarray, labels: list[str],
@@ -36,14 +59,7 @@ def batch_figure(metric: str, values: np.ndarray, variant: np.ndarray, labels: l
     labels : one per variant (its overrides). More than 3 components (e.g. the errors at
     every azimuth of a north-finding sweep) are pooled into one subplot.
     """
-    values = np.asarray(values, float)
-    if values.ndim == 1:
-        values = values[:, None]
-    k = values.shape[1]
-    pooled = k > 3
-    comps = ["all components pooled"] if pooled else (components or
-                                                      ([""] if k == 1 else [str(i) for i in
-                                                                           range(k)]))
+    values, comps, pooled = _values_and_components(values, components)
     n_var = len(labels)
     fig, axes = new_figure(len(comps), width=max(6.0, 1.1 * n_var + 3.0),
                            height=2.8 * len(comps) + 1.4)
@@ -76,11 +92,6 @@ def numeric_axes(grid: dict) -> list[str]:
             if k != CASE_KEY and all(map(_is_number, vals)) and len(set(vals)) >= 2]
 
 
-def _short_keys(keys: list[str]) -> dict[str, str]:
-    tails = [k.rsplit(".", 1)[-1] for k in keys]
-    return {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
-
-
 def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides: list[dict],
                  x_key: str, components: list[str] | None = None, units: str = "",
                  title: str | None = None, name: str | None = None) -> Figure:
@@ -94,14 +105,8 @@ def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides
     A row shares one y scale, logarithmic when its medians span more than a factor 30 and
     are all > 0.
     """
-    values = np.abs(np.asarray(values, float))
-    if values.ndim == 1:
-        values = values[:, None]
-    k = values.shape[1]
-    pooled = k > 3
-    comps = ["all components pooled"] if pooled else (components or
-                                                      ([""] if k == 1 else [str(i) for i in
-                                                                           range(k)]))
+    values, comps, pooled = _values_and_components(values, components)
+    values = np.abs(values)
     keys = [key for key in dict.fromkeys(key for o in overrides for key in o) if key != x_key]
     other = [key for key in keys if key != CASE_KEY]
     # Cases get a column each when other grid values draw the lines; else they are the lines.
@@ -109,11 +114,8 @@ def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides
     cases = list(dict.fromkeys(o.get(CASE_KEY) for o in overrides)) if by_column else [None]
     if not by_column and CASE_KEY in keys:
         other = [CASE_KEY]
-    short = _short_keys(other)
-
     def line_of(o: dict) -> str:
-        return ", ".join(f"{short[key]}={o[key]:g}" if isinstance(o[key], float) else
-                         f"{short[key]}={o[key]}" for key in other if key in o) or "median"
+        return _pairs(o, other, ", ") or "median"
 
     lines = list(dict.fromkeys(line_of(o) for o in overrides))
     fig, axes = new_figure(len(comps), len(cases), width=4.3 * len(cases) + 1.5,
