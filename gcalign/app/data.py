@@ -143,7 +143,7 @@ def _simulation(scenario: Scenario):
 def scenario_stream(scenario: Scenario, seed: int | None = None,
                     block: int | None = None) -> Stream:
     """The scenario's data as blocks (simulated with its sensor errors, or recorded)."""
-    from gcalign.sim.ideal import BLOCK, ideal_blocks, initial_truth
+    from gcalign.sim.ideal import ideal_blocks, initial_truth
 
     earth = scenario.earth_model
     if scenario.imu_file is not None:
@@ -157,7 +157,7 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
 
     def simulated_blocks() -> Iterator[DataBlock]:
         stream = ErrorStream(errors, ts, np.random.default_rng(seed), n)
-        for b in ideal_blocks(motion, site, ts, earth, mech, block=block or BLOCK):
+        for b in ideal_blocks(motion, site, ts, earth, mech, block=block):
             dtheta, dv = stream.apply(b.dtheta, b.dv)
             yield DataBlock(b.k0, b.t, dtheta, dv,
                             BlockTruth(b.att, b.q_nb, b.v_n, b.pos, b.segment), b.q_bs)
