@@ -139,9 +139,9 @@ class Case:
 
     def __post_init__(self) -> None:
         if not self.steps:
-            raise ValueError(f"case {self.name!r}: steps: a case needs at least one row")
+            raise ValueError(f"steps: case {self.name!r} needs at least one row")
         if self.duration_s is not None and not self.duration_s > 0:
-            raise ValueError(f"case {self.name!r}: duration_s: must be > 0, "
+            raise ValueError(f"duration_s: must be > 0 (case {self.name!r}), "
                              f"got {self.duration_s!r}")
 
     # ------------------------------------------------------------------ motion
@@ -225,10 +225,10 @@ def accel_case(name: str, accel: float, rate_limit: float, duration: float, *,
     """Rest `rest_s`, then from rest uniform acceleration `accel` (rad/s², optional finite
     `jerk`, rad/s³) up to `rate_limit` (rad/s), held to the end; `duration` (s) in all."""
     if not 0 <= rest_s < duration:
-        raise ValueError(f"case {name!r}: rest_s: must be in [0, duration), got {rest_s!r}")
-    steps = (Step(axis, AngleProfile.rest(rest_s)),) if rest_s > 0 else ()
-    steps += (Step(axis, AngleProfile.ramp(accel, rate_limit, duration - rest_s, jerk)),)
-    return Case(name=name, steps=steps, **kw)
+        raise ValueError(f"rest_s: must be in [0, duration) (case {name!r}), got {rest_s!r}")
+    steps = [Step(axis, AngleProfile.rest(rest_s))] if rest_s > 0 else []
+    steps.append(Step(axis, AngleProfile.ramp(accel, rate_limit, duration - rest_s, jerk)))
+    return Case(name=name, steps=tuple(steps), **kw)
 
 
 def swing_case(name: str, amplitude: float, frequency: float, duration: float, *,
@@ -273,9 +273,10 @@ def table1_cases(duration_s: float = 12.0) -> tuple[Case, ...]:
 
 def async_case(duration_s: float = 12.0) -> Case:
     """A 13th case (not in the seed): 20 °/s with asynchronous 100 Hz pulses from a clock
-    50 ppm off the INS's, 2 µs jitter, Δt counted at 1 µs — Δt then sweeps [0, τ)."""
+    100 ppm off the INS's, 2 µs jitter, Δt counted at 1 µs — Δt then sweeps the solution
+    interval [0, τ) once every 10 s (1 µs per pulse)."""
     return rate_case("rate 20°/s async", 20.0 * DEG, duration_s, pulses=PulseSettings(
-        mode="async", rate_hz=100.0, offset_s=None, jitter_s=2e-6, drift_ppm=50.0,
+        mode="async", rate_hz=100.0, offset_s=None, jitter_s=2e-6, drift_ppm=100.0,
         resolution_s=1e-6))
 
 
