@@ -76,7 +76,6 @@ from gcalign.io.scenario.base import Model, Vec3
 from gcalign.io.scenario.schedule import RowModel
 from gcalign.realtime.cases import Case, check_case
 from gcalign.realtime.settings import (
-    PREDICTORS,
     FilterSettings,
     PulseSettings,
     SensorSettings,
@@ -87,6 +86,7 @@ from gcalign.realtime.settings import (
 from gcalign.sim.schedule import Step
 
 PredictorName = Literal["none", "taylor", "kalman-ls"]
+DEFAULT_PREDICTORS: list[PredictorName] = ["none", "taylor", "kalman-ls"]  # = core PREDICTORS
 SEED_DELAY_MS = 4.0  #: the seed's T (§3.2: n = 4 solution intervals of 1 ms)
 MAX_CASES = 100
 MAX_SAMPLES = 50_000_000  #: sensor samples of all cases together (a run holds its pulses)
@@ -192,7 +192,7 @@ class RealtimeConfig(Model):
     semi_physical: bool = False
     solution_hz: float = Field(1000.0, gt=0)
     delay_ms: float | None = Field(None, ge=0, description="T used; null: the chain's delay")
-    predictors: list[PredictorName] = Field(default_factory=lambda: list(PREDICTORS),
+    predictors: list[PredictorName] = Field(default_factory=lambda: list(DEFAULT_PREDICTORS),
                                             min_length=1)
     filter: FilterConfig = Field(default_factory=FilterConfig)
     sensor: SensorConfig = Field(default_factory=SensorConfig)
