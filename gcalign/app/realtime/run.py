@@ -90,20 +90,25 @@ def _as(x: float) -> float | None:
     return None if not math.isfinite(x) else float(x) / u.ARCSEC
 
 
+def _user(x: float, unit: float = 1.0) -> float:
+    """SI → user units, without the round trip's last-digit noise (15 °/s, not 14.999…)."""
+    return float(f"{x / unit:.12g}")
+
+
 def _motion(case: Case) -> dict:
     s = case.shape
     d = u.DEG
     out: dict = {"motion": s.kind, "axis": None if s.axis is None else list(s.axis),
                  "component": COMPONENTS[case.component], "duration_s": case.duration,
-                 "attitude_deg": list(np.degrees(case.att0))}
+                 "attitude_deg": [_user(a, d) for a in case.att0]}
     if s.kind in ("rate", "accel"):
-        out["rate_dps"] = s.rate / d
+        out["rate_dps"] = _user(s.rate, d)
     if s.kind == "accel":
-        out["accel_dps2"] = s.accel / d
-        out["jerk_dps3"] = None if s.jerk is None else s.jerk / d
+        out["accel_dps2"] = _user(s.accel, d)
+        out["jerk_dps3"] = None if s.jerk is None else _user(s.jerk, d)
     if s.kind == "swing":
-        out["amplitude_deg"] = s.amplitude / d
-        out["frequency_hz"] = s.frequency
+        out["amplitude_deg"] = _user(s.amplitude, d)
+        out["frequency_hz"] = _user(s.frequency)
     return out
 
 
