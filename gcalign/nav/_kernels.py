@@ -316,6 +316,7 @@ def error_block(states, q_bs, has_qbs, att_t, q_t, v_t, pos_t, has_truth, E, pos
     rows = 0
     e = np.zeros(12)
     two_pi = 2.0 * math.pi
+    r_mt, r_nt, _, _, clt = earth_at(E, pos_t[0, 0], pos_t[0, 2])  # a fixed truth: once
     for i in range(n):
         q0, q1, q2, q3 = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
         if has_qbs:
@@ -333,9 +334,10 @@ def error_block(states, q_bs, has_qbs, att_t, q_t, v_t, pos_t, has_truth, E, pos
             e[2] = (y - att_t[j, 2] + math.pi) % two_pi - math.pi
             for c in range(3):
                 e[3 + c] = states[i, 4 + c] - v_t[j, c]
-            r_m, r_n, _, _, cl = earth_at(E, pos_t[j, 0], pos_t[j, 2])
-            e[6] = (lon - pos_t[j, 1]) * (r_n + pos_t[j, 2]) * cl
-            e[7] = (lat - pos_t[j, 0]) * (r_m + pos_t[j, 2])
+            if nt > 1:
+                r_mt, r_nt, _, _, clt = earth_at(E, pos_t[j, 0], pos_t[j, 2])
+            e[6] = (lon - pos_t[j, 1]) * (r_nt + pos_t[j, 2]) * clt
+            e[7] = (lat - pos_t[j, 0]) * (r_mt + pos_t[j, 2])
             e[8] = h - pos_t[j, 2]
             # φ = −rotvec(q_est ⊗ q_true*)
             dw, dx, dy, dz = qmul(q0, q1, q2, q3, q_t[j, 0], -q_t[j, 1], -q_t[j, 2], -q_t[j, 3])

@@ -107,39 +107,35 @@ def run_chunk(tasks: list[dict]) -> list[dict]:
 
 
 def kernel_cache_stats() -> dict:
-    """Numba dispatchers of gcalign loaded in this process: cache hits and misses.
-
-    A miss means the kernel was compiled here instead of loaded from the on-disk cache.
-    """
+    """Numba dispatchers of gcalign loaded in this process: cache hits and misses, and the
+    dispatchers that missed (a miss means the kernel was compiled here instead of loaded
+    from the on-disk cache)."""
     hits = misses = 0
-    for name in ("gcalign.nav._kernels", "gcalign.align.kernel", "gcalign.northfind._kernel"):
-        mod = sys.modules.get(name)
-        for obj in vars(mod).values() if mod else ():
+    missed = []
+    for name, mod in list(sys.modules.items()):
+        if not name.startswith("gcalign.") or mod is None:
+            continue
+        for attr, obj in vars(mod).items():
             stats = getattr(obj, "stats", None)
             if stats is not None and hasattr(stats, "cache_misses"):
                 hits += sum(stats.cache_hits.values())
-                misses += sum(stats.cache_misses.values())
-    return {"pid": os.getpid(), "cache_hits": hits, "cache_misses": misses}
-
-
-WARM_SCENARIO = {
-    "name": "warm-up",
-    "site": {"lat_deg": 45.0, "lon_deg": 126.0},
-    "imu": {"gyro": {"bias_dph": [0.01, 0.01, 0.01]}, "accel": {"bias_ug": [50, 50, 50]}},
-    "motion": {"kind": "moving", "attitude_deg": [0, 0, 30], "duration_s": 3,
-               "segments": [{"duration_s": 1}, {"duration_s": 2, "accel_mps2": 0.5}]},
-    "align": {"t1_s": 1, "t2_s": 2, "t3_s": 2.5, "passes": 3, "level_s": 0.1,
-              "aiding": {"source": "odometer"}},
-}
+                m = sum(stats.cache_misses.values())
+                misses += m
+                if m:
+                    missed.append(f"{name}.{attr}")
+    return {"pid": os.getpid(), "cache_hits": hits, "cache_misses": misses,
+            "missed": sorted(set(missed))}
 
 
 def warm_up(command: str = "align") -> dict:
-    """Load the numba kernels (from the on-disk JIT cache) with a tiny run, once per process."""
-    if command == "align":
-        from gcalign.io.scenario import parse_scenario
+    """Load the numba kernels a command runs (from the on-disk JIT cache) with a tiny run of
+    its room's ``warm_up()``, if it has one; once per process."""
+    from gcalign.app.registry import COMMANDS
 
+    room = COMMANDS[command].load() if command in COMMANDS else None
+    if room is not None and hasattr(room, "warm_up"):
         try:
-            run_summary("align", parse_scenario(copy.deepcopy(WARM_SCENARIO), "warm-up"), 1)
+            room.warm_up()
         except Exception:  # noqa: BLE001 - warming is an optimisation only
             pass
     return kernel_cache_stats()
