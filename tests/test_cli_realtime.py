@@ -374,3 +374,16 @@ def test_motion_form_checks(tmp_path):
 def test_bad_predictor_option_exits_2(tmp_path):
     _bad(tmp_path, [str(_small(tmp_path)), "--predictor", "foo"], "realtime.predictors.0",
          "got 'foo'")
+
+
+def test_show_and_plot_do_not_load_scipy_or_numba(builtin, tmp_path):
+    """`gcalign show` and `gcalign plot` of a realtime file read it without the kernels."""
+    _, out, _ = builtin
+    code = ("import sys, json\nfrom typer.testing import CliRunner\nfrom gcalign.cli import app\n"
+            f"a = CliRunner().invoke(app, ['show', {str(out)!r}])\n"
+            f"b = CliRunner().invoke(app, ['plot', {str(out)!r}, '-o', {str(tmp_path)!r}])\n"
+            "print(json.dumps([a.exit_code, b.exit_code, 'numba' in sys.modules, "
+            "'scipy' in sys.modules]))\n")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert json.loads(res.stdout.strip().splitlines()[-1]) == [0, 0, False, False]
