@@ -69,10 +69,14 @@ def main() -> None:
     _command(sc, out)
     times: dict[str, list[float]] = {"core": [], "ideal_blocks": [], "command": []}
     for k in range(RUNS):
-        for name, fn in (("core", lambda: _core(s, k + 1)), ("ideal_blocks", _ideal),
-                         ("command", lambda: _command(sc, out))):
+        for name in times:
             t0 = time.perf_counter()
-            fn()
+            if name == "core":
+                _core(s, k + 1)
+            elif name == "ideal_blocks":
+                _ideal()
+            else:
+                _command(sc, out)
             times[name].append(time.perf_counter() - t0)
     cli = []
     for _ in range(3):
