@@ -71,8 +71,9 @@ def realtime_table(s: dict) -> Table:
     truth = " / ".join(after)
     lags = [f"{c['name']} {c['lag_ms']:.3f} ms" for c in s["cases"] if c.get("lag_ms")]
     table.caption = (
-        f"″ of the turned Euler angle against {REFERENCE_TEXT[s['reference']]} (truth: "
-        f"{truth} against the true attitude at the pulse time), after "
+        f"″ of the turned Euler angle against {REFERENCE_TEXT[s['reference']]}"
+        + (f" (truth: {truth} against the true attitude at the pulse time)"
+           if s["reference"] != "truth" else "") + f", after "
         f"{s['settle_s']:g} s, ±{s['corner_ms']:g} ms around the ramp corners excluded; "
         f"ramps: before = slope. Gyros (ours, the seed gives none): counts "
         f"{m['quantum_arcsec']:g}″, ARW {m['arw_dprh']:g} °/√h, dither "
