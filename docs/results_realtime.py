@@ -216,9 +216,9 @@ the PSINS coning correction (`integrate_attitude`) → Euler angles → tracker 
 INS removes the earth rate by turning the navigation frame at ω_ie^n (fixed site, v = 0);
 with the filter's delay its attitude is then C_nb(t − T) with no earth-rate offset (the
 alignment at t = 0 absorbs the earth's turn during T). Tested against a single-axis route
-without earth rate: they agree to 1e-10 rad; what is left is the filter's smoothing of
-increments that do not commute (a turn and the earth rate about another axis), ≤ 2.5e-5″
-over 12 s.
+without earth rate: the headings agree to 2.3e-13 rad; what is left is the filter's
+smoothing of increments that do not commute (a turn and the earth rate about another
+axis), a drift of pitch and roll ≤ 2.5e-5″ over 12 s.
 
 **What the seed does not state, and what we chose** (all in `configs/seed003_table1.yaml`).
 
