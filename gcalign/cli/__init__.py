@@ -80,3 +80,4 @@ from gcalign.cli import batch as _batch  # noqa: E402,F401
 from gcalign.cli import data as _data  # noqa: E402,F401
 from gcalign.cli import northfind as _northfind  # noqa: E402,F401
 from gcalign.cli import plot as _plot  # noqa: E402,F401
+from gcalign.cli import realtime as _realtime  # noqa: E402,F401

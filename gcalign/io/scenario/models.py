@@ -14,6 +14,7 @@ from gcalign.io.scenario.base import Model, NonNegVec3, Vec3
 from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
+from gcalign.io.scenario.realtime import RealtimeConfig
 from gcalign.nav.earth import MODELS, EarthModel
 from gcalign.sim.errors import ImuErrors, SensorErrors
 
@@ -139,6 +140,7 @@ class Scenario(Model):
     output: OutputConfig = Field(default_factory=OutputConfig)
     align: AlignConfig | None = None
     northfind: NorthfindConfig | None = None
+    realtime: RealtimeConfig | None = None
 
     @property
     def earth_model(self) -> EarthModel:
