@@ -154,15 +154,11 @@ def noise_free() -> list[str]:
 def lasergyro() -> list[str]:
     from gcalign.align.coarse import inertial_frame_coarse
     from gcalign.app.align.run import run_alignment
-    from gcalign.app.data import scenario_data
-    from gcalign.io.imu_files import read_imu_file
+    from gcalign.app.data import read_data_file, scenario_data
     from gcalign.io.scenario import load_scenario
     from gcalign.nav.strapdown import NavState
 
-    path = (ROOT / "../shared/data/lasergyro.imu").resolve()
-    if not path.is_file():
-        return ["(lasergyro.imu not found)"]
-    imu = read_imu_file(path)
+    imu, _ = read_data_file(ROOT / "tests/data/lasergyro.imu.xz")
     out = ["| window start (s) | KF ZUPT yaw (°) | gyrocompass yaw (°) | KF pitch, roll (°) | "
            "gyrocompass pitch, roll (°) | KF σ yaw (′) |", "|---|---|---|---|---|---|"]
     for start_s in (0.0, 600.0, 1200.0):

@@ -3,7 +3,7 @@ alignment on the real recorded file `lasergyro.imu`.
 
 Expected values come from physics (the linear compass loop's transient, the forgetting
 time of a loop, the closed-form steady state) and from the seed (§5.2 Table 1, §5.3, §6.1,
-§6.2); for the real file, from its known heading (yaw −90.6°, shared/data/README.md).
+§6.2); for the real file, from its known heading (yaw −90.6°, tests/data/README.md).
 docs/results.md tables the numbers beside the seed's.
 """
 
@@ -222,10 +222,6 @@ def test_two_stage_variable_beats_fixed_section_6_2(base):
 REAL = CONFIGS / "lasergyro_align.yaml"
 
 
-@pytest.mark.skipif(
-    not (CONFIGS / "../../shared/data/lasergyro.imu").resolve().is_file(),
-    reason="shared/data/lasergyro.imu is not beside the repository",
-)
 @pytest.mark.parametrize("start_s", [0.0, 600.0, 1200.0])
 @pytest.mark.parametrize("offset_yaw", [0.0, 5.0, -5.0])
 def test_real_lasergyro_heading(start_s, offset_yaw):

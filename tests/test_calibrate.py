@@ -41,7 +41,6 @@ from gcalign.sim.imu import ideal_imu
 from gcalign.units import DEG
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = (ROOT / "../shared/data/lasergyro.imu").resolve()
 IMU = ie.IMU
 
 
@@ -290,9 +289,8 @@ def test_calibration_time_590_s():
 # --------------------------------------------------------------------------- real data
 
 
-@pytest.mark.skipif(not DATA.is_file(), reason="shared/data/lasergyro.imu is not beside the repo")
 @pytest.mark.parametrize("start_s", [0.0, 600.0, 1200.0])
-def test_zero_velocity_alignment_on_lasergyro(start_s):
+def test_zero_velocity_alignment_on_lasergyro(start_s, lasergyro):
     """Must-show 5: the same filter as a zero-velocity fine alignment on the parked vehicle
     (100 Hz navigation, 1 Hz filter, inertial-frame coarse alignment over the first 60 s of
     the window, then 340 s of zero-velocity updates): yaw within 0.1° of −90.6° and within
@@ -304,7 +302,7 @@ def test_zero_velocity_alignment_on_lasergyro(start_s):
     from gcalign.io.scenario import load_scenario
     from gcalign.nav.strapdown import NavState
 
-    imu = read_imu_file(DATA)
+    imu = read_imu_file(lasergyro)
     ts = imu.ts
     i0 = int(round(start_s / ts))
     i1, i2 = i0 + int(round(60.0 / ts)), i0 + int(round(400.0 / ts))

@@ -133,20 +133,17 @@ def test_missing_and_foreign_files(tmp_path):
     assert res.exit_code == 2 and "not an HDF5 file" in res.output
 
 
-def test_recorded_psins_file_navigates(tmp_path):
-    data = (ROOT / "../shared/data/lasergyro.imu").resolve()
-    if not data.is_file():
-        pytest.skip("shared/data is not beside the repository")
-    p = write(tmp_path, {"name": "real", "imu_file": str(data)})
+def test_recorded_psins_file_navigates(tmp_path, lasergyro):
+    p = write(tmp_path, {"name": "real", "imu_file": str(lasergyro)})
     res = runner.invoke(app, ["simulate", str(p), "-o", str(tmp_path / "r.h5"), "--json"])
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout)["samples"] == 184718
 
 
-def test_navigate_a_bare_psins_file(tmp_path):
-    data = (ROOT / "../shared/data/lasergyro.imu").resolve()
-    if not data.is_file():
-        pytest.skip("shared/data is not beside the repository")
+@pytest.mark.parametrize("compressed", [False, True])
+def test_navigate_a_bare_psins_file(tmp_path, lasergyro, compressed):
+    """The plain recording and its xz copy (read compressed) navigate alike."""
+    data = ROOT / "tests/data/lasergyro.imu.xz" if compressed else lasergyro
     res = runner.invoke(app, ["navigate", str(data), "-o", str(tmp_path / "n.h5"), "--json"])
     assert res.exit_code == 0, res.output
     s = json.loads(res.stdout)
@@ -161,11 +158,9 @@ def test_pole_latitude_rejected(tmp_path):
     assert res.exit_code == 2 and "site.lat_deg" in res.output and "poles" in res.output
 
 
-REAL = (ROOT / "../shared/data/lasergyro.imu").resolve()
+REAL = ROOT / "tests/data/lasergyro.imu.xz"  # what configs/lasergyro_align.yaml reads
 
 
-@pytest.mark.skipif(not REAL.is_file(), reason="shared/data/lasergyro.imu is not beside the "
-                    "repository")
 def test_navigate_from_an_alignment_of_the_real_file(tmp_path):
     """Align lasergyro.imu (gyrocompass, T3 = 400 s), then navigate 600 s of the same data
     from its attitude at T3 with the height held: the table and the plot show the drift."""

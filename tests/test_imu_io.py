@@ -19,8 +19,6 @@ from gcalign.nav import earth
 from gcalign.sim.imu import ImuData
 from gcalign.units import ARCSEC, DEG
 
-LASERGYRO = Path("/work/shared/data/lasergyro.imu")
-needs_lasergyro = pytest.mark.skipif(not LASERGYRO.exists(), reason="lasergyro.imu not found")
 
 PSINS_HEADER = """% a PSINS-format test file
 % three header rows follow
@@ -39,14 +37,13 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
 # ------------------------------------------------------------------ real file
 
 
-@pytest.fixture(scope="module")
-def lasergyro() -> ImuData:
-    return read_psins_imu(LASERGYRO)
+@pytest.fixture(scope="module", name="laser")
+def _laser(lasergyro) -> ImuData:
+    return read_psins_imu(lasergyro)
 
 
-@needs_lasergyro
-def test_lasergyro_header_and_size(lasergyro):
-    d = lasergyro
+def test_lasergyro_header_and_size(laser, lasergyro):
+    d = laser
     assert len(d) == 184_718
     assert d.dtheta.shape == d.dv.shape == (184_718, 3)
     assert d.ts == pytest.approx(0.01, abs=1e-15)
@@ -59,23 +56,21 @@ def test_lasergyro_header_and_size(lasergyro):
     # t = t0 + ts * (1..N): end time of each increment.
     assert d.t[0] == pytest.approx(0.01, abs=1e-15)
     assert d.t[-1] == pytest.approx(1847.18, abs=1e-9)
-    assert d.source == str(LASERGYRO)
+    assert d.source == str(lasergyro)
 
 
-@needs_lasergyro
-def test_lasergyro_first_rows_conversion(lasergyro):
+def test_lasergyro_first_rows_conversion(laser):
     # First three rows of the file, by hand: "0 0 2 0 0 80", "0 0 7 0 0 80", "0 0 7 0 2 80".
     counts = np.array([[0, 0, 2, 0, 0, 80], [0, 0, 7, 0, 0, 80], [0, 0, 7, 0, 2, 80]], float)
     dtheta = counts[:, :3] * 0.1 * ARCSEC  # 0.1″ per count
     dv = counts[:, 3:] * 125e-6 * 9.780327  # 125 µg·s per count, g from header 2
-    np.testing.assert_allclose(lasergyro.dtheta[:3], dtheta, rtol=1e-15, atol=0)
-    np.testing.assert_allclose(lasergyro.dv[:3], dv, rtol=1e-15, atol=0)
-    assert lasergyro.dv[0, 2] == pytest.approx(0.09780327, rel=1e-15)  # 80 counts ≈ 1 g·10 ms
+    np.testing.assert_allclose(laser.dtheta[:3], dtheta, rtol=1e-15, atol=0)
+    np.testing.assert_allclose(laser.dv[:3], dv, rtol=1e-15, atol=0)
+    assert laser.dv[0, 2] == pytest.approx(0.09780327, rel=1e-15)  # 80 counts ≈ 1 g·10 ms
 
 
-@needs_lasergyro
-def test_lasergyro_physics(lasergyro):
-    d = lasergyro
+def test_lasergyro_physics(laser):
+    d = laser
     lat, h = d.site[0], d.site[2]
     # Specific force at rest: |mean f| = local normal gravity (9.7955 m/s² here, not the
     # header's equatorial 9.780327, which is 0.15 % smaller).
@@ -90,10 +85,9 @@ def test_lasergyro_physics(lasergyro):
     assert w[2] == pytest.approx(earth.OMEGA_IE * np.sin(lat), rel=0.05)
 
 
-@needs_lasergyro
-def test_lasergyro_is_fast():
+def test_lasergyro_is_fast(lasergyro):
     start = time.perf_counter()
-    read_imu_file(LASERGYRO)
+    read_imu_file(lasergyro)
     assert time.perf_counter() - start < 1.0
 
 

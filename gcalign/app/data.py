@@ -99,8 +99,13 @@ class Stream:
         return 0.0 if self.header is None else float(self.header.t[0] - self.ts)
 
 
+#: Compressed recordings (``x.imu.xz``), opened by the standard library.
+COMPRESSED = {".gz": "gzip", ".xz": "lzma"}
+
+
 def read_data_file(path: Path) -> tuple[ImuData, Truth | None]:
-    """IMU (and truth, if the file has it) from our HDF5, a PSINS .imu or a CSV/text file."""
+    """IMU (and truth, if the file has it) from our HDF5, a PSINS .imu or a CSV/text file;
+    a text file may be gzip- or xz-compressed (``lasergyro.imu.xz``)."""
     from gcalign.io import results
     from gcalign.io.imu_files import read_imu_file
 
@@ -110,9 +115,32 @@ def read_data_file(path: Path) -> tuple[ImuData, Truth | None]:
     if path.suffix.lower() in HDF5_SUFFIXES:
         return results.read_imu(path), results.read_truth(path)
     try:
+        if path.suffix.lower() in COMPRESSED:
+            return _read_compressed(path, read_imu_file), None
         return read_imu_file(path), None
     except ValueError as err:
         raise ScenarioError(f"imu_file: {err}") from None
+
+
+def _read_compressed(path: Path, reader) -> ImuData:
+    """Decompress into a temporary file of the inner name (the readers take paths and
+    dispatch on the suffix), read it, and name the compressed file as the source."""
+    import importlib
+    import tempfile
+
+    module = importlib.import_module(COMPRESSED[path.suffix.lower()])
+    with tempfile.TemporaryDirectory(prefix="gcalign-") as tmp:
+        inner = Path(tmp) / path.with_suffix("").name
+        try:
+            with module.open(path, "rb") as src:
+                inner.write_bytes(src.read())
+        except (OSError, EOFError) as err:
+            raise ScenarioError(f"imu_file: {path}: cannot decompress ({err})") from None
+        try:
+            imu = reader(inner)
+        except ValueError as err:
+            raise ScenarioError(str(err).replace(str(inner), str(path))) from None
+    return replace(imu, source=str(path))
 
 
 def _recorded(scenario: Scenario) -> RunData:
@@ -124,7 +152,8 @@ def _recorded(scenario: Scenario) -> RunData:
         site = np.asarray(imu.site, float)
     else:
         raise ScenarioError(
-            f"site: missing; {scenario.imu_file} does not give the site, so the scenario must"
+            f"site: missing: {scenario.imu_file} does not give the site (a CSV file has no "
+            "header); give --lat/--lon/--height, or a site section in the scenario"
         )
     return RunData(imu=imu, truth=truth, site=site, seed=None, earth=scenario.earth_model)
 

@@ -4,7 +4,10 @@ Each command's room is a subpackage of :mod:`gcalign.app` whose ``__init__`` off
 plain functions that import their heavy parts only when called (so ``gcalign show`` and
 ``gcalign validate`` never load numba):
 
-* ``execute(sc, seed=None, cache_key=None) -> Outcome`` -- run a scenario (not ``batch``);
+* ``execute(sc, seed=None, cache_key=None, progress=None) -> Outcome`` -- run a scenario
+  (not ``batch``); a room whose run can take longer than a second or two takes
+  ``progress``, a plain callable ``progress(done, total, what)`` (any units; the command
+  line draws a bar from it, the core never sees rich);
 * ``table(summary) -> rich.table.Table`` -- the table the command prints (and ``show``);
 * ``figures(f, name) -> dict[str, Figure]`` -- the figures of its results file (``plot``);
 * optionally ``components(metric, k)`` -- names of a batch metric's vector components.
@@ -50,6 +53,7 @@ class Command:
     builtin: str | None = None  # built-in scenario (package data gcalign/scenarios)
     batch_metrics: tuple[str, ...] = field(default=())  # default metrics; () = not batchable
     streams: bool = False  # execute() writes its series into an open results file (sink=)
+    recorded: bool = False  # can run on recorded data (the CLI adds --imu-file, --lat, ...)
 
     def load(self) -> ModuleType:
         return importlib.import_module(f"gcalign.app.{self.room}")
@@ -60,9 +64,9 @@ COMMANDS: dict[str, Command] = {
     for c in (
         Command("simulate", "simulate", "Simulate truth and IMU data.", streams=True),
         Command("navigate", "navigate", "Strapdown navigation of simulated or recorded data.",
-                "navigation", streams=True),
+                "navigation", streams=True, recorded=True),
         Command("align", "align", "Gyrocompass alignment (seed 000).", "align",
-                "seed000_moving_full_cycle.yaml", ("error_t3_deg",)),
+                "seed000_moving_full_cycle.yaml", ("error_t3_deg",), recorded=True),
         Command("northfind", "northfind", "Multi-position north-finding (seed 001).",
                 "northfind", "seed001_simulation.yaml", ("methods.coordinate.rms_error_deg",)),
         Command("realtime", "realtime", "Attitude at sync pulses: filter delay and prediction "

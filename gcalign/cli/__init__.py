@@ -16,14 +16,45 @@ from pathlib import Path
 import typer
 from rich.console import Console
 
+from gcalign import __version__
+from gcalign.app.registry import COMMANDS
 from gcalign.errors import GcalignError
 
+
+def _top_help() -> str:
+    """The command list with what each does, from the registry (so it never promises a
+    command that is not there)."""
+    lines = "\n".join(f"  {c.name:<10} {c.help}" for c in COMMANDS.values())
+    return ("Strapdown INS laboratory: scenario in, results file (HDF5) and table out.\n\n"
+            f"\b\n{lines}\n\n"
+            "Also: show, plot, validate, example (built-in scenarios). Exit codes: 0 success, "
+            "2 bad input, 1 other failures.")
+
+
 app = typer.Typer(
-    add_completion=False,
-    no_args_is_help=True,
+    add_completion=True,
     pretty_exceptions_enable=False,
-    help="Strapdown INS alignment and north-finding laboratory (seeds 000-004).",
+    rich_markup_mode=None,  # plain click help: flags without <bool>, [dask] kept as written
+    help=_top_help(),
 )
+
+
+def _version(value: bool) -> None:
+    if value:
+        sys.stdout.write(f"gcalign {__version__}\n")
+        raise typer.Exit(0)
+
+
+@app.callback(invoke_without_command=True)
+def _root(
+    ctx: typer.Context,
+    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                 help="Print the version and exit."),
+) -> None:
+    """Bare `gcalign` prints the help and succeeds (exit 0)."""
+    if ctx.invoked_subcommand is None:
+        typer.echo(ctx.get_help())
+        raise typer.Exit(0)
 
 
 def consoles(as_json: bool) -> Console:
@@ -65,9 +96,11 @@ def user_errors(fn):
     return wrapper
 
 
-def default_output(name: str, kind: str, seed: int | None) -> Path:
-    suffix = f"-seed{seed}" if seed is not None else ""
-    return Path("runs") / f"{name}-{kind}{suffix}.h5"
+def default_output(name: str, kind: str, seed: int | None, overrides=()) -> Path:
+    """``runs/NAME-COMMAND[-OVERRIDES][-rngN].h5`` (:func:`gcalign.cli.common.output_name`)."""
+    from gcalign.cli.common import output_name
+
+    return output_name(name, kind, seed, list(overrides))
 
 
 def main() -> None:
@@ -78,6 +111,12 @@ def main() -> None:
 from gcalign.cli import align as _align  # noqa: E402,F401
 from gcalign.cli import batch as _batch  # noqa: E402,F401
 from gcalign.cli import data as _data  # noqa: E402,F401
+from gcalign.cli import example as _example  # noqa: E402,F401
 from gcalign.cli import northfind as _northfind  # noqa: E402,F401
 from gcalign.cli import plot as _plot  # noqa: E402,F401
 from gcalign.cli import realtime as _realtime  # noqa: E402,F401
+
+# Last: the options every scenario command shares (--set, --imu-file, --lat/--lon/--height).
+from gcalign.cli.common import install as _install  # noqa: E402
+
+_install(app)

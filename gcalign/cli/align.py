@@ -10,7 +10,7 @@ import typer
 from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
-from gcalign.cli.data import JSON_HELP, OUT_HELP
+from gcalign.cli.data import JSON_HELP, OUT_HELP, SEED_HELP
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["align"].builtin or ""
@@ -35,24 +35,45 @@ def _t3(value: str | None):
     return seconds
 
 
+def passes_into_stages(section: dict, given: dict) -> None:
+    """--passes N (passes in all) sets the last stage's count to N minus the earlier
+    stages' (the pass count is the sum of the stages' passes)."""
+    n = given.pop("passes", None)
+    if n is None:
+        return
+    stages = section.get("stages")
+    stages = [dict(x) if isinstance(x, dict) else x for x in stages] if isinstance(
+        stages, list) and stages else [{}]
+    earlier = sum(int(x.get("passes") or 0) for x in stages[:-1] if isinstance(x, dict))
+    if n - earlier < 1:
+        raise ScenarioError(f"align.stages: --passes {n} leaves no pass for the last stage "
+                            f"(the earlier stages take {earlier})")
+    if isinstance(stages[-1], dict):
+        stages[-1]["passes"] = n - earlier
+    section["stages"] = stages
+
+
 @app.command()
 @user_errors
 def align(
     scenario: Path | None = typer.Argument(
-        None, help="Scenario YAML; without it, the built-in seed 000 §5.3 moving-base case."
+        None, help="Scenario YAML; without it, the built-in seed 000 §5.3 moving-base case "
+        "(`gcalign example align` prints it)."
     ),
     mode: str | None = typer.Option(None, "--mode", help="conventional | full-cycle | half-cycle"),
     compensation: str | None = typer.Option(
-        None, "--compensation", help="none | one-off | continued"
+        None, "--compensation", help="none | one-off | continued (T2 -> T3)"
     ),
-    passes: int | None = typer.Option(None, "--passes", help="Forward and reverse passes in all."),
+    passes: int | None = typer.Option(
+        None, "--passes", help="Forward and reverse passes in all (sets the last stage's "
+        "align.stages.N.passes)."),
     t2: float | None = typer.Option(None, "--t2", help="End of the stored data block T2 (s)."),
     t3: str | None = typer.Option(None, "--t3", help="Result time T3 (s) or 'measured'."),
-    seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
+    seed: int | None = typer.Option(None, "--seed", help=SEED_HELP),
     output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
     as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ):
-    """Gyrocompass fine alignment with forward/reverse passes and T2→T3 compensation."""
+    """Gyrocompass fine alignment with forward/reverse passes and T2 -> T3 compensation."""
     overrides = {
         "mode": mode,
         "compensation": compensation,
@@ -60,5 +81,6 @@ def align(
         "t2_s": t2,
         "t3_s": _t3(t3),
     }
-    sc, text, _ = load_with_overrides(scenario, BUILTIN, "align", overrides)
+    sc, text, _ = load_with_overrides(scenario, BUILTIN, "align", overrides,
+                                      passes_into_stages)
     run_and_show("align", sc, text, seed, output, as_json)

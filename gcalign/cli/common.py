@@ -1,25 +1,189 @@
-"""What the commands share: loading a scenario with option overrides, saving and showing."""
+"""What the commands share: scenario loading with overrides, the common options, default
+output names, progress, warnings, saving and showing.
+
+Every command of the registry gets the same habits here, not by hand:
+
+* ``--set KEY=VALUE`` (any scenario key, dotted as in a sweep's grid) and, for commands that
+  read recorded data (``Command.recorded``), ``--imu-file``, ``--lat``, ``--lon``,
+  ``--height``: :func:`install` adds them to every registered command that does not declare
+  them itself; :func:`load_with_overrides` applies them.
+* A default results file named after every override that changes the result
+  (:func:`output_name`), and a warning when it replaces a run of other inputs.
+* A progress bar on stderr for long runs (:class:`ProgressBar`; a room's ``execute`` that
+  takes ``progress=`` reports to it), keys that cannot matter as warnings (stderr, table,
+  JSON), the wall time beside what ``compute`` measured.
+
+The options reach :func:`load_with_overrides` and :func:`run_and_show` through one context
+variable set for the duration of a command (:data:`_INVOCATION`), so a command module only
+calls those two functions.
+"""
 
 from __future__ import annotations
 
+import contextvars
+import copy
+import functools
+import hashlib
+import inspect
+import os
+import re
 import sys
+import time
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
+import typer
 import yaml
 
-from gcalign.app.registry import command
+from gcalign.app.registry import COMMANDS, command
 from gcalign.cli import consoles, emit_json
 from gcalign.errors import ScenarioError
 from gcalign.io import results
 from gcalign.io.scenario import Scenario, parse_scenario
 from gcalign.io.scenario.loader import read_yaml
 
+# --------------------------------------------------------------------------- options
+
+SET_HELP = ("Set any scenario key, dotted as in a sweep grid; VALUE is YAML "
+            "(--set align.stages.0.t_z_s=200 --set imu.gyro.bias_dph=0.01). Repeatable.")
+IMU_FILE_HELP = ("Recorded IMU data (PSINS .imu, CSV/text, gcalign HDF5; .gz/.xz "
+                 "compressed) instead of the scenario's motion; the site then comes from the "
+                 "file's header or --lat/--lon/--height.")
+
+
+@dataclass
+class Invocation:
+    """The common options of the running command and what loading made of them."""
+
+    sets: list[str] = field(default_factory=list)
+    imu_file: Path | None = None
+    site: dict = field(default_factory=dict)  # lat_deg, lon_deg, height_m given as options
+    applied: list[tuple[str, object]] = field(default_factory=list)  # (key, value), in order
+    notes: list[str] = field(default_factory=list)  # warnings found while loading
+
+
+_INVOCATION: contextvars.ContextVar[Invocation | None] = contextvars.ContextVar(
+    "gcalign_invocation", default=None)
+
+
+def _option(name: str, annotation, default, *decls: str, help: str) -> inspect.Parameter:
+    return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, annotation=annotation,
+                             default=typer.Option(default, *decls, help=help))
+
+
+def _common_parameters(recorded: bool) -> list[inspect.Parameter]:
+    params = [_option("set_", list[str] | None, None, "--set", help=SET_HELP)]
+    if recorded:
+        params += [
+            _option("imu_file", Path | None, None, "--imu-file", help=IMU_FILE_HELP),
+            _option("lat", float | None, None, "--lat", help="Site latitude (deg); replaces "
+                    "the site of the scenario or the data file's header."),
+            _option("lon", float | None, None, "--lon", help="Site longitude (deg)."),
+            _option("height", float | None, None, "--height", help="Site height (m)."),
+        ]
+    return params
+
+
+def with_common_options(fn: Callable, recorded: bool) -> Callable:
+    """`fn` with the common options added to its signature (those it does not declare);
+    their values are kept in :data:`_INVOCATION` while `fn` runs."""
+    sig = inspect.signature(fn, eval_str=True)
+    extra = [p for p in _common_parameters(recorded) if p.name not in sig.parameters]
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        given = {p.name: kwargs.pop(p.name, None) for p in extra}
+        site = {k: given.get(o) for k, o in (("lat_deg", "lat"), ("lon_deg", "lon"),
+                                             ("height_m", "height"))}
+        inv = Invocation(sets=list(given.get("set_") or []), imu_file=given.get("imu_file"),
+                         site={k: v for k, v in site.items() if v is not None})
+        token = _INVOCATION.set(inv)
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            _INVOCATION.reset(token)
+
+    wrapper.__signature__ = sig.replace(  # type: ignore[attr-defined]
+        parameters=[*sig.parameters.values(), *extra])
+    return wrapper
+
+
+def install(app: typer.Typer) -> None:
+    """Give every scenario command registered on `app` the common options (see the module
+    docstring): the registry's commands except ``batch``, and ``validate``."""
+    for info in app.registered_commands:
+        name = info.name or (info.callback.__name__ if info.callback else "")
+        cmd = COMMANDS.get(name)
+        if info.callback is None or getattr(info.callback, "_common", False):
+            continue
+        if (cmd is not None and name != "batch") or name == "validate":
+            recorded = cmd.recorded if cmd is not None else True
+            info.callback = with_common_options(info.callback, recorded)
+            info.callback._common = True  # type: ignore[attr-defined]
+
+
+# --------------------------------------------------------------------------- loading
+
 
 def builtin_text(name: str) -> str:
     """YAML text of a built-in scenario (package data in gcalign/scenarios)."""
     return resources.files("gcalign.scenarios").joinpath(name).read_text(encoding="utf-8")
+
+
+def parse_set(item: str) -> tuple[str, object]:
+    """``KEY=VALUE`` -> (key, YAML value); ScenarioError names the option."""
+    key, sep, text = item.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise ScenarioError(f"--set: expected KEY=VALUE (e.g. align.mode=conventional), "
+                            f"got {item!r}")
+    try:
+        value = yaml.safe_load(text) if text.strip() else None
+    except yaml.YAMLError:
+        raise ScenarioError(f"--set {key}: the value {text!r} is not YAML") from None
+    if value is None:
+        raise ScenarioError(f"--set {key}: give a value (KEY=VALUE)")
+    return key, value
+
+
+def _apply_sets(data: dict, sets: list[str], taken: set[str], source: str,
+                applied: list) -> None:
+    from gcalign.app.batch.overrides import apply_override
+
+    try:
+        base = parse_scenario(copy.deepcopy(data), source)
+    except ScenarioError:
+        base = None  # the file may need the --set to become valid
+    for item in sets:
+        key, value = parse_set(item)
+        if key in taken:
+            raise ScenarioError(f"--set {key}: also given by an option; give it once")
+        try:
+            apply_override(data, key, value, base)
+        except ScenarioError as err:
+            raise ScenarioError(f"--set {key}: {err}") from None
+        taken.add(key)
+        applied.append((key, value))
+
+
+def _apply_recorded(data: dict, inv: Invocation, applied: list) -> None:
+    """--imu-file replaces the motion, the mechanism and the site (the file's header, or
+    --lat/--lon/--height, gives it); --lat/--lon/--height replace the site."""
+    if inv.imu_file is not None:
+        path = Path(inv.imu_file)
+        if not path.is_file():
+            raise ScenarioError(f"--imu-file: {path}: file not found")
+        for key in ("motion", "mechanism", "site"):
+            data.pop(key, None)
+        data["imu_file"] = str(path.resolve())
+        applied.append(("imu_file", path))
+    if inv.site:
+        site = dict(data.get("site") or {}) if isinstance(data.get("site"), dict) else {}
+        site.update(inv.site)
+        data["site"] = site
+        applied.extend((f"site.{k}", v) for k, v in inv.site.items())
 
 
 def load_with_overrides(
@@ -33,9 +197,11 @@ def load_with_overrides(
 ) -> tuple[Scenario, str, str]:
     """Scenario (the file, the built-in one, or a given mapping `data` with its `text`),
     its text and its source name, with the options that were given written into `section`
-    before validation, so that a bad option is reported like a bad key in the file.
-    `adjust(section, given)` may drop keys that a given option replaces. The text stored in
-    results files records the overrides.
+    before validation, so that a bad option is reported like a bad key in the file; then
+    the common options of the running command (``--set``, ``--imu-file``, site).
+    `adjust(section, given)` may drop keys of the section that a given option replaces, and
+    may take options out of `given` that it wrote elsewhere in the section. The text stored
+    in results files records the overrides.
     """
     if data is not None:
         source = str(path)
@@ -47,57 +213,240 @@ def load_with_overrides(
         data, source = read_yaml(path), str(path)
         text = Path(path).read_text(encoding="utf-8")
     assert text is not None
+    inv = _INVOCATION.get() or Invocation()
     given = {k: v for k, v in overrides.items() if v is not None}
-    if isinstance(data, dict) and given:
-        current = data.get(section)
-        merged = dict(current) if isinstance(current, dict) else {}
-        if adjust is not None:
-            adjust(merged, given)
-        merged.update(given)
-        data[section] = merged
+    named = dict(given)  # what the file name and the stored text record
+    recorded: list = []
+    if isinstance(data, dict):
+        if given:
+            current = data.get(section)
+            merged = dict(current) if isinstance(current, dict) else {}
+            if adjust is not None:
+                adjust(merged, given)
+            merged.update(given)
+            data[section] = merged
+        _apply_recorded(data, inv, recorded)
+        _apply_sets(data, inv.sets, {f"{section}.{k}" for k in given} | {
+            k for k, _ in recorded}, source, recorded)
     sc = parse_scenario(data, source)
     if sc.imu_file is not None and path is not None and not sc.imu_file.is_absolute():
         sc.imu_file = (Path(path).parent / sc.imu_file).resolve()
-    if given:
-        text += f"\n# command-line overrides of {section}:\n" + yaml.safe_dump(
-            {section: given}, sort_keys=False
-        )
+    inv.applied = [(f"{section}.{k}", v) for k, v in named.items()] + recorded
+    if inv.applied:
+        text += "\n# command-line overrides:\n" + yaml.safe_dump(
+            {k: (str(v) if isinstance(v, Path) else v) for k, v in inv.applied},
+            sort_keys=False)
     return sc, text, source
+
+
+# --------------------------------------------------------------------------- output names
+
+
+#: Units at the end of a key, left out of a file name (``t2_s=300`` -> ``t2_300``).
+_UNIT = re.compile(r"_(deg|s|dph|dprh|ug|ugrhz|ppm|hz|m|mps|mps2|dps|arcsec|ms|us)$")
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.+-]+")
+MAX_TAG = 60
+
+
+def _word(value) -> str:
+    if isinstance(value, Path):
+        return value.stem
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, (list, tuple)):
+        return "+".join(_word(v) for v in value)
+    if isinstance(value, dict):
+        return "_".join(f"{k}{_word(v)}" for k, v in value.items())
+    return str(value)
+
+
+_DATA_SUFFIXES = (".h5", ".hdf5", ".imu", ".csv", ".txt", ".gz", ".xz", ".yaml")
+
+
+def _pathlike(value) -> bool:
+    return isinstance(value, Path) or (isinstance(value, str) and (
+        "/" in value or value.lower().endswith(_DATA_SUFFIXES)))
+
+
+def tag(key: str, value) -> str:
+    """One override as a file-name word: a word value alone (``conventional``, ``one-off``,
+    ``coordinate+vector``), a file by its stem (``imu-lasergyro``), otherwise the key's
+    last part without its unit and the value (``passes7``, ``t2_300``, ``tilt5``,
+    ``sweep_0-360-5``)."""
+    tail = _UNIT.sub("", key.rsplit(".", 1)[-1])
+    if _pathlike(value):
+        word = f"{tail.removesuffix('_file')}-{Path(str(value)).name.split('.')[0]}"
+    elif isinstance(value, str) and not re.fullmatch(r"[-+0-9.eE]+", value):
+        word = value
+    elif isinstance(value, (list, tuple)) and value and all(isinstance(v, str) for v in value):
+        word = "+".join(value)
+    elif isinstance(value, dict):
+        word = f"{tail}_" + "-".join(_word(v) for v in value.values())
+    else:
+        v = _word(value)
+        word = tail + ("_" if tail[-1:].isdigit() and v[:1].isdigit() else "") + v
+    return _UNSAFE.sub("_", word).strip("_") or "x"
+
+
+def output_name(name: str, kind: str, seed: int | None,
+                overrides: list[tuple[str, object]] = ()) -> Path:
+    """``runs/NAME-COMMAND[-OVERRIDES][-rngN].h5``: every override that changes the result
+    is in the name (too many: the first ones and a hash of all), the random seed last."""
+    words = "-".join(tag(k, v) for k, v in overrides)
+    if len(words) > MAX_TAG:
+        digest = hashlib.sha256(repr(list(overrides)).encode()).hexdigest()[:8]
+        words = words[:MAX_TAG - 9].rstrip("-_") + "-" + digest
+    parts = [name, kind] + ([words] if words else []) + (
+        [f"rng{seed}"] if seed is not None else [])
+    return Path("runs") / ("-".join(parts) + ".h5")
+
+
+def _replaced_other(out: Path, kind: str, text: str, seed: int | None) -> str | None:
+    """A warning if `out` exists and holds a run of other inputs."""
+    if not out.is_file():
+        return None
+    try:
+        _, _, attrs = results.read_summary(out)
+    except (ScenarioError, KeyError, ValueError):
+        return f"replaced {out}, which was not a gcalign results file"
+    same = (attrs.get("kind") == kind and attrs.get("scenario_yaml") == text
+            and int(attrs.get("seed", -1)) == (-1 if seed is None else seed))
+    if same:
+        return None
+    return (f"replaced {out}, a run of other inputs (scenario text, options or seed); "
+            "give -o FILE to keep both")
+
+
+# --------------------------------------------------------------------------- progress
+
+
+class ProgressBar:
+    """A transient rich progress bar on stderr for a run's ``progress(done, total, what)``
+    reports. It appears only once a run has taken more than `delay_s` (short runs stay
+    quiet) and only on a terminal; ``GCALIGN_PROGRESS=always`` forces it (also into a
+    pipe), ``never`` turns it off."""
+
+    def __init__(self, title: str, delay_s: float = 1.0):
+        mode = os.environ.get("GCALIGN_PROGRESS", "auto").lower()
+        self.enabled = mode == "always" or (mode == "auto" and sys.stderr.isatty())
+        self.force = mode == "always"
+        self.title, self.delay = title, delay_s
+        self.t0 = time.perf_counter()
+        self.bar = None
+        self.tasks: dict[str, int] = {}
+
+    def _start(self):
+        from rich.console import Console
+        from rich.progress import (
+            BarColumn,
+            Progress,
+            TaskProgressColumn,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
+
+        self.bar = Progress(
+            TextColumn(f"[bold]{self.title}[/bold] {{task.description}}"), BarColumn(),
+            TaskProgressColumn(), TimeElapsedColumn(), TextColumn("elapsed,"),
+            TimeRemainingColumn(), TextColumn("left"),
+            console=Console(stderr=True, force_terminal=self.force or None),
+            transient=not self.force)
+        self.bar.start()
+
+    def __call__(self, done: float, total: float, what: str = "") -> None:
+        if not self.enabled or total <= 0:
+            return
+        if self.bar is None:
+            if time.perf_counter() - self.t0 < self.delay and done < total:
+                return
+            self._start()
+        assert self.bar is not None
+        if what not in self.tasks:
+            for other in self.tasks.values():  # a new stage: the earlier ones are done
+                task = self.bar.tasks[other]
+                self.bar.update(other, completed=task.total)
+            self.tasks[what] = self.bar.add_task(what, total=total)
+        self.bar.update(self.tasks[what], completed=min(done, total), total=total)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+            self.bar = None
+
+    def __enter__(self) -> ProgressBar:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def accepts(fn: Callable, name: str) -> bool:
+    """Does `fn` take a keyword `name` (explicitly or through ``**kwargs``)?"""
+    params = inspect.signature(fn).parameters
+    return name in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
+
+
+# --------------------------------------------------------------------------- run and show
 
 
 def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: Path | None,
                  as_json: bool, **options) -> None:
     """Run command `name` on a loaded scenario through its room, write the results file
-    (default name from the scenario, command and seed) and show its table. A streaming
-    command writes its series into the (temporary) file while it runs; `options` go to its
-    ``execute``."""
-    from gcalign.cli import default_output
-
+    and show its table. Default file name: :func:`output_name` with the overrides of the
+    command line (and `options`, e.g. ``--init``). A streaming command writes its series
+    into the (temporary) file while it runs; `options` go to its ``execute``, and a
+    ``progress`` callback if it takes one. Keys that cannot matter become warnings."""
     cmd = command(name)
     room = cmd.load()
-    run_seed = None if sc.imu_file is not None else (sc.imu.seed if seed is None else seed)
-    out = output or default_output(sc.name, name, run_seed)
-    try:
-        with results.atomic_h5(out) as f:
-            if cmd.streams:
-                outcome = room.execute(sc, seed, sink=f, **options)
-            else:
-                outcome = room.execute(sc, seed, **options)
-            for line in outcome.warnings:
-                sys.stderr.write(f"warning: {line}\n")
-            summary = outcome.summary
-            summary["output"] = str(out)
-            results.write_header(f, name, text, outcome.seed, summary)
-            if outcome.truth is not None:
-                results.write_truth(f, outcome.truth)
-            outcome.write(f)
-    except OSError as err:
-        raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
+    inv = _INVOCATION.get() or Invocation()
+    recorded = sc.imu_file is not None
+    run_seed = None if recorded else (sc.imu.seed if seed is None else seed)
+    given = [*inv.applied, *((k, v) for k, v in options.items() if v is not None)]
+    out = output or output_name(sc.name, name, run_seed, given)
+    notes = [*inv.notes, *sc.unused(cmd.section)]
+    if recorded and seed is not None:
+        notes.append("--seed: cannot matter with recorded data (no random numbers are drawn)")
+    if output is None:
+        replaced = _replaced_other(out, name, text, run_seed)
+        if replaced:
+            notes.append(replaced)
+    kwargs = dict(options)
+    t0 = time.perf_counter()
+    with ProgressBar(f"{name} {sc.name}") as bar:
+        if accepts(room.execute, "progress"):
+            kwargs["progress"] = bar
+        try:
+            with results.atomic_h5(out) as f:
+                if cmd.streams:
+                    outcome = room.execute(sc, seed, sink=f, **kwargs)
+                else:
+                    outcome = room.execute(sc, seed, **kwargs)
+                bar.close()
+                summary = outcome.summary
+                warnings = list(dict.fromkeys([*notes, *outcome.warnings,
+                                               *summary.get("warnings", [])]))
+                summary["warnings"] = warnings
+                summary["wall_s"] = time.perf_counter() - t0
+                summary["output"] = str(out)
+                results.write_header(f, name, text, outcome.seed, summary)
+                if outcome.truth is not None:
+                    results.write_truth(f, outcome.truth)
+                outcome.write(f)
+        except OSError as err:
+            raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
+    for line in warnings:
+        sys.stderr.write(f"warning: {line}\n")
     show(name, summary, as_json)
 
 
 def show(kind: str, summary: dict, as_json: bool) -> None:
-    """Print a command's table (stderr under --json) and, under --json, the summary."""
-    consoles(as_json).print(command(kind).load().table(summary))
+    """Print a command's table (stderr under --json), its warnings under it, and, under
+    --json, the summary."""
+    from gcalign.app.report import summary_table
+
+    consoles(as_json).print(summary_table(kind, summary))
     if as_json:
         emit_json(summary)

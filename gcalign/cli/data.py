@@ -3,22 +3,34 @@
 from __future__ import annotations
 
 import re
+import sys
 from pathlib import Path
 
 import typer
 import yaml
 
-from gcalign.app.report import kv_table, summary_table
+from gcalign.app.registry import COMMANDS
+from gcalign.app.report import kv_table, summary_table, with_warnings
 from gcalign.cli import app, consoles, emit_json, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.io import results
 from gcalign.io.results import HDF5_SUFFIXES
-from gcalign.io.scenario import load_scenario
 from gcalign.io.scenario.resolve import resolved_rows
 
 DATA_SUFFIXES = {".imu", ".csv", ".txt"}
+COMPRESSED = (".gz", ".xz")
+
+
+def data_suffix(path: Path) -> str:
+    """The suffix that says what a file holds, under a compression suffix (x.imu.xz: .imu)."""
+    suffixes = [x.lower() for x in path.suffixes]
+    if suffixes and suffixes[-1] in COMPRESSED:
+        suffixes = suffixes[:-1]
+    return suffixes[-1] if suffixes else ""
 JSON_HELP = "Print one JSON object on stdout (tables go to stderr)."
-OUT_HELP = "Results file (default runs/NAME-COMMAND[-seedN].h5)."
+OUT_HELP = ("Results file; default runs/NAME-COMMAND[-OVERRIDES][-rngN].h5, with every option "
+            "that changes the result in the name and N the random seed.")
+SEED_HELP = "Random seed of the simulated sensor noise (overrides imu.seed)."
 
 
 @app.command()
@@ -26,11 +38,11 @@ OUT_HELP = "Results file (default runs/NAME-COMMAND[-seedN].h5)."
 def simulate(
     scenario: Path = typer.Argument(..., help="Scenario YAML."),
     output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
+    seed: int | None = typer.Option(None, "--seed", help=SEED_HELP),
     as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ):
     """Simulate truth and IMU data; write /truth and /imu."""
-    sc, text = load_scenario(scenario)
+    sc, text, _ = load_with_overrides(scenario, "", "", {})
     run_and_show("simulate", sc, text, seed, output, as_json)
 
 
@@ -38,7 +50,8 @@ def simulate(
 @user_errors
 def navigate(
     source: Path = typer.Argument(
-        ..., help="Scenario YAML, a results file with /imu, or a PSINS .imu / CSV data file."
+        ..., help="Scenario YAML, a results file with /imu, or a PSINS .imu / CSV data file "
+        "(.gz/.xz compressed too); a CSV has no site: give --lat/--lon/--height."
     ),
     init: str | None = typer.Option(
         None, "--init", help="Start from: truth | header | an alignment results file (its "
@@ -48,7 +61,7 @@ def navigate(
     start: float | None = typer.Option(None, "--start", help="Data time to start at (s)."),
     duration: float | None = typer.Option(None, "--duration", help="How long to navigate (s)."),
     output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
+    seed: int | None = typer.Option(None, "--seed", help=SEED_HELP),
     as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ):
     """Strapdown navigation, streamed block by block; errors against truth at every sample.
@@ -59,7 +72,7 @@ def navigate(
     start (`final_error` is null in the JSON).
     """
     overrides = {"vertical": vertical, "start_s": start, "duration_s": duration}
-    suffix = source.suffix.lower()
+    suffix = data_suffix(source)
     data = text = None
     if suffix in DATA_SUFFIXES | HDF5_SUFFIXES:
         # A bare data file stands for the scenario `imu_file: SOURCE`; our own results
@@ -67,7 +80,7 @@ def navigate(
         text = results.read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
         stored = yaml.safe_load(text) if text else None
         name = stored.get("name") if isinstance(stored, dict) else None
-        name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.stem) or "data"
+        name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.name.split(".")[0]) or "data"
         data = {"name": name, "imu_file": str(source.resolve())}
         if isinstance(stored, dict):
             for key in ("earth", "navigation", "output"):
@@ -102,9 +115,17 @@ def validate(
     scenario: Path = typer.Argument(..., help="Scenario YAML."),
     as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ):
-    """Check a scenario and print its resolved values in user units and SI."""
-    sc, _ = load_scenario(scenario)
+    """Check a scenario and print its resolved values in user units and SI, and the keys
+    that cannot matter (as warnings)."""
+    sc, _, _ = load_with_overrides(scenario, "", "", {})
     rows = resolved_rows(sc)
-    consoles(as_json).print(kv_table(f"{scenario}: valid", rows, ("field", "value", "SI")))
+    sections = [c.section for c in COMMANDS.values() if c.section]
+    warnings = list(dict.fromkeys(w for sec in sections for w in sc.unused(sec)))
+    for line in warnings:
+        sys.stderr.write(f"warning: {line}\n")
+    table = kv_table(f"{scenario}: valid", rows, ("field", "value", "SI"),
+                     ("left", "right", "left"))
+    consoles(as_json).print(with_warnings(table, warnings))
     if as_json:
-        emit_json({"valid": True, "values": {k: {"value": v, "si": s} for k, v, s in rows}})
+        emit_json({"valid": True, "values": {k: {"value": v, "si": s} for k, v, s in rows},
+                   "warnings": warnings})

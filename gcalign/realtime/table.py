@@ -115,10 +115,14 @@ def summarise(res: CaseResult) -> CaseSummary:
 
 
 def table1(settings: Settings, rng: np.random.Generator, cases: Sequence[Case] = TABLE1, *,
-           site=SITE, earth: EarthModel = WGS84) -> list[CaseResult]:
+           site=SITE, earth: EarthModel = WGS84, progress=None) -> list[CaseResult]:
     """Run the seed's 12 cases (or `cases`) with `settings` at `site`; each case draws from
     its own child generator (``rng.spawn``), so a case's numbers do not depend on the
-    others."""
+    others. `progress(done, total, what)`, if given, hears of each case finished."""
     children = rng.spawn(len(cases))
-    return [run_case(c, settings, g, site=site, earth=earth)
-            for c, g in zip(cases, children, strict=True)]
+    out = []
+    for i, (c, g) in enumerate(zip(cases, children, strict=True)):
+        out.append(run_case(c, settings, g, site=site, earth=earth))
+        if progress is not None:
+            progress(i + 1, len(cases), "cases")
+    return out

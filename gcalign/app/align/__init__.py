@@ -9,10 +9,11 @@ from __future__ import annotations
 from gcalign.app.registry import Outcome
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None) -> Outcome:
+def execute(sc, seed: int | None = None, cache_key: str | None = None,
+            progress=None) -> Outcome:
     from gcalign.app.align.run import execute as run
 
-    return run(sc, seed, cache_key)
+    return run(sc, seed, cache_key, progress)
 
 
 def table(summary: dict):

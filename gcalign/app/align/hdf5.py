@@ -11,8 +11,8 @@ GAIN_NAMES = "K_E1, K_E2, K_E3, K_N1, K_N2, K_N3, K_U1, K_U2, K_U3, K_U4"
 
 
 def write_alignment(f: h5py.File, run, stream=None) -> None:
-    """/align/pass_NN (attitude and error per pass), /align/result, /align/gains, and the
-    true attitude at the stored samples under /truth (t, att)."""
+    """/align/pass_NN (attitude and error per pass, NN = 01, 02, …), /align/result,
+    /align/gains, and the true attitude at the stored samples under /truth (t, att)."""
     if run.pass_truth is not None:
         rows = {}
         for rec, tr in zip(run.passes, run.pass_truth, strict=True):
@@ -28,8 +28,9 @@ def write_alignment(f: h5py.File, run, stream=None) -> None:
     g.attrs["t1_s"], g.attrs["t2_s"], g.attrs["t3_s"] = run.t1, run.t2, run.t3
     for rec, att, err, phi in zip(run.passes, run.pass_att, run.pass_errors, run.pass_phi,
                                   strict=True):
-        p = g.create_group(f"pass_{rec.index:02d}")
-        p.attrs["direction"], p.attrs["kind"], p.attrs["stage"] = rec.direction, rec.kind, rec.stage
+        p = g.create_group(f"pass_{rec.index + 1:02d}")  # numbered from 1, as in the table
+        p.attrs["direction"], p.attrs["kind"] = rec.direction, rec.kind
+        p.attrs["stage"] = rec.stage + 1
         put(p, "t", rec.t, "s",
             description="data time, processing order (decreasing in a reverse pass)")
         put(p, "att", att, "rad", ATT_FRAME)

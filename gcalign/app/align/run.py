@@ -94,6 +94,20 @@ class AlignRun:
             return None
         return attitude_error(quat_to_euler(self.passes[i].q_nb[-1]), self.pass_truth[i][-1])
 
+    def last_pass_spread(self) -> dict | None:
+        """The error's spread over the second half of the last pass (where a pass has
+        settled; the first half of a conventional run's only pass holds the coarse
+        transient): mean, std (ddof 0) and max |·| per angle (rad) of the stored rows, and
+        the window's first and last data times (s). None without truth."""
+        if self.pass_truth is None:
+            return None
+        r, tr = self.passes[-1], self.pass_truth[-1]
+        h = len(r.t) // 2
+        err = attitude_error(quat_to_euler(r.q_nb[h:]), tr[h:])
+        return {"mean": err.mean(0), "std": err.std(0), "max": np.abs(err).max(0),
+                "t_from": float(min(r.t[h], r.t[-1])), "t_to": float(max(r.t[h], r.t[-1])),
+                "rows": len(err)}
+
     @property
     def phi_t2(self):
         """Misalignment φ at T2 (rad, ENU): C_nb,est C_nb,true^T = exp(−[φ×])."""
@@ -179,9 +193,12 @@ def _reference(cfg: AlignConfig, att, v_n, rng: np.random.Generator, body: bool)
     return np.stack([z, speed, z], -1)
 
 
-def collect(stream: Stream, cfg: AlignConfig, lo: int, hi: int, truth_rows) -> AlignInputs:
+def collect(stream: Stream, cfg: AlignConfig, lo: int, hi: int, truth_rows,
+            progress=None) -> AlignInputs:
     """One pass over the stream: increments lo .. hi-1, reference velocity at lo .. hi,
-    true attitude where `truth_rows(k)` (sample indices, bool array) says, position at T1."""
+    true attitude where `truth_rows(k)` (sample indices, bool array) says, position at T1.
+    `progress(done_s, total_s, what)` hears of every block (the simulation, if it is one,
+    is most of an alignment's time)."""
     source = cfg.aiding.source
     has_truth = stream.truth0 is not None
     if source != "none" and not has_truth:
@@ -224,6 +241,9 @@ def collect(stream: Stream, cfg: AlignConfig, lo: int, hi: int, truth_rows) -> A
             dv[b.k0 + a - lo:b.k0 + c - lo] = b.dv[a:c]
         if b.truth is not None:
             take(b.k0 + 1, b.truth.att, b.truth.v_n, b.truth.pos)
+        if progress is not None:
+            what = "simulating (data s)" if has_truth else "reading (data s)"
+            progress(min(b.k0 + n, hi) * stream.ts, hi * stream.ts, what)
         if b.k0 + n >= hi and (source == "none" or b.k0 + 1 + n > hi):
             break  # everything needed is in; the rest of the run is never generated
     kind = stream.header.meta.get("motion_kind") if stream.header is not None else None
@@ -237,34 +257,72 @@ def collect(stream: Stream, cfg: AlignConfig, lo: int, hi: int, truth_rows) -> A
 
 
 def coarse_attitude(data: AlignInputs, cfg: AlignConfig, i0: int, i1: int):
-    """Attitude at T1 from the coarse method, plus the configured offset (rad)."""
+    """Attitude at T1 from the coarse method (rad): the truth plus ``error_deg`` (given), or
+    the analytic / inertial result over [0, T1] plus ``offset_deg``; and the warnings."""
     c = cfg.coarse
-    offset = np.radians(c.offset_deg)
     if c.method == "given":
         if data.truth_idx is None:
             raise ScenarioError(
                 "align.coarse.method: 'given' needs truth; use 'analytic' or "
                 "'inertial' for recorded data"
             )
-        return data.att_at(i1) + np.radians(c.error_deg) + offset
-    lo = _coarse_start(cfg, i0, i1, data.ts)
-    dth, dv = data.dtheta[lo - data.lo:i1 - data.lo], data.dv[lo - data.lo:i1 - data.lo]
+        return data.att_at(i1) + np.radians(c.error_deg), []
+    offset = np.radians(c.offset_deg)
+    dth, dv = data.dtheta[i0 - data.lo:i1 - data.lo], data.dv[i0 - data.lo:i1 - data.lo]
     ts, site = data.ts, data.site
     try:
         if c.method == "analytic":
-            return coarse_mod.analytic_coarse(dth, dv, ts, site[0], data.earth) + offset
+            att = coarse_mod.analytic_coarse(dth, dv, ts, site[0], data.earth) + offset
+            return att, still_base_warnings(dth, dv, ts, site[0], data.earth)
         return coarse_mod.inertial_frame_coarse(dth, dv, ts, site[0], site[1], site[2],
-                                                earth=data.earth) + offset
+                                                earth=data.earth) + offset, []
     except ValueError as err:  # too short a window
         raise ScenarioError(
-            f"align.coarse.duration_s: the coarse window [{(lo - i0) * ts:g}, "
-            f"{(i1 - i0) * ts:g}] s does not fit method {c.method!r}: {err}"
+            f"align.t1_s: the coarse window [0, {(i1 - i0) * ts:g}] s does not fit method "
+            f"{c.method!r}: {err}"
         ) from None
 
 
-def _coarse_start(cfg: AlignConfig, i0: int, i1: int, ts: float) -> int:
-    c = cfg.coarse
-    return i1 - int(round(c.duration_s / ts)) if c.duration_s else i0
+#: The share of the signal an excursion of the base may reach before the analytic coarse
+#: alignment is warned about: 1 % of the horizontal earth rotation over the window (the
+#: heading signal) and an equivalent tilt of 1e-4 rad for the specific force (20″).
+STILL_SHARE = 0.01
+STILL_TILT_RAD = 1e-4
+
+
+def still_base_warnings(dtheta: np.ndarray, dv: np.ndarray, ts: float, lat: float,
+                        earth: EarthModel) -> list[str]:
+    """Is the base still enough for the analytic coarse alignment?
+
+    The analytic (static double-vector) method takes the block-averaged angular rate for
+    the earth rate and the averaged specific force for gravity; a base that turns or
+    accelerates and comes back biases both averages (a swing of a few degrees turns the
+    heading by more than 100°). Measure it: the largest excursion of the integrated
+    increments about their mean trend (sensor noise only, on a still base), against 1 % of
+    the horizontal earth rotation over the window (ω_ie cos L · T) and against the velocity
+    a tilt of 1e-4 rad would give (1e-4 · g · T).
+    """
+    T = len(dtheta) * ts
+    k = np.arange(1, len(dtheta) + 1)[:, None]
+
+    def excursion(inc: np.ndarray) -> float:
+        wander = np.cumsum(inc, axis=0) - k * inc.mean(axis=0)
+        return float(np.max(np.linalg.norm(wander, axis=1))) if len(inc) else 0.0
+
+    arcsec = 180.0 / math.pi * 3600.0
+    turn, limit = excursion(dtheta), STILL_SHARE * earth.omega_ie * math.cos(lat) * T
+    if turn > limit:
+        return [f"align.coarse.method: 'analytic' assumes a still base, but the base turned "
+                f"by up to {turn * arcsec:.3g}″ about its mean rate during the {T:g} s coarse "
+                f"window (1 % of the earth's rotation over it: {limit * arcsec:.3g}″); expect "
+                "a wrong heading: use 'inertial' on a moving or swinging base"]
+    shift, limit = excursion(dv), STILL_TILT_RAD * float(earth.gravity(lat)) * T
+    if shift > limit:
+        return [f"align.coarse.method: 'analytic' assumes a still base, but its velocity "
+                f"changed by up to {shift:.3g} m/s during the {T:g} s coarse window (a tilt "
+                f"of 1e-4 rad gives {limit:.3g} m/s); expect wrong tilts: use 'inertial' on a "
+                "moving or swinging base"]
+    return []
 
 
 def warm_up() -> None:
@@ -275,7 +333,7 @@ def warm_up() -> None:
                         np.empty((2, 4)))
 
 
-def run_alignment(sc: Scenario, stream: Stream | RunData) -> AlignRun:
+def run_alignment(sc: Scenario, stream: Stream | RunData, progress=None) -> AlignRun:
     """Coarse alignment, the passes of the mode, and the T2 → T3 compensation, on a stream
     of the run's data (or the whole run in memory)."""
     if isinstance(stream, RunData):
@@ -301,7 +359,7 @@ def run_alignment(sc: Scenario, stream: Stream | RunData) -> AlignRun:
     i0 = _index(stream, cfg, 0.0, "start_s")
     i1 = _index(stream, cfg, cfg.t1_s, "t1_s")
     i2 = _index(stream, cfg, cfg.t2_s, "t2_s")
-    realtime = cfg.mode == "conventional" and cfg.realtime
+    realtime = cfg.realtime_conventional
     if cfg.t3_s == "measured":
         i3 = i2 if realtime else None
         hi = i2 if realtime else min(stream.samples, i2 + int(round(MEASURED_MAX_S / ts)))
@@ -312,15 +370,16 @@ def run_alignment(sc: Scenario, stream: Stream | RunData) -> AlignRun:
         stride = sc.output.stride(1.0 / ts, stream.samples * ts)
     except ValueError as err:
         raise ScenarioError(str(err)) from None
-    lo = min(i1, _coarse_start(cfg, i0, i1, ts)) if cfg.coarse.method != "given" else i1
+    lo = i0 if cfg.coarse.method != "given" else i1
     ends = {i1, i2, hi} | ({i3} if i3 is not None else set())
 
     def truth_rows(k):
         """Samples whose true attitude is kept: the stored pass rows and the ends."""
         return ((k >= i1) & (k <= hi) & ((k - i1) % stride == 0)) | np.isin(k, list(ends))
 
-    data = collect(stream, cfg, lo, hi, truth_rows)
-    att1 = coarse_attitude(data, cfg, i0, i1)
+    data = collect(stream, cfg, lo, hi, truth_rows, progress)
+    att1, coarse_warnings = coarse_attitude(data, cfg, i0, i1)
+    warnings += coarse_warnings
     q1 = euler_to_quat(att1)
     v1 = quat_to_dcm(q1) @ data.vref[i1 - lo] if data.vref_body else data.vref[i1 - lo]
     state0 = K.new_state(q1, v1, data.pos_t1)
@@ -331,7 +390,7 @@ def run_alignment(sc: Scenario, stream: Stream | RunData) -> AlignRun:
     t_start = time.perf_counter()
     state_end, records = run_passes(
         state0, data.block(i1, i3 if realtime else i2),  # type: ignore[arg-type]
-        cfg.mode, cfg.pass_count, [s.to_stage() for s in cfg.stages], poles,
+        cfg.mode, cfg.pass_count, cfg.stage_list(), poles,
         cfg.level_phase_s, data.earth, stride,
     )
     compute = time.perf_counter() - t_start
@@ -391,12 +450,18 @@ def alignment_summary(run: AlignRun, stream: Stream | RunData, name: str) -> dic
     if isinstance(stream, RunData):
         stream = stream_of(stream)
     cfg = run.cfg
-    realtime = cfg.mode == "conventional" and cfg.realtime
+    realtime = cfg.realtime_conventional
     start, ts = stream.t0, stream.ts  # data time of sample 0
 
     def aligned_time(t_data: float) -> float:
         return (round((t_data - start) / ts) - run.index_offset) * ts
 
+    spread = run.last_pass_spread()
+    last = None if spread is None else {
+        "window_s": [aligned_time(spread["t_from"]), aligned_time(spread["t_to"])],
+        "rows": spread["rows"],
+        **{f"{k}_deg": _deg(spread[k]) for k in ("mean", "std", "max")}}
+    stages = cfg.stage_list()
     return {
         "scenario": name,
         "seed": stream.seed,
@@ -404,7 +469,8 @@ def alignment_summary(run: AlignRun, stream: Stream | RunData, name: str) -> dic
         "mode": cfg.mode,
         "compensation": "real time" if realtime else cfg.compensation,
         "azimuth_poles": run.azimuth_poles,
-        "stages": [s.model_dump() for s in cfg.stages],
+        "stages": [{"stage": i + 1, "t_xy_s": s.t_xy, "t_z_s": s.t_z, "xi": s.xi,
+                    "passes": s.passes} for i, s in enumerate(stages)],
         "t1_s": run.t1,
         "t2_s": run.t2,
         "t3_s": run.t3,
@@ -418,12 +484,13 @@ def alignment_summary(run: AlignRun, stream: Stream | RunData, name: str) -> dic
         "error_t3_deg": _deg(run.error_t3),
         "misalignment_t2_deg": _deg(run.phi_t2),
         "misalignment_t3_deg": _deg(run.phi_t3),
+        "last_pass_error": last,
         "passes": [
             {
-                "index": r.index,
+                "pass": r.index + 1,
                 "direction": r.direction,
                 "kind": r.kind,
-                "stage": r.stage,
+                "stage": r.stage + 1,
                 "t_end_s": aligned_time(float(r.t[-1])),
                 "error_deg": _deg(run.pass_end_error(r.index)),
                 "attitude_deg": np.degrees(quat_to_euler(r.q_nb[-1])).tolist(),
@@ -437,7 +504,8 @@ def alignment_summary(run: AlignRun, stream: Stream | RunData, name: str) -> dic
     }
 
 
-def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Outcome:
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+            progress=None) -> Outcome:
     """Simulate (or read) the data, align, summarise; the registry's entry point."""
     from gcalign.app.align.hdf5 import write_alignment
 
@@ -445,6 +513,6 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None)
         stream = stream_of(scenario_data(sc, seed, cache_key))
     else:
         stream = scenario_stream(sc, seed)
-    run = run_alignment(sc, stream)
+    run = run_alignment(sc, stream, progress)
     return Outcome(alignment_summary(run, stream, sc.name),
                    lambda f: write_alignment(f, run, stream), None, stream.seed, run.warnings)

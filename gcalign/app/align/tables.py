@@ -1,48 +1,88 @@
-"""The `gcalign align` table: truth, estimate and error at T2 and T3, the passes."""
+"""The `gcalign align` table: truth and estimate at T2 and T3, the error there and its
+spread over the last pass, the error (or, without truth, the attitude) at the end of every
+pass. Attitudes in degrees; errors in deg, ′ or ″ as their size needs."""
 
 from __future__ import annotations
 
 from rich.table import Table
 from rich.text import Text
 
-from gcalign.app.report import fmt
+from gcalign.app.report import DASH, UNIT_NAME, angle_unit, angles, flat, number, run_line
+
+
+def _pass_label(p: dict) -> str:
+    return f"{p['pass']}: {p['direction']}, {p['kind']}, stage {p['stage']}"
 
 
 def align_table(s: dict) -> Table:
-    """Truth, estimate and error at T2 and T3, the error after each pass, timing."""
+    """See the module docstring; every number of a section in one unit and format."""
+    passes = s["passes"]
+    n_fwd = sum(p["direction"] == "forward" for p in passes)
+    plan = (f"{len(passes)} passes ({n_fwd} forward + {len(passes) - n_fwd} reverse)"
+            if len(passes) > 1 else "1 pass")
+    comp = ("real time (no compensation)" if s["compensation"] == "real time"
+            else f"compensation {s['compensation']} T2 → T3")
     table = Table(
-        title=f"gcalign align: {s['scenario']} — {s['mode']}, compensation {s['compensation']}, "
+        title=f"gcalign align: {s['scenario']} — {s['mode']}, {plan}, {comp}, azimuth "
         f"poles {s['azimuth_poles']}",
-        title_justify="left",
-        header_style="bold",
-    )
-    for name in ("", "t (s)", "pitch (deg)", "roll (deg)", "yaw (deg)"):
+        title_justify="left", header_style="bold")
+    for name in ("", "t (s)", "pitch", "roll", "yaw"):
         table.add_column(name, justify="left" if not name else "right")
+    has_truth = s.get("truth_t3_deg") is not None
+
+    def row(label, t, values, unit, end=False):
+        t_text = t if isinstance(t, str) else number(t, 2)
+        cells = [DASH] * 3 if values is None else angles(values, unit)
+        table.add_row(Text(label), t_text, *cells, end_section=end)
+
     for when in ("t2", "t3"):
-        for what, name in (("truth", "truth"), ("attitude", "estimate"), ("error", "error")):
-            vals = s.get(f"{what}_{when}_deg")
-            digits = 5 if what == "error" else 4
-            cells = ["—"] * 3 if vals is None else [fmt(v, digits) for v in vals]
-            table.add_row(
-                Text(f"{name} at T{when[1]}"),
-                fmt(s[f"{when}_s"], 2),
-                *cells,
-                end_section=what == "error",
-            )
-    for p in s["passes"]:
-        has_error = p["error_deg"] is not None
-        vals = p["error_deg"] if has_error else p["attitude_deg"]
-        table.add_row(
-            Text(
-                f"pass {p['index'] + 1} {p['direction'][0].upper()} {p['kind']} "
-                f"s{p['stage'] + 1} {'error' if has_error else 'attitude'}"
-            ),
-            fmt(p["t_end_s"], 1),
-            *[fmt(v, 5) for v in vals],
-        )
-    table.caption = (
-        f"data used {s['data_used_s']:.1f} s, equivalent length "
-        f"{s['equivalent_s']:.1f} s; compute {s['compute_s'] * 1e3:.1f} ms; "
-        f"output {s.get('output') or '—'}"
-    )
+        t = s[f"{when}_s"]
+        if has_truth:
+            row(f"truth at T{when[1]} (deg)", t, s[f"truth_{when}_deg"], "deg")
+        row(f"estimate at T{when[1]} (deg)", t, s[f"attitude_{when}_deg"], "deg",
+            end=when == "t3")
+
+    last = s.get("last_pass_error")
+    if has_truth:
+        stats = [] if last is None else [last["mean_deg"], last["std_deg"], last["max_deg"]]
+        unit = angle_unit(flat([s["error_t2_deg"], s["error_t3_deg"], *stats]))
+        u = UNIT_NAME[unit]
+        row(f"error at T2 ({u})", s["t2_s"], s["error_t2_deg"], unit)
+        row(f"error at T3 ({u})", s["t3_s"], s["error_t3_deg"], unit, end=last is None)
+        if last is not None:
+            a, b = last["window_s"]
+            table.add_row(Text(f"last pass, 2nd half ({u})", style="bold"),
+                          f"{a:.0f}–{b:.0f}", "", "", "")
+            row("  mean", "", last["mean_deg"], unit)
+            row("  std", "", last["std_deg"], unit)
+            row("  max |error|", "", last["max_deg"], unit, end=True)
+        ends = [p["error_deg"] for p in passes]
+        unit = angle_unit(flat(ends))
+        table.add_row(Text(f"error at the end of pass ({UNIT_NAME[unit]})", style="bold"),
+                      "", "", "", "")
+        for p in passes:
+            row(_pass_label(p), p["t_end_s"], p["error_deg"], unit)
+    else:
+        table.add_row(Text("attitude at the end of pass (deg)", style="bold"), "", "", "", "")
+        for p in passes:
+            row(_pass_label(p), p["t_end_s"], p["attitude_deg"], "deg")
+
+    notes = [
+        f"T1 = {s['t1_s']:g} s; data used {s['data_used_s']:.1f} s, equivalent length "
+        f"{s['equivalent_s']:.1f} s (passes laid end to end)"
+        + ("" if s.get("t3_source") != "measured" else
+           f"; T3 measured: T2 + the passes' compute time = {s['t3_s']:.2f} s"),
+    ]
+    notes.append("pass: direction, loop (compass: the gyrocompass loops; attitude: "
+                 "attitude-only strapdown), stage of the loop parameters (align.stages); t: "
+                 "alignment time (a reverse pass ends at T1)")
+    if has_truth:
+        notes.append("error: estimate − truth as Euler angles (yaw wrapped)"
+                     + ("" if last is None else
+                        f"; last pass, 2nd half: its {last['rows']} stored rows, std ddof 0"))
+    else:
+        notes.append("recorded data: no truth, so no errors; the estimate only")
+    notes.append(run_line(s, "compute (the passes)"))
+    table.caption = "\n".join(notes)
+    table.caption_justify = "left"
     return table

@@ -90,11 +90,12 @@ def vertical_of(cfg: NavigationConfig, sc: Scenario, motion_kind: str | None = N
 
 
 def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
-                    duration_s: float | None = None, sink=None) -> dict:
+                    duration_s: float | None = None, sink=None, progress=None) -> dict:
     """Navigate from `start` to the end of the data (or for `duration_s`), compare with the
     truth at every sample (:func:`gcalign.nav._kernels.error_block`), write every
     `stride`-th row to `sink` (an h5py group), and return the plain-number pieces of the
-    summary (SI, radians)."""
+    summary (SI, radians). `progress(done_s, total_s, what)`, if given, hears of every
+    block (seconds of data navigated)."""
     from gcalign.io.results import ATT_FRAME, PHI_FRAME, Series
 
     ts, earth = stream.ts, stream.earth
@@ -166,6 +167,8 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
                          "error/pos": r[:, 15:18], "error/phi": r[:, 18:21]}
             series.append(**data)
         last = (states[-1], None if b.q_bs is None else b.q_bs[hi - 1])
+        if progress is not None:
+            progress((b.k0 + hi - start.k) * ts, (k_end - start.k) * ts, "navigating (data s)")
     assert last is not None
     s_end, qbs_end = last
     q_end = s_end[K.Q] if qbs_end is None else body_attitude(s_end[K.Q][None], qbs_end[None])[0]
@@ -192,7 +195,7 @@ def _qmul(a, b):
 
 
 def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | None = None,
-                   sink=None) -> tuple[dict, Stream]:
+                   sink=None, progress=None) -> tuple[dict, Stream]:
     """Navigate a scenario's data; the summary (plain numbers, degrees/m) and the stream."""
     cfg = sc.navigation or NavigationConfig()
     stream = scenario_stream(sc, seed)
@@ -228,7 +231,7 @@ def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | Non
             v0 = hd.v0_n if hd.v0_n is not None else np.zeros(3)
             state = NavState.from_euler(hd.att0, v0, stream.site)
         start = Start(k, state, source)
-    part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink)
+    part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink, progress)
     return _summary(sc, stream, start, vertical, stride, part), stream
 
 
@@ -277,9 +280,9 @@ def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, str
 
 
 def execute(sc, seed: int | None = None, cache_key: str | None = None, sink=None,
-            init: str | Path | None = None) -> Outcome:
+            init: str | Path | None = None, progress=None) -> Outcome:
     """Navigate (streamed); the registry's entry point. With `sink` (an open results file)
     the decimated series go into its /navigate group as they are computed."""
     group = None if sink is None else sink.create_group("navigate")
-    summary, stream = run_navigation(sc, seed, init, group)
+    summary, stream = run_navigation(sc, seed, init, group, progress)
     return Outcome(summary, lambda f: None, None, stream.seed)

@@ -58,7 +58,7 @@ class RealtimeRun:
     compute_s: float
 
 
-def run_realtime(sc: Scenario, seed: int | None = None) -> RealtimeRun:
+def run_realtime(sc: Scenario, seed: int | None = None, progress=None) -> RealtimeRun:
     """Run every case of the scenario's ``realtime`` section.
 
     Raises
@@ -78,7 +78,7 @@ def run_realtime(sc: Scenario, seed: int | None = None) -> RealtimeRun:
     assert sc.site is not None  # checked by cases_of
     t0 = time.perf_counter()
     results = table1(settings, np.random.default_rng(seed), cases, site=sc.site.to_si(),
-                     earth=sc.earth_model)
+                     earth=sc.earth_model, progress=progress)
     rows = [summarise(r) for r in results]
     return RealtimeRun(cfg=cfg, settings=settings, chain=build_chain(settings),
                        results=results, rows=rows, seed=seed,
@@ -189,10 +189,11 @@ def realtime_summary(run: RealtimeRun, sc: Scenario) -> dict:
     }
 
 
-def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Outcome:
-    """Run, summarise; the registry's entry point."""
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+            progress=None) -> Outcome:
+    """Run, summarise; the registry's entry point (`progress`: one report per case)."""
     from gcalign.app.realtime.hdf5 import write_realtime
 
-    run = run_realtime(sc, seed)
+    run = run_realtime(sc, seed, progress)
     return Outcome(realtime_summary(run, sc), lambda f: write_realtime(f, run), None,
                    run.seed)

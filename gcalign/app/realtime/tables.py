@@ -5,6 +5,8 @@ from __future__ import annotations
 from rich.table import Table
 from rich.text import Text
 
+from gcalign.app.report import run_line
+
 REFERENCE_TEXT = {
     "seed": "the INS's own output T after the pulse (the seed's semi-physical reference)",
     "truth": "the true attitude at the pulse time",
@@ -38,35 +40,42 @@ def _tdelay(c: dict, T_ms: float) -> str:
 
 
 def realtime_table(s: dict) -> Table:
-    """Per case: T + Δt, the error before prediction (seed's, ours, closed form), the seed's
-    "after", and ours per predictor (max and rms, ″) on the run's reference; the last
-    column is against the truth."""
+    """Two tables, one above the other (each fits 80 columns): per case T + Δt and the
+    error before prediction (the seed's, ours, the closed form); then the seed's "after"
+    and ours per predictor (max and rms, ″) on the run's reference, and the max against
+    the truth."""
     after = [p for p in s["predictors"] if p != "none"] or list(s["predictors"])
     T = s["filter_delay_ms"]
     setting = ("the seed's semi-physical setting: T fixed at 4 ms (n = 4), pulses on the "
                "solution instants (Δt = 0)" if s["semi_physical"] else
                f"T = {T:.4f} ms")
-    table = Table(
-        title=f"gcalign realtime: {s['scenario']} — {setting}; the designed chain's own "
-        f"delay {s['chain_delay_ms']:.4f} ms (FIR {s['fir_delay_ms']:.3f} ms + notch "
-        f"{s['notch_delay_us']:.2f} µs)",
-        title_justify="left", header_style="bold")
-    table.add_column("case", justify="left", no_wrap=True)
-    table.add_column("T+Δt ms", justify="right")
-    table.add_column("before: seed", justify="right")
-    table.add_column("ours", justify="right")
-    table.add_column("closed form", justify="right")
-    table.add_column("after: seed", justify="right")
+    before = Table(title="before prediction: the attitude latched at the pulse",
+                   title_justify="left", header_style="bold")
+    before.add_column("case", justify="left", no_wrap=True)
+    for name in ("T+Δt (ms)", "seed", "ours", "closed form"):
+        before.add_column(name, justify="right")
+    later = Table(title="after prediction to the pulse time: max (rms), ″",
+                  title_justify="left", header_style="bold")
+    later.add_column("case", justify="left", no_wrap=True)
+    later.add_column("seed", justify="right")
     for p in after:
-        table.add_column(f"{p} max (rms)", justify="right")
-    table.add_column("truth: max", justify="right")
+        later.add_column(p, justify="right")
+    later.add_column(f"truth: max ({' / '.join(after)})", justify="right")
     for c in s["cases"]:
-        cells = [Text(c["name"]), _tdelay(c, T), c["seed_before"] or "—", _before(c),
-                 _theory(c), c["seed_after"] or "—"]
+        before.add_row(Text(c["name"]), _tdelay(c, T), c["seed_before"] or "—", _before(c),
+                       _theory(c))
+        cells = [Text(c["name"]), c["seed_after"] or "—"]
         for p in after:
             cells.append(f"{_a(c['after_max_arcsec'][p])} ({_a(c['after_rms_arcsec'][p])})")
         cells.append(" / ".join(_a(c["truth"]["after_max_arcsec"][p], 2) for p in after))
-        table.add_row(*cells)
+        later.add_row(*cells)
+    table = Table.grid(padding=(1, 0))
+    table.title = (f"gcalign realtime: {s['scenario']} — {setting}; the designed chain's own "
+                   f"delay {s['chain_delay_ms']:.4f} ms (FIR {s['fir_delay_ms']:.3f} ms + "
+                   f"notch {s['notch_delay_us']:.2f} µs)")
+    table.title_justify = "left"
+    table.add_row(before)
+    table.add_row(later)
     m = s["model"]
     truth = " / ".join(after)
     lags = [f"{c['name']} {c['lag_ms']:.3f} ms" for c in s["cases"] if c.get("lag_ms")]
@@ -81,5 +90,6 @@ def realtime_table(s: dict) -> Table:
         f"rad²/s⁵, R = ({m['r_std_arcsec']:g}″)². "
         + (f"INS lag behind the table at uniform rate (seed Fig. 4: 4.4 ms): "
            f"{'; '.join(lags)}. " if lags else "")
-        + f"seed {s['seed']}; compute {s['compute_s']:.2f} s; output {s.get('output') or '—'}")
+        + "\n" + run_line(s, f"compute ({len(s['cases'])} cases)"))
+    table.caption_justify = "left"
     return table

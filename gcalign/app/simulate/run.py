@@ -22,8 +22,9 @@ SENSOR = "sensor frame s (turned by the mechanism; C_s^b in q_bs)"
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            sink=None) -> Outcome:
-    """Simulate block by block; with `sink` (an open results file) write /truth and /imu."""
+            sink=None, progress=None) -> Outcome:
+    """Simulate block by block; with `sink` (an open results file) write /truth and /imu.
+    `progress(done_s, total_s, what)`, if given, hears of every block."""
     from gcalign.io.results import ATT_FRAME, Series
 
     t_start = time.perf_counter()
@@ -88,6 +89,8 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             extra = {} if b.q_bs is None else {"q_bs": b.q_bs[keep]}
             imu.append(t=b.t[keep], **rows, **extra)
         last = b
+        if progress is not None:
+            progress((b.k0 + len(b.t)) * ts, stream.samples * ts, "simulating (data s)")
     summary: dict = {
         "scenario": sc.name,
         "seed": stream.seed,

@@ -1,24 +1,35 @@
-"""The `gcalign simulate` table."""
+"""The `gcalign simulate` table: what was simulated and where the motion ended."""
 
 from __future__ import annotations
 
 from rich.table import Table
 
-from gcalign.app.report import fmt, kv_table
+from gcalign.app.report import DASH, angles, kv_table, numbers, run_line, span
+
+
+def _vec(values, **kw) -> str:
+    return DASH if values is None else "  ".join(numbers(values, **kw))
 
 
 def simulate_table(s: dict) -> Table:
+    metric = {"sig": 4, "most": 6, "tiny_as_zero": True}
+    att0, att1 = s["initial_attitude_deg"], s["final_attitude_deg"]
     rows = [
-        ("scenario", s["scenario"]),
-        ("seed", str(s["seed"])),
-        ("samples", str(s["samples"])),
-        ("rate (Hz)", fmt(s["rate_hz"], 2)),
-        ("duration (s)", fmt(s["duration_s"], 2)),
-        ("initial attitude (pitch, roll, yaw) (deg)", fmt(s["initial_attitude_deg"])),
-        ("final attitude (pitch, roll, yaw) (deg)", fmt(s["final_attitude_deg"])),
-        ("final velocity ENU (m/s)", fmt(s["final_velocity_mps"])),
-        ("distance travelled (m)", fmt(s["distance_m"], 2)),
-        ("compute (s)", fmt(s["compute_s"], 3)),
-        ("output", s.get("output") or "—"),
+        ("samples", f"{s['samples']} at {s['rate_hz']:g} Hz ({span(s['duration_s'])})"),
+        ("stored at", f"{s['output_rate_hz']:g} Hz"
+         + ("; IMU on a mechanism (sensor frame)" if s.get("mechanism") else "")),
+        ("initial attitude (pitch, roll, yaw) (deg)",
+         DASH if att0 is None else "  ".join(angles(att0, "deg"))),
+        ("final attitude (pitch, roll, yaw) (deg)",
+         DASH if att1 is None else "  ".join(angles(att1, "deg"))),
+        ("final velocity ENU (m/s)", _vec(s["final_velocity_mps"], **metric)),
+        ("distance travelled (m)", _vec(None if s["distance_m"] is None else
+                                        [s["distance_m"]], **metric)),
+        ("height range (m)", _vec(s.get("height_range_m"), **metric)),
+        ("final displacement ENU (m)", _vec(s.get("final_displacement_m"), **metric)),
     ]
-    return kv_table("gcalign simulate", rows, ("", "value"))
+    table = kv_table(f"gcalign simulate: {s['scenario']} (earth {s.get('earth', 'wgs84')})",
+                     rows, ("", "value"))
+    table.caption = run_line(s, "compute (simulation and writing)")
+    table.caption_justify = "left"
+    return table

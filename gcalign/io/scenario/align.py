@@ -1,4 +1,17 @@
-"""The `align` section of a scenario (seed 000; README "Scenario format")."""
+"""The `align` section of a scenario (seed 000; README "Scenario format").
+
+One key per quantity: the coarse window is ``[start_s, t1_s]`` (no separate duration), the
+method ``given`` takes ``error_deg`` and the measuring methods ``offset_deg``, and the pass
+count is the sum of the stages' ``passes``. Two kinds of keys that cannot matter:
+
+* a key contradicting the method of its own mapping (``coarse: {method: analytic,
+  error_deg: …}``) is an error: it was written together with what makes it void;
+* a key a mode makes void (``compensation`` in real-time conventional mode, the stage pass
+  counts of conventional mode, ``realtime`` in the cycle modes, ``aiding.noise_mps``
+  without aiding) is reported by :meth:`AlignConfig.unused`: the command shows it on
+  stderr, in its table and in the JSON ``warnings`` (a ``--mode`` option must not make a
+  scenario invalid).
+"""
 
 from __future__ import annotations
 
@@ -10,21 +23,47 @@ from pydantic import Field, model_validator
 from gcalign.align.stages import Stage, stage_of_passes
 from gcalign.io.scenario.base import Model, Vec3
 
+#: Passes in all when the last stage does not say: 3 forward + 2 reverse in the cycle
+#: modes (seed 000 §5.3), one forward pass in conventional mode.
+DEFAULT_PASSES = {"conventional": 1, "full-cycle": 5, "half-cycle": 5}
+
+
+def _removed(data, key: str, instead: str):
+    """A key that was dropped: say what replaced it (pydantic would say 'unknown key')."""
+    if isinstance(data, dict) and key in data:
+        raise ValueError(f"{key}: removed; {instead}")
+    return data
+
 
 class Coarse(Model):
     method: Literal["given", "analytic", "inertial"] = "given"
-    duration_s: float | None = Field(
-        None, gt=0, description="coarse window ending at T1; default T1"
-    )
     error_deg: Vec3 = Field(
         default_factory=lambda: [1.0, 1.0, 10.0],
         description="method given: added to the true attitude at T1",
     )
     offset_deg: Vec3 = Field(
         default_factory=lambda: [0.0, 0.0, 0.0],
-        description="added to the coarse result of any method (studies of "
-        "the initial error on recorded data)",
+        description="methods analytic and inertial: added to their result (studies of the "
+        "initial error on recorded data)",
     )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _one_window(cls, data):
+        return _removed(data, "duration_s", "the coarse window is [start_s, t1_s]: set "
+                        "align.t1_s (and align.start_s for a later window)")
+
+    @model_validator(mode="after")
+    def _one_error_key(self):
+        given = self.method == "given"
+        if given and "offset_deg" in self.model_fields_set:
+            raise ValueError("offset_deg: cannot matter with method 'given', which takes "
+                             "error_deg (the error added to the true attitude at T1)")
+        if not given and "error_deg" in self.model_fields_set:
+            raise ValueError(f"error_deg: cannot matter with method {self.method!r}; it is "
+                             "the error of method 'given' (offset_deg adds a fixed error to "
+                             f"the {self.method} result)")
+        return self
 
 
 class Aiding(Model):
@@ -36,10 +75,9 @@ class StageModel(Model):
     t_xy_s: float = Field(20.0, gt=0)
     t_z_s: float = Field(100.0, gt=0)
     xi: float = Field(0.707, gt=0, lt=1)
-    passes: int | None = Field(None, ge=1)
-
-    def to_stage(self) -> Stage:
-        return Stage(self.t_xy_s, self.t_z_s, self.xi, self.passes)
+    passes: int | None = Field(
+        None, ge=1, description="passes this stage covers; the last stage may omit it and "
+        "takes the rest of the mode's default (5 in the cycle modes)")
 
 
 class AlignConfig(Model):
@@ -48,10 +86,9 @@ class AlignConfig(Model):
     start_s: float = Field(
         0.0, ge=0, description="offset from the first sample taken as t = 0 (data windows)"
     )
-    t1_s: float = Field(10.0, ge=0)
+    t1_s: float = Field(10.0, ge=0, description="end of the coarse window [0, T1]")
     t2_s: float = Field(300.0, gt=0)
     t3_s: float | Literal["measured"] = 330.0
-    passes: int = Field(5, ge=1, le=101)
     realtime: bool = Field(
         True,
         description="conventional mode: run the loop through T3 in real time; false stops "
@@ -63,6 +100,12 @@ class AlignConfig(Model):
     level_s: float | None = Field(None, ge=0, description="level-only phase; default 3·T_xy")
     stages: list[StageModel] = Field(default_factory=lambda: [StageModel()], min_length=1)
 
+    @model_validator(mode="before")
+    @classmethod
+    def _one_pass_count(cls, data):
+        return _removed(data, "passes", "the pass count is the sum of the stages' passes: "
+                        "set align.stages.N.passes on the last stage (or --passes N)")
+
     @model_validator(mode="after")
     def _timeline(self):
         if self.t2_s <= self.t1_s:
@@ -71,32 +114,28 @@ class AlignConfig(Model):
             raise ValueError(
                 f"t3_s: must be at least t2_s ({self.t2_s} s) or 'measured', got {self.t3_s}"
             )
-        if self.coarse.duration_s is not None and self.coarse.duration_s > self.t1_s:
-            raise ValueError(
-                f"coarse.duration_s: must not exceed t1_s ({self.t1_s} s), "
-                f"got {self.coarse.duration_s}"
-            )
         if self.coarse.method != "given" and self.t1_s <= 0:
             raise ValueError(
                 f"t1_s: coarse method {self.coarse.method!r} needs data before T1, "
                 f"got t1_s = {self.t1_s}"
             )
-        if self.mode != "conventional":
-            if self.passes < 3 or self.passes % 2 == 0:
-                raise ValueError(
-                    f"passes: mode {self.mode!r} needs an odd number of passes ≥ 3 (forward, "
-                    f"reverse, …, forward), got {self.passes}"
-                )
-        passes = self.pass_count
-        covered = stage_of_passes([s.to_stage() for s in self.stages], passes)
-        for i in range(len(self.stages)):
-            if i not in covered:
-                raise ValueError(
-                    f"stages: stage {i} covers no pass ({passes} pass(es) in mode {self.mode!r}, "
-                    f"earlier stages take them all); remove it or lower an earlier 'passes'"
-                )
         if any(s.passes is None for s in self.stages[:-1]):
             raise ValueError("stages: only the last stage may omit 'passes' (it takes the rest)")
+        if self.mode != "conventional":
+            last = self.stages[-1]
+            earlier = sum(s.passes or 0 for s in self.stages[:-1])
+            if last.passes is None and earlier >= DEFAULT_PASSES[self.mode]:
+                raise ValueError(
+                    f"stages.{len(self.stages) - 1}.passes: missing, and the earlier stages "
+                    f"take all {DEFAULT_PASSES[self.mode]} passes of the default; give this "
+                    "stage's passes")
+            passes = self.pass_count
+            if passes < 3 or passes % 2 == 0:
+                raise ValueError(
+                    f"stages: mode {self.mode!r} needs an odd number of passes ≥ 3 in all "
+                    f"(forward, reverse, …, forward), the stages give {passes} "
+                    f"({' + '.join(str(s.passes) for s in self.stage_list())})"
+                )
         if self.level_phase_s >= self.t2_s - self.t1_s:
             raise ValueError(
                 f"level_s: the level phase ({self.level_phase_s} s) must be shorter "
@@ -105,8 +144,29 @@ class AlignConfig(Model):
         return self
 
     @property
+    def realtime_conventional(self) -> bool:
+        """One forward pass over live data to T3: nothing to compensate."""
+        return self.mode == "conventional" and self.realtime
+
+    def stage_list(self) -> list[Stage]:
+        """The stages with their pass counts resolved (conventional: one pass, stage 1)."""
+        if self.mode == "conventional":
+            s = self.stages[0]
+            return [Stage(s.t_xy_s, s.t_z_s, s.xi, 1)]
+        out: list[Stage] = []
+        for s in self.stages:  # only the last may omit its count: the rest of the default
+            n = s.passes if s.passes is not None else DEFAULT_PASSES[self.mode] - sum(
+                int(o.passes or 0) for o in out)
+            out.append(Stage(s.t_xy_s, s.t_z_s, s.xi, n))
+        return out
+
+    @property
     def pass_count(self) -> int:
-        return 1 if self.mode == "conventional" else self.passes
+        return sum(int(s.passes or 0) for s in self.stage_list())
+
+    def stage_of_pass(self) -> list[int]:
+        """Index of the stage each pass uses (0-based)."""
+        return stage_of_passes(self.stage_list(), self.pass_count)
 
     @property
     def level_phase_s(self) -> float:
@@ -119,9 +179,40 @@ class AlignConfig(Model):
             return self.azimuth_poles
         return "double-oscillator" if motion_kind == "moving" else "oscillator-overdamped"
 
+    def unused(self, sc=None) -> list[str]:
+        """Keys set in the scenario that this mode makes void, one line each (shown as
+        warnings; see the module docstring)."""
+        out = []
+        if self.realtime_conventional and "compensation" in self.model_fields_set:
+            out.append(f"align.compensation: {self.compensation!r} cannot matter in real-time "
+                       "conventional mode (the loop runs on live data to T3); set "
+                       "align.realtime: false to stop at T2 and compensate")
+        if self.mode != "conventional" and "realtime" in self.model_fields_set:
+            out.append(f"align.realtime: cannot matter in mode {self.mode!r} (it applies to "
+                       "conventional mode only)")
+        if self.mode == "conventional":
+            counts = [s.passes for s in self.stages]
+            if len(self.stages) > 1:
+                out.append(f"align.stages: {len(self.stages)} stages, but conventional mode "
+                           "runs one pass, on stage 1; the others cannot matter")
+            elif counts[0] not in (None, 1):
+                out.append(f"align.stages.0.passes: {counts[0]} cannot matter in conventional "
+                           "mode (one forward pass)")
+        if self.aiding.source == "none" and "noise_mps" in self.aiding.model_fields_set \
+                and self.aiding.noise_mps:
+            out.append("align.aiding.noise_mps: cannot matter with aiding source 'none'")
+        return out
+
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
         kind = sc.motion.kind if sc.motion is not None else None
-        realtime = self.mode == "conventional" and self.realtime
+        realtime = self.realtime_conventional
+        c = self.coarse
+        if c.method == "given":
+            coarse = (f"given: truth at T1 + error {c.error_deg} °",
+                      str(np.radians(c.error_deg).round(6).tolist()) + " rad")
+        else:
+            coarse = (f"{c.method} over [0, {self.t1_s:g}] s, + offset {c.offset_deg} °",
+                      str(np.radians(c.offset_deg).round(6).tolist()) + " rad")
         rows = [
             ("align.mode", self.mode, f"{self.pass_count} pass(es)"),
             (
@@ -136,11 +227,7 @@ class AlignConfig(Model):
                 ),
             ),
             ("align.start_s", f"{self.start_s} s", "offset of t = 0 from the first sample"),
-            (
-                "align.coarse",
-                f"{self.coarse.method}, error {self.coarse.error_deg} °",
-                str(np.radians(self.coarse.error_deg).round(6).tolist()) + " rad",
-            ),
+            ("align.coarse", *coarse),
             ("align.t1_s / t2_s / t3_s", f"{self.t1_s} / {self.t2_s} / {self.t3_s} s", ""),
             (
                 "align.compensation",
@@ -151,12 +238,14 @@ class AlignConfig(Model):
             ("align.aiding", f"{self.aiding.source}, {self.aiding.noise_mps} m/s", ""),
             ("align.level_s", f"{self.level_phase_s} s", ""),
         ]
+        stages = self.stage_list()
         for i, s in enumerate(self.stages):
+            n = stages[i].passes if i < len(stages) else 0
             rows.append(
                 (
                     f"align.stages.{i}",
                     f"T_xy {s.t_xy_s} s, T_z {s.t_z_s} s, ξ {s.xi}",
-                    f"passes {s.passes or 'rest'}",
+                    f"stage {i + 1}: {n} pass(es)",
                 )
             )
         return rows

@@ -19,16 +19,26 @@ from gcalign.nav.earth import MODELS, EarthModel
 from gcalign.sim.errors import ImuErrors, SensorErrors
 
 
+def _is_number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
 def _broadcast_scalar(x):
-    if isinstance(x, (int, float)) and not isinstance(x, bool):
+    if _is_number(x):
         if x < 0:
             raise ValueError(f"must be ≥ 0 (one number, or one per axis), got {x}")
         return [x, x, x]
     return x
 
 
+def _broadcast(x):
+    return [x, x, x] if _is_number(x) else x
+
+
 # A noise density: one number for all three axes, or one per axis.
 Noise = Annotated[NonNegVec3, BeforeValidator(_broadcast_scalar)]
+# A bias or scale-factor error: one number for all three axes (the same sign), or one per axis.
+PerAxis = Annotated[Vec3, BeforeValidator(_broadcast)]
 
 
 def _vec(x) -> np.ndarray:
@@ -69,12 +79,12 @@ class Site(Model):
 
 
 class Gyro(Model):
-    bias_dph: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    bias_dph: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     arw_dprh: Noise = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    scale_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    scale_ppm: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     misalignment_arcsec: list[list[float]] | None = None
     quantum_arcsec: float = Field(0.0, ge=0)
-    asym_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0],
+    asym_ppm: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0],
                            description="asymmetric scale factor: + for positive input, − negative")
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
@@ -91,12 +101,12 @@ class Gyro(Model):
 
 
 class Accel(Model):
-    bias_ug: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    bias_ug: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     vrw_ugrhz: Noise = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    scale_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    scale_ppm: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     misalignment_arcsec: list[list[float]] | None = None
     quantum_ugs: float = Field(0.0, ge=0, description="velocity quantum, µg·s (PSINS header unit)")
-    asym_ppm: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0],
+    asym_ppm: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0],
                            description="asymmetric scale factor: + for positive input, − negative")
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
@@ -161,3 +171,30 @@ class Scenario(Model):
             raise ValueError("mechanism: recorded data carry their own sensor frame; a "
                              "mechanism applies to simulated motion only (remove it)")
         return self
+
+    def unused(self, section: str | None = None) -> list[str]:
+        """Keys set in the scenario that cannot matter to the run, one line each: the
+        simulated IMU with recorded data, and what the command's `section` reports itself
+        (its ``unused(sc)``). The commands show them as warnings (stderr, table, JSON)."""
+        out = []
+        if self.imu_file is not None:
+            keys = _set_keys(self.imu, "imu")
+            if keys:
+                out.append(f"{', '.join(keys)}: cannot matter with recorded data (imu_file): "
+                           "the recording carries its own rate and sensor errors")
+        model = getattr(self, section, None) if section else None
+        if model is not None and hasattr(model, "unused"):
+            out += model.unused(self)
+        return out
+
+
+def _set_keys(model: Model, prefix: str) -> list[str]:
+    """The dotted keys the scenario set explicitly below `model`."""
+    out = []
+    for name in model.model_fields_set:
+        value = getattr(model, name)
+        if isinstance(value, Model):
+            out += _set_keys(value, f"{prefix}.{name}")
+        else:
+            out.append(f"{prefix}.{name}")
+    return sorted(out)

@@ -1,0 +1,54 @@
+"""`gcalign example`: list the built-in scenarios, or print one to start a scenario from.
+
+``gcalign example align > mine.yaml`` writes the scenario `gcalign align` runs without a
+file; edit it and run ``gcalign align mine.yaml``.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+
+from gcalign.app.registry import COMMANDS
+from gcalign.cli import app, consoles, emit_json, user_errors
+from gcalign.cli.common import builtin_text
+from gcalign.errors import ScenarioError
+
+
+def builtins() -> dict[str, str]:
+    """Command -> its built-in scenario file (package data), from the registry."""
+    return {name: c.builtin for name, c in COMMANDS.items() if c.builtin}
+
+
+def first_comment(text: str) -> str:
+    """The first comment line of a scenario file: what it is."""
+    for line in text.splitlines():
+        if line.startswith("#"):
+            return line.lstrip("# ").strip()
+    return ""
+
+
+@app.command()
+@user_errors
+def example(
+    name: str | None = typer.Argument(
+        None, help="A command with a built-in scenario; without it, the list."),
+    as_json: bool = typer.Option(False, "--json", help="The list as one JSON object."),
+):
+    """Print a built-in scenario (YAML) to start your own from, or list them."""
+    known = builtins()
+    if name is None:
+        from gcalign.app.report import kv_table
+
+        rows = [(cmd, file, first_comment(builtin_text(file))) for cmd, file in known.items()]
+        consoles(as_json).print(kv_table(
+            "built-in scenarios: `gcalign example NAME > mine.yaml`, then "
+            "`gcalign NAME mine.yaml`", rows, ("name", "file", "what")))
+        if as_json:
+            emit_json({"examples": {cmd: {"file": f, "what": w} for cmd, f, w in rows}})
+        return
+    if name not in known:
+        raise ScenarioError(f"example: {name!r} has no built-in scenario; built-in: "
+                            f"{', '.join(known)}")
+    sys.stdout.write(builtin_text(known[name]))
