@@ -11,6 +11,27 @@ Conventions, fixed once for the whole package (PSINS-compatible; DESIGN.md):
   printed tables with the unit in the name (``bias_dph``), converted once in the config.
 * Time along axis 0: arrays are ``(N,)``, ``(N, 3)``, ``(N, 3, 3)``; time is a separate
   ``(N,)`` array in seconds. IMU sample k holds the increments over ``(t_k - T, t_k]``.
+
+The Python API (:mod:`gcalign.api`; README "Python"): :func:`load` a scenario (a file, a
+mapping or recorded data; overrides by dotted key) or take a built-in one
+(:func:`example`), :func:`run` any command on it (``run("align", sc)``, the same run and
+results file as ``gcalign align``), and :func:`read` a results file back into the same
+:class:`Result`. Importing gcalign loads none of it until it is used.
 """
 
+
 __version__ = "0.1.0"
+
+_API = ("load", "example", "run", "read", "commands", "Result")
+
+
+def __getattr__(name: str):
+    if name in _API:
+        from gcalign import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'gcalign' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*(n for n in globals() if n.startswith("__")), *_API})

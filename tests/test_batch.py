@@ -43,7 +43,7 @@ SMALL = {
                             {"duration_s": 10, "rate_dps": [0, 0, -1]},
                             {"duration_s": 10, "rate_dps": [0, 0, 1]}, {"duration_s": 40}]},
     "align": {"coarse": {"method": "given", "error_deg": [1, 1, 10]}, "mode": "full-cycle",
-              "t1_s": 10, "t2_s": 60, "t3_s": 70, "passes": 3, "level_s": 20,
+              "t1_s": 10, "t2_s": 60, "t3_s": 70, "stages": [{"passes": 3}], "level_s": 20,
               "azimuth_poles": "double-oscillator",
               "aiding": {"source": "odometer", "noise_mps": 0.01}},
 }
@@ -130,7 +130,8 @@ def test_apply_override_checks_the_schema_not_only_the_mapping():
     ({"align.mode": []}, "grid: align.mode = []: empty list of values"),
     ({"align.stages.5.t_z_s": [100]}, "align.stages.5: no item 5; align.stages has 1 item"),
     ({"align.mode": ["fast"]}, "grid: align.mode = 'fast': align.mode: Input should be"),
-    ({"align.passes": [3, 4]}, "grid: align.passes = 4: align.passes: mode 'full-cycle' needs"),
+    ({"align.stages.0.passes": [3, 4]},
+     "grid: align.stages.0.passes = 4: align.stages: mode 'full-cycle' needs an odd number"),
 ])
 def test_bad_grid_exits_2_before_any_run(tmp_path, grid, message):
     out = tmp_path / "o.h5"
@@ -186,7 +187,8 @@ def test_cases_are_crossed_with_the_grid_and_applied_first(tmp_path):
     ({"q": {"imu.gyro.arw": 0}}, GRID, "cases: q: imu.gyro.arw = 0: imu.gyro.arw: unknown key"),
     ({"q": [1]}, GRID, "cases: q: must be a mapping"),
     ([], GRID, "cases: must be a non-empty mapping"),
-    ({"q": {"align.passes": 4}}, GRID, "cases: q: align.passes: mode 'full-cycle' needs"),
+    ({"q": {"align.stages.0.passes": 4}}, GRID,
+     "cases: q: align.stages: mode 'full-cycle' needs an odd number"),
     ({"q": {}}, {"case": ["a"]}, "grid: case: reserved"),
 ])
 def test_bad_cases_exit_2_before_any_run(tmp_path, cases, grid, message):

@@ -20,7 +20,8 @@ def _small(tmp_path: Path, **align) -> Path:
     """The seed moving scenario shortened: T2 = 60 s, 3 passes."""
     d = yaml.safe_load((ROOT / "configs/seed000_moving_full_cycle.yaml").read_text())
     d["motion"]["duration_s"] = 80
-    d["align"].update({"t2_s": 60, "t3_s": 70, "passes": 3, "level_s": 20, **align})
+    d["align"]["stages"][0]["passes"] = 3
+    d["align"].update({"t2_s": 60, "t3_s": 70, "level_s": 20, **align})
     p = tmp_path / "small.yaml"
     p.write_text(yaml.safe_dump(d))
     return p
@@ -56,8 +57,9 @@ def test_align_json_contract_and_show(tmp_path):
     import h5py
 
     with h5py.File(out) as f:
-        assert f["align/pass_01"].attrs["direction"] == "reverse"
-        assert f["align/pass_00/error"].attrs["units"] == "rad"
+        assert f["align/pass_02"].attrs["direction"] == "reverse"
+        assert f["align/pass_01/error"].attrs["units"] == "rad"
+        assert f["align/pass_03"].attrs["stage"] == 1 and "align/pass_00" not in f
         assert f["align/result/att_t3"].shape == (3,)
         assert "moving" in f.attrs["scenario_yaml"]
 
@@ -99,9 +101,18 @@ def test_same_seed_same_numbers_and_overrides(tmp_path):
         ({"stages": [{"t_xy_s": 20, "t_z_s": 0}]}, [], "align.stages.0.t_z_s"),
         ({"stages": [{"xi": 1.0}]}, [], "align.stages.0.xi"),
         ({"stages": [{"xi": 0}]}, [], "align.stages.0.xi"),
-        ({"stages": [{"passes": 3}, {"t_z_s": 200}]}, [], "align.stages"),
-        ({"mode": "full-cycle", "passes": 1}, [], "align.passes"),
-        ({}, ["--mode", "half-cycle", "--passes", "1"], "align.passes"),
+        ({"stages": [{"passes": 5}, {"t_z_s": 200}]}, [], "align.stages.1.passes"),
+        ({"stages": [{"t_z_s": 200}, {"passes": 2}]}, [], "align.stages"),
+        ({"mode": "full-cycle", "stages": [{"passes": 1}]}, [], "align.stages"),
+        ({}, ["--mode", "half-cycle", "--passes", "1"], "align.stages"),
+        ({}, ["--passes", "4"], "align.stages"),
+        ({"passes": 5}, [], "align.passes: removed"),
+        ({"coarse": {"method": "given", "duration_s": 10}}, [], "align.coarse.duration_s: "
+         "removed"),
+        ({"coarse": {"method": "analytic", "error_deg": [0, 0, 1]}}, [],
+         "align.coarse.error_deg: cannot matter"),
+        ({"coarse": {"method": "given", "offset_deg": [0, 0, 1]}}, [],
+         "align.coarse.offset_deg: cannot matter"),
         ({}, ["--mode", "sideways"], "align.mode"),
         ({}, ["--t3", "soon"], "align.t3_s"),
     ],
@@ -134,7 +145,7 @@ def test_scenario_file_errors(tmp_path):
             [],
             "align.coarse.error_deg.0",
         ),
-        ({"coarse": {"method": "inertial", "duration_s": 0.01}}, [], "align.coarse.duration_s"),
+        ({"coarse": {"method": "inertial"}, "t1_s": 0.01}, [], "align.t1_s"),
     ],
 )
 def test_non_finite_and_too_short_inputs_exit_2_on_one_line(tmp_path, align, args, field):

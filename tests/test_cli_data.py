@@ -188,7 +188,7 @@ def test_navigate_from_an_alignment_of_the_real_file(tmp_path):
     assert res.exit_code == 0, res.output
     assert [Path(p).name for p in json.loads(res.stdout)["figures"]] == ["navigate.png"]
     # data from another file than the alignment's is refused
-    other = tmp_path / "other.imu"
+    other = tmp_path / "other.imu.xz"
     other.write_bytes(REAL.read_bytes())
     res = runner.invoke(app, ["navigate", str(other), "--init", str(aligned)])
     assert res.exit_code == 2 and "align the same data" in res.output

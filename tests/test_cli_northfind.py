@@ -135,7 +135,7 @@ def test_repeats_table_like_seed_table_1(tmp_path):
     assert c["mean_deg"][0] == pytest.approx(48.0 + err.mean())
     shown = runner.invoke(app, ["show", str(out)])
     assert shown.exit_code == 0, shown.output
-    for text in ("mean (deg)", "std (′)", "bias (′)", "│ 7 "):
+    for text in ("mean (deg)", "std (′)", "bias (′)", "│ group 7 "):
         assert text in shown.stdout
     with h5py.File(out) as f:
         assert f["northfind/coordinate/error"].shape == (7, 1)

@@ -211,7 +211,8 @@ def test_direction_change_does_not_kick_and_cycles_reach_forward_steady_state():
     # Level biases and east/north gyro biases (no up-gyro bias, whose compass shift
     # legitimately changes sign in a reverse pass: DESIGN.md).
     imu = {"gyro": {"bias_dph": [0.02, -0.015, 0.0]}, "accel": {"bias_ug": [60, -40, 0]}}
-    d = _static({"imu": imu}, mode="full-cycle", passes=3, t2_s=760, t3_s=760, compensation="none")
+    d = _static({"imu": imu}, mode="full-cycle", t2_s=760, t3_s=760, compensation="none",
+                stages=[{"t_xy_s": 20, "t_z_s": 100, "xi": 0.707, "passes": 3}])
     _, _, run = _run(d)
     fwd_end = run.passes[0].q_nb[-1]
     rev = run.passes[1].q_nb
@@ -233,7 +234,7 @@ def test_up_gyro_bias_shift_changes_sign_in_reverse_as_designed():
     d = _static(
         {"imu": {"gyro": {"bias_dph": [0, 0, 0.05]}}},
         mode="full-cycle",
-        passes=3,
+        stages=[{"t_xy_s": 20, "t_z_s": 100, "xi": 0.707, "passes": 3}],
         t2_s=760,
         t3_s=760,
         compensation="none",

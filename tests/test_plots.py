@@ -15,6 +15,7 @@ from gcalign.app import plots
 from gcalign.cli import app
 from gcalign.io import results
 
+ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -27,7 +28,7 @@ SMALL = {
                "segments": [{"duration_s": 10}, {"duration_s": 10, "accel_mps2": 1.0},
                             {"duration_s": 10, "rate_dps": [0, 0, -1]},
                             {"duration_s": 10, "rate_dps": [0, 0, 1]}, {"duration_s": 40}]},
-    "align": {"mode": "full-cycle", "t1_s": 10, "t2_s": 60, "t3_s": 70, "passes": 3,
+    "align": {"mode": "full-cycle", "t1_s": 10, "t2_s": 60, "t3_s": 70, "stages": [{"passes": 3}],
               "level_s": 20, "aiding": {"source": "odometer", "noise_mps": 0.01}},
 }
 
@@ -57,37 +58,72 @@ def align_files(tmp_path_factory):
 
 
 def test_alignment_figures_per_pass_on_equivalent_time(align_files):
+    """Rows pitch, roll, yaw; left all passes, right the zoom after pass 1; linear axes in
+    the unit of the values; pass boundaries dotted; the legend below the panels."""
     figs = plots.figures_for(align_files["full-cycle"])
     assert set(figs) == {"align_error", "align_attitude"}
     err = figs["align_error"]
-    assert len(err.axes) == 3
-    for ax, name in zip(err.axes, ("pitch", "roll", "yaw"), strict=True):
-        assert len(data_series(ax)) == 3  # one line per pass
-        assert len(boundaries(ax)) == 2  # between passes 1|2 and 2|3
-        assert ax.get_ylabel().startswith(f"{name} error (deg)")
-    assert "equivalent time (s)" in err.axes[-1].get_xlabel()
+    assert len(err.axes) == 6
+    full, zoom = err.axes[0::2], err.axes[1::2]
+    assert full[0].get_title() == "all passes" and zoom[0].get_title() == "after pass 1 (zoom)"
+    with results.open_results(align_files["full-cycle"]) as f:
+        errors = [f[f"align/pass_{i:02d}/error"][()] for i in (1, 2, 3)]
+    for j, name in enumerate(("pitch", "roll", "yaw")):
+        for ax in (full[j], zoom[j]):
+            assert ax.get_yscale() == "linear"
+            assert ax.get_ylabel().startswith(f"{name} error (")
+        assert len(data_series(full[j])) == 3  # one line per pass
+        assert len(data_series(zoom[j])) == 2  # passes 2 and 3
+        assert len(boundaries(full[j])) == 2  # between passes 1|2 and 2|3
+        # Each panel's unit is the one its values need (deg from 1°, ′ from 1′, else ″).
+        for ax, values in ((full[j], np.concatenate([e[:, j] for e in errors])),
+                           (zoom[j], np.concatenate([e[:, j] for e in errors[1:]]))):
+            unit = ax.get_ylabel().split("(")[1].rstrip(")")
+            assert unit == plots.angle_scale(values)[1]
+            scale = plots.angle_scale(values)[0]
+            drawn = np.concatenate([ln.get_ydata() for ln in data_series(ax)])
+            np.testing.assert_allclose(drawn, values * scale)
+    assert "equivalent time (s)" in full[-1].get_xlabel()
     # Passes laid end to end: 10 s + 3 × 50 s of fine-alignment data.
-    lines = data_series(err.axes[2])
+    lines = data_series(full[2])
     np.testing.assert_allclose([ln.get_xdata()[0] for ln in lines], [10, 60, 110])
     np.testing.assert_allclose(lines[-1].get_xdata()[-1], 160)
-    np.testing.assert_allclose([b.get_xdata()[0] for b in boundaries(err.axes[0])], [60, 110])
-    # The reverse pass's error, read from the file, is what is drawn (deg).
-    with results.open_results(align_files["full-cycle"]) as f:
-        e1 = f["align/pass_01/error"][()]
-    np.testing.assert_allclose(lines[1].get_ydata(), np.degrees(e1[:, 2]))
+    np.testing.assert_allclose([b.get_xdata()[0] for b in boundaries(full[0])], [60, 110])
+    assert [t.get_text() for t in err.legends[0].get_texts()] == [
+        "pass 1 forward (stage 1)", "pass 2 reverse (stage 1)", "pass 3 forward (stage 1)"]
     att = figs["align_attitude"]
     assert len(att.axes) == 3
     for ax in att.axes:
         labels = [ln.get_label() for ln in data_series(ax)]
         assert len(labels) == 4 and labels[-1] == "truth"
         assert ax.get_ylabel().endswith("(deg)")
-    assert att.get_suptitle() and err.get_suptitle()
+    assert not any(ax.get_legend() for ax in att.axes) and att.legends  # below, not on a panel
+    assert att.get_suptitle().endswith("vs truth") and err.get_suptitle()
 
 
 def test_conventional_has_one_pass_and_no_boundary(align_files):
     fig = plots.figures_for(align_files["conventional"])["align_error"]
+    assert fig.axes[1].get_title() == "second half of the pass (zoom)"
     for ax in fig.axes:
         assert len(data_series(ax)) == 1 and not boundaries(ax)
+    full, zoom = data_series(fig.axes[4])[0], data_series(fig.axes[5])[0]
+    n = len(full.get_xdata())
+    np.testing.assert_allclose(zoom.get_xdata(), full.get_xdata()[n // 2:])
+
+
+def test_alignment_of_recorded_data_has_no_truth_in_its_figures(tmp_path):
+    """The real file: the attitude figure alone, titled as having no truth."""
+    out = tmp_path / "real.h5"
+    res = runner.invoke(app, ["align", str(ROOT / "configs/lasergyro_align.yaml"), "-o",
+                              str(out), "--set", "align.t2_s=150", "--set", "align.t3_s=150"])
+    assert res.exit_code == 0, res.output
+    figs = plots.figures_for(out)
+    assert set(figs) == {"align_attitude"}
+    fig = figs["align_attitude"]
+    assert "no truth" in fig.get_suptitle() and "vs truth" not in fig.get_suptitle()
+    assert [ln.get_label() for ln in data_series(fig.axes[2])] == ["pass 1 forward (stage 1)"]
+    assert "truth at T2" not in res.stdout and "estimate at T2 (deg)" in res.stdout
+    assert "recorded data: no truth" in res.stdout
 
 
 def _northfind_file(path: Path, repeats: int | None):
@@ -123,8 +159,31 @@ def test_northfind_figures_error_against_true_azimuth(tmp_path, repeats):
     np.testing.assert_allclose(data_series(fig.axes[0])[0].get_xdata(), np.arange(0, 360, 30))
     assert "true azimuth (deg" in fig.axes[-1].get_xlabel()
     diff = figs["northfind_difference"]
-    assert len(diff.axes) == 1 and len(data_series(diff.axes[0])) == 1
-    assert diff.axes[0].get_ylabel() == "difference (arcsec)"
+    ax = diff.axes[0]
+    assert len(diff.axes) == 1 and ax.get_ylabel() == "difference (arcsec)"
+    curve, seed = data_series(ax)  # the difference; the seed's ±1e-4° (dashed)
+    assert seed.get_label() == "seed fig. 5 size: ±1e-4°"
+    assert seed.get_ydata()[0] == pytest.approx(0.36)
+    # coordinate and vector carry independent noise here: their difference is drawn
+    with results.open_results(path) as f:
+        d = np.degrees(f["northfind/coordinate/error"][()] - f["northfind/vector/error"][()])
+    np.testing.assert_allclose(curve.get_ydata(), np.atleast_2d(d).mean(0) * 3600.0)
+    assert ax.get_ylim()[1] >= 1.25 * np.abs(d * 3600.0).max() - 1e-12
+
+
+def test_northfind_difference_at_round_off_is_drawn_as_zero():
+    """Two methods that agree to round-off (1e-10″): a flat zero with the largest value in
+    the label, and the axis spans the seed's ±1e-4° (no magnified noise)."""
+    from gcalign.app.northfind.plots import northfind_difference_figure
+
+    az = np.radians(np.arange(0.0, 360.0, 5.0))
+    a = 1e-3 * np.sin(az)
+    fig = northfind_difference_figure(az, a, a + 5e-16 * np.cos(az))
+    ax = fig.axes[0]
+    curve = data_series(ax)[0]
+    assert not np.any(curve.get_ydata())
+    assert "zero to round-off" in curve.get_label() and "1.0e-10″" in curve.get_label()
+    assert ax.get_ylim() == pytest.approx((-0.54, 0.54))
 
 
 def test_northfind_figures_from_the_real_command(tmp_path):
@@ -176,7 +235,8 @@ def test_batch_figures_box_per_variant_and_component(batch_file):
     assert len(fig.axes) == 3  # pitch, roll, yaw
     for ax, comp in zip(fig.axes, ("pitch", "roll", "yaw"), strict=True):
         assert len(ax.patches) == 4  # one box per variant
-        assert comp in ax.get_ylabel() and "(deg)" in ax.get_ylabel()
+        unit = ax.get_ylabel().rsplit("(", 1)[1].rstrip(")")
+        assert comp in ax.get_ylabel() and unit in ("deg", "arcmin", "arcsec")
     labels = [t.get_text() for t in fig.axes[-1].get_xticklabels()]  # shared x: bottom axes
     assert labels == ["mode=conventional\ncompensation=none",
                       "mode=conventional\ncompensation=continued",
@@ -267,3 +327,110 @@ def test_plot_bad_input(tmp_path):
     bad.write_text("not hdf5")
     res = runner.invoke(app, ["plot", str(bad)])
     assert res.exit_code == 2 and "not an HDF5 file" in res.stderr
+
+
+# ------------------------------------------------------------ navigate, truth, IMU output
+
+
+@pytest.fixture(scope="module")
+def sim_and_nav(tmp_path_factory):
+    """simulate and navigate of the small moving scenario (80 s, navigation-grade IMU)."""
+    folder = tmp_path_factory.mktemp("nav")
+    sc = folder / "m.yaml"
+    d = {k: v for k, v in copy.deepcopy(SMALL).items() if k != "align"}
+    sc.write_text(yaml.safe_dump(d))
+    out = {}
+    for cmd in ("simulate", "navigate"):
+        out[cmd] = folder / f"{cmd}.h5"
+        res = runner.invoke(app, [cmd, str(sc), "-o", str(out[cmd])])
+        assert res.exit_code == 0, res.output
+    return out
+
+
+def test_navigate_error_figure_phi_velocity_position_and_horizontal_norm(sim_and_nav):
+    figs = plots.figures_for(sim_and_nav["navigate"])
+    assert set(figs) == {"navigate_error"}
+    fig = figs["navigate_error"]
+    phi_ax, v_ax, p_ax = fig.axes
+    with results.open_results(sim_and_nav["navigate"]) as f:
+        t, phi = f["navigate/t"][()], f["navigate/error/phi"][()]
+        pos = f["navigate/error/pos"][()]
+    scale, unit = plots.angle_scale(phi)
+    assert phi_ax.get_ylabel() == f"misalignment ({unit})"
+    assert [ln.get_label() for ln in data_series(phi_ax)] == ["φ east", "φ north", "φ up"]
+    x, mean, _, _ = plots.envelope(t - t[0], phi[:, 2] * scale)  # 8001 rows: bins
+    np.testing.assert_allclose(data_series(phi_ax)[2].get_ydata(), mean)
+    np.testing.assert_allclose(data_series(phi_ax)[0].get_xdata(), x)
+    assert [ln.get_label() for ln in data_series(v_ax)] == ["east", "north", "up"]
+    horiz = data_series(p_ax)[-1]
+    assert horiz.get_label() == "horizontal |·|"
+    np.testing.assert_allclose(horiz.get_ydata(),
+                               plots.envelope(t, np.hypot(pos[:, 0], pos[:, 1]))[1])
+    assert p_ax.get_xlabel() == "time from the start (s)"
+    for ax in fig.axes:  # legends beside the panels, never on the data
+        legend = ax.get_legend()
+        assert legend is not None and legend.get_bbox_to_anchor().x0 > ax.bbox.x1 - 1
+
+
+def test_envelope_bins_are_means_minima_and_maxima():
+    x = np.arange(10.0)
+    y = np.array([0, 5, 1, 2, -3, 4, 9, 0, 1, 1.0])
+    xc, mean, lo, hi = plots.envelope(x, y, max_points=4)  # bins of 3, the last row dropped
+    np.testing.assert_allclose(xc, [1, 4, 7])
+    np.testing.assert_allclose(mean, [2, 1, 10 / 3])
+    np.testing.assert_allclose(lo, [0, -3, 0])
+    np.testing.assert_allclose(hi, [5, 4, 9])
+    assert plots.envelope(x, y, max_points=10)[1] is not None  # short: as it is
+    np.testing.assert_array_equal(plots.envelope(x, y, max_points=10)[1], y)
+
+
+def test_simulate_figures_truth_and_imu_output(sim_and_nav):
+    figs = plots.figures_for(sim_and_nav["simulate"])
+    assert set(figs) == {"truth", "imu"}
+    truth = figs["truth"]
+    assert [ln.get_label() for ln in data_series(truth.axes[0])] == ["pitch", "roll", "yaw"]
+    assert truth.axes[1].get_ylabel().startswith("velocity (m/s)")
+    imu = figs["imu"]
+    assert len(imu.axes) == 6  # gyro x, y, z over accel x, y, z
+    with results.open_results(sim_and_nav["simulate"]) as f:
+        dtheta, dv, ts = f["imu/dtheta"][()], f["imu/dv"][()], float(f["imu"].attrs["ts"])
+    w = dtheta / ts
+    scale, unit = plots.rate_scale(w)
+    assert unit == "deg/s"  # the base turns at 1°/s
+    assert imu.axes[0].get_ylabel() == "angular rate (deg/s)"
+    assert imu.axes[3].get_ylabel() == "specific force (m/s²)"
+    assert len(w) == 8000 > plots.MAX_POINTS  # drawn as bins: means, and a min-max band
+    k = int(np.ceil(len(w) / plots.MAX_POINTS))
+    n = len(w) // k * k
+    gyro_z = data_series(imu.axes[2])[0]
+    np.testing.assert_allclose(gyro_z.get_ydata(), (w[:n, 2] * scale).reshape(-1, k).mean(1))
+    band = imu.axes[2].collections[0].get_paths()[0].vertices[:, 1]
+    assert band.max() == pytest.approx(w[:n, 2].max() * scale)  # a peak is not averaged away
+    accel_y = data_series(imu.axes[4])[0]
+    np.testing.assert_allclose(accel_y.get_ydata(), (dv[:n, 1] / ts).reshape(-1, k).mean(1))
+
+
+def test_plot_of_a_recorded_data_file_draws_its_imu_output(tmp_path):
+    """`gcalign plot` of the compressed recording itself: its IMU output (°/s, the vehicle
+    is disturbed), the file's own axes and rate."""
+    res = runner.invoke(app, ["plot", str(ROOT / "tests/data/lasergyro.imu.xz"), "-o",
+                              str(tmp_path), "--json"])
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.stdout)
+    assert out["kind"] == "data" and [Path(p).name for p in out["figures"]] == ["imu.png"]
+    assert Path(out["figures"][0]).read_bytes().startswith(PNG)
+    fig = plots.figures_for(ROOT / "tests/data/lasergyro.imu.xz")["imu"]
+    assert "increments / 10 ms" in fig.get_suptitle()
+    assert fig.axes[3].get_xlabel() == "time from the start (min)"  # 1847 s
+    # the specific force along z is gravity: its bin means sit at 9.79 m/s²
+    mean_z = data_series(fig.axes[5])[0].get_ydata()
+    assert np.median(mean_z) == pytest.approx(9.79, abs=0.02)
+
+
+def test_a_results_file_without_figures_says_so(tmp_path):
+    path = tmp_path / "empty.h5"
+    with results.atomic_h5(path) as f:
+        results.write_header(f, "align", "", 1, {"scenario": "x"})
+    res = runner.invoke(app, ["plot", str(path)])
+    assert res.exit_code == 2
+    assert "nothing to plot: this 'align' results file holds none of the groups" in res.output

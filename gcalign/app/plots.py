@@ -4,9 +4,13 @@ One function per figure; each returns a :class:`matplotlib.figure.Figure` so tha
 inspect ``fig.axes`` and ``ax.lines``. :func:`figures_for` picks the figures of a results
 file by its ``kind``; :func:`plot_file` writes them as PNG.
 
-Each command's figures live in its room (``gcalign/app/<command>/figures.py``, reached
-through the registry); this module holds what they share and the truth figure that any
-file with ``/truth`` can show.
+Each command's figures live in its room (``gcalign/app/<command>/plots.py``, reached
+through the registry); this module holds what they share: linear axes in the unit the
+values need (:func:`angle_scale`, :func:`time_axis`), legends beside or below the panels
+so that they never cover data (:func:`legend_right`, :func:`legend_below`), titles wrapped
+to the figure (:func:`suptitle`), long series drawn as bins (:func:`envelope`), and the
+figures any file can have: the truth (``/truth``) and the IMU output (``/imu``, or a
+recorded data file itself).
 
 Series that are data carry a label; pass boundaries and other guides are labelled with a
 leading underscore (matplotlib's "not in the legend"), so ``[l for l in ax.lines if not
@@ -16,6 +20,7 @@ l.get_label().startswith("_")]`` are the data series.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -25,34 +30,140 @@ from gcalign.errors import ScenarioError
 
 ANGLES = ("pitch", "roll", "yaw")
 ENU = ("east", "north", "up")
+AXES = ("x", "y", "z")
 
 DPI = 120
+#: Points per line above which a series is drawn as its min/max envelope per bin.
+MAX_POINTS = 4000
 
 
 def new_figure(rows: int, cols: int = 1, *, width: float = 9.0, height: float | None = None,
-               sharex: bool = True) -> tuple[Figure, list]:
+               sharex: bool | str = True) -> tuple[Figure, list]:
     """A Figure on the Agg canvas (no global pyplot state) and its axes, flattened."""
     fig = Figure(figsize=(width, height or 2.4 * rows + 1.0), dpi=DPI, layout="constrained")
     axes = fig.subplots(rows, cols, sharex=sharex, squeeze=False)
     return fig, list(axes.ravel())
 
 
+def legend_below(fig: Figure, ax, ncols: int | None = None) -> None:
+    """One legend for the figure, below the panels (it never covers a curve; above them,
+    constrained layout would put it over the title), from the labelled series of `ax`."""
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", fontsize="small",
+                   ncols=ncols or min(len(handles), 4), frameon=False)
+
+
+def suptitle(fig: Figure, text: str) -> None:
+    """The figure's title, wrapped to the figure's width (a long title is not cut off)."""
+    import textwrap
+
+    width = max(40, int(fig.get_figwidth() * 10.5))
+    fig.suptitle("\n".join(textwrap.wrap(text, width)) if len(text) > width else text)
+
+
+def legend_right(ax) -> None:
+    """The panel's legend outside it, on the right (constrained layout makes room)."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
+              borderaxespad=0.0)
+
+
+def time_axis(t: np.ndarray) -> tuple[np.ndarray, str]:
+    """Time from the first sample in s, min or h, whichever reads best."""
+    span = float(t[-1] - t[0]) if len(t) else 0.0
+    x = t - t[0] if len(t) else t
+    if span > 3 * 3600:
+        return x / 3600.0, "time from the start (h)"
+    if span > 20 * 60:
+        return x / 60.0, "time from the start (min)"
+    return x, "time from the start (s)"
+
+
+def angle_scale(values_rad: np.ndarray) -> tuple[float, str]:
+    """Multiplier from rad and the unit: deg from 1°, arc-minutes from 1′, else ″ (the
+    table's rule, :func:`gcalign.app.report.angle_unit`)."""
+    v = np.asarray(values_rad, float)
+    v = v[np.isfinite(v)]
+    peak = float(np.max(np.abs(v))) if v.size else 0.0
+    deg = math.degrees(peak)
+    if deg >= 1.0:
+        return math.degrees(1.0), "deg"
+    if deg * 60.0 >= 1.0:
+        return math.degrees(1.0) * 60.0, "arcmin"
+    return math.degrees(1.0) * 3600.0, "arcsec"
+
+
+def rate_scale(values_rad_s: np.ndarray) -> tuple[float, str]:
+    """Multiplier from rad/s and the unit: °/s from 1°/s, else °/h."""
+    v = np.asarray(values_rad_s, float)
+    peak = float(np.nanmax(np.abs(v))) if v.size else 0.0
+    if math.degrees(peak) >= 1.0:
+        return math.degrees(1.0), "deg/s"
+    return math.degrees(1.0) * 3600.0, "deg/h"
+
+
+def envelope(x: np.ndarray, y: np.ndarray, max_points: int = MAX_POINTS):
+    """A long series as bins: centre times, mean, min and max of each bin (all (n,));
+    short series come back as they are (min = max = mean = y)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    if len(x) <= max_points:
+        return x, y, y, y
+    k = math.ceil(len(x) / max_points)
+    n = len(x) // k * k
+    xs, ys = x[:n].reshape(-1, k), y[:n].reshape(-1, k)
+    return xs.mean(1), ys.mean(1), ys.min(1), ys.max(1)
+
+
+def plot_series(ax, x, y, label: str, **style) -> None:
+    """A line, or for a long series its bin means and a band from min to max (a peak
+    stays visible however many samples it stands for)."""
+    xc, mean, lo, hi = envelope(x, y)
+    (line,) = ax.plot(xc, mean, label=label, linewidth=style.pop("linewidth", 1.0), **style)
+    if len(xc) < len(x):
+        ax.fill_between(xc, lo, hi, color=line.get_color(), alpha=0.25, linewidth=0,
+                        label="_envelope")
+
+
 def truth_figure(t: np.ndarray, att: np.ndarray, v_n: np.ndarray,
                  title: str = "truth") -> Figure:
     """True attitude (deg) and velocity (m/s, ENU) against time."""
+    x, xlabel = time_axis(t)
     fig, axes = new_figure(2)
     for j, name in enumerate(ANGLES):
         y = np.unwrap(att[:, j]) if j == 2 else att[:, j]
-        axes[0].plot(t, np.degrees(y), label=name)
+        plot_series(axes[0], x, np.degrees(y), name)
     for j, name in enumerate(ENU):
-        axes[1].plot(t, v_n[:, j], label=name)
-    axes[0].set_ylabel("attitude (deg)")
-    axes[1].set_ylabel("velocity (m/s)")
-    axes[1].set_xlabel("time (s)")
+        plot_series(axes[1], x, v_n[:, j], name)
+    axes[0].set_ylabel("attitude (deg)\npitch, roll, yaw")
+    axes[1].set_ylabel("velocity (m/s)\neast, north, up")
+    axes[1].set_xlabel(xlabel)
     for ax in axes:
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="best", fontsize="small")
-    fig.suptitle(title)
+        legend_right(ax)
+    suptitle(fig, title)
+    return fig
+
+
+def imu_figure(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, ts: float,
+               frame: str = "body", title: str = "IMU output") -> Figure:
+    """The IMU output as rates: angular rate (°/h, or °/s for a turning base) and specific
+    force (m/s²) per sensor axis against time; long records as min/max bands."""
+    x, xlabel = time_axis(t)
+    w, f = np.asarray(dtheta) / ts, np.asarray(dv) / ts
+    scale, unit = rate_scale(w)
+    fig, axes = new_figure(2, 3, width=11.0, height=5.6)
+    for j, name in enumerate(AXES):
+        plot_series(axes[j], x, w[:, j] * scale, f"gyro {name}", color=f"C{j}")
+        plot_series(axes[3 + j], x, f[:, j], f"accel {name}", color=f"C{j}")
+        axes[j].set_title(f"{name} axis", fontsize="medium")
+        axes[3 + j].set_xlabel(xlabel)
+    axes[0].set_ylabel(f"angular rate ({unit})")
+    axes[3].set_ylabel("specific force (m/s²)")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    suptitle(fig, f"{title}: increments / {ts * 1e3:g} ms, {frame} frame"
+                 + (f"; bins of {math.ceil(len(t) / MAX_POINTS)} samples: mean line, "
+                    "min-max band" if len(t) > MAX_POINTS else ""))
     return fig
 
 
@@ -60,40 +171,80 @@ def _s(x) -> str:
     return x.decode() if isinstance(x, bytes) else str(x)
 
 
+def imu_figure_of(g, title: str) -> Figure:
+    """The IMU figure of an ``/imu`` group (its increments are sums over each stored
+    interval when decimated: rates over that interval)."""
+    ts = float(g.attrs["ts"])
+    frame = _s(g["dtheta"].attrs.get("frame", "body")).split(":")[0]
+    return imu_figure(g["t"][()], g["dtheta"][()], g["dv"][()], ts, frame, title)
+
+
+def truth_and_imu(f, name: str) -> dict[str, Figure]:
+    """The truth (``/truth`` with velocities) and IMU output (``/imu``) figures of a file."""
+    figs: dict[str, Figure] = {}
+    if "truth" in f and "v_n" in f["truth"]:
+        figs["truth"] = truth_figure(f["truth/t"][()], f["truth/att"][()], f["truth/v_n"][()],
+                                     title=f"{name}: truth")
+    if "imu" in f and "dtheta" in f["imu"]:
+        figs["imu"] = imu_figure_of(f["imu"], f"{name}: IMU output")
+    return figs
+
+
 def figures_for(path: Path) -> dict[str, Figure]:
     """The figures of a results file, by name (file stem of the PNG), from the room of the
-    command that wrote it (its ``figures(f, name)``); the truth when it has no others."""
+    command that wrote it (its ``figures(f, name)``), else the truth and the IMU output if
+    the file holds them; a recorded data file (``.imu``, CSV, compressed) gives its IMU
+    figure."""
     from gcalign.app.registry import COMMANDS
     from gcalign.io import results
 
     path = Path(path)
+    if not _is_hdf5(path):
+        return {"imu": _recorded_imu_figure(path)}
     with results.open_results(path) as f:
         kind = _s(f.attrs.get("kind", ""))
         summary = json.loads(_s(f.attrs.get("summary_json", "{}")))
         name = summary.get("scenario") or summary.get("sweep") or path.stem
         figs: dict[str, Figure] = COMMANDS[kind].load().figures(f, name) if kind in COMMANDS else {}
-        if not figs and "truth" in f:
-            figs["truth"] = truth_figure(f["truth/t"][()], f["truth/att"][()],
-                                         f["truth/v_n"][()], title=f"{name}: truth")
+        if not figs:
+            figs = truth_and_imu(f, name)
     if not figs:
-        raise ScenarioError(f"{path}: nothing to plot in a {kind!r} results file")
+        raise ScenarioError(f"{path}: nothing to plot: this {kind!r} results file holds "
+                            "none of the groups its figures are drawn from")
     return figs
 
 
+def _is_hdf5(path: Path) -> bool:
+    if not path.is_file():
+        raise ScenarioError(f"{path}: file not found")
+    with open(path, "rb") as fh:
+        return fh.read(8) == b"\x89HDF\r\n\x1a\n"
+
+
+def _recorded_imu_figure(path: Path) -> Figure:
+    from gcalign.app.data import read_data_file
+
+    imu, _ = read_data_file(path)
+    return imu_figure(imu.t, imu.dtheta, imu.dv, imu.ts, "body", f"{path.name}: IMU output")
+
+
 def default_plot_dir(path: Path) -> Path:
-    """``runs/x.h5`` -> ``runs/x_plots/``."""
+    """``runs/x.h5`` -> ``runs/x_plots/``; ``data.imu.xz`` -> ``data_plots/``."""
     path = Path(path)
-    return path.with_name(path.stem + "_plots")
+    return path.with_name(path.name.split(".")[0] + "_plots")
 
 
-def plot_file(path: Path, out_dir: Path | None = None) -> list[Path]:
-    """Write every figure of a results file as PNG; the paths written."""
+def plot_file(path: Path, out_dir: Path | None = None, progress=None) -> list[Path]:
+    """Write every figure of a results file as PNG; the paths written. `progress(done,
+    total, what)` hears of each figure written."""
     figs = figures_for(path)
     out_dir = Path(out_dir) if out_dir is not None else default_plot_dir(path)
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
-    for stem, fig in figs.items():
+    for i, (stem, fig) in enumerate(figs.items()):
         p = out_dir / f"{stem}.png"
         fig.savefig(p, dpi=DPI)
         written.append(p)
+        if progress is not None:
+            progress(i + 1, len(figs), "figures")
     return written

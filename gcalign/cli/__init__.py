@@ -22,13 +22,14 @@ from gcalign.errors import GcalignError
 
 
 def _top_help() -> str:
-    """The command list with what each does, from the registry (so it never promises a
-    command that is not there)."""
-    lines = "\n".join(f"  {c.name:<10} {c.help}" for c in COMMANDS.values())
-    return ("Strapdown INS laboratory: scenario in, results file (HDF5) and table out.\n\n"
-            f"\b\n{lines}\n\n"
-            "Also: show, plot, validate, example (built-in scenarios). Exit codes: 0 success, "
-            "2 bad input, 1 other failures.")
+    """What gcalign does, from the registry (so it never promises a command that is not
+    there); the command list below it takes each command's line from the registry too."""
+    seeds = sorted({c.help.rsplit("(seed ", 1)[1].rstrip(").") for c in COMMANDS.values()
+                    if "(seed " in c.help})
+    return ("Strapdown INS laboratory: write a scenario (YAML), run a command, read its "
+            "table and its results file (HDF5). Algorithms of the seed papers "
+            f"{', '.join(seeds)}; `gcalign example` lists the built-in scenarios. Exit "
+            "codes: 0 success, 2 bad input, 1 other failures.")
 
 
 app = typer.Typer(

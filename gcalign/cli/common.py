@@ -37,7 +37,7 @@ from pathlib import Path
 import typer
 import yaml
 
-from gcalign.app.registry import COMMANDS, command
+from gcalign.app.registry import COMMANDS
 from gcalign.cli import consoles, emit_json
 from gcalign.errors import ScenarioError
 from gcalign.io import results
@@ -49,8 +49,9 @@ from gcalign.io.scenario.loader import read_yaml
 SET_HELP = ("Set any scenario key, dotted as in a sweep grid; VALUE is YAML "
             "(--set align.stages.0.t_z_s=200 --set imu.gyro.bias_dph=0.01). Repeatable.")
 IMU_FILE_HELP = ("Recorded IMU data (PSINS .imu, CSV/text, gcalign HDF5; .gz/.xz "
-                 "compressed) instead of the scenario's motion; the site then comes from the "
-                 "file's header or --lat/--lon/--height.")
+                 "compressed) instead of the scenario's simulation: it replaces the motion, "
+                 "mechanism, imu and site sections; the site then comes from the file's "
+                 "header or --lat/--lon/--height.")
 
 
 @dataclass
@@ -68,20 +69,21 @@ _INVOCATION: contextvars.ContextVar[Invocation | None] = contextvars.ContextVar(
     "gcalign_invocation", default=None)
 
 
-def _option(name: str, annotation, default, *decls: str, help: str) -> inspect.Parameter:
+def _option(name: str, annotation, metavar: str, *decls: str, help: str) -> inspect.Parameter:
     return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, annotation=annotation,
-                             default=typer.Option(default, *decls, help=help))
+                             default=typer.Option(None, *decls, help=help, metavar=metavar))
 
 
 def _common_parameters(recorded: bool) -> list[inspect.Parameter]:
-    params = [_option("set_", list[str] | None, None, "--set", help=SET_HELP)]
+    params = [_option("set_", list[str] | None, "KEY=VALUE", "--set", help=SET_HELP)]
     if recorded:
         params += [
-            _option("imu_file", Path | None, None, "--imu-file", help=IMU_FILE_HELP),
-            _option("lat", float | None, None, "--lat", help="Site latitude (deg); replaces "
-                    "the site of the scenario or the data file's header."),
-            _option("lon", float | None, None, "--lon", help="Site longitude (deg)."),
-            _option("height", float | None, None, "--height", help="Site height (m)."),
+            _option("imu_file", Path | None, "FILE", "--imu-file", help=IMU_FILE_HELP),
+            _option("lat", float | None, "DEG", "--lat", help="Site latitude (deg); with "
+                    "--lon (and --height) replaces the site of the scenario or of the data "
+                    "file's header."),
+            _option("lon", float | None, "DEG", "--lon", help="Site longitude (deg)."),
+            _option("height", float | None, "M", "--height", help="Site height (m)."),
         ]
     return params
 
@@ -118,6 +120,8 @@ def install(app: typer.Typer) -> None:
         cmd = COMMANDS.get(name)
         if info.callback is None or getattr(info.callback, "_common", False):
             continue
+        if cmd is not None and info.help is None and info.short_help is None:
+            info.short_help = cmd.help  # the command list shows the registry's line
         if (cmd is not None and name != "batch") or name == "validate":
             recorded = cmd.recorded if cmd is not None else True
             info.callback = with_common_options(info.callback, recorded)
@@ -175,7 +179,7 @@ def _apply_recorded(data: dict, inv: Invocation, applied: list) -> None:
         path = Path(inv.imu_file)
         if not path.is_file():
             raise ScenarioError(f"--imu-file: {path}: file not found")
-        for key in ("motion", "mechanism", "site"):
+        for key in ("motion", "mechanism", "site", "imu"):  # the simulation it replaces
             data.pop(key, None)
         data["imu_file"] = str(path.resolve())
         applied.append(("imu_file", path))
@@ -275,7 +279,10 @@ def tag(key: str, value) -> str:
     ``coordinate+vector``), a file by its stem (``imu-lasergyro``), otherwise the key's
     last part without its unit and the value (``passes7``, ``t2_300``, ``tilt5``,
     ``sweep_0-360-5``)."""
-    tail = _UNIT.sub("", key.rsplit(".", 1)[-1])
+    parts = key.split(".")
+    tail = _UNIT.sub("", parts[-1])
+    if len(parts) > 2 and not parts[-2].isdigit():  # imu.gyro.bias_dph: gyro_bias
+        tail = f"{parts[-2]}_{tail}"
     if _pathlike(value):
         word = f"{tail.removesuffix('_file')}-{Path(str(value)).name.split('.')[0]}"
     elif isinstance(value, str) and not re.fullmatch(r"[-+0-9.eE]+", value):
@@ -383,12 +390,6 @@ class ProgressBar:
         self.close()
 
 
-def accepts(fn: Callable, name: str) -> bool:
-    """Does `fn` take a keyword `name` (explicitly or through ``**kwargs``)?"""
-    params = inspect.signature(fn).parameters
-    return name in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
-
-
 # --------------------------------------------------------------------------- run and show
 
 
@@ -397,47 +398,27 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
     """Run command `name` on a loaded scenario through its room, write the results file
     and show its table. Default file name: :func:`output_name` with the overrides of the
     command line (and `options`, e.g. ``--init``). A streaming command writes its series
-    into the (temporary) file while it runs; `options` go to its ``execute``, and a
-    ``progress`` callback if it takes one. Keys that cannot matter become warnings."""
-    cmd = command(name)
-    room = cmd.load()
+    into the (temporary) file while it runs; `options` go to its ``execute``, a progress
+    bar to a room that reports progress (:func:`gcalign.app.runner.run_command`). Keys that
+    cannot matter become warnings."""
+    from gcalign.app.runner import run_command
+
     inv = _INVOCATION.get() or Invocation()
     recorded = sc.imu_file is not None
     run_seed = None if recorded else (sc.imu.seed if seed is None else seed)
     given = [*inv.applied, *((k, v) for k, v in options.items() if v is not None)]
     out = output or output_name(sc.name, name, run_seed, given)
-    notes = [*inv.notes, *sc.unused(cmd.section)]
+    notes = list(inv.notes)
     if recorded and seed is not None:
         notes.append("--seed: cannot matter with recorded data (no random numbers are drawn)")
     if output is None:
         replaced = _replaced_other(out, name, text, run_seed)
         if replaced:
             notes.append(replaced)
-    kwargs = dict(options)
-    t0 = time.perf_counter()
     with ProgressBar(f"{name} {sc.name}") as bar:
-        if accepts(room.execute, "progress"):
-            kwargs["progress"] = bar
-        try:
-            with results.atomic_h5(out) as f:
-                if cmd.streams:
-                    outcome = room.execute(sc, seed, sink=f, **kwargs)
-                else:
-                    outcome = room.execute(sc, seed, **kwargs)
-                bar.close()
-                summary = outcome.summary
-                warnings = list(dict.fromkeys([*notes, *outcome.warnings,
-                                               *summary.get("warnings", [])]))
-                summary["warnings"] = warnings
-                summary["wall_s"] = time.perf_counter() - t0
-                summary["output"] = str(out)
-                results.write_header(f, name, text, outcome.seed, summary)
-                if outcome.truth is not None:
-                    results.write_truth(f, outcome.truth)
-                outcome.write(f)
-        except OSError as err:
-            raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
-    for line in warnings:
+        summary = run_command(name, sc, text, seed, out, progress=bar, notes=notes,
+                              before_write=bar.close, **options)
+    for line in summary["warnings"]:
         sys.stderr.write(f"warning: {line}\n")
     show(name, summary, as_json)
 

@@ -6,6 +6,7 @@ file; edit it and run ``gcalign align mine.yaml``.
 
 from __future__ import annotations
 
+import re
 import sys
 
 import typer
@@ -22,11 +23,14 @@ def builtins() -> dict[str, str]:
 
 
 def first_comment(text: str) -> str:
-    """The first comment line of a scenario file: what it is."""
+    """The first sentence of a scenario file's leading comment: what it is."""
+    lines = []
     for line in text.splitlines():
-        if line.startswith("#"):
-            return line.lstrip("# ").strip()
-    return ""
+        if not line.startswith("#"):
+            break
+        lines.append(line.lstrip("# ").strip())
+    words = " ".join(lines)
+    return re.split(r"\.\s+(?=[A-Z])", words)[0].rstrip(".") if words else ""
 
 
 @app.command()
@@ -44,7 +48,8 @@ def example(
         rows = [(cmd, file, first_comment(builtin_text(file))) for cmd, file in known.items()]
         consoles(as_json).print(kv_table(
             "built-in scenarios: `gcalign example NAME > mine.yaml`, then "
-            "`gcalign NAME mine.yaml`", rows, ("name", "file", "what")))
+            "`gcalign NAME mine.yaml`", [(cmd, what) for cmd, _, what in rows],
+            ("name", "what"), ("left", "left")))
         if as_json:
             emit_json({"examples": {cmd: {"file": f, "what": w} for cmd, f, w in rows}})
         return

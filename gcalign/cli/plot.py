@@ -1,4 +1,5 @@
-"""`gcalign plot`: PNG figures from a results file (alignment, north-finding, batch, ...)."""
+"""`gcalign plot`: PNG figures from a results file (alignment, north-finding, navigation,
+batch, ...) or of a recorded IMU data file."""
 
 from __future__ import annotations
 
@@ -13,25 +14,32 @@ from gcalign.cli.data import JSON_HELP
 @app.command()
 @user_errors
 def plot(
-    file: Path = typer.Argument(..., help="A gcalign results file (.h5)."),
+    file: Path = typer.Argument(..., help="A gcalign results file (.h5), or recorded IMU "
+                                "data (PSINS .imu, CSV; .gz/.xz): its IMU output."),
     out_dir: Path | None = typer.Option(
         None,
         "-o",
         "--output",
         help="Folder for the PNG files (default: FILE without its "
-        "suffix + '_plots/', next to the file).",
+        "suffixes + '_plots/', next to the file).",
     ),
     as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
 ):
-    """Write PNG figures: alignment error and attitude per pass (equivalent time),
-    north-finding error against true azimuth, batch distributions per variant."""
+    """Write PNG figures: every figure the command that wrote FILE draws (alignment error
+    and attitude per pass, navigation errors, north-finding error against azimuth, batch
+    distributions, truth and IMU output, ...)."""
     from gcalign.app import plots
-    from gcalign.io import results
+    from gcalign.cli.common import ProgressBar
 
-    kind, _, _ = results.read_summary(file)
-    written = plots.plot_file(file, out_dir)
+    with ProgressBar(f"plot {file.name}") as bar:
+        written = plots.plot_file(file, out_dir, progress=bar)
     console = consoles(as_json)
     for p in written:
         console.print(str(p), highlight=False, soft_wrap=True)
     if as_json:
+        kind = "data"
+        if file.suffix.lower() in (".h5", ".hdf5", ".hdf"):
+            from gcalign.io import results
+
+            kind = results.read_summary(file)[0]
         emit_json({"file": str(file), "kind": kind, "figures": [str(p) for p in written]})

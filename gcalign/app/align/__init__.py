@@ -50,7 +50,7 @@ WARM_SCENARIO = {  # a tiny align scenario: every align kernel, in milliseconds
     "imu": {"gyro": {"bias_dph": [0.01, 0.01, 0.01]}, "accel": {"bias_ug": [50, 50, 50]}},
     "motion": {"kind": "moving", "attitude_deg": [0, 0, 30], "duration_s": 3,
                "segments": [{"duration_s": 1}, {"duration_s": 2, "accel_mps2": 0.5}]},
-    "align": {"t1_s": 1, "t2_s": 2, "t3_s": 2.5, "passes": 3, "level_s": 0.1,
+    "align": {"t1_s": 1, "t2_s": 2, "t3_s": 2.5, "stages": [{"passes": 3}], "level_s": 0.1,
               "aiding": {"source": "odometer"}},
 }
 

@@ -1,7 +1,13 @@
-"""Alignment figures (seed 000 figs. 7-12): the error of every pass against an *equivalent
-time* axis (the passes laid end to end, so a full-cycle run of 290 s of data × 5 passes spans
-1450 s), pass boundaries as dotted lines, one subplot per angle (degrees); and the attitude
-estimate against the truth on the same axis."""
+"""Alignment figures (seed 000 figs. 7-12) on an *equivalent time* axis (the passes laid end
+to end, so a full-cycle run of 290 s of data × 5 passes spans 1450 s), pass boundaries as
+dotted lines.
+
+* ``align_error``: the error of every pass, one row per angle, linear axes in the unit the
+  values need: all passes on the left (the coarse transient whole), and on the right the
+  same curves after the first pass (the second half of a single pass), where the settled
+  error can be read;
+* ``align_attitude``: the estimate of every pass and, when known, the truth.
+"""
 
 from __future__ import annotations
 
@@ -10,20 +16,21 @@ from dataclasses import dataclass
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.plots import ANGLES, _s, new_figure
+from gcalign.app.plots import ANGLES, _s, angle_scale, legend_below, new_figure, suptitle
 from gcalign.errors import ScenarioError
 
 PASS_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
                "tab:pink", "tab:olive", "tab:cyan")
-
+XLABEL = "equivalent time (s): passes laid end to end; dotted lines: pass boundaries"
 
 
 @dataclass(frozen=True)
 class PassSeries:
-    """One pass read from ``/align/pass_NN``: times in processing order (s), attitude and
-    error (rad, (n, 3)); direction, kind ("compass"/"attitude") and stage."""
+    """One pass read from ``/align/pass_NN``: its number (from 1), times in processing
+    order (s), attitude and error (rad, (n, 3)); direction, kind ("compass"/"attitude") and
+    stage (from 1)."""
 
-    index: int
+    number: int
     direction: str
     kind: str
     stage: int
@@ -46,45 +53,73 @@ def equivalent_time(passes: list[PassSeries]) -> tuple[list[np.ndarray], list[fl
 
 
 def _pass_label(p: PassSeries) -> str:
-    kind = "" if p.kind == "compass" else f" {p.kind}"
-    return f"pass {p.index + 1} {p.direction}{kind} (stage {p.stage + 1})"
+    kind = "" if p.kind == "compass" else f" {p.kind} only"
+    return f"pass {p.number} {p.direction}{kind} (stage {p.stage})"
 
 
-def _mark_boundaries(ax, bounds) -> None:
+def _color(p: PassSeries) -> str:
+    return PASS_COLORS[(p.number - 1) % len(PASS_COLORS)]
+
+
+def _mark_boundaries(ax, bounds, lo: float = -np.inf, hi: float = np.inf) -> None:
     for b in bounds:
-        ax.axvline(b, color="0.45", linestyle=":", linewidth=1.0, label="_pass boundary")
+        if lo <= b <= hi:
+            ax.axvline(b, color="0.45", linestyle=":", linewidth=1.0, label="_pass boundary")
 
 
-def _symlog_threshold(values: np.ndarray) -> float:
-    """Linear range of the symlog axis: about the size of the converged error."""
-    v = np.abs(values[np.isfinite(values)])
-    if v.size == 0:
-        return 1e-3
-    tail = np.median(v[-max(1, v.size // 5):])
-    return float(10.0 ** np.floor(np.log10(max(tail, 1e-6))))
+def zoom_of(xs: list[np.ndarray], passes: list[PassSeries]) -> tuple[float, str]:
+    """Where the zoom starts on the equivalent axis, and what it shows: after the first
+    pass, or the second half of a single pass."""
+    if len(passes) > 1:
+        return float(xs[1][0]), "after pass 1"
+    x = xs[0]
+    return float(x[len(x) // 2]), "second half of the pass"
+
+
+def _zoomed(x: np.ndarray, p: PassSeries, start: float, n_passes: int) -> np.ndarray:
+    """The rows of a pass in the zoom: every pass after the first, or the second half of a
+    single pass."""
+    if n_passes > 1:
+        return np.full(len(x), p.number > 1)
+    return x >= start
 
 
 def align_error_figure(passes: list[PassSeries], title: str = "alignment error") -> Figure:
-    """Error (deg) of every pass against equivalent time, one subplot per angle."""
+    """Error of every pass against equivalent time: one row per angle; left all passes,
+    right the zoom (:func:`zoom_of`); linear axes, deg / arcmin / arcsec per panel."""
     xs_all, bounds = equivalent_time(passes)
     with_err = [(x, p, p.error) for x, p in zip(xs_all, passes, strict=True)
                 if p.error is not None]
     if not with_err:
         raise ScenarioError("plot: the file has no alignment errors (no truth: recorded data)")
-    fig, axes = new_figure(3)
-    for j, (ax, name) in enumerate(zip(axes, ANGLES, strict=True)):
-        for x, p, err in with_err:
-            ax.plot(x, np.degrees(err[:, j]), color=PASS_COLORS[p.index % len(PASS_COLORS)],
-                    linewidth=1.0, label=_pass_label(p))
-        _mark_boundaries(ax, bounds)
-        lin = _symlog_threshold(np.degrees(with_err[-1][2][:, j]))
-        ax.set_yscale("symlog", linthresh=lin)
-        ax.set_ylabel(f"{name} error (deg)\nsymlog, linear < {lin:g}")
-        ax.grid(True, which="major", alpha=0.3)
-    axes[0].legend(loc="upper right", fontsize="small", ncols=min(3, len(with_err)))
-    axes[-1].set_xlabel("equivalent time (s): passes laid end to end; dotted lines: "
-                        "pass boundaries")
-    fig.suptitle(title)
+    start, what = zoom_of(xs_all, passes)
+    fig, axes = new_figure(3, 2, width=12.0, height=8.4, sharex="col")
+    for j, name in enumerate(ANGLES):
+        full, zoom = axes[2 * j], axes[2 * j + 1]
+        values = np.concatenate([e[:, j] for _, _, e in with_err])
+        scale, unit = angle_scale(values)
+        kept = [_zoomed(x, p, start, len(passes)) for x, p, _ in with_err]
+        zscale, zunit = angle_scale(np.concatenate(
+            [e[k, j] for (_, _, e), k in zip(with_err, kept, strict=True)]))
+        for (x, p, err), keep in zip(with_err, kept, strict=True):
+            full.plot(x, err[:, j] * scale, color=_color(p), linewidth=1.0,
+                      label=_pass_label(p))
+            if keep.any():
+                zoom.plot(x[keep], err[keep, j] * zscale, color=_color(p), linewidth=1.0,
+                          label=_pass_label(p))
+        _mark_boundaries(full, bounds)
+        _mark_boundaries(zoom, bounds, lo=start)
+        full.set_ylabel(f"{name} error ({unit})")
+        zoom.set_ylabel(f"{name} error ({zunit})")
+        for ax in (full, zoom):
+            ax.axhline(0.0, color="0.6", linewidth=0.6, label="_zero")
+            ax.grid(True, alpha=0.3)
+    axes[0].set_title("all passes", fontsize="medium")
+    axes[1].set_title(f"{what} (zoom)", fontsize="medium")
+    for ax in axes[-2:]:
+        ax.set_xlabel(XLABEL if ax is axes[-2] else "equivalent time (s)")
+    legend_below(fig, axes[0], ncols=min(3, len(with_err)))
+    suptitle(fig, title)
     return fig
 
 
@@ -98,8 +133,7 @@ def align_attitude_figure(passes: list[PassSeries], truth_t: np.ndarray | None =
     for j, (ax, name) in enumerate(zip(axes, ANGLES, strict=True)):
         for x, p in zip(xs, passes, strict=True):
             y = np.degrees(np.unwrap(p.att[:, j]) if j == 2 else p.att[:, j])
-            ax.plot(x, y, color=PASS_COLORS[p.index % len(PASS_COLORS)], linewidth=1.0,
-                    label=_pass_label(p))
+            ax.plot(x, y, color=_color(p), linewidth=1.0, label=_pass_label(p))
         if truth_t is not None and truth_att is not None:
             ref = np.unwrap(truth_att[:, j]) if j == 2 else truth_att[:, j]
             tx = np.concatenate([np.append(x, np.nan) for x in xs])
@@ -110,21 +144,26 @@ def align_attitude_figure(passes: list[PassSeries], truth_t: np.ndarray | None =
         _mark_boundaries(ax, bounds)
         ax.set_ylabel(f"{name} (deg)")
         ax.grid(True, alpha=0.3)
-    axes[0].legend(loc="best", fontsize="small", ncols=min(3, len(passes) + 1))
-    axes[-1].set_xlabel("equivalent time (s): passes laid end to end; dotted lines: "
-                        "pass boundaries")
-    fig.suptitle(title)
+    legend_below(fig, axes[0], ncols=min(4, len(passes) + 1))
+    axes[-1].set_xlabel(XLABEL)
+    suptitle(fig, title)
     return fig
 
 
 def read_passes(f) -> list[PassSeries]:
+    """The passes of ``/align`` (numbered from 1; files written before gcalign numbered
+    them from 1 start at ``pass_00`` and stage 0, and are renumbered)."""
     g = f["align"]
+    names = sorted(k for k in g if k.startswith("pass_"))
+    shift = 1 if "pass_00" in names else 0
     out = []
-    for name in sorted(k for k in g if k.startswith("pass_")):
+    for name in names:
         p = g[name]
         out.append(PassSeries(
-            index=int(name.split("_")[1]), direction=_s(p.attrs.get("direction", "forward")),
-            kind=_s(p.attrs.get("kind", "compass")), stage=int(p.attrs.get("stage", 0)),
+            number=int(name.split("_")[1]) + shift,
+            direction=_s(p.attrs.get("direction", "forward")),
+            kind=_s(p.attrs.get("kind", "compass")),
+            stage=int(p.attrs.get("stage", 1 - shift)) + shift,
             t=p["t"][()], att=p["att"][()], error=p["error"][()] if "error" in p else None))
     return out
 
@@ -137,11 +176,12 @@ def figures(f, name: str) -> dict[str, Figure]:
     passes = read_passes(f)
     mode = _s(f["align"].attrs.get("mode", ""))
     head = f"{name}: {mode}, {len(passes)} pass(es)"
-    has_truth = "truth" in f
+    has_truth = "truth" in f and any(p.error is not None for p in passes)
     figs["align_attitude"] = align_attitude_figure(
         passes, truth_t=f["truth/t"][()] if has_truth else None,
         truth_att=f["truth/att"][()] if has_truth else None,
-        title=f"{head} — attitude estimate vs truth")
-    if any(p.error is not None for p in passes):
+        title=f"{head} — attitude estimate" + (
+            " vs truth" if has_truth else " (recorded data: no truth)"))
+    if has_truth:
         figs["align_error"] = align_error_figure(passes, title=f"{head} — attitude error per pass")
     return figs

@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 
 from gcalign.app.batch.aggregate import metric_label, metric_units
 from gcalign.app.batch.sweep import CASE_KEY
-from gcalign.app.plots import _s, new_figure
+from gcalign.app.plots import _s, angle_scale, legend_below, new_figure, suptitle
 
 
 def _short_keys(keys: list[str]) -> dict[str, str]:
@@ -69,15 +69,19 @@ def batch_figure(metric: str, values: np.ndarray, variant: np.ndarray, labels: l
             sel = values[variant == vi]
             x = sel.ravel() if pooled else sel[:, j]
             data.append(x[np.isfinite(x)])
+        unit = units
+        if units == "deg":  # angles in the unit their size needs, as in the tables
+            scale, unit = angle_scale(np.radians(np.concatenate(data)))
+            data = [np.radians(d) * scale for d in data]
         ax.boxplot(data, patch_artist=True, showfliers=True, whis=(5, 95),
                    boxprops={"facecolor": "tab:blue", "alpha": 0.35},
                    medianprops={"color": "black"})
         ax.set_xticks(range(1, n_var + 1), labels, fontsize="small")
         name = metric if not comp else f"{metric}\n{comp}"
-        ax.set_ylabel(f"{name} ({units})" if units else name)
+        ax.set_ylabel(f"{name} ({unit})" if unit else name)
         ax.grid(True, axis="y", alpha=0.3)
     axes[-1].set_xlabel("variant (whiskers 5–95 %, box quartiles, line median)")
-    fig.suptitle(title or f"{metric}: distribution over seeds per variant")
+    suptitle(fig, title or f"{metric}: distribution over seeds per variant")
     return fig
 
 
@@ -164,8 +168,8 @@ def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides
                 ax.set_ylabel(f"{label} ({units})" if units else label)
             if j == len(comps) - 1:
                 ax.set_xlabel(f"{x_key} ({x_units})" if x_units else x_key)
-    axes[0].legend(loc="best", fontsize="small")
-    fig.suptitle(title or f"median |{name}| over seeds against {x_key} "
+    legend_below(fig, axes[0])
+    suptitle(fig, title or f"median |{name}| over seeds against {x_key} "
                           "(band: 25-75 % of the seeds)")
     return fig
 

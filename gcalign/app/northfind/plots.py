@@ -7,11 +7,9 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.plots import _s, new_figure
+from gcalign.app.plots import _s, angle_scale, legend_below, legend_right, new_figure, suptitle
 
 METHOD_ORDER = ("coordinate", "vector", "naive", "none")
-
-
 
 
 def _methods_in_order(names) -> list[str]:
@@ -22,7 +20,8 @@ def _methods_in_order(names) -> list[str]:
 def northfind_error_figure(azimuth_true: np.ndarray, errors: dict[str, np.ndarray],
                            error_pred: dict[str, np.ndarray] | None = None,
                            title: str = "north-finding error") -> Figure:
-    """Azimuth error (deg) against true azimuth (deg), one subplot per method.
+    """Azimuth error (deg, arcmin or arcsec per panel) against true azimuth (deg), one
+    subplot per method.
 
     errors : method -> (M,) or (repeats, M) rad. error_pred : method -> (M,) rad (closed
     form, NaN where there is none).
@@ -30,9 +29,14 @@ def northfind_error_figure(azimuth_true: np.ndarray, errors: dict[str, np.ndarra
     methods = _methods_in_order(errors)
     az = np.degrees(np.asarray(azimuth_true, float))
     order = np.argsort(az)
-    fig, axes = new_figure(len(methods), height=2.2 * len(methods) + 1.0)
+    fig, axes = new_figure(len(methods), width=10.0, height=2.2 * len(methods) + 1.0)
     for ax, m in zip(axes, methods, strict=True):
-        e = np.degrees(np.atleast_2d(errors[m]))[:, order]
+        rad = np.atleast_2d(errors[m])[:, order]
+        pred = None if error_pred is None else error_pred.get(m)
+        has_pred = pred is not None and bool(np.any(np.isfinite(pred)))
+        scale, unit = angle_scale(np.concatenate(
+            [rad.ravel(), np.asarray(pred, float).ravel() if has_pred else []]))
+        e = rad * scale
         r = e.shape[0]
         mean = e.mean(0)
         ax.plot(az[order], mean, marker="." if az.size < 100 else None, linewidth=1.0,
@@ -40,18 +44,23 @@ def northfind_error_figure(azimuth_true: np.ndarray, errors: dict[str, np.ndarra
         if r > 1:
             sd = e.std(0, ddof=1)
             ax.fill_between(az[order], mean - sd, mean + sd, alpha=0.25, label="±1σ")
-        pred = None if error_pred is None else error_pred.get(m)
-        if pred is not None and np.any(np.isfinite(pred)):
-            ax.plot(az[order], np.degrees(np.asarray(pred))[order], color="black",
+        if has_pred:
+            ax.plot(az[order], np.asarray(pred)[order] * scale, color="black",
                     linestyle="--", linewidth=0.8, label="closed form (noise-free)")
-        ax.set_ylabel(f"{m}\nerror (deg)")
+        ax.set_ylabel(f"{m}\nerror ({unit})")
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize="small")
+        legend_right(ax)
     axes[-1].set_xlabel("true azimuth (deg, clockwise from north)")
     axes[-1].set_xlim(0, 360)
     axes[-1].set_xticks(np.arange(0, 361, 45))
-    fig.suptitle(title)
+    suptitle(fig, title)
     return fig
+
+
+#: Below this the difference of two methods is round-off (arc-seconds).
+ROUND_OFF_ARCSEC = 1e-6
+#: The size of the difference in seed 001 fig. 5 (1e-4°), as a reference line (arcsec).
+SEED_FIG5_ARCSEC = 0.36
 
 
 def northfind_difference_figure(azimuth_true: np.ndarray, a: np.ndarray, b: np.ndarray,
@@ -59,21 +68,35 @@ def northfind_difference_figure(azimuth_true: np.ndarray, a: np.ndarray, b: np.n
                                 title: str = "difference of the two compensation methods"
                                 ) -> Figure:
     """Seed 001 fig. 5: estimate difference of two methods (arc-seconds) against true
-    azimuth; a, b are errors (M,) or (repeats, M) rad."""
+    azimuth; a, b are errors (M,) or (repeats, M) rad. The axis spans at least the seed's
+    ±1e-4° (dashed); a difference below 1e-6″ is round-off and is drawn as zero, its
+    largest value in the label (a curve of 1e-10″ noise would read as a finding)."""
     az = np.degrees(np.asarray(azimuth_true, float))
     order = np.argsort(az)
     d = (np.degrees(np.atleast_2d(a) - np.atleast_2d(b)) * 3600.0)[:, order]
+    mean = d.mean(0)
+    peak = float(np.max(np.abs(d))) if d.size else 0.0
     fig, axes = new_figure(1, height=3.6)
     ax = axes[0]
-    ax.plot(az[order], d.mean(0), marker="." if az.size < 100 else None, linewidth=1.0,
-            label=f"{names[0]} − {names[1]}" + (f" (mean of {d.shape[0]})" if len(d) > 1 else ""))
+    what = f"{names[0]} − {names[1]}" + (f" (mean of {d.shape[0]})" if len(d) > 1 else "")
+    if peak < ROUND_OFF_ARCSEC:
+        ax.plot(az[order], np.zeros_like(mean), linewidth=1.5,
+                label=f"{what}: zero to round-off (largest |difference| {peak:.1e}″)")
+    else:
+        ax.plot(az[order], mean, marker="." if az.size < 100 else None, linewidth=1.0,
+                label=what)
+    for sign in (1.0, -1.0):
+        ax.axhline(sign * SEED_FIG5_ARCSEC, color="0.5", linestyle="--", linewidth=0.8,
+                   label="seed fig. 5 size: ±1e-4°" if sign > 0 else "_seed size")
+    lim = max(1.25 * peak, 1.5 * SEED_FIG5_ARCSEC)
+    ax.set_ylim(-lim, lim)
     ax.set_xlabel("true azimuth (deg, clockwise from north)")
     ax.set_ylabel("difference (arcsec)")
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper right", fontsize="small")
-    fig.suptitle(title)
+    legend_below(fig, ax, ncols=1)
+    suptitle(fig, title)
     return fig
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.plots import ANGLES, _s, new_figure
+from gcalign.app.plots import ANGLES, _s, legend_right, new_figure, suptitle
 
 ARCSEC = np.pi / 180.0 / 3600.0
 REFERENCE = {"seed": "against the INS's output T later (the seed's reference)",
@@ -56,9 +56,9 @@ def case_figure(t: np.ndarray, scored: np.ndarray, before: np.ndarray,
         if (~scored).any():
             ax.axvspan(t[0], t[~scored][-1], color="0.85", label="_not scored")
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize="small")
+        legend_right(ax)
     axes[-1].set_xlabel("pulse time (s)")
-    fig.suptitle(title)
+    suptitle(fig, title)
     return fig
 
 
@@ -86,8 +86,8 @@ def filter_figure(freq: np.ndarray, magnitude: dict[str, np.ndarray], group_dela
     axes[1].set_ylabel("group delay (ms)")
     for ax in axes:
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="lower left" if ax is axes[0] else "upper left", fontsize="small")
-    fig.suptitle(title)
+        legend_right(ax)
+    suptitle(fig, title)
     return fig
 
 
@@ -114,8 +114,8 @@ def lag_figure(window: tuple | None,
     axes[1].set_xlabel("pulse time (s)")
     for ax in axes:
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="best", fontsize="small")
-    fig.suptitle(title)
+        legend_right(ax)
+    suptitle(fig, title)
     return fig
 
 

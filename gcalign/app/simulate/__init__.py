@@ -22,4 +22,7 @@ def table(summary: dict):
 
 
 def figures(f, name: str) -> dict:
-    return {}  # the truth figure, which every file with /truth gets
+    """The truth and the IMU output (the shared figures of :mod:`gcalign.app.plots`)."""
+    from gcalign.app.plots import truth_and_imu
+
+    return truth_and_imu(f, name)

@@ -1,0 +1,200 @@
+"""The Python API: load a scenario, run any command on it, read a results file back.
+
+:func:`run` runs a command of the registry (:mod:`gcalign.app.registry`: ``simulate``,
+``navigate``, ``align``, ``northfind``, ``realtime``, …) exactly as the command line does,
+writes the same results file and returns a :class:`Result`; :func:`read` gives the same
+object back from the file.
+
+>>> import gcalign
+>>> sc = gcalign.example("northfind", {"northfind.sweep": None, "northfind.azimuth_deg": 48})
+>>> res = gcalign.run("northfind", sc, seed=3)
+>>> res.kind, res.seed, res["shape"]
+('northfind', 3, [1, 1])
+>>> abs(res["methods"]["coordinate"]["errors_deg"][0]) < 0.1   # deg, 24 positions × 60 s
+True
+>>> gcalign.read(res.path) == res
+True
+"""
+
+from __future__ import annotations
+
+import atexit
+import copy
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from gcalign.errors import ScenarioError
+
+#: Suffixes read as recorded IMU data rather than as a scenario (``load("x.imu.xz")``).
+DATA_SUFFIXES = (".imu", ".csv", ".txt", ".h5", ".hdf5", ".hdf")
+
+
+@dataclass(frozen=True)
+class Result:
+    """What a run produced: the command (``kind``), its summary (plain numbers, degrees and
+    seconds: the JSON of ``--json``), the random seed (None for recorded data), the
+    warnings and the results file (``path``). ``res["error_t3_deg"]`` reads the summary."""
+
+    kind: str
+    summary: dict
+    seed: int | None
+    path: Path
+    warnings: tuple[str, ...] = field(default=())
+
+    def __getitem__(self, key: str):
+        return self.summary[key]
+
+    def table(self):
+        """The rich table the command prints."""
+        from gcalign.app.report import summary_table
+
+        return summary_table(self.kind, self.summary)
+
+    def figures(self) -> dict:
+        """The figures ``gcalign plot`` writes, as matplotlib Figures, by name."""
+        from gcalign.app.plots import figures_for
+
+        return figures_for(self.path)
+
+    def open(self):
+        """The results file, open for reading (h5py.File; use it in a ``with``)."""
+        from gcalign.io.results import open_results
+
+        return open_results(self.path)
+
+    def truth(self):
+        """The truth stored in the file (:class:`gcalign.sim.motions.Truth`), or None."""
+        from gcalign.io.results import read_truth
+
+        return read_truth(self.path)
+
+    def imu(self):
+        """The IMU increments stored by ``simulate`` (:class:`gcalign.sim.imu.ImuData`)."""
+        from gcalign.io.results import read_imu
+
+        return read_imu(self.path)
+
+    def save(self, path: str | Path) -> Result:
+        """A copy of the results file at `path`; the Result read from there."""
+        shutil.copyfile(self.path, path)
+        return read(path)
+
+
+def _mapping(source) -> tuple[dict, str, Path | None]:
+    """(mapping, source name, folder of relative paths) of a scenario source."""
+    from gcalign.io.scenario.loader import read_yaml
+
+    if isinstance(source, dict):
+        return copy.deepcopy(source), "scenario", None
+    path = Path(source)
+    names = path.name.lower().split(".")
+    if len(names) > 1 and ("." + names[-1] in DATA_SUFFIXES or (
+            names[-1] in ("gz", "xz") and len(names) > 2)):
+        return {"name": names[0] or "data", "imu_file": str(path.resolve())}, str(path), None
+    return read_yaml(path), str(path), path.parent
+
+
+def load(source, overrides: dict | None = None):
+    """A scenario (:class:`gcalign.io.scenario.Scenario`) from a YAML file, a mapping, or
+    a recorded data file (``.imu``, CSV, gcalign HDF5, ``.gz``/``.xz``; it stands for
+    ``imu_file: SOURCE``), with `overrides` (dotted key -> value, as ``--set`` and a
+    sweep's grid: ``{"align.mode": "conventional"}``; None removes a key). ScenarioError
+    names a bad field. The model validates assignments too (``sc.align.t2_s = 200``)."""
+    from gcalign.app.batch.overrides import apply_override
+    from gcalign.io.scenario import parse_scenario
+
+    data, name, folder = _mapping(source)
+    if overrides:
+        base = parse_scenario(copy.deepcopy(data), name)
+        for key, value in overrides.items():
+            if value is None:
+                _remove(data, key)
+            else:
+                apply_override(data, key, value, base)
+    model = parse_scenario(data, name)
+    if model.imu_file is not None and folder is not None and not model.imu_file.is_absolute():
+        model.imu_file = (folder / model.imu_file).resolve()
+    return model
+
+
+def scenario_text(sc) -> str:
+    """The YAML a results file stores for a scenario run from Python: the keys it sets
+    (defaults stay defaults), as it is at run time."""
+    return yaml.safe_dump(sc.model_dump(mode="json", exclude_unset=True), sort_keys=False)
+
+
+def _remove(data: dict, key: str) -> None:
+    *head, last = key.split(".")
+    node = data
+    for part in head:
+        node = node[int(part)] if isinstance(node, list) else node.get(part, {})
+    if isinstance(node, dict):
+        node.pop(last, None)
+
+
+def example(command: str, overrides: dict | None = None):
+    """The built-in scenario of `command` (``gcalign example COMMAND``), with `overrides`."""
+    from gcalign.app.registry import COMMANDS
+    from gcalign.cli.common import builtin_text
+
+    c = COMMANDS.get(command)
+    if c is None or not c.builtin:
+        have = ", ".join(n for n, x in COMMANDS.items() if x.builtin)
+        raise ScenarioError(f"example: {command!r} has no built-in scenario; built-in: {have}")
+    return load(yaml.safe_load(builtin_text(c.builtin)), overrides)
+
+
+_TEMP: list[str] = []
+
+
+def _scratch() -> Path:
+    """A folder for results files nobody asked to keep (removed when Python exits)."""
+    if not _TEMP:
+        _TEMP.append(tempfile.mkdtemp(prefix="gcalign-"))
+        atexit.register(shutil.rmtree, _TEMP[0], True)
+    return Path(_TEMP[0])
+
+
+def run(command: str, scenario, seed: int | None = None, output: str | Path | None = None,
+        progress=None, **options) -> Result:
+    """Run `command` (a registry name) on `scenario` (a scenario model, or anything
+    :func:`load` takes) as the command line does, write the results file (`output`, or a
+    temporary file kept while Python runs) and return its :class:`Result`. `options` are the
+    command's own (``navigate``: ``init="align.h5"``); `progress(done, total, what)`
+    hears of long runs."""
+    from gcalign.app.registry import COMMANDS
+    from gcalign.app.runner import run_command
+
+    if command not in COMMANDS or command == "batch":
+        raise ScenarioError(f"run: {command!r} is not a command that runs a scenario; "
+                            f"commands: {', '.join(c for c in COMMANDS if c != 'batch')}")
+    from gcalign.io.scenario import Scenario
+
+    sc = scenario if isinstance(scenario, Scenario) else load(scenario)
+    out = Path(output) if output is not None else Path(tempfile.mkstemp(
+        suffix=".h5", prefix=f"{sc.name}-{command}-", dir=_scratch())[1])
+    if options.get("init") is not None:
+        options["init"] = str(options["init"])
+    run_command(command, sc, scenario_text(sc), seed, out, progress=progress, **options)
+    return read(out)
+
+
+def read(path: str | Path) -> Result:
+    """The :class:`Result` of a results file (any command's), from the file alone."""
+    from gcalign.io.results import read_summary
+
+    kind, summary, attrs = read_summary(Path(path))
+    seed = int(attrs.get("seed", -1))
+    return Result(kind, summary, None if seed < 0 else seed, Path(path),
+                  tuple(summary.get("warnings") or ()))
+
+
+def commands() -> list[str]:
+    """The commands that run a scenario (each is also a function of the package)."""
+    from gcalign.app.registry import COMMANDS
+
+    return [c for c in COMMANDS if c != "batch"]

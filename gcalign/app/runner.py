@@ -1,0 +1,63 @@
+"""Run a registered command on a scenario and write its results file: what the command line
+(:func:`gcalign.cli.common.run_and_show`) and the Python API (:func:`gcalign.run`) share.
+
+No typer, no rich: progress is a plain callable and warnings are strings.
+"""
+
+from __future__ import annotations
+
+import inspect
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from gcalign.app.registry import command
+from gcalign.errors import ScenarioError
+from gcalign.io import results
+from gcalign.io.scenario import Scenario
+
+
+def accepts(fn: Callable, name: str) -> bool:
+    """Does `fn` take a keyword `name` (explicitly or through ``**kwargs``)?"""
+    params = inspect.signature(fn).parameters
+    return name in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
+
+
+def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path, *,
+                progress: Callable | None = None, notes: Sequence[str] = (),
+                before_write: Callable[[], None] | None = None, **options) -> dict:
+    """Run command `name` through its room, write the results file `out` (atomically: an
+    interrupted run leaves no file) and return the summary it stored.
+
+    The summary gets ``warnings`` (`notes`, the scenario's keys that cannot matter, and the
+    run's own), ``wall_s`` (the whole call) and ``output``. `progress(done, total, what)`
+    goes to a room whose ``execute`` takes it; `before_write` is called when the run is
+    done, before the file is finished (the command line closes its progress bar there).
+    """
+    cmd = command(name)
+    room = cmd.load()
+    kwargs = dict(options)
+    if progress is not None and accepts(room.execute, "progress"):
+        kwargs["progress"] = progress
+    t0 = time.perf_counter()
+    try:
+        with results.atomic_h5(out) as f:
+            if cmd.streams:
+                outcome = room.execute(sc, seed, sink=f, **kwargs)
+            else:
+                outcome = room.execute(sc, seed, **kwargs)
+            if before_write is not None:
+                before_write()
+            summary = outcome.summary
+            summary["warnings"] = list(dict.fromkeys(
+                [*notes, *sc.unused(cmd.section), *outcome.warnings,
+                 *summary.get("warnings", [])]))
+            summary["wall_s"] = time.perf_counter() - t0
+            summary["output"] = str(out)
+            results.write_header(f, name, text, outcome.seed, summary)
+            if outcome.truth is not None:
+                results.write_truth(f, outcome.truth)
+            outcome.write(f)
+    except OSError as err:
+        raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
+    return summary
