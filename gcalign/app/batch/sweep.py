@@ -286,3 +286,71 @@ def _check_section(sc, command: str, where: str) -> None:
             check(sc)
         except ScenarioError as err:
             raise ScenarioError(f"{where}: {err}") from None
+
+
+#: The pseudo grid key of a batch over a list of scenario files: each file is a variant.
+FILE_KEY = "scenario"
+
+
+def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int = 1,
+                     seed_start: int = 1, metrics: list[str] | None = None) -> Sweep:
+    """A batch over a plain list of scenario files (``gcalign batch a.yaml b.yaml …``):
+    every file is a variant (labelled by its name under the pseudo key ``scenario``), run
+    for the same seeds; each file is validated before anything runs.
+
+    The command is `command`, or the one batchable command whose section every file has
+    (``align`` when they have none); `metrics` default to the command's.
+    """
+    import yaml
+
+    from gcalign.io.scenario import parse_scenario
+    from gcalign.io.scenario.loader import read_yaml
+
+    if not paths:
+        raise ScenarioError("batch: give a sweep file or one or more scenario files")
+    paths = [Path(p) for p in paths]
+    datas, texts = [], []
+    for path in paths:
+        data = read_yaml(path)
+        if isinstance(data, dict) and "base" in data:
+            raise ScenarioError(f"{path}: a sweep file (it has 'base'); a batch takes one "
+                                "sweep file, or a list of scenario files")
+        if isinstance(data, dict) and isinstance(data.get("imu_file"), str):
+            p = Path(data["imu_file"])  # workers may run elsewhere: make it absolute
+            data["imu_file"] = str(p if p.is_absolute() else (path.parent / p).resolve())
+        parse_scenario(copy.deepcopy(data), str(path))
+        datas.append(data)
+        texts.append(path.read_text(encoding="utf-8"))
+    if command is None:
+        found = {c for d in datas for c in COMMANDS if isinstance(d, dict) and c in d}
+        if len(found) > 1:
+            raise ScenarioError(f"batch: the files have sections of {', '.join(sorted(found))}; "
+                                "say which command to run (--command)")
+        command = found.pop() if found else "align"
+    if command not in COMMANDS:
+        raise ScenarioError(f"--command: must be one of {', '.join(COMMANDS)}, got {command!r}")
+    labels = [p.name for p in paths]
+    if len(set(labels)) < len(labels):
+        labels = [str(p) for p in paths]
+    if len(set(labels)) < len(labels):
+        raise ScenarioError("batch: a scenario file is listed twice")
+    spec = {"files": [str(p) for p in paths], "command": command, "seeds": seeds,
+            "seed_start": seed_start, "metrics": list(metrics or DEFAULT_METRICS[command])}
+    stems = [p.name.split(".")[0] for p in paths]
+    name = "+".join(stems) if len(stems) <= 3 else f"{stems[0]}+{len(stems) - 1}-more"
+    # The checks of seeds, seed_start and metrics are the sweep's (one variant: file 1).
+    sweep = sweep_from_mapping({"name": name, "base": copy.deepcopy(datas[0]),
+                                "command": command, "seeds": seeds, "seed_start": seed_start,
+                                "metrics": spec["metrics"]}, "batch")
+    variants = []
+    for i, (label, data) in enumerate(zip(labels, datas, strict=True)):
+        where = f"{paths[i]}"
+        _check_section(parse_scenario(copy.deepcopy(data), where), command, where)
+        variants.append(Variant(i, {FILE_KEY: label}, data,
+                                _hash(command, list(sweep.metrics), data)))
+    base_text = "".join(f"# --- {p}\n{t}\n" for p, t in zip(paths, texts, strict=True))
+    return Sweep(name=name, command=command, source="batch of " + ", ".join(map(str, paths)),
+                 text=yaml.safe_dump(spec, sort_keys=False), base_source=", ".join(
+                     map(str, paths)), base_text=base_text, grid={FILE_KEY: labels}, cases={},
+                 seeds=sweep.seeds, seed_start=sweep.seed_start, metrics=sweep.metrics,
+                 variants=tuple(variants))

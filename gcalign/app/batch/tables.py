@@ -1,78 +1,99 @@
-"""The `gcalign batch` table: statistics over seeds of each metric, per variant."""
+"""The `gcalign batch` table: statistics over seeds of each metric, per variant.
+
+One small table per metric (and vector component), its name and unit in the title line
+(never wrapped into a cell); all statistics of a metric in one unit and format (angles in
+deg, ′ or ″ as their size needs); variant names broken only between overrides."""
 
 from __future__ import annotations
 
+from rich import box
 from rich.table import Table
 from rich.text import Text
 
+from gcalign.app.report import UNIT_NAME, angle_unit, angles, numbers
 
-def batch_table(s: dict) -> Table:
-    """Variants compared: for each metric (and vector component) a section with one row per
-    variant; columns are the statistics over seeds (mean, std, RMS, median, 5 and 95 %
-    percentiles), three significant digits (``--json`` has them all)."""
-    from rich import box
+STATS = (("mean", "mean"), ("std", "std"), ("RMS", "rms"), ("median", "median"),
+         ("5 %", "p05"), ("95 %", "p95"))
+#: Columns a variant name may take before it wraps (between its overrides).
+NAME_WIDTH = 28
 
-    def _plain(x) -> str:  # an override value as the user wrote it (150, 0.5, full-cycle)
-        return x if isinstance(x, str) else f"{x:g}" if isinstance(x, float) else str(x)
 
-    variants = s["variants"]
+def _plain(x) -> str:  # an override value as the user wrote it (150, 0.5, full-cycle)
+    return x if isinstance(x, str) else f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def _names(s: dict) -> list[str]:
+    """Each variant's overrides, one per line (a batch of files: the file name alone)."""
     keys = list(s.get("grid") or {})
     tails = [k.rsplit(".", 1)[-1] for k in keys]
     short = {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
-    title = (
-        f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) × "
-        f"{s['seeds']} seed(s) {s['seed_start']}…{s['seed_start'] + s['seeds'] - 1}"
-    )
-    table = Table(
-        title=title,
-        title_justify="left",
-        header_style="bold",
-        box=box.SIMPLE_HEAD,
-        pad_edge=False,
-        padding=(0, 0, 0, 1),
-    )
-    for name in ("variant", "n", "mean", "std", "RMS", "median", "5 %", "95 %"):
-        table.add_column(
-            name,
-            justify="left" if name == "variant" else "right",
-            overflow="fold" if name == "variant" else "ellipsis",
-        )
+    out = []
+    for v in s["variants"]:
+        lines = [_plain(x) if k == "scenario" else f"{short.get(k, k)}={_plain(x)}"
+                 for k, x in v["overrides"].items()]
+        name = "\n".join(lines) or "base"
+        if v["failed"]:
+            name += f"\n[{v['failed']} failed]"
+        out.append(name)
+    return out
+
+
+def _cells(values: list, units: str) -> tuple[list[str], str]:
+    """The statistics of one metric section in one format, and the unit to show."""
+    if units == "deg":
+        unit = angle_unit(values)
+        return angles(values, unit), UNIT_NAME[unit]
+    return numbers(values, sig=4), units
+
+
+def batch_table(s: dict) -> Table:
+    """Variants compared: for each metric (and vector component) a table with one row per
+    variant; columns are the statistics over seeds (mean, std, RMS, median, 5 and 95 %
+    percentiles); ``--json`` has every digit."""
+    variants = s["variants"]
+    names = _names(s)
+    width = min(NAME_WIDTH, max((len(line) for n in names for line in n.split("\n")),
+                                default=7))
+    outer = Table.grid(padding=(0, 0))
+    outer.title = (f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) "
+                   f"× {s['seeds']} seed(s) {s['seed_start']}…"
+                   f"{s['seed_start'] + s['seeds'] - 1}")
+    outer.title_justify = "left"
+    ns = {st["n"] for v in variants for st in v["stats"].values() if st}
     for m in s["metrics"]:
         per = [(v, v["stats"].get(m)) for v in variants]
         comps = next((st["components"] for _, st in per if st and st.get("components")), None)
         units = next((st.get("units") for _, st in per if st and st.get("units")), "")
         shown = (comps or [None])[:6]  # a long vector (e.g. one error per azimuth): the start
         for ci, comp in enumerate(shown):
-            label = m + (f" {comp}" if comp is not None else "") + (f" ({units})" if units else "")
-            if ci == len(shown) - 1 and comps and len(comps) > len(shown):
-                label += f"  (+{len(comps) - len(shown)} more components in --json / the file)"
-            table.add_row(Text(label, style="bold"), *[""] * 7)
-            for j, (v, st) in enumerate(per):
-                name = (
-                    "\n".join(f"{short.get(k, k)}={_plain(x)}" for k, x in v["overrides"].items())
-                    or "base"
-                )
-                if v["failed"]:
-                    name += f"\n[{v['failed']} failed]"
-                cells = []
-                for stat in ("mean", "std", "rms", "median", "p05", "p95"):
-                    x = None if st is None else st.get(stat)
+            values = []
+            for _, st in per:
+                for _, key in STATS:
+                    x = None if st is None else st.get(key)
                     if isinstance(x, list):
                         x = x[ci] if ci < len(x) else None
-                    cells.append("—" if x is None else f"{x:.3g}")
-                table.add_row(
-                    Text(name),
-                    str(0 if st is None else st["n"]),
-                    *cells,
-                    end_section=j == len(per) - 1,
-                )
+                    values.append(x)
+            cells, unit = _cells(values, units)
+            label = m + (f" {comp}" if comp is not None else "") + (f" ({unit})" if unit else "")
+            if ci == len(shown) - 1 and comps and len(comps) > len(shown):
+                label += f"; +{len(comps) - len(shown)} more components in --json and the file"
+            table = Table(title=label, title_justify="left", title_style="bold",
+                          header_style="bold", box=box.SIMPLE_HEAD, pad_edge=False,
+                          padding=(0, 0, 0, 1))
+            table.add_column("variant", justify="left", min_width=width, overflow="fold")
+            for head, _ in STATS:
+                table.add_column(head, justify="right", no_wrap=True)
+            for j, name in enumerate(names):
+                table.add_row(Text(name), *cells[j * len(STATS):(j + 1) * len(STATS)])
+            outer.add_row(table)
     done = f"{s['runs']} runs" if s["complete"] else f"{s['finished']} of {s['runs']} runs finished"
-    notes = [f"{done}: {s['ok']} ok, {s['failed']} failed"]
+    per_variant = f"; {ns.pop()} seed(s) per statistic" if len(ns) == 1 else ""
+    notes = [f"{done}: {s['ok']} ok, {s['failed']} failed{per_variant}"]
     for f in s.get("failures", [])[:3]:
         notes.append(f"failed: variant {f['variant']} seed {f['seed']}: {f['error']}")
     if s.get("wall_s") is not None:
         notes.append(f"{s.get('executor') or ''}; wall {s['wall_s']:.2f} s".lstrip("; "))
     notes.append(f"output {s.get('output') or '—'}")
-    table.caption = "\n".join(notes)
-    table.caption_justify = "left"
-    return table
+    outer.caption = "\n".join(notes)
+    outer.caption_justify = "left"
+    return outer
