@@ -331,15 +331,15 @@ def _replaced_other(out: Path, kind: str, text: str, seed: int | None) -> str | 
 
 class ProgressBar:
     """A transient rich progress bar on stderr for a run's ``progress(done, total, what)``
-    reports. It appears only once a run has taken more than `delay_s` (short runs stay
-    quiet) and only on a terminal; ``GCALIGN_PROGRESS=always`` forces it (also into a
-    pipe), ``never`` turns it off."""
+    reports. It appears only on a terminal and once a run has taken more than `delay_s`
+    (short runs stay quiet); ``GCALIGN_PROGRESS=always`` forces it at once (also into a
+    pipe or a log, where it stays), ``never`` turns it off."""
 
     def __init__(self, title: str, delay_s: float = 1.0):
         mode = os.environ.get("GCALIGN_PROGRESS", "auto").lower()
         self.enabled = mode == "always" or (mode == "auto" and sys.stderr.isatty())
         self.force = mode == "always"
-        self.title, self.delay = title, delay_s
+        self.title, self.delay = title, 0.0 if self.force else delay_s
         self.t0 = time.perf_counter()
         self.bar = None
         self.tasks: dict[str, int] = {}
