@@ -339,7 +339,7 @@ T = {chain_ms:.4f} ms (notch + FIR41), pulses on every solution instant (Δt = 0
 
 ```sh
 gcalign realtime                           # the first table; runs/seed003-table1-…h5
-gcalign plot runs/seed003-table1-realtime-seed2027.h5
+gcalign plot runs/seed003-table1-realtime-rng2027.h5
 python docs/results_realtime.py --seeds 10 # this section and its three figures
 python benchmarks/bench_realtime.py        # Table 1 end to end, median of 7 warm runs
 ```

@@ -139,13 +139,12 @@ def _remove(data: dict, key: str) -> None:
 def example(command: str, overrides: dict | None = None):
     """The built-in scenario of `command` (``gcalign example COMMAND``), with `overrides`."""
     from gcalign.app.registry import COMMANDS
-    from gcalign.cli.common import builtin_text
 
     c = COMMANDS.get(command)
     if c is None or not c.builtin:
         have = ", ".join(n for n, x in COMMANDS.items() if x.builtin)
         raise ScenarioError(f"example: {command!r} has no built-in scenario; built-in: {have}")
-    return load(yaml.safe_load(builtin_text(c.builtin)), overrides)
+    return load(yaml.safe_load(c.builtin_text()), overrides)
 
 
 _TEMP: list[str] = []

@@ -109,7 +109,7 @@ def test_analytic_coarse_starts_on_the_steady_state_so_no_mode_differs():
     biases = {"gyro": {"bias_dph": [0.01] * 3}, "accel": {"bias_ug": [50] * 3}}
     aid = {"source": "odometer", "noise_mps": 0.0}
     analytic = scenario("seed000_moving_full_cycle.yaml", 300, biases, aiding=aid,
-                        coarse={"method": "analytic", "duration_s": 10})
+                        coarse={"method": "analytic"})
     yaw = {m: e[0] for m, e in yaw_by_mode(analytic, [1]).items()}
     assert max(yaw.values()) - min(yaw.values()) < 2e-3
     given = scenario("seed000_moving_full_cycle.yaml", 300, biases, aiding=aid)

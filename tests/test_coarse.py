@@ -11,7 +11,6 @@ Reference data is built here from exact physics (not from gcalign output):
 """
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -19,7 +19,6 @@ from gcalign.nav import earth
 from gcalign.sim.imu import ImuData
 from gcalign.units import ARCSEC, DEG
 
-
 PSINS_HEADER = """% a PSINS-format test file
 % three header rows follow
 1.0 -2.0 30.0 0.5 -0.25 0.0

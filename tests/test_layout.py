@@ -19,6 +19,7 @@ ALLOWED = {
     "io": set(CORE) | {"io"},
     "app": set(CORE) | {"io", "app"},
     "cli": set(CORE) | {"io", "app", "cli"},
+    "api": set(CORE) | {"io", "app", "api"},  # the Python API: never the command line
 }
 CORE_FORBIDDEN = {"typer", "rich", "yaml", "pydantic", "h5py", "matplotlib"}
 

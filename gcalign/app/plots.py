@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -38,7 +39,8 @@ MAX_POINTS = 4000
 
 
 def new_figure(rows: int, cols: int = 1, *, width: float = 9.0, height: float | None = None,
-               sharex: bool | str = True) -> tuple[Figure, list]:
+               sharex: bool | Literal["none", "all", "row", "col"] = True
+               ) -> tuple[Figure, list]:
     """A Figure on the Agg canvas (no global pyplot state) and its axes, flattened."""
     fig = Figure(figsize=(width, height or 2.4 * rows + 1.0), dpi=DPI, layout="constrained")
     axes = fig.subplots(rows, cols, sharex=sharex, squeeze=False)

@@ -58,6 +58,19 @@ class Command:
     def load(self) -> ModuleType:
         return importlib.import_module(f"gcalign.app.{self.room}")
 
+    def builtin_text(self) -> str:
+        """YAML text of the built-in scenario (`gcalign example NAME`); KeyError if none."""
+        if not self.builtin:
+            raise KeyError(f"{self.name!r} has no built-in scenario")
+        return builtin_text(self.builtin)
+
+
+def builtin_text(name: str) -> str:
+    """YAML text of a built-in scenario file (package data in gcalign/scenarios)."""
+    from importlib import resources
+
+    return resources.files("gcalign.scenarios").joinpath(name).read_text(encoding="utf-8")
+
 
 COMMANDS: dict[str, Command] = {
     c.name: c

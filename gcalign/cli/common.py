@@ -29,15 +29,14 @@ import os
 import re
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 
 import typer
 import yaml
 
-from gcalign.app.registry import COMMANDS
+from gcalign.app.registry import COMMANDS, builtin_text
 from gcalign.cli import consoles, emit_json
 from gcalign.errors import ScenarioError
 from gcalign.io import results
@@ -129,11 +128,6 @@ def install(app: typer.Typer) -> None:
 
 
 # --------------------------------------------------------------------------- loading
-
-
-def builtin_text(name: str) -> str:
-    """YAML text of a built-in scenario (package data in gcalign/scenarios)."""
-    return resources.files("gcalign.scenarios").joinpath(name).read_text(encoding="utf-8")
 
 
 def parse_set(item: str) -> tuple[str, object]:
@@ -298,7 +292,7 @@ def tag(key: str, value) -> str:
 
 
 def output_name(name: str, kind: str, seed: int | None,
-                overrides: list[tuple[str, object]] = ()) -> Path:
+                overrides: Sequence[tuple[str, object]] = ()) -> Path:
     """``runs/NAME-COMMAND[-OVERRIDES][-rngN].h5``: every override that changes the result
     is in the name (too many: the first ones and a hash of all), the random seed last."""
     words = "-".join(tag(k, v) for k, v in overrides)

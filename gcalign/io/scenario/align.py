@@ -55,11 +55,13 @@ class Coarse(Model):
 
     @model_validator(mode="after")
     def _one_error_key(self):
+        """The other method's key, set to anything but its default, is a mistake (a dump of
+        a model with its defaults still loads)."""
         given = self.method == "given"
-        if given and "offset_deg" in self.model_fields_set:
+        if given and self.offset_deg != [0.0, 0.0, 0.0]:
             raise ValueError("offset_deg: cannot matter with method 'given', which takes "
                              "error_deg (the error added to the true attitude at T1)")
-        if not given and "error_deg" in self.model_fields_set:
+        if not given and self.error_deg != [1.0, 1.0, 10.0]:
             raise ValueError(f"error_deg: cannot matter with method {self.method!r}; it is "
                              "the error of method 'given' (offset_deg adds a fixed error to "
                              f"the {self.method} result)")
