@@ -15,6 +15,12 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
+from gcalign.calibrate.trajectories import (  # noqa: E402
+    CONVENTIONAL,
+    DESIGNED,
+    SECTION_41,
+    moving_motion,
+)
 from scipy.stats import chi2  # noqa: E402
 
 from gcalign.calibrate import (  # noqa: E402
@@ -27,12 +33,6 @@ from gcalign.calibrate import (  # noqa: E402
     proposed_truth,
     simulate_flight,
     zero_velocity_data,
-)
-from gcalign.calibrate.trajectories import (  # noqa: E402
-    CONVENTIONAL,
-    DESIGNED,
-    SECTION_41,
-    moving_motion,
 )
 from gcalign.estimation import ins_error as ie  # noqa: E402
 from gcalign.sim.imu import ideal_imu  # noqa: E402
