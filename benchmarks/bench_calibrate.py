@@ -55,14 +55,15 @@ def main() -> None:
     from gcalign.app.batch import run_batch, sweep_from_mapping
     from gcalign.app.calibrate.run import simulated_case
     from gcalign.app.data import noise_free
-    from gcalign.app.observability.run import run_table
-    from gcalign.calibrate import calibrate
+    from gcalign.app.observability.run import flight_truth
+    from gcalign.calibrate import calibrate, observability_table
     from gcalign.io.scenario import load_scenario
 
     sc, _ = load_scenario(DESIGNED)
     sim = _median(lambda: noise_free(sc), 3)
     case = simulated_case(sc)
     s = case.settings
+    traj, spans = flight_truth(sc)
 
     def one(settings):
         return calibrate(case.data, settings, np.random.default_rng(2))
@@ -70,7 +71,8 @@ def main() -> None:
     rows = [
         ("calibrate 590 s", _median(lambda: one(s)), 0.5),
         ("calibrate 590 s + smoother", _median(lambda: one(replace(s, smoother=True))), None),
-        ("observability table 590 s", _median(lambda: run_table(sc)[3]), 0.5),
+        ("observability table 590 s",
+         _median(lambda: observability_table(traj, spans, settings=s)), 0.5),
         ("(simulation of the flight, 100 Hz)", sim, None),
     ]
     base = yaml.safe_load(DESIGNED.read_text(encoding="utf-8"))

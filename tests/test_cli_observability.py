@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 import yaml
 from calibrate_cases import DESIGNED
+from cli_checks import assert_bad_input
 from typer.testing import CliRunner
 
 from gcalign.cli import app
@@ -124,13 +125,7 @@ def test_batch_over_scaling(tmp_path):
 
 def _bad(tmp_path, args, field, *more):
     out = tmp_path / "out.h5"
-    res = _obs(*args, "-o", out)
-    assert res.exit_code == 2, res.output
-    lines = [ln for ln in res.output.splitlines() if ln.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error: ") and field in lines[0], res.output
-    for text in more:
-        assert text in lines[0], res.output
-    assert not out.exists()
+    assert_bad_input(_obs(*args, "-o", out), out, field, *more)
 
 
 @pytest.mark.parametrize(

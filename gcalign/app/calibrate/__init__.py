@@ -8,6 +8,10 @@ from __future__ import annotations
 
 from gcalign.app.registry import Outcome
 
+UNIT_TEXT = {"arcsec": "″", "arcmin": "′", "deg/h": "°/h", "ug": "µg", "ppm": "ppm",
+             "m/s": "m/s", "m": "m"}
+"""Printed symbols of the display units (:data:`gcalign.estimation.ins_error.DISPLAY_UNITS`)."""
+
 
 def execute(sc, seed: int | None = None, cache_key: str | None = None, **options) -> Outcome:
     from gcalign.app.calibrate.run import execute as run

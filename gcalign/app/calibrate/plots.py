@@ -16,14 +16,13 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
+from gcalign.app.calibrate import UNIT_TEXT
 from gcalign.app.plots import _s, new_figure
 
 STYLE = {"both": dict(color="tab:red", linestyle="--"),
          "velocity": dict(color="tab:cyan", linestyle="-"),
          "position": dict(color="tab:purple", linestyle="-.")}
 AXES = ("x", "y", "z")
-UNIT_TEXT = {"arcsec": "″", "arcmin": "′", "deg/h": "°/h", "ug": "µg", "ppm": "ppm",
-             "m/s": "m/s", "m": "m"}
 
 
 def read_runs(f) -> tuple[list[dict], dict]:
@@ -63,6 +62,22 @@ def _ylim(est, sig, truth, t) -> float:
     return 1.15 * lim if lim > 0 else 1.0
 
 
+def _panel(ax, name: str, unit: str, lim: float) -> None:
+    ax.set_ylim(-lim, lim)
+    ax.set_title(name, fontsize="medium")
+    ax.set_ylabel(UNIT_TEXT.get(unit, unit))
+    ax.grid(True, alpha=0.3)
+
+
+def _finish(fig, axes, xlabel: str, title: str) -> Figure:
+    """A 2 × 3 grid: time labels on the bottom row, the legend in the first panel."""
+    for ax in axes[3:]:
+        ax.set_xlabel(xlabel)
+    axes[0].legend(loc="upper right", fontsize="x-small")
+    fig.suptitle(title)
+    return fig
+
+
 def estimates_figure(runs, attrs, states: list[str], title: str) -> Figure:
     """Estimates of `states` (2 rows × 3 axes) against time with ±3σ and the truth."""
     names = attrs["states"].split(",")
@@ -95,15 +110,8 @@ def estimates_figure(runs, attrs, states: list[str], title: str) -> Figure:
             ax.axhline(runs[0]["truth"][0, i] * k, color="black", linewidth=0.9,
                        linestyle=(0, (4, 2)), label="truth")
         _segment_lines(ax, attrs["segments"], minutes)
-        ax.set_ylim(-lim, lim)
-        ax.set_title(name, fontsize="medium")
-        ax.set_ylabel(UNIT_TEXT.get(units[i], units[i]))
-        ax.grid(True, alpha=0.3)
-    for ax in axes[3:]:
-        ax.set_xlabel(xlabel)
-    axes[0].legend(loc="upper right", fontsize="x-small")
-    fig.suptitle(title)
-    return fig
+        _panel(ax, name, units[i], lim)
+    return _finish(fig, axes, xlabel, title)
 
 
 def sigma_figure(runs, attrs, title: str) -> Figure:
@@ -149,16 +157,8 @@ def navigation_figure(run, attrs, title: str) -> Figure:
         ax.fill_between(tx, -3 * sig, 3 * sig, color="tab:blue", alpha=0.18, linewidth=0,
                         label="±3σ")
         ax.plot(tx, err, color="black", linewidth=0.8, label="error")
-        lim = _ylim(err, sig, None, run["t"])
-        ax.set_ylim(-lim, lim)
-        ax.set_title(name, fontsize="medium")
-        ax.set_ylabel(UNIT_TEXT.get(units[i], units[i]))
-        ax.grid(True, alpha=0.3)
-    for ax in axes[3:]:
-        ax.set_xlabel(xlabel)
-    axes[0].legend(loc="upper right", fontsize="x-small")
-    fig.suptitle(title)
-    return fig
+        _panel(ax, name, units[i], _ylim(err, sig, None, run["t"]))
+    return _finish(fig, axes, xlabel, title)
 
 
 def innovations_figure(run, title: str) -> Figure:

@@ -10,11 +10,10 @@ from rich import box
 from rich.table import Table
 from rich.text import Text
 
+from gcalign.app.calibrate import UNIT_TEXT
 from gcalign.app.report import fmt
 
 GROUP_ENDS = ("phiU", "dvU", "dh", "ebz", "dbz", "dKgz", "dKaz")
-UNIT_TEXT = {"arcsec": "″", "arcmin": "′", "deg/h": "°/h", "ug": "µg", "ppm": "ppm",
-             "m/s": "m/s", "m": "m"}
 SHORT = {"velocity": "v", "position": "p", "both": "v+p"}
 
 
@@ -30,6 +29,12 @@ def _display(s: dict):
     names = list(s["units"])
     scale = dict(zip(names, s["display_scale"], strict=True))
     return names, scale, s["display_units"]
+
+
+def _captioned(table: Table, notes: list[str]) -> Table:
+    table.caption = "\n".join(notes)
+    table.caption_justify = "left"
+    return table
 
 
 def _scaled(v, k):
@@ -67,7 +72,8 @@ def run_table(s: dict) -> Table:
     if nees is not None:
         lo, hi = nees["band_95"]
         notes.append(f"NEES final {nees['final']:.1f}, mean {nees['mean']:.1f} (χ²₂₁ 95 % band "
-                     f"{lo:.1f}…{hi:.1f}; {100 * nees['inside_95']:.0f} % of epochs inside)")
+                     f"{lo:.1f}…{hi:.1f} for a truth drawn from P0; {100 * nees['inside_95']:.0f}"
+                     " % of epochs inside)")
     nis, inn = s["nis"], s["innovation"]
     notes.append(f"NIS mean {nis['mean']:.2f} (χ²_{nis['dof']} mean {nis['dof']}); standardized "
                  f"innovations {', '.join(inn['names'])}: mean "
@@ -86,11 +92,10 @@ def run_table(s: dict) -> Table:
                      "final filtered σ)")
     notes.append("navigation states at the end: estimate = estimated error of the INS before "
                  "the last correction; error = what the correction leaves; injected at t = 0")
-    notes.append(f"truth {s['truth_source'] or 'unknown (recorded data)'}; seed {s['seed']}; "
+    seed = "—" if s["seed"] is None else s["seed"]
+    notes.append(f"truth {s['truth_source'] or 'unknown (recorded data)'}; seed {seed}; "
                  f"compute {s['compute_s']:.2f} s; output {s.get('output') or '—'}")
-    table.caption = "\n".join(notes)
-    table.caption_justify = "left"
-    return table
+    return _captioned(table, notes)
 
 
 def _c(x) -> str:
@@ -144,6 +149,4 @@ def compare_table(s: dict) -> Table:
                  "correction leaves; the same data and DGNSS noise in every column")
     notes.append(f"seed {s['seed']}; compute {s['compute_s']:.2f} s; output "
                  f"{s.get('output') or '—'}")
-    outer.caption = "\n".join(notes)
-    outer.caption_justify = "left"
-    return outer
+    return _captioned(outer, notes)

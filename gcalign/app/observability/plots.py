@@ -11,9 +11,10 @@ from gcalign.app.plots import _s
 
 
 def heat_map(values: np.ndarray, rows: list[str], cols: list[str], title: str, label: str,
-             zero: str = "0") -> Figure:
-    """log10 of `values` (rows × cols) as colours, with the exponent written in each cell;
-    zeros (unobservable) grey and marked `zero`."""
+             zero: str = "0", exponents: bool = True) -> Figure:
+    """log10 of `values` (rows × cols) as colours, with the rounded exponent (or, with
+    ``exponents=False``, the value to two digits) written in each cell; zeros
+    (unobservable) grey and marked `zero`."""
     with np.errstate(divide="ignore"):
         logv = np.where(values > 0, np.log10(np.where(values > 0, values, 1.0)), np.nan)
     height = 1.2 + 0.3 * len(rows)
@@ -29,7 +30,12 @@ def heat_map(values: np.ndarray, rows: list[str], cols: list[str], title: str, l
     for i in range(len(rows)):
         for j in range(len(cols)):
             v = logv[i, j]
-            text = zero if not np.isfinite(v) else f"{round(v):d}"
+            if not np.isfinite(v):
+                text = zero
+            else:
+                x = values[i, j]
+                text = (f"{round(v):d}" if exponents else f"{x:.0f}" if x >= 100
+                        else f"{x:.2g}")
             dark = np.isfinite(v) and (v - lo) < 0.55 * (hi - lo)
             ax.text(j, i, text, ha="center", va="center", fontsize=6,
                     color="white" if dark else "black")
@@ -58,5 +64,5 @@ def figures(f, name: str) -> dict[str, Figure]:
         figs["covariance_degree"] = heat_map(
             g["cov_degree"][()], [f"after {s}" for s in segs], states,
             f"{name}: covariance degree σ(0)/σ(t) at the end of each segment (PSINS kfstat, "
-            f"{_s(g.attrs['measure'])})", "log10 σ(0)/σ(t)")
+            f"{_s(g.attrs['measure'])})", "log10 σ(0)/σ(t)", exponents=False)
     return figs
