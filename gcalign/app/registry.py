@@ -70,6 +70,9 @@ COMMANDS: dict[str, Command] = {
                 ("nees.final", "normalized_error")),
         Command("observability", "observability", "PWCS/SVD observability table of a flight "
                 "(seed 002).", "observability", "seed002_designed.yaml", ("rank_final",)),
+        Command("realtime", "realtime", "Attitude at sync pulses: filter delay and prediction "
+                "(seed 003).", "realtime", "seed003_table1.yaml",
+                ("cases.0.after_max_arcsec.kalman-ls",)),
         Command("batch", "batch", "Sweeps and Monte Carlo over any batchable command."),
     )
 }

@@ -33,7 +33,8 @@ from gcalign.sim.mechanism import Mechanism
 from gcalign.sim.motions import MotionType, Moving, Static, Truth, Turntable, sample_count
 from gcalign.sim.schedule import AngleProfile, Schedule, Step
 
-BLOCK = 1 << 16  #: samples per block
+BLOCK = 1 << 16  #: samples per block of the numba route (fixed site)
+GENERIC_BLOCK = 1 << 14  #: of the NumPy route: ~1.4 KB of temporaries per sample
 
 
 @dataclass(frozen=True)
@@ -72,7 +73,7 @@ def initial_truth(motion: MotionType, site, earth: EarthModel = WGS84) -> Truth:
 
 
 def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
-                 mechanism: Mechanism | None = None, block: int = BLOCK,
+                 mechanism: Mechanism | None = None, block: int | None = None,
                  substeps: int = 2) -> Iterator[SimBlock]:
     """The ideal increments of `motion` at `site` ``[lat, lon, h]`` in blocks."""
     if substeps % 2:
@@ -85,8 +86,10 @@ def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
     weights *= h / 3.0
     site = np.asarray(site, dtype=float)
     if isinstance(motion, Static | Turntable):
-        yield from _fixed_site_blocks(motion, site, ts, earth, mechanism, block, m, n_total)
+        yield from _fixed_site_blocks(motion, site, ts, earth, mechanism, block or BLOCK, m,
+                                      n_total)
         return
+    block = block or GENERIC_BLOCK
     for k0 in range(0, n_total, block):
         n = min(block, n_total - k0)
         # Sub-point times from integers, so a boundary is the same number in both rows.

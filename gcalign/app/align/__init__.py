@@ -34,6 +34,15 @@ def components(metric: str, k: int) -> list[str]:
     return [str(i) for i in range(k)]
 
 
+def label(metric: str) -> str:
+    """A metric's name in tables and figures: one component of an attitude triple by its
+    name (``error_t3_deg.2`` -> ``error_t3_deg yaw``)."""
+    head, _, tail = metric.rpartition(".")
+    if head.endswith("_deg") and tail in ("0", "1", "2"):
+        return f"{head} {components(head, 3)[int(tail)]}"
+    return metric
+
+
 WARM_SCENARIO = {  # a tiny align scenario: every align kernel, in milliseconds
     "name": "warm-up",
     "site": {"lat_deg": 45.0, "lon_deg": 126.0},

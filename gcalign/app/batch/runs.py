@@ -2,8 +2,9 @@
 
 Everything here is a top-level, picklable function that never imports rich: a task
 (a plain dict) goes in, a record (a plain dict) comes out, and a failing run is recorded,
-never raised. Each worker process caches the parsed scenario and the noise-free
-simulation of a variant, so successive seeds only add their sensor errors.
+never raised. Each worker process caches the parsed scenario of a variant and the
+noise-free simulation of a site and motion, so successive runs only add their sensor
+errors (and variants that differ only in errors or algorithm settings share it).
 """
 
 from __future__ import annotations
@@ -36,10 +37,22 @@ def _scenario(task: dict):
     return sc
 
 
+def noise_free_key(sc) -> str | None:
+    """What the noise-free part of a simulation depends on (site, earth, motion, mechanism,
+    IMU rate: :func:`gcalign.app.data.noise_free`), as a cache key: variants that differ only
+    in sensor errors or algorithm settings (a T_z × mode sweep) share one simulation."""
+    if sc.motion is None or sc.site is None:
+        return None
+    mech = "" if sc.mechanism is None else sc.mechanism.model_dump_json()
+    return "|".join((sc.site.model_dump_json(), sc.earth, sc.motion.model_dump_json(), mech,
+                     repr(float(sc.imu.rate_hz))))
+
+
 def run_summary(command: str, sc, seed: int, cache_key: str | None = None) -> dict:
     """The summary dict a single run of `command` would print (through its room).
 
-    `cache_key` (the variant) lets successive seeds share the noise-free simulation.
+    `cache_key` (:func:`noise_free_key`) lets successive runs share the noise-free
+    simulation.
     """
     from gcalign.app.registry import command as lookup
 
@@ -89,7 +102,8 @@ def run_task(task: dict) -> dict:
     rec = {"variant": task["variant"], "vkey": task["vkey"], "seed": task["seed"],
            "status": "ok", "metrics": {}, "error": ""}
     try:
-        summary = run_summary(task["command"], _scenario(task), task["seed"], task["vkey"])
+        sc = _scenario(task)
+        summary = run_summary(task["command"], sc, task["seed"], noise_free_key(sc))
         rec["metrics"] = {m: metric_value(summary, m) for m in task["metrics"]}
     except MetricError as err:
         rec.update(status="bad-metric", error=str(err), metrics={})

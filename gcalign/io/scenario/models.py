@@ -15,6 +15,7 @@ from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
+from gcalign.io.scenario.realtime import RealtimeConfig
 from gcalign.nav.earth import MODELS, EarthModel
 from gcalign.sim.errors import ImuErrors, SensorErrors
 
@@ -142,6 +143,7 @@ class Scenario(Model):
     northfind: NorthfindConfig | None = None
     calibrate: CalibrateConfig | None = None
     observability: ObservabilityConfig | None = None
+    realtime: RealtimeConfig | None = None
 
     @property
     def earth_model(self) -> EarthModel:
