@@ -200,7 +200,7 @@ def strapdown_step(s, dth, dvb, ts, earth_sign, E, vertical, h_ref):
 
     Velocity:  v_k = v_{k-1} + R(-ω_in T/2) C_nb(k-1) R(Δθ/2) Δv + (g_n - (2ω_ie + ω_en) × v_mid) T
                (the specific-force increment resolved at mid-interval; Coriolis at a
-               predicted mid-interval velocity)
+               predicted mid-interval velocity, gravity at the height it gives)
     Attitude:  q_k = q(-ω_in T) ⊗ q_{k-1} ⊗ q(Δθ_k),  ω_in = ω_ie + ω_en(v_mid)
     Position:  trapezoid in velocity, radii at the mid-interval latitude.
     Vertical:  HOLD: h = h_ref, v_U = 0; DAMPED: v_U −= (k2 δh + a) T, h −= k1 δh T,
@@ -229,7 +229,9 @@ def strapdown_step(s, dth, dvb, ts, earth_sign, E, vertical, h_ref):
     cx, cy, cz = tx, 2.0 * wie_n + ty, 2.0 * wie_u + tz
     ve1 = ve + fx - (cy * mu - cz * mn) * ts
     vn1 = vn + fy - (cz * me - cx * mu) * ts
-    vu1 = vu + fz - ((cx * mn - cy * me) + g) * ts
+    # gravity at the mid-interval height (g is linear in h): at the start height a climb
+    # at v_U would leave a bias of ½ g3 v_U T in the vertical velocity
+    vu1 = vu + fz - ((cx * mn - cy * me) + g - E[7] * 0.5 * mu * ts) * ts
 
     s[0], s[1], s[2], s[3] = attitude_update(
         s[0], s[1], s[2], s[3], dth[0], dth[1], dth[2], tx * ts, (wie_n + ty) * ts,
