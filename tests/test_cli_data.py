@@ -196,8 +196,10 @@ def test_navigate_from_an_alignment_of_the_real_file(tmp_path):
 
 def test_long_runs_are_stored_at_the_output_rate_and_summed_increments_are_refused(tmp_path):
     """Beyond an hour the series are stored at 1 Hz: truth decimated, increments summed over
-    each second (exact sums), which navigation refuses; 'full' keeps every sample."""
-    sc = {"name": "two-hours", "site": SCENARIO["site"], "imu": {"rate_hz": 20},
+    each second (exact sums, row by row: noise makes every second differ), which navigation
+    refuses; 'full' keeps every sample."""
+    sc = {"name": "two-hours", "site": SCENARIO["site"],
+          "imu": {"rate_hz": 20, "gyro": {"arw_dprh": 0.01}, "accel": {"vrw_ugrhz": 50}},
           "motion": {"kind": "static", "attitude_deg": [1, 2, 30], "duration_s": 7200}}
     sim = tmp_path / "sim.h5"
     res = runner.invoke(app, ["simulate", str(write(tmp_path, sc)), "-o", str(sim), "--json"])
@@ -221,6 +223,11 @@ def test_long_runs_are_stored_at_the_output_rate_and_summed_increments_are_refus
     assert res.exit_code == 0, res.output
     with h5py.File(full) as f:
         assert f["imu/dtheta"].shape == (144000, 3) and "summed_from_ts" not in f["imu"].attrs
+        every = {n: f[f"imu/{n}"][()] for n in ("dtheta", "dv")}
+    with h5py.File(sim) as f:
+        for n, inc in every.items():
+            np.testing.assert_allclose(f[f"imu/{n}"][()], inc.reshape(7200, 20, 3).sum(1),
+                                       rtol=1e-12, atol=1e-16)
     res = runner.invoke(app, ["navigate", str(full), "--json"])
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout)["vertical"] == "hold"
