@@ -1,13 +1,15 @@
 """Regenerate docs/figures/: one example of every figure kind `gcalign plot` draws, from
 the commands themselves (the built-in scenarios, the configs and the real recording).
 
-    python docs/make_figures.py            # about two minutes on one core
+    python docs/make_figures.py            # two to three minutes on one core
 
 Every figure is written exactly as ``gcalign plot`` writes it (:func:`plot_file`), then
 renamed after what it shows. tests/test_plots.py checks the axes and series of each kind
 on small runs; this script is for the documentation (README, docs/batch.md, docs/results*).
-The realtime figures are also made by docs/results_realtime.py and the T_z sweep figure
-``seed000_tz.png`` by docs/seed000_results.py (from the full sweep; here a small one).
+The realtime figures are also made by docs/results_realtime.py, the calibrate and
+observability ones by docs/make_results_calibrate.py, and the T_z sweep figure
+``seed000_tz.png`` by docs/seed000_results.py (from the full sweep; here a small one,
+``batch_error_t3_yaw_vs_t_z.png``).
 """
 
 from __future__ import annotations
@@ -96,6 +98,17 @@ def main() -> list[Path]:
         made += _plot(tmp / "rt.h5", {"realtime_case11": "realtime_case11",
                                        "realtime_filter": "realtime_filter",
                                        "realtime_lag": "realtime_lag"}, tmp)
+        _cli("calibrate", "-o", tmp / "cal.h5")
+        made += _plot(tmp / "cal.h5", {k: f"calibrate_{k}" for k in (
+            "trajectory", "sensor_biases", "scale_factors", "sigma", "navigation_errors",
+            "innovations")}, tmp)
+        _cli("calibrate", ROOT / "configs" / "lasergyro_calibrate.yaml", "-o", tmp / "zv.h5")
+        made += _plot(tmp / "zv.h5", {"attitude": "calibrate_lasergyro_attitude"}, tmp)
+        _cli("observability", "-o", tmp / "obs.h5")
+        made += _plot(tmp / "obs.h5", {"observability_segments": "observability_segments",
+                                        "observability_cumulative": "observability_cumulative",
+                                        "covariance_degree": "observability_covariance_degree"},
+                      tmp)
         made += _plot(_mode_batch(tmp), {"batch_error_t3_deg": "batch_error_t3_deg"}, tmp)
         made += _plot(_small_batch(tmp), {
             "batch_error_t3_deg_2_vs_t_z_s": "batch_error_t3_yaw_vs_t_z"}, tmp)

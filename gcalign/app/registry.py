@@ -84,7 +84,7 @@ COMMANDS: dict[str, Command] = {
                 "northfind", "seed001_simulation.yaml", ("methods.coordinate.rms_error_deg",)),
         Command("calibrate", "calibrate", "In-flight calibration, 21-state Kalman filter "
                 "(seed 002).", "calibrate", "seed002_designed.yaml",
-                ("nees.final", "normalized_error")),
+                ("nees.final", "normalized_error"), recorded=True),
         Command("observability", "observability", "PWCS/SVD observability table of a flight "
                 "(seed 002).", "observability", "seed002_designed.yaml", ("rank_final",)),
         Command("realtime", "realtime", "Attitude at sync pulses: filter delay and prediction "

@@ -18,9 +18,9 @@ from gcalign.io.scenario import Scenario
 
 
 def accepts(fn: Callable, name: str) -> bool:
-    """Does `fn` take a keyword `name` (explicitly or through ``**kwargs``)?"""
-    params = inspect.signature(fn).parameters
-    return name in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
+    """Does `fn` name the keyword `name` in its signature? (A ``**options`` that a room
+    passes on does not count: a room opts in to ``progress`` by naming it.)"""
+    return name in inspect.signature(fn).parameters
 
 
 def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path, *,

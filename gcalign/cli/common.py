@@ -277,7 +277,9 @@ def tag(key: str, value) -> str:
     tail = _UNIT.sub("", parts[-1])
     if len(parts) > 2 and not parts[-2].isdigit():  # imu.gyro.bias_dph: gyro_bias
         tail = f"{parts[-2]}_{tail}"
-    if _pathlike(value):
+    if isinstance(value, bool):
+        word = tail if value else f"no-{tail}"
+    elif _pathlike(value):
         word = f"{tail.removesuffix('_file')}-{Path(str(value)).name.split('.')[0]}"
     elif isinstance(value, str) and not re.fullmatch(r"[-+0-9.eE]+", value):
         word = value
@@ -400,7 +402,8 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
     inv = _INVOCATION.get() or Invocation()
     recorded = sc.imu_file is not None
     run_seed = None if recorded else (sc.imu.seed if seed is None else seed)
-    given = [*inv.applied, *((k, v) for k, v in options.items() if v is not None)]
+    given = [*inv.applied, *((k, v) for k, v in options.items()
+                             if v is not None and v is not False)]  # a flag not given
     out = output or output_name(sc.name, name, run_seed, given)
     notes = list(inv.notes)
     if recorded and seed is not None:

@@ -14,9 +14,17 @@ def _pass_label(p: dict) -> str:
     return f"{p['pass']}: {p['direction']}, {p['kind']}, stage {p['stage']}"
 
 
+def _numbered(p: dict) -> dict:
+    """A pass of the summary numbered from 1 (files written before that have 'index' and a
+    stage from 0)."""
+    if "pass" in p:
+        return p
+    return {**p, "pass": p["index"] + 1, "stage": p["stage"] + 1}
+
+
 def align_table(s: dict) -> Table:
     """See the module docstring; every number of a section in one unit and format."""
-    passes = s["passes"]
+    passes = [_numbered(p) for p in s["passes"]]
     n_fwd = sum(p["direction"] == "forward" for p in passes)
     plan = (f"{len(passes)} passes ({n_fwd} forward + {len(passes) - n_fwd} reverse)"
             if len(passes) > 1 else "1 pass")

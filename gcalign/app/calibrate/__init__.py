@@ -13,10 +13,11 @@ UNIT_TEXT = {"arcsec": "″", "arcmin": "′", "deg/h": "°/h", "ug": "µg", "pp
 """Printed symbols of the display units (:data:`gcalign.estimation.ins_error.DISPLAY_UNITS`)."""
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None, **options) -> Outcome:
+def execute(sc, seed: int | None = None, cache_key: str | None = None, progress=None,
+            **options) -> Outcome:
     from gcalign.app.calibrate.run import execute as run
 
-    return run(sc, seed, cache_key, **options)
+    return run(sc, seed, cache_key, progress=progress, **options)
 
 
 def table(summary: dict):

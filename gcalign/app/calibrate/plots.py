@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.app.calibrate import UNIT_TEXT
-from gcalign.app.plots import _s, new_figure
+from gcalign.app.plots import _s, legend_below, legend_right, new_figure, suptitle
 
 STYLE = {"both": dict(color="tab:red", linestyle="--"),
          "velocity": dict(color="tab:cyan", linestyle="-"),
@@ -62,19 +62,22 @@ def _ylim(est, sig, truth, t) -> float:
     return 1.15 * lim if lim > 0 else 1.0
 
 
+UNIT_WORD = {"arcsec": "arcsec", "arcmin": "arcmin"}  # readable as a label, unlike ″ and ′
+
+
 def _panel(ax, name: str, unit: str, lim: float) -> None:
     ax.set_ylim(-lim, lim)
     ax.set_title(name, fontsize="medium")
-    ax.set_ylabel(UNIT_TEXT.get(unit, unit))
+    ax.set_ylabel(UNIT_WORD.get(unit) or UNIT_TEXT.get(unit, unit))
     ax.grid(True, alpha=0.3)
 
 
 def _finish(fig, axes, xlabel: str, title: str) -> Figure:
-    """A 2 × 3 grid: time labels on the bottom row, the legend in the first panel."""
+    """A 2 × 3 grid: time labels on the bottom row, one legend below the panels."""
     for ax in axes[3:]:
         ax.set_xlabel(xlabel)
-    axes[0].legend(loc="upper right", fontsize="x-small")
-    fig.suptitle(title)
+    legend_below(fig, axes[0])
+    suptitle(fig, title)
     return fig
 
 
@@ -134,10 +137,10 @@ def sigma_figure(runs, attrs, title: str) -> Figure:
         ax.set_title(label, fontsize="medium")
         ax.set_ylabel("σ / σ0")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(loc="lower left", fontsize="x-small", ncol=3 if len(runs) > 1 else 1)
+        legend_right(ax)
     for ax in axes[2:]:
         ax.set_xlabel(xlabel)
-    fig.suptitle(title)
+    suptitle(fig, title)
     return fig
 
 
@@ -188,9 +191,9 @@ def innovations_figure(run, title: str) -> Figure:
         axes[2].set_ylabel("NEES")
     for ax in axes:
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize="x-small", ncol=4)
+        legend_right(ax)
     axes[-1].set_xlabel(xlabel)
-    fig.suptitle(title)
+    suptitle(fig, title)
     return fig
 
 
@@ -211,9 +214,9 @@ def attitude_figure(run, title: str) -> Figure:
         ax.set_ylim(a[-1] - 1.5 * span, a[-1] + 1.5 * span)
         ax.set_ylabel(f"{name} (deg)")
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize="x-small")
+        legend_right(ax)
     axes[-1].set_xlabel(xlabel)
-    fig.suptitle(title)
+    suptitle(fig, title)
     return fig
 
 
@@ -253,7 +256,7 @@ def trajectory_figure(t, pos, segment, names, title: str) -> Figure:
     ax_track.set_aspect("equal", adjustable="datalim")
     ax_track.set_xlabel("east (km)")
     ax_track.set_ylabel("north (km)")
-    ax_track.legend(loc="best", fontsize="small")
+    legend_right(ax_track)
     ax_h.set_xlabel("time (s)")
     ax_h.set_ylabel("height above the start (km)")
     for ax in (ax_track, ax_h):
@@ -265,7 +268,7 @@ def trajectory_figure(t, pos, segment, names, title: str) -> Figure:
     listing = "\n".join(f"{i + 1:2d} {n}" for i, n in enumerate(names))
     ax_h.text(1.02, 1.0, listing, transform=ax_h.transAxes, va="top", ha="left",
               fontsize=7, family="monospace")
-    fig.suptitle(title)
+    suptitle(fig, title)
     return fig
 
 

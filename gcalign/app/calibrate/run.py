@@ -192,9 +192,10 @@ def run_filter(case: Case, measure: str | None = None, data: FlightData | None =
     return Run(label, data, result, time.perf_counter() - t0)
 
 
-def compare_runs(case: Case, segments: int) -> list[Run]:
+def compare_runs(case: Case, segments: int, progress=None) -> list[Run]:
     """The seed's Table 3: velocity, position and both on the whole flight ("designed")
-    and on its first `segments` segments ("conventional"), on the same data and noise."""
+    and on its first `segments` segments ("conventional"), on the same data and noise;
+    `progress(done, total, what)` hears of each of the six filter runs."""
     spans = case.data.segments
     if case.data.truth is None or len(spans) <= segments:
         raise ScenarioError(f"calibrate.conventional_segments: --compare needs a simulated "
@@ -205,6 +206,8 @@ def compare_runs(case: Case, segments: int) -> list[Run]:
     for label, data in (("designed", case.data), ("conventional", short)):
         for measure in MEASURES:
             runs.append(run_filter(case, measure, data, label))
+            if progress is not None:
+                progress(len(runs), 2 * len(MEASURES), "filter runs")
     return runs
 
 
@@ -310,12 +313,12 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            compare: bool = False) -> Outcome:
+            compare: bool = False, progress=None) -> Outcome:
     """Build the case, run the filter (or the six runs of `compare`), summarise."""
     from gcalign.app.calibrate.hdf5 import write_calibration
 
     case = scenario_case(sc, seed, cache_key)
-    runs = (compare_runs(case, config_of(sc).conventional_segments) if compare
+    runs = (compare_runs(case, config_of(sc).conventional_segments, progress) if compare
             else [run_filter(case)])
     out = summary(sc, case, runs, compare)
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),

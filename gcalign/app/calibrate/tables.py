@@ -11,18 +11,19 @@ from rich.table import Table
 from rich.text import Text
 
 from gcalign.app.calibrate import UNIT_TEXT
-from gcalign.app.report import fmt
+from gcalign.app.report import number, numbers, run_line
 
 GROUP_ENDS = ("phiU", "dvU", "dh", "ebz", "dbz", "dKgz", "dKaz")
 SHORT = {"velocity": "v", "position": "p", "both": "v+p"}
+#: Decimals per display unit: one resolution for every number of a state group (0.01″,
+#: 0.001′, 0.1 mm/s, 1 cm, 1e-4 °/h, 0.1 µg, 0.1 ppm), so columns compare at a glance.
+DECIMALS = {"arcsec": 2, "arcmin": 3, "m/s": 4, "m": 2, "deg/h": 4, "ug": 1, "ppm": 1}
 
 
-def _g(x, digits: int = 3) -> str:
+def _g(x, unit: str) -> str:
     if x is None or (isinstance(x, float) and not math.isfinite(x)):
         return "—"
-    if x == 0:
-        return "0"
-    return f"{x:.{digits}g}"
+    return number(x, DECIMALS.get(unit, 3))
 
 
 def _display(s: dict):
@@ -62,10 +63,12 @@ def run_table(s: dict) -> Table:
     for name in names:
         st, k = s["states"][name], scale[name]
         err = st["error"]
-        table.add_row(Text(name), UNIT_TEXT.get(units[name], units[name]),
-                      _g(_scaled(st["injected"], k)), _g(st["estimate"] * k),
-                      _g(_scaled(err, k)), _g(st["sigma"] * k), _g(st["sigma0"] * k),
-                      "—" if err is None else f"{err / st['sigma']:+.2f}",
+        u = units[name]
+        table.add_row(Text(name), UNIT_TEXT.get(u, u),
+                      _g(_scaled(st["injected"], k), u), _g(st["estimate"] * k, u),
+                      _g(_scaled(err, k), u), _g(st["sigma"] * k, u), _g(st["sigma0"] * k, u),
+                      "—" if err is None else f"{err / st['sigma']:+.2f}".replace("-0.00",
+                                                                                 "+0.00"),
                       end_section=name in GROUP_ENDS)
     notes = []
     nees = s.get("nees")
@@ -77,12 +80,13 @@ def run_table(s: dict) -> Table:
     nis, inn = s["nis"], s["innovation"]
     notes.append(f"NIS mean {nis['mean']:.2f} (χ²_{nis['dof']} mean {nis['dof']}); standardized "
                  f"innovations {', '.join(inn['names'])}: mean "
-                 f"{fmt([round(x, 3) for x in inn['standardized_mean']], 3)}, std "
-                 f"{fmt([round(x, 3) for x in inn['standardized_std']], 3)}")
+                 f"{'  '.join(number(x, 3) for x in inn['standardized_mean'])}, std "
+                 f"{'  '.join(number(x, 3) for x in inn['standardized_std'])}")
     att = s["attitude_deg"]
     notes.append(f"INS attitude at the end (pitch, roll, yaw) {att[0]:.4f}°, {att[1]:.4f}°, "
-                 f"{att[2]:.4f}°" + (f"; coarse {fmt(s['coarse_attitude_deg'], 4)}°"
-                                     if s.get("coarse_attitude_deg") else ""))
+                 f"{att[2]:.4f}°" + (
+                     f"; coarse {'  '.join(numbers(s['coarse_attitude_deg'], most=4))}°"
+                     if s.get("coarse_attitude_deg") else ""))
     sm = s.get("smoothed_initial")
     if sm:
         k = scale["phiU"]
@@ -92,19 +96,11 @@ def run_table(s: dict) -> Table:
                      "final filtered σ)")
     notes.append("navigation states at the end: estimate = estimated error of the INS before "
                  "the last correction; error = what the correction leaves; injected at t = 0")
-    seed = "—" if s["seed"] is None else s["seed"]
-    notes.append(f"truth {s['truth_source'] or 'unknown (recorded data)'}; seed {seed}; "
-                 f"compute {s['compute_s']:.2f} s; output {s.get('output') or '—'}")
+    notes.append(f"truth {s['truth_source'] or 'unknown (recorded data)'}; "
+                 + run_line(s, "compute (the filter)"))
     return _captioned(table, notes)
 
 
-def _c(x) -> str:
-    """A compact number for the comparison cells (at most 8 characters)."""
-    if x is None or (isinstance(x, float) and not math.isfinite(x)):
-        return "—"
-    if x == 0 or abs(x) >= 100:
-        return f"{x:.0f}"
-    return f"{x:.3g}" if abs(x) >= 1 else f"{x:.2g}"
 
 
 def _tag(run: dict) -> str:
@@ -129,9 +125,10 @@ def compare_table(s: dict) -> Table:
             t.add_column(_tag(r), justify="right", min_width=8, no_wrap=True)
         for name in shown:
             k = scale[name]
-            cells = [_c(_scaled(r["states"][name][what], k)) for r in runs]
-            t.add_row(Text(name), UNIT_TEXT.get(units[name], units[name]),
-                      _c(_scaled(runs[0]["states"][name]["injected"], k)), *cells,
+            u = units[name]
+            cells = [_g(_scaled(r["states"][name][what], k), u) for r in runs]
+            t.add_row(Text(name), UNIT_TEXT.get(u, u),
+                      _g(_scaled(runs[0]["states"][name]["injected"], k), u), *cells,
                       end_section=name in GROUP_ENDS)
         blocks.append(t)
     outer = Table(title=_title(s, "designed vs conventional take-off (seed Table 3)"),
@@ -147,6 +144,5 @@ def compare_table(s: dict) -> Table:
         notes.append("NEES final (χ²₂₁): " + ", ".join(nees))
     notes.append("v: velocity, p: position, v+p: both; φU: the INS heading error the "
                  "correction leaves; the same data and DGNSS noise in every column")
-    notes.append(f"seed {s['seed']}; compute {s['compute_s']:.2f} s; output "
-                 f"{s.get('output') or '—'}")
+    notes.append(run_line(s, "compute (the six filter runs)"))
     return _captioned(outer, notes)

@@ -9,10 +9,11 @@ from __future__ import annotations
 from gcalign.app.registry import Outcome
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None, **options) -> Outcome:
+def execute(sc, seed: int | None = None, cache_key: str | None = None, progress=None,
+            **options) -> Outcome:
     from gcalign.app.navigate.run import execute as run
 
-    return run(sc, seed, cache_key, **options)
+    return run(sc, seed, cache_key, progress=progress, **options)
 
 
 def table(summary: dict):
