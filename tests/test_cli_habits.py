@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from pathlib import Path
 
 import h5py
@@ -195,6 +196,11 @@ def test_passes_option_sets_the_last_stage(tmp_path):
 # ------------------------------------------------------------------ progress
 
 
+def unstyled(text: str) -> str:
+    """`text` without terminal escape sequences (colours, cursor moves)."""
+    return re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", text)
+
+
 def test_progress_bar_when_a_terminal_is_forced(tmp_path, monkeypatch):
     sc = {"name": "static", "site": {"lat_deg": 45, "lon_deg": 126},
           "motion": {"kind": "static", "duration_s": 60}}
@@ -203,9 +209,21 @@ def test_progress_bar_when_a_terminal_is_forced(tmp_path, monkeypatch):
     monkeypatch.setenv("GCALIGN_PROGRESS", "always")
     res = runner.invoke(app, ["navigate", str(p), "-o", str(tmp_path / "n.h5")])
     assert res.exit_code == 0, res.output
-    assert "navigate static" in res.stderr and "navigating (data s)" in res.stderr
-    assert "100%" in res.stderr and "\x1b[" in res.stderr  # drawn as on a terminal
+    assert "\x1b[" in res.stderr  # drawn as on a terminal
+    bar = unstyled(res.stderr)
+    assert "navigate navigating (data s)" in bar
+    assert "100% 60/60" in bar  # done/total in the unit the description names
     assert "navigating" not in res.stdout  # the table's stream holds no bar
+    for args, line in ((["simulate", p, "-o", tmp_path / "s.h5"], "simulate simulating "
+                        "(data s)"),
+                       (["align", small_align(tmp_path), "-o", tmp_path / "a.h5"],
+                        "align simulating (data s)"),
+                       (["plot", tmp_path / "a.h5", "-o", tmp_path / "figs"], "plot figures")):
+        other = runner.invoke(app, [str(a) for a in args])
+        assert other.exit_code == 0, other.output
+        bar = unstyled(other.stderr)
+        assert line in bar and "100%" in bar, bar
+        assert all(len(x) <= 80 for x in bar.replace("\r", "\n").splitlines())  # one line
     monkeypatch.setenv("GCALIGN_PROGRESS", "auto")  # not a terminal: nothing
     res = runner.invoke(app, ["navigate", str(p), "-o", str(tmp_path / "n.h5")])
     assert res.exit_code == 0 and "navigating" not in res.stderr

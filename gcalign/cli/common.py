@@ -347,14 +347,15 @@ class ProgressBar:
             Progress,
             TaskProgressColumn,
             TextColumn,
-            TimeElapsedColumn,
             TimeRemainingColumn,
         )
 
+        # one line of 80 columns (a pipe or a log has no width): what, how far, how long
         self.bar = Progress(
-            TextColumn(f"[bold]{self.title}[/bold] {{task.description}}"), BarColumn(),
-            TaskProgressColumn(), TimeElapsedColumn(), TextColumn("elapsed,"),
-            TimeRemainingColumn(), TextColumn("left"),
+            TextColumn(f"[bold]{self.title}[/bold] {{task.description}}"),
+            BarColumn(bar_width=20), TaskProgressColumn(),
+            TextColumn("{task.completed:.0f}/{task.total:.0f}"), TimeRemainingColumn(),
+            TextColumn("left"),
             console=Console(stderr=True, force_terminal=self.force or None),
             transient=not self.force)
         self.bar.start()
@@ -412,7 +413,7 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
         replaced = _replaced_other(out, name, text, run_seed)
         if replaced:
             notes.append(replaced)
-    with ProgressBar(f"{name} {sc.name}") as bar:
+    with ProgressBar(name) as bar:  # the scenario's name heads the table
         summary = run_command(name, sc, text, seed, out, progress=bar, notes=notes,
                               before_write=bar.close, **options)
     for line in summary["warnings"]:

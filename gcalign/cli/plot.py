@@ -31,7 +31,7 @@ def plot(
     from gcalign.app import plots
     from gcalign.cli.common import ProgressBar
 
-    with ProgressBar(f"plot {file.name}") as bar:
+    with ProgressBar("plot") as bar:
         written = plots.plot_file(file, out_dir, progress=bar)
     console = consoles(as_json)
     for p in written:

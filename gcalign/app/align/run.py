@@ -309,12 +309,16 @@ def still_base_warnings(dtheta: np.ndarray, dv: np.ndarray, ts: float, lat: floa
         wander = np.cumsum(inc, axis=0) - k * inc.mean(axis=0)
         return float(np.max(np.linalg.norm(wander, axis=1))) if len(inc) else 0.0
 
-    arcsec = 180.0 / math.pi * 3600.0
+    def angle(rad: float) -> str:  # in the unit that reads best for its size
+        deg = math.degrees(rad)
+        return (f"{deg:.3g}°" if deg >= 1.0 else f"{deg * 60:.3g}′" if deg * 60 >= 1.0
+                else f"{deg * 3600:.3g}″")
+
     turn, limit = excursion(dtheta), STILL_SHARE * earth.omega_ie * math.cos(lat) * T
     if turn > limit:
         return [f"align.coarse.method: 'analytic' assumes a still base, but the base turned "
-                f"by up to {turn * arcsec:.3g}″ about its mean rate during the {T:g} s coarse "
-                f"window (1 % of the earth's rotation over it: {limit * arcsec:.3g}″); expect "
+                f"by up to {angle(turn)} about its mean rate during the {T:g} s coarse "
+                f"window (1 % of the earth's rotation over it: {angle(limit)}); expect "
                 "a wrong heading: use 'inertial' on a moving or swinging base"]
     shift, limit = excursion(dv), STILL_TILT_RAD * float(earth.gravity(lat)) * T
     if shift > limit:
