@@ -263,6 +263,10 @@ def test_sweep_figure_median_against_the_numeric_key(sweep_file):
         key = (o["case"], o["align.mode"])
         expected.setdefault(key, {})[o["align.stages.0.t_z_s"]] = float(
             np.median(np.abs(yaw[variant == v["index"]])))
+    # the unit the row's largest |yaw| needs (deg from 1°, arcmin from 1′, else arcsec)
+    top = float(np.max(np.abs(yaw[np.isfinite(yaw)])))
+    unit, factor = (("deg", 1.0) if top >= 1 else ("arcmin", 60.0) if top * 60 >= 1
+                    else ("arcsec", 3600.0))
     fig = figs["batch_error_t3_deg_2_vs_t_z_s"]
     assert len(fig.axes) == 2  # one row (a scalar metric) × two cases
     for ax, case in zip(fig.axes, ("noisy", "quiet"), strict=True):
@@ -271,16 +275,17 @@ def test_sweep_figure_median_against_the_numeric_key(sweep_file):
         assert [ln.get_label() for ln in lines] == ["mode=conventional", "mode=full-cycle"]
         for ln, mode in zip(lines, ("conventional", "full-cycle"), strict=True):
             np.testing.assert_allclose(ln.get_xdata(), [40, 50, 60])
-            np.testing.assert_allclose(ln.get_ydata(),
-                                       [expected[(case, mode)][t] for t in (40, 50, 60)])
+            np.testing.assert_allclose(ln.get_ydata(), [
+                factor * expected[(case, mode)][t] for t in (40, 50, 60)])
         assert len(ax.collections) == 2  # the 25-75 % bands
         assert ax.get_xlabel() == "align.stages.0.t_z_s (s)"
-    assert fig.axes[0].get_ylabel() == "median |error_t3_deg yaw| (deg)"
+    assert fig.axes[0].get_ylabel() == f"median |error_t3_deg yaw| ({unit})"
     assert fig.axes[0].get_ylim() == fig.axes[1].get_ylim()  # one scale per row
     vec = figs["batch_error_t3_deg_vs_t_z_s"]
     assert len(vec.axes) == 6  # pitch, roll, yaw rows × two cases
-    assert [ax.get_ylabel() for ax in vec.axes[::2]] == [
-        f"median |error_t3_deg {c}| (deg)" for c in ("pitch", "roll", "yaw")]
+    assert [ax.get_ylabel().rsplit(" (", 1)[0] for ax in vec.axes[::2]] == [
+        f"median |error_t3_deg {c}|" for c in ("pitch", "roll", "yaw")]
+    assert vec.axes[4].get_ylabel() == fig.axes[0].get_ylabel()
     np.testing.assert_allclose(data_series(vec.axes[4])[0].get_ydata(),
                                data_series(fig.axes[0])[0].get_ydata())
 

@@ -107,10 +107,17 @@ def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides
     values too, one column per case, else one line per case. One row per component (more
     than 3 are pooled); the band spans 25-75 % of |metric| over the seeds.
     A row shares one y scale, logarithmic when its medians span more than a factor 30 and
-    are all > 0.
+    are all > 0. Angles (`units` deg) are shown in the unit each row's values need
+    (:func:`gcalign.app.plots.angle_scale`).
     """
     values, comps, pooled = _values_and_components(values, components)
     values = np.abs(values)
+    row_units = [units] * len(comps)
+    if units == "deg":  # angles in the unit each row's size needs, as in the tables
+        for j in range(len(comps)):
+            col = slice(None) if pooled else j
+            scale, row_units[j] = angle_scale(np.radians(values[:, col]))
+            values[:, col] = np.radians(values[:, col]) * scale
     keys = [key for key in dict.fromkeys(key for o in overrides for key in o) if key != x_key]
     other = [key for key in keys if key != CASE_KEY]
     # Cases get a column each when other grid values draw the lines; else they are the lines.
@@ -165,7 +172,7 @@ def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides
                 ax.set_title(f"{CASE_KEY}: {case}", fontsize="medium")
             if c == 0:
                 label = f"median |{name}{' ' + comp if comp else ''}|"
-                ax.set_ylabel(f"{label} ({units})" if units else label)
+                ax.set_ylabel(f"{label} ({row_units[j]})" if row_units[j] else label)
             if j == len(comps) - 1:
                 ax.set_xlabel(f"{x_key} ({x_units})" if x_units else x_key)
     legend_below(fig, axes[0])
