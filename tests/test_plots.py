@@ -439,3 +439,158 @@ def test_a_results_file_without_figures_says_so(tmp_path):
     res = runner.invoke(app, ["plot", str(path)])
     assert res.exit_code == 2
     assert "nothing to plot: this 'align' results file holds none of the groups" in res.output
+
+
+# ------------------------------------------------------------ navigate on recorded data
+
+
+def test_navigate_figure_of_recorded_data_is_the_solution_and_its_drift(tmp_path):
+    """No truth: pitch/roll, yaw (unwrapped), velocity and the displacement from the start
+    (east, north, horizontal norm) read back from the file; minutes for a 30 min run."""
+    from gcalign.app.navigate.run import position_error_enu
+
+    nav = tmp_path / "nav.h5"
+    res = runner.invoke(app, ["navigate", str(ROOT / "tests/data/lasergyro.imu.xz"),
+                              "--init", "header", "--duration", "1800", "-o", str(nav)])
+    assert res.exit_code == 0, res.output
+    figs = plots.figures_for(nav)
+    assert set(figs) == {"navigate"}
+    fig = figs["navigate"]
+    assert "no truth" in fig.get_suptitle() and "estimate vs truth" not in fig.get_suptitle()
+    att_ax, yaw_ax, v_ax, d_ax = fig.axes
+    with results.open_results(nav) as f:
+        t, att = f["navigate/t"][()], f["navigate/att"][()]
+        v_n, pos = f["navigate/v_n"][()], f["navigate/pos"][()]
+    assert [ln.get_label() for ln in data_series(att_ax)] == ["pitch", "roll"]
+    assert att_ax.get_ylabel() == "pitch, roll (deg)" and yaw_ax.get_ylabel() == "yaw (deg)"
+    x, mean, _, _ = plots.envelope(t - t[0], np.degrees(att[:, 1]))
+    np.testing.assert_allclose(data_series(att_ax)[1].get_ydata(), mean)
+    np.testing.assert_allclose(data_series(yaw_ax)[0].get_ydata(),
+                               plots.envelope(t, np.degrees(np.unwrap(att[:, 2])))[1])
+    assert [ln.get_label() for ln in data_series(v_ax)] == ["east", "north", "up"]
+    np.testing.assert_allclose(data_series(v_ax)[0].get_ydata(),
+                               plots.envelope(t, v_n[:, 0])[1])
+    disp = position_error_enu(pos, np.broadcast_to(pos[0], pos.shape))
+    assert [ln.get_label() for ln in data_series(d_ax)] == ["east", "north", "horizontal |·|"]
+    np.testing.assert_allclose(data_series(d_ax)[2].get_ydata(),
+                               plots.envelope(t, np.hypot(disp[:, 0], disp[:, 1]))[1])
+    assert d_ax.get_xlabel() == "time from the start (min)"
+    np.testing.assert_allclose(data_series(d_ax)[0].get_xdata(), x / 60.0)
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        assert legend is not None and legend.get_bbox_to_anchor().x0 > ax.bbox.x1 - 1
+
+
+# ------------------------------------------------------------ calibrate, observability
+
+
+@pytest.fixture(scope="module")
+def calibrate_file(tmp_path_factory):
+    """`gcalign calibrate` and `gcalign observability` on a short flight (the seed-002
+    test flight of tests/calibrate_cases.py, 25 Hz)."""
+    from calibrate_cases import SHORT
+
+    folder = tmp_path_factory.mktemp("cal")
+    sc = folder / "short.yaml"
+    sc.write_text(yaml.safe_dump({**copy.deepcopy(SHORT), "imu": {
+        "rate_hz": 25, "seed": 2, "gyro": {"bias_dph": [0.01, -0.01, 0.01]},
+        "accel": {"bias_ug": [50, -50, 50]}}}))
+    out = {}
+    for cmd in ("calibrate", "observability"):
+        out[cmd] = folder / f"{cmd}.h5"
+        res = runner.invoke(app, [cmd, str(sc), "-o", str(out[cmd])])
+        assert res.exit_code == 0, res.output
+    return out
+
+
+def test_calibrate_figures_estimates_sigma_errors_innovations(calibrate_file):
+    """Each panel draws the file's series in the display unit of its state (°/h, µg, ppm,
+    ″/′, m/s): the estimate, its ±3σ band and the injected truth; σ/σ0 from 1 at the start;
+    the navigation error estimate − truth; standardized innovations and NIS; one legend
+    outside the panels."""
+    from gcalign.app.calibrate.plots import read_runs
+
+    path = calibrate_file["calibrate"]
+    figs = plots.figures_for(path)
+    assert set(figs) == {"trajectory", "sensor_biases", "scale_factors", "sigma",
+                         "navigation_errors", "innovations"}
+    with results.open_results(path) as f:
+        runs, attrs = read_runs(f)
+    run = runs[0]
+    names = attrs["states"].split(",")
+    units = attrs["display_units"].split(",")
+    scale = np.asarray(attrs["display_scale"])
+    t = run["t"]
+    for fig_name, states in (("sensor_biases", ["ebx", "eby", "ebz", "dbx", "dby", "dbz"]),
+                             ("scale_factors", ["dKgx", "dKgy", "dKgz", "dKax", "dKay",
+                                                "dKaz"])):
+        fig = figs[fig_name]
+        for ax, name in zip(fig.axes, states, strict=True):
+            i = names.index(name)
+            assert ax.get_title() == name
+            est = data_series(ax)[0]
+            assert est.get_label() == "estimate"
+            np.testing.assert_allclose(est.get_ydata(), run["estimate"][:, i] * scale[i])
+            np.testing.assert_allclose(est.get_xdata(), t)
+            truth = [ln for ln in ax.lines if ln.get_label() == "truth"][0]
+            assert truth.get_ydata()[0] == pytest.approx(run["truth"][0, i] * scale[i])
+            band = ax.collections[0].get_paths()[0].vertices[:, 1]
+            top = run["estimate"][:, i] * scale[i] + 3 * run["sigma"][:, i] * scale[i]
+            assert band.max() == pytest.approx(top.max())
+            lo, hi = ax.get_ylim()
+            assert lo == pytest.approx(-hi)  # symmetric about zero: the sign reads at once
+            assert abs(truth.get_ydata()[0]) < hi  # the truth is inside the panel
+            assert ax.get_ylabel() == {"deg/h": "°/h", "ug": "µg", "ppm": "ppm"}[units[i]]
+        assert fig.legends and all(ax.get_legend() is None for ax in fig.axes)
+    assert [units[names.index(n)] for n in ("ebx", "dbx", "dKgx")] == ["deg/h", "ug", "ppm"]
+    sig = figs["sigma"]
+    assert [ax.get_title() for ax in sig.axes] == [
+        "gyro bias ε", "accelerometer bias ∇", "gyro scale factor δKg",
+        "accelerometer scale factor δKa"]
+    ln = data_series(sig.axes[0])[2]  # gyro bias z
+    assert ln.get_label() == "z" and sig.axes[0].get_yscale() == "log"
+    i = names.index("ebz")
+    np.testing.assert_allclose(ln.get_ydata(), run["sigma"][:, i] / run["sigma"][0, i])
+    assert ln.get_ydata()[0] == 1.0
+    nav = figs["navigation_errors"]
+    assert [ax.get_title() for ax in nav.axes] == names[:6]
+    for ax, i in zip(nav.axes, range(6), strict=True):
+        err = data_series(ax)[0]
+        assert err.get_label() == "error"
+        np.testing.assert_allclose(err.get_ydata(),
+                                   (run["estimate"][:, i] - run["truth"][:, i]) * scale[i])
+        assert ax.get_ylabel() in ("arcsec", "arcmin", "m/s")
+    inn = figs["innovations"]
+    z = data_series(inn.axes[0])
+    assert [ln.get_label() for ln in z] == run["measure_names"]
+    np.testing.assert_allclose(z[0].get_ydata(), run["standardized"][:, 0])
+    np.testing.assert_allclose(data_series(inn.axes[1])[0].get_ydata(),
+                               np.maximum(run["nis"], 1e-6))
+    assert inn.axes[1].get_yscale() == "log"
+    traj = figs["trajectory"]
+    track, height = traj.axes[:2]
+    assert track.get_xlabel() == "east (km)" and height.get_ylabel().startswith("height")
+
+
+def test_observability_heat_maps_are_log10_of_the_file(calibrate_file):
+    """The cells are log10 η (zeros masked, drawn grey) of /observability, segments ×
+    states, the text in each cell its rounded exponent."""
+    path = calibrate_file["observability"]
+    figs = plots.figures_for(path)
+    assert {"trajectory", "observability_segments", "observability_cumulative"} <= set(figs)
+    with results.open_results(path) as f:
+        g = f["observability"]
+        eta, eta_cum = g["eta"][()], g["eta_cum"][()]
+        states = g.attrs["states"]
+        states = (states.decode() if isinstance(states, bytes) else states).split(",")
+    for key, values in (("observability_segments", eta), ("observability_cumulative", eta_cum)):
+        ax = figs[key].axes[0]
+        img = ax.images[0].get_array()
+        assert img.shape == values.shape == (values.shape[0], 21)
+        pos = values > 0
+        np.testing.assert_allclose(img[pos], np.log10(values[pos]))
+        assert np.all(np.ma.getmaskarray(img)[~pos])  # unobservable: masked (grey)
+        assert [tk.get_text() for tk in ax.get_xticklabels()] == states
+        texts = [tx.get_text() for tx in ax.texts]
+        assert len(texts) == values.size
+        assert texts[1] == (f"{round(np.log10(values[0, 1]))}" if values[0, 1] > 0 else "·")
