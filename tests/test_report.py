@@ -144,3 +144,27 @@ def test_batch_table_metric_names_never_wrap(tmp_path):
     assert "mode=conventional" in text and "t_z_s=100" in text
     assert "15.48" in text and "-1.90" in text  # 0.0043° and -5.291e-4° in ″, one format
     assert not re.search(r"\de[-+]\d", text)
+
+
+def test_batch_of_files_names_break_between_words_at_80_columns():
+    """A batch of scenario files labels a variant by its file name without `.yaml`; a name
+    too long for the column breaks after `_`, `-` or `.`, never inside a word, and the
+    table fits 80 columns."""
+    stats = {"n": 4, "units": "deg", "mean": -0.22195, "std": 0.04858, "rms": 0.2259,
+             "median": -0.2357, "p05": -0.26073, "p95": -0.16395}
+    files = ["seed000_moving_conventional.yaml", "seed000_moving_full_cycle.yaml",
+             "a_rather_long_scenario_name_for_the_test.yaml"]
+    summary = {
+        "sweep": "files", "command": "align", "seeds": 4, "seed_start": 1,
+        "metrics": ["error_t3_deg.2"], "grid": None,
+        "variants": [{"overrides": {"scenario": f}, "failed": 0,
+                      "stats": {"error_t3_deg.2": stats}} for f in files],
+        "runs": 12, "complete": True, "finished": 12, "ok": 12, "failed": 0, "wall_s": 1.0,
+        "executor": "local pool", "output": "runs/files-batch.h5"}
+    text = _rendered("batch", summary)
+    assert max(len(line) for line in text.splitlines()) <= 80
+    assert ".yaml" not in text
+    assert "seed000_moving_conventional " in text and "seed000_moving_full_cycle " in text
+    assert re.search(r"a_rather_long_scenario_name_ +-?\d", text)  # broken after a '_'
+    assert re.search(r"^ ?for_the_test\s*$", text, re.M)
+    assert "-13.317" in text  # −0.22195° in arc-minutes, the unit its size needs

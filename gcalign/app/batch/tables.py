@@ -6,6 +6,8 @@ deg, ′ or ″ as their size needs); variant names broken only between override
 
 from __future__ import annotations
 
+import re
+
 from rich import box
 from rich.table import Table
 from rich.text import Text
@@ -22,6 +24,18 @@ def _plain(x) -> str:  # an override value as the user wrote it (150, 0.5, full-
     return x if isinstance(x, str) else f"{x:g}" if isinstance(x, float) else str(x)
 
 
+def _file_label(name: str) -> str:
+    """A scenario file as a variant label: its name without ``.yaml``, broken after ``_``,
+    ``-`` or ``.`` into lines of at most NAME_WIDTH (never inside a word)."""
+    stem = re.sub(r"\.ya?ml$", "", name)
+    lines = [""]
+    for part in re.findall(r"[^_.\-/]*[_.\-/]?", stem):
+        if lines[-1] and len(lines[-1]) + len(part) > NAME_WIDTH:
+            lines.append("")
+        lines[-1] += part
+    return "\n".join(line for line in lines if line)
+
+
 def _names(s: dict) -> list[str]:
     """Each variant's overrides, one per line (a batch of files: the file name alone)."""
     keys = list(s.get("grid") or {})
@@ -29,7 +43,7 @@ def _names(s: dict) -> list[str]:
     short = {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
     out = []
     for v in s["variants"]:
-        lines = [_plain(x) if k == "scenario" else f"{short.get(k, k)}={_plain(x)}"
+        lines = [_file_label(_plain(x)) if k == "scenario" else f"{short.get(k, k)}={_plain(x)}"
                  for k, x in v["overrides"].items()]
         name = "\n".join(lines) or "base"
         if v["failed"]:
