@@ -324,7 +324,8 @@ def test_bad_options_exit_2(tmp_path, args, field):
 
 
 def test_recorded_data_need_a_coarse_alignment(tmp_path):
-    d = {"name": "rec", "imu_file": str(ROOT / "tests/data/lasergyro.imu.xz"), "calibrate": {"coarse": {"method": "none"}}}
+    d = {"name": "rec", "imu_file": str(ROOT / "tests/data/lasergyro.imu.xz"),
+         "calibrate": {"coarse": {"method": "none"}}}
     _bad(tmp_path, [_write(tmp_path, d)], "calibrate.coarse.method", "analytic or inertial")
 
 

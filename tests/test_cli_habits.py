@@ -358,6 +358,28 @@ def test_imu_file_option_replaces_the_simulation(tmp_path):
     assert missing.exit_code == 2 and "--imu-file: " in missing.stderr
 
 
+def test_imu_file_option_of_navigate_and_calibrate(tmp_path, lasergyro):
+    """The other commands that run on recorded data take --imu-file too: the same recording
+    (plain here, xz in the config) gives calibrate the same estimates, and a simulated
+    navigate scenario runs on the file instead (no truth, the name says which file)."""
+    cal = ROOT / "configs/lasergyro_calibrate.yaml"
+    own = runner.invoke(app, ["calibrate", str(cal), "-o", str(tmp_path / "a.h5"), "--json"])
+    other = run_in(tmp_path, "calibrate", cal, "--imu-file", lasergyro, "--json")
+    assert own.exit_code == 0 and other.exit_code == 0, other.output
+    a, b = json.loads(own.stdout), json.loads(other.stdout)
+    assert b["source"] == str(lasergyro) and b["output"].endswith(
+        "lasergyro-calibrate-calibrate-imu-lasergyro.h5")
+    assert a["states"] == b["states"]
+    nav = run_in(tmp_path, "navigate", ROOT / "configs/seed000_moving_full_cycle.yaml",
+                 "--imu-file", lasergyro, "--init", "header", "--duration", "60", "--json")
+    assert nav.exit_code == 0, nav.output
+    s = json.loads(nav.stdout)
+    assert s["final_error"] is None and s["duration_s"] == pytest.approx(60.0)
+    assert s["source"] == str(lasergyro)
+    assert s["output"] == "runs/seed000-moving-full-cycle-navigate-duration60-imu-lasergyro-" \
+        "header.h5"  # no -rngN: recorded data have no random seed
+
+
 def test_a_csv_without_a_site_asks_for_lat_lon_height(tmp_path, lasergyro):
     """A bare CSV has no header: the error says how to give the site, and --lat/--lon/
     --height give it (the PSINS file's header site, for comparison)."""
