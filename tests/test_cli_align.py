@@ -8,23 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from align_cases import small_align
 from typer.testing import CliRunner
 
 from gcalign.cli import app
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()
-
-
-def _small(tmp_path: Path, **align) -> Path:
-    """The seed moving scenario shortened: T2 = 60 s, 3 passes."""
-    d = yaml.safe_load((ROOT / "configs/seed000_moving_full_cycle.yaml").read_text())
-    d["motion"]["duration_s"] = 80
-    d["align"]["stages"][0]["passes"] = 3
-    d["align"].update({"t2_s": 60, "t3_s": 70, "level_s": 20, **align})
-    p = tmp_path / "small.yaml"
-    p.write_text(yaml.safe_dump(d))
-    return p
 
 
 def test_builtin_equals_configs_copy():
@@ -35,7 +25,7 @@ def test_builtin_equals_configs_copy():
 
 def test_align_json_contract_and_show(tmp_path):
     out = tmp_path / "a.h5"
-    res = runner.invoke(app, ["align", str(_small(tmp_path)), "-o", str(out), "--json"])
+    res = runner.invoke(app, ["align", str(small_align(tmp_path)), "-o", str(out), "--json"])
     assert res.exit_code == 0, res.output
     s = json.loads(res.stdout)
     for key in (
@@ -65,7 +55,7 @@ def test_align_json_contract_and_show(tmp_path):
 
 
 def test_same_seed_same_numbers_and_overrides(tmp_path):
-    p = _small(tmp_path)
+    p = small_align(tmp_path)
     a = runner.invoke(app, ["align", str(p), "-o", str(tmp_path / "1.h5"), "--json", "--seed", "4"])
     b = runner.invoke(app, ["align", str(p), "-o", str(tmp_path / "2.h5"), "--json", "--seed", "4"])
     c = runner.invoke(
@@ -119,7 +109,7 @@ def test_same_seed_same_numbers_and_overrides(tmp_path):
 )
 def test_bad_input_exits_2_without_file(tmp_path, align, args, field):
     out = tmp_path / "bad.h5"
-    res = runner.invoke(app, ["align", str(_small(tmp_path, **align)), "-o", str(out), *args])
+    res = runner.invoke(app, ["align", str(small_align(tmp_path, **align)), "-o", str(out), *args])
     assert res.exit_code == 2, res.output
     assert field in res.output and "Traceback" not in res.output
     assert not out.exists()
@@ -149,13 +139,13 @@ def test_scenario_file_errors(tmp_path):
     ],
 )
 def test_non_finite_and_too_short_inputs_exit_2_on_one_line(tmp_path, align, args, field):
-    res = runner.invoke(app, ["align", str(_small(tmp_path, **align)), *args])
+    res = runner.invoke(app, ["align", str(small_align(tmp_path, **align)), *args])
     assert res.exit_code == 2, res.output
     assert field in res.output and res.output.count("\n") == 1, res.output
 
 
 def test_unwritable_output_is_a_clear_error(tmp_path):
-    res = runner.invoke(app, ["align", str(_small(tmp_path)), "-o", str(tmp_path)])
+    res = runner.invoke(app, ["align", str(small_align(tmp_path)), "-o", str(tmp_path)])
     assert res.exit_code == 2 and "--output: cannot write" in res.output
 
 
@@ -164,7 +154,7 @@ def test_moving_base_without_aiding_warns(tmp_path):
         app,
         [
             "align",
-            str(_small(tmp_path, aiding={"source": "none"})),
+            str(small_align(tmp_path, aiding={"source": "none"})),
             "-o",
             str(tmp_path / "w.h5"),
             "--json",
@@ -176,7 +166,8 @@ def test_moving_base_without_aiding_warns(tmp_path):
 
 def test_misalignment_reported_and_pole_default_survives_a_data_file(tmp_path):
     sim = tmp_path / "sim.h5"
-    assert runner.invoke(app, ["simulate", str(_small(tmp_path)), "-o", str(sim)]).exit_code == 0
+    res = runner.invoke(app, ["simulate", str(small_align(tmp_path)), "-o", str(sim)])
+    assert res.exit_code == 0
     d = yaml.safe_load((tmp_path / "small.yaml").read_text())
     d.pop("motion")
     d.pop("site")

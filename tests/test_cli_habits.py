@@ -14,6 +14,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
+from align_cases import small_align
 from typer.testing import CliRunner
 
 from gcalign.cli import app
@@ -22,17 +23,6 @@ from gcalign.cli.common import output_name, tag
 ROOT = Path(__file__).resolve().parents[1]
 REAL = ROOT / "tests/data/lasergyro.imu.xz"
 runner = CliRunner()
-
-
-def small_align(tmp_path: Path, **align) -> Path:
-    """The built-in moving-base scenario, shortened: T2 = 60 s, 3 passes (fast)."""
-    d = yaml.safe_load((ROOT / "configs/seed000_moving_full_cycle.yaml").read_text())
-    d["motion"]["duration_s"] = 80
-    d["align"]["stages"][0]["passes"] = 3
-    d["align"].update({"t2_s": 60, "t3_s": 70, "level_s": 20, **align})
-    p = tmp_path / "small.yaml"
-    p.write_text(yaml.safe_dump(d))
-    return p
 
 
 def run_in(folder: Path, *args) -> object:

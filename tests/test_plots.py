@@ -337,6 +337,16 @@ def test_plot_bad_input(tmp_path):
 # ------------------------------------------------------------ navigate, truth, IMU output
 
 
+def run_each(commands, scenario: Path, folder: Path) -> dict[str, Path]:
+    """Run each command on `scenario`; its results file by command name."""
+    out = {}
+    for cmd in commands:
+        out[cmd] = folder / f"{cmd}.h5"
+        res = runner.invoke(app, [cmd, str(scenario), "-o", str(out[cmd])])
+        assert res.exit_code == 0, res.output
+    return out
+
+
 @pytest.fixture(scope="module")
 def sim_and_nav(tmp_path_factory):
     """simulate and navigate of the small moving scenario (80 s, navigation-grade IMU)."""
@@ -344,12 +354,7 @@ def sim_and_nav(tmp_path_factory):
     sc = folder / "m.yaml"
     d = {k: v for k, v in copy.deepcopy(SMALL).items() if k != "align"}
     sc.write_text(yaml.safe_dump(d))
-    out = {}
-    for cmd in ("simulate", "navigate"):
-        out[cmd] = folder / f"{cmd}.h5"
-        res = runner.invoke(app, [cmd, str(sc), "-o", str(out[cmd])])
-        assert res.exit_code == 0, res.output
-    return out
+    return run_each(("simulate", "navigate"), sc, folder)
 
 
 def test_navigate_error_figure_phi_velocity_position_and_horizontal_norm(sim_and_nav):
@@ -495,12 +500,7 @@ def calibrate_file(tmp_path_factory):
     sc.write_text(yaml.safe_dump({**copy.deepcopy(SHORT), "imu": {
         "rate_hz": 25, "seed": 2, "gyro": {"bias_dph": [0.01, -0.01, 0.01]},
         "accel": {"bias_ug": [50, -50, 50]}}}))
-    out = {}
-    for cmd in ("calibrate", "observability"):
-        out[cmd] = folder / f"{cmd}.h5"
-        res = runner.invoke(app, [cmd, str(sc), "-o", str(out[cmd])])
-        assert res.exit_code == 0, res.output
-    return out
+    return run_each(("calibrate", "observability"), sc, folder)
 
 
 def test_calibrate_figures_estimates_sigma_errors_innovations(calibrate_file):

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from align_cases import small_align
 from rich.console import Console
 from typer.testing import CliRunner
 
@@ -65,13 +66,8 @@ def _rendered(kind: str, summary: dict, width: int = 80) -> str:
 
 @pytest.fixture(scope="module")
 def align_summary(tmp_path_factory):
-    d = yaml.safe_load((ROOT / "configs/seed000_moving_full_cycle.yaml").read_text())
-    d["motion"]["duration_s"] = 80
-    d["align"]["stages"][0]["passes"] = 3
-    d["align"].update({"t2_s": 60, "t3_s": 70, "level_s": 20})
     folder = tmp_path_factory.mktemp("t")
-    p = folder / "s.yaml"
-    p.write_text(yaml.safe_dump(d))
+    p = small_align(folder)
     res = runner.invoke(app, ["align", str(p), "-o", str(folder / "a.h5"), "--json"])
     assert res.exit_code == 0, res.output
     return json.loads(res.stdout)
