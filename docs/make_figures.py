@@ -1,7 +1,7 @@
 """Regenerate docs/figures/: one example of every figure kind `gcalign plot` draws, from
 the commands themselves (the built-in scenarios, the configs and the real recording).
 
-    python docs/make_figures.py            # two to three minutes on one core
+    python docs/make_figures.py            # about a minute on one core
 
 Every figure is written exactly as ``gcalign plot`` writes it (:func:`plot_file`), then
 renamed after what it shows. tests/test_plots.py checks the axes and series of each kind
