@@ -78,5 +78,6 @@ def main() -> None:
 from gcalign.cli import align as _align  # noqa: E402,F401
 from gcalign.cli import batch as _batch  # noqa: E402,F401
 from gcalign.cli import data as _data  # noqa: E402,F401
+from gcalign.cli import modulate as _modulate  # noqa: E402,F401
 from gcalign.cli import northfind as _northfind  # noqa: E402,F401
 from gcalign.cli import plot as _plot  # noqa: E402,F401

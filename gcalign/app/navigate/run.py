@@ -90,11 +90,12 @@ def vertical_of(cfg: NavigationConfig, sc: Scenario, motion_kind: str | None = N
 
 
 def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
-                    duration_s: float | None = None, sink=None) -> dict:
+                    duration_s: float | None = None, sink=None, on_rows=None) -> dict:
     """Navigate from `start` to the end of the data (or for `duration_s`), compare with the
     truth at every sample (:func:`gcalign.nav._kernels.error_block`), write every
-    `stride`-th row to `sink` (an h5py group), and return the plain-number pieces of the
-    summary (SI, radians)."""
+    `stride`-th row to `sink` (an h5py group) and hand it to `on_rows` (called with the
+    dict of arrays appended to the series, block by block), and return the plain-number
+    pieces of the summary (SI, radians)."""
     from gcalign.io.results import ATT_FRAME, PHI_FRAME, Series
 
     ts, earth = stream.ts, stream.earth
@@ -156,7 +157,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
                              none if tr is None else np.ascontiguousarray(tr.v_n[lo:hi]),
                              none if tr is None else np.ascontiguousarray(tr.pos[lo:hi]),
                              tr is not None, E, pos0, b.k0 + lo - start.k, stride, acc, out)
-        if series is not None and rows:
+        if (series is not None or on_rows is not None) and rows:
             keep = np.flatnonzero((b.k0 + np.arange(lo, hi) + 1 - start.k) % stride == 0)
             r = out[:rows]
             data = {"t": b.t[lo:hi][keep], "att": r[:, 0:3], "v_n": r[:, 3:6],
@@ -164,7 +165,10 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
             if has_truth:
                 data |= {"error/att": r[:, 9:12], "error/v_n": r[:, 12:15],
                          "error/pos": r[:, 15:18], "error/phi": r[:, 18:21]}
-            series.append(**data)
+            if series is not None:
+                series.append(**data)
+            if on_rows is not None:
+                on_rows(data)
         last = (states[-1], None if b.q_bs is None else b.q_bs[hi - 1])
     assert last is not None
     s_end, qbs_end = last
@@ -192,8 +196,9 @@ def _qmul(a, b):
 
 
 def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | None = None,
-                   sink=None) -> tuple[dict, Stream]:
-    """Navigate a scenario's data; the summary (plain numbers, degrees/m) and the stream."""
+                   sink=None, on_rows=None) -> tuple[dict, Stream]:
+    """Navigate a scenario's data; the summary (plain numbers, degrees/m) and the stream.
+    `sink` and `on_rows` as :func:`navigate_stream`."""
     cfg = sc.navigation or NavigationConfig()
     stream = scenario_stream(sc, seed)
     kind = None if stream.header is None else stream.header.meta.get("motion_kind")
@@ -228,7 +233,7 @@ def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | Non
             v0 = hd.v0_n if hd.v0_n is not None else np.zeros(3)
             state = NavState.from_euler(hd.att0, v0, stream.site)
         start = Start(k, state, source)
-    part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink)
+    part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink, on_rows)
     return _summary(sc, stream, start, vertical, stride, part), stream
 
 
