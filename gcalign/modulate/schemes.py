@@ -340,7 +340,7 @@ def builtin_rows(name: str, *, dwell: float | None = None, turn: Turn = SEED_TUR
     turns at `rate` (rad/s) about `axis`."""
     if name not in _DESCRIPTIONS:
         raise ScenarioError(f"scheme: unknown scheme {name!r}; built-in: "
-                            f"{', '.join(BUILTIN_NAMES)} (or give rows)")
+                            f"{', '.join(BUILTIN_NAMES)} (or a table of rows)")
     if dwell is not None and not dwell >= 0:
         raise ScenarioError(f"scheme dwell_s: must be ≥ 0, got {dwell!r}")
     if name == "fixed":

@@ -37,8 +37,8 @@ def write_scheme(g, entry: Entry, r: InvariantReport, lin: LinearErrors | None,
                  cycle: dict[str, np.ndarray], ts: float) -> None:
     s = entry.scheme
     g.attrs["scheme"] = entry.name
-    g.attrs["reference"] = s.reference  # type: ignore[attr-defined]
-    g.attrs["description"] = s.description  # type: ignore[attr-defined]
+    g.attrs["reference"] = s.reference
+    g.attrs["description"] = s.description
     g.attrs["period_s"] = r.period
     g.attrs["imu_ts"] = ts
     g.attrs["mechanism"] = entry.mechanism is not None

@@ -109,7 +109,7 @@ def error_terms(sc: Scenario, entry: Entry) -> ErrorTerms:
 def linear_C0(sc: Scenario, entry: Entry) -> np.ndarray:
     """C_s^n = C0 · S(t) of the linear model: the schedule S starts at its own q0 (the body's
     attitude for a navigation-referenced scheme), so C0 is I there and C_b^n otherwise."""
-    if entry.scheme.reference == "navigation":  # type: ignore[attr-defined]
+    if entry.scheme.reference == "navigation":
         return np.eye(3)
     assert sc.motion is not None
     return euler_to_dcm(np.radians(sc.motion.attitude_deg))
@@ -177,17 +177,17 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group=N
     terms = error_terms(sc, entry)
     assert sc.site is not None
     lat = float(sc.site.to_si()[0])
-    report = invariant_report(entry.scheme, terms, earth=sc.earth_model, lat=lat)  # type: ignore[arg-type]
+    report = invariant_report(entry.scheme, terms, earth=sc.earth_model, lat=lat)
     lin = None
     if linear and sc.motion is not None and sc.motion.kind == "static":
-        lin = linear_errors(entry.scheme.schedule, terms,  # type: ignore[attr-defined]
+        lin = linear_errors(entry.scheme.schedule, terms,
                             duration=plan.duration_s, dt_out=LINEAR_DT_S, lat=lat,
                             earth=sc.earth_model, C0=linear_C0(sc, entry), name=entry.name)
     me, fe = nav["max_error"], nav["final_error"]
     s = entry.scheme
     out = {
-        "description": s.description,  # type: ignore[attr-defined]
-        "reference": s.reference,  # type: ignore[attr-defined]
+        "description": s.description,
+        "reference": s.reference,
         "mechanism": entry.mechanism is not None,
         **invariants_summary(report),
         "horizontal_error_m": {k: probe.value[k] for k in probe.keys},
@@ -201,7 +201,7 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group=N
         "compute_s": nav["compute_s"],
     }
     if group is not None:
-        cycle = mechanism_cycle(s.schedule)  # type: ignore[attr-defined]
+        cycle = mechanism_cycle(s.schedule)
         write_scheme(group, entry, report, lin, cycle, stream.ts)
     return out
 

@@ -82,8 +82,8 @@ def modulate_table(s: dict) -> Group:
             "warn" if r["schuler_warnings"] else "–"]))
     notes = [
         "navigation against truth at each hour; max: over every sample; linear: the linear "
-        "error model (static base) for the same errors; φ max: largest misalignment, E N U; T: cycle; diag C̄: "
-        "mean of C_s^r over the cycle (* off-diagonal terms too)",
+        "error model (static base) for the same errors; φ max: largest misalignment, E N U; "
+        "T: cycle; diag C̄: mean of C_s^r over the cycle (* off-diagonal terms too)",
         _errors_line(s["errors"]),
     ]
     for name in s["compare"]:

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 from pydantic import BeforeValidator, Field, field_validator
@@ -32,6 +32,9 @@ from pydantic import BeforeValidator, Field, field_validator
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.base import Model
 from gcalign.io.scenario.navigation import MechanismConfig
+
+if TYPE_CHECKING:
+    from gcalign.modulate.schemes import Scheme
 
 CYCLE_TOL = 1e-9  # rad: a table's cycle rotation below this returns the IMU to its start
 MAX_HOURS = 1e6 / 3600.0  # the longest motion a scenario may have (1e6 s)
@@ -78,7 +81,7 @@ class Entry:
     orientation the run uses) and the mechanism section of its run (None: IMU on the body)."""
 
     name: str
-    scheme: object  # gcalign.modulate.schemes.Scheme (imported lazily)
+    scheme: Scheme
     mechanism: MechanismConfig | None
 
 
