@@ -371,3 +371,38 @@ def linear_errors(scheme: Scheme | Schedule, errors: ErrorTerms, *,
             if paths is not None:
                 paths[:, m] = x[:, 1:].T
     return LinearErrors(name, t_out, X, Ps, paths, float(lat), float(r_m), float(r_n))
+
+
+def gyro_increment_response(scheme: Scheme | Schedule, dtheta: np.ndarray, ts: float, *,
+                            lat: float = SEED004_LAT, earth: EarthModel = SEED004,
+                            C0: np.ndarray | None = None, window: float = 10.0,
+                            block: int = 1 << 17) -> tuple[np.ndarray, np.ndarray]:
+    """The model's response to given sensor-frame gyro error increments, one path.
+
+    ``dtheta`` (n, 3) rad: the error of each increment (say the noise a simulation drew),
+    sample k over ``[k ts, (k+1) ts]``. Each enters φ as the impulse ``−C(t_k) dθ_k``
+    (C = C0 · S at the sample's middle); impulses are summed over windows of `window` s
+    (a whole number of samples) and applied at the window's middle, which is exact to
+    O((ω_s · window/2)²) of the response. Returns the times (0, window, 2·window, …) and
+    the states there, (m,), (m, 7) (order :data:`STATES`).
+    """
+    from scipy.linalg import expm
+
+    schedule = scheme.schedule if isinstance(scheme, Scheme) else scheme
+    per = int(round(window / ts))
+    if per < 1 or abs(per * ts - window) > 1e-9 * window:
+        raise ValueError(f"window {window} s is not a whole number of samples of {ts} s")
+    n = (len(dtheta) // per) * per
+    F = error_matrix(lat, earth)
+    Phi, half = expm(F * window), expm(F * window / 2)[:, PHI]
+    C0 = np.eye(3) if C0 is None else np.asarray(C0, dtype=float)
+    step = max(per, (block // per) * per)
+    x, out = np.zeros(7), [np.zeros(7)]
+    for k0 in range(0, n, step):
+        k1 = min(n, k0 + step)
+        C = C0 @ schedule.dcm((np.arange(k0, k1) + 0.5) * ts)
+        u = -np.einsum("nij,nj->ni", C, dtheta[k0:k1]).reshape(-1, per, 3).sum(1)
+        for uj in u:
+            x = Phi @ x + half @ uj
+            out.append(x)
+    return window * np.arange(len(out)), np.array(out)

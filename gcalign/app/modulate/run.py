@@ -136,12 +136,20 @@ def _arcsec(v) -> list[float]:
     return (np.asarray(v, dtype=float) / ARCSEC).tolist()
 
 
+def _clean(v: np.ndarray, scale: float) -> np.ndarray:
+    """Entries below 1e-12 of `scale` (round-off of a cancelling sum) as 0."""
+    return np.where(np.abs(v) <= 1e-12 * scale, 0.0, v)
+
+
 def invariants_summary(r: InvariantReport) -> dict:
+    e = r.errors
     return {
         "cycle_s": r.period,
-        "cycle_mean": np.round(r.mean_C, 12).tolist(),
-        "residual_gyro_bias_dph": (r.residual_gyro_bias / DPH).tolist(),
-        "residual_accel_bias_ug": (r.residual_accel_bias / UG).tolist(),
+        "cycle_mean": _clean(r.mean_C, 1.0).tolist(),
+        "residual_gyro_bias_dph": (_clean(r.residual_gyro_bias, np.abs(e.gyro_bias).sum())
+                                   / DPH).tolist(),
+        "residual_accel_bias_ug": (_clean(r.residual_accel_bias, np.abs(e.accel_bias).sum())
+                                   / UG).tolist(),
         "gyro_bias_excursion_arcsec": _arcsec(r.gyro_bias_excursion),
         "scale_factor_net_arcsec": _arcsec(r.scale_factor_net),
         "scale_factor_peak_arcsec": _arcsec(r.scale_factor_peak),
