@@ -161,6 +161,61 @@ def test_unknown_metric_stops_the_batch_with_exit_2(tmp_path):
     assert "metric 'error_t9_deg'" in res.stderr and "error_t3_deg" in res.stderr
 
 
+def test_cases_are_crossed_with_the_grid_and_applied_first(tmp_path):
+    """A case sets several keys together; variants = cases × grid, the case first in the
+    overrides and in the canonical order; a grid value is applied after the case's."""
+    cases = {"noisy": {}, "quiet": {"imu.gyro": {"bias_dph": [0.01, 0.01, 0.01]},
+                                    "imu.accel.vrw_ugrhz": 0, "align.stages.0.t_z_s": 30}}
+    sw = B.load_sweep(write_sweep(tmp_path, cases=cases))
+    assert list(sw.grid) == ["case", "align.mode", "align.stages.0.t_z_s"]
+    assert sw.grid["case"] == ["noisy", "quiet"] and sw.cases == cases
+    assert len(sw.variants) == 12
+    v = sw.variants[7]
+    assert v.overrides == {"case": "quiet", "align.mode": "conventional",
+                           "align.stages.0.t_z_s": 60}
+    assert v.label == "case=quiet, align.mode=conventional, align.stages.0.t_z_s=60"
+    sc = parse_scenario(copy.deepcopy(v.scenario))
+    assert sc.imu.gyro.arw_dprh == [0.0, 0.0, 0.0] and sc.imu.accel.vrw_ugrhz == [0.0] * 3
+    assert sc.imu.gyro.bias_dph == [0.01] * 3 and sc.align.stages[0].t_z_s == 60  # grid wins
+    noisy = parse_scenario(copy.deepcopy(sw.variants[1].scenario))
+    assert noisy.imu.gyro.arw_dprh == [0.001] * 3
+    assert len({x.key for x in sw.variants}) == 12  # every variant its own runs
+
+
+@pytest.mark.parametrize(("cases", "grid", "message"), [
+    ({"q": {"imu.gyro.arw": 0}}, GRID, "cases: q: imu.gyro.arw = 0: imu.gyro.arw: unknown key"),
+    ({"q": [1]}, GRID, "cases: q: must be a mapping"),
+    ([], GRID, "cases: must be a non-empty mapping"),
+    ({"q": {"align.passes": 4}}, GRID, "cases: q: align.passes: mode 'full-cycle' needs"),
+    ({"q": {}}, {"case": ["a"]}, "grid: case: reserved"),
+])
+def test_bad_cases_exit_2_before_any_run(tmp_path, cases, grid, message):
+    out = tmp_path / "o.h5"
+    res = batch_cli(write_sweep(tmp_path, cases=cases, grid=grid), "-o", out)
+    assert res.exit_code == 2, res.output
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], res.stderr
+    assert not out.exists()
+
+
+def test_cases_in_the_file_and_the_table(tmp_path):
+    out = tmp_path / "c.h5"
+    sweep = write_sweep(tmp_path, cases={"a": {}, "b": {"imu.accel.vrw_ugrhz": 0}},
+                        grid={"align.mode": ["conventional"]}, seeds=2,
+                        metrics=["error_t3_deg.2"])
+    res = batch_cli(sweep, "--workers", 1, "-o", out, "--json")
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["cases"] == {"a": {}, "b": {"imu.accel.vrw_ugrhz": 0}}
+    assert [v["overrides"]["case"] for v in s["variants"]] == ["a", "b"]
+    assert s["variants"][0]["stats"]["error_t3_deg.2"]["units"] == "deg"
+    with h5py.File(out, "r") as f:
+        assert json.loads(f["batch"].attrs["cases_json"]) == s["cases"]
+        assert f["batch/aggregate/v001"].attrs["case"] == "b"
+    res = runner.invoke(app, ["show", str(out)])
+    assert res.exit_code == 0 and "case=b" in res.stdout
+
+
 # ------------------------------------------------------------------ engine
 
 
@@ -187,6 +242,20 @@ def test_batch_equals_single_runs(reference):
     np.testing.assert_array_equal(st["rms"], np.sqrt((arr**2).mean(0)))
     np.testing.assert_array_equal(st["p95"], np.percentile(arr, 95, axis=0))
     assert st["components"] == ["pitch", "roll", "yaw"] and st["units"] == "deg"
+
+
+def test_noise_free_key_shared_only_where_the_simulation_is_the_same(tmp_path):
+    """Variants that change mode, T_z or sensor errors share the noise-free simulation;
+    a different motion, site or IMU rate does not."""
+    from gcalign.app.batch.runs import noise_free_key
+
+    sw = B.load_sweep(write_sweep(tmp_path, cases={"a": {}, "b": {"imu.gyro.arw_dprh": 0}}))
+    keys = {noise_free_key(parse_scenario(copy.deepcopy(v.scenario))) for v in sw.variants}
+    assert len(keys) == 1 and None not in keys
+    for key, value in (("motion.duration_s", 70), ("site.lat_deg", 30.0), ("imu.rate_hz", 50)):
+        d = copy.deepcopy(SMALL)
+        B.apply_override(d, key, value, parse_scenario(copy.deepcopy(SMALL)))
+        assert noise_free_key(parse_scenario(d)) not in keys, key
 
 
 def test_same_aggregate_with_one_and_two_workers(reference, tmp_path):
@@ -216,15 +285,21 @@ def test_same_aggregate_with_one_and_two_workers(reference, tmp_path):
 
 
 def test_numba_cache_is_loaded_not_compiled_in_fresh_processes():
+    """A fresh process (a single CLI run) loads the align kernels from the on-disk cache;
+    pool workers forked after the parent's warm-up inherit them: no cache load, no compile."""
     B.warm_up()  # populates the on-disk cache if this checkout has none yet
     code = "import json; from gcalign.app.batch import warm_up; print(json.dumps(warm_up()))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     stats = json.loads(out.stdout)
-    assert stats["cache_hits"] >= 1 and stats["cache_misses"] == 0
+    assert stats["cache_hits"] >= 1 and stats["cache_misses"] == 0, stats
     backend = B.LocalBackend(1, "align")
+    parent = B.kernel_cache_stats()
     try:
-        assert all(s["cache_misses"] == 0 for s in backend.run_on_workers(B.kernel_cache_stats))
+        for s in backend.run_on_workers(B.warm_up):
+            assert s["cache_misses"] == 0, s
+            if backend.start_method == "fork":  # inherited: nothing new was loaded
+                assert s["cache_hits"] == parent["cache_hits"], (s, parent)
     finally:
         backend.close()
 

@@ -54,7 +54,8 @@ def test_simulate_navigate_show_roundtrip(tmp_path):
     res = runner.invoke(app, ["navigate", str(sim), "-o", str(nav), "--json"])
     assert res.exit_code == 0, res.output
     n = json.loads(res.stdout)
-    assert set(n["final_error"]) == {"attitude_deg", "velocity_mps", "position_m"}
+    assert set(n["final_error"]) == {"attitude_deg", "velocity_mps", "position_m",
+                                     "misalignment_deg"}
     assert n["output"] == str(nav)
     # 20 s of a navigation-grade IMU: small but non-zero errors.
     assert 0 < np.abs(n["final_error"]["velocity_mps"]).max() < 0.05

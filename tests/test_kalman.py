@@ -76,3 +76,65 @@ def test_filter_on_its_own_model_is_consistent():
     assert lo < nees_sum / runs < hi
     lo, hi = chi2.ppf([0.025, 0.975], runs * steps) / (runs * steps)
     assert lo < nis_sum / (runs * steps) < hi
+
+
+def test_rts_equals_the_batch_posterior():
+    """The smoothed means and covariances of all epochs equal the marginals of the joint
+    Gaussian posterior of x_0…x_K given every measurement (the information form), 1e-9."""
+    from gcalign.estimation.kalman import rts
+
+    rng = np.random.default_rng(12)
+    n, m, K = 3, 1, 6
+    F = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -0.2]])
+    Phi, Qd = van_loan(F, np.array([[0.0], [0.0], [1.0]]), np.array([[0.3]]), 0.5)
+    H, R = np.array([[1.0, 0.0, 0.0]]), np.array([[0.2]])
+    P0 = np.diag([1.0, 0.5, 0.2])
+    z = rng.normal(size=(K, m))
+    x, P = np.zeros(n), P0
+    xs_post, Ps_post, xs_pri, Ps_pri = [x], [P], [], []
+    for k in range(K):
+        x, P = predict(x, P, Phi, Qd)
+        xs_pri.append(x)
+        Ps_pri.append(P)
+        u = update(x, P, z[k], H, R)
+        x, P = u.x, u.P
+        xs_post.append(x)
+        Ps_post.append(P)
+    xs, Ps = rts(np.repeat(Phi[None], K, 0), np.array(Ps_pri), np.array(xs_pri),
+                 np.array(Ps_post), np.array(xs_post))
+    # information form of the joint density over X = [x_0; …; x_K]
+    N = n * (K + 1)
+    Lam = np.zeros((N, N))
+    eta = np.zeros(N)
+    Lam[:n, :n] += np.linalg.inv(P0)
+    Qi, Ri = np.linalg.inv(Qd), np.linalg.inv(R)
+    for k in range(K):
+        a, b = slice(k * n, (k + 1) * n), slice((k + 1) * n, (k + 2) * n)
+        Lam[a, a] += Phi.T @ Qi @ Phi
+        Lam[b, b] += Qi + H.T @ Ri @ H
+        Lam[a, b] -= Phi.T @ Qi
+        Lam[b, a] -= Qi @ Phi
+        eta[b] += H.T @ Ri @ z[k]
+    cov = np.linalg.inv(Lam)
+    mean = cov @ eta
+    for k in range(K + 1):
+        s = slice(k * n, (k + 1) * n)
+        np.testing.assert_allclose(xs[k], mean[s], rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(Ps[k], cov[s, s], rtol=1e-9, atol=1e-12)
+    assert not np.allclose(xs[0], xs_post[0])  # smoothing moved the start: the check can fail
+
+
+def test_solve_spd_on_a_badly_scaled_covariance():
+    """A covariance mixing 1e-14 and 1e6 variances: the scaled solve keeps its relative
+    accuracy, and agrees with a plain solve on a well-scaled one."""
+    from gcalign.estimation.kalman import solve_spd
+
+    rng = np.random.default_rng(2)
+    A = rng.normal(size=(6, 6))
+    C = A @ A.T + 6 * np.eye(6)
+    d = np.array([1e-7, 1e-5, 1.0, 1e3, 1e-6, 10.0])
+    P = C * np.outer(d, d)
+    e = rng.normal(size=6) * d
+    ref = np.linalg.solve(C, e / d) / d  # exact: P⁻¹ = D⁻¹ C⁻¹ D⁻¹
+    np.testing.assert_allclose(solve_spd(P, e), ref, rtol=1e-12)
+    np.testing.assert_allclose(solve_spd(C, e), np.linalg.solve(C, e), rtol=1e-12)

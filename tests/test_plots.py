@@ -139,18 +139,34 @@ def test_northfind_figures_from_the_real_command(tmp_path):
     assert all(len(data_series(ax)[0].get_xdata()) == m for ax in fig.axes)
 
 
-@pytest.fixture(scope="module")
-def batch_file(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("batch")
-    sweep = folder / "b.yaml"
-    sweep.write_text(yaml.safe_dump({
-        "name": "b", "base": copy.deepcopy(SMALL), "seeds": 3,
-        "grid": {"align.mode": ["conventional", "full-cycle"], "align.stages.0.t_z_s": [40, 60]},
-        "metrics": ["error_t3_deg", "equivalent_s"]}))
-    out = folder / "b.h5"
-    res = runner.invoke(app, ["batch", str(sweep), "--workers", "1", "-o", str(out)])
+def _batch(folder: Path, name: str, **sweep) -> Path:
+    (folder / f"{name}.yaml").write_text(yaml.safe_dump({
+        "name": name, "base": copy.deepcopy(SMALL), "seeds": 3, **sweep}, sort_keys=False))
+    out = folder / f"{name}.h5"
+    res = runner.invoke(app, ["batch", str(folder / f"{name}.yaml"), "--workers", "1",
+                              "-o", str(out)])
     assert res.exit_code == 0, res.output
     return out
+
+
+@pytest.fixture(scope="module")
+def batch_file(tmp_path_factory):
+    """A categorical grid only: box plots."""
+    return _batch(tmp_path_factory.mktemp("batch"), "b",
+                  grid={"align.mode": ["conventional", "full-cycle"],
+                        "align.compensation": ["none", "continued"]},
+                  metrics=["error_t3_deg", "equivalent_s"])
+
+
+@pytest.fixture(scope="module")
+def sweep_file(tmp_path_factory):
+    """Cases × a categorical × a numeric grid key: lines against the numeric key."""
+    return _batch(tmp_path_factory.mktemp("sweep"), "s",
+                  cases={"noisy": {}, "quiet": {"imu.gyro.arw_dprh": 0,
+                                                "imu.accel.vrw_ugrhz": 0}},
+                  grid={"align.mode": ["conventional", "full-cycle"],
+                        "align.stages.0.t_z_s": [60, 40, 50]},
+                  metrics=["error_t3_deg.2", "error_t3_deg"])
 
 
 def test_batch_figures_box_per_variant_and_component(batch_file):
@@ -162,11 +178,68 @@ def test_batch_figures_box_per_variant_and_component(batch_file):
         assert len(ax.patches) == 4  # one box per variant
         assert comp in ax.get_ylabel() and "(deg)" in ax.get_ylabel()
     labels = [t.get_text() for t in fig.axes[-1].get_xticklabels()]  # shared x: bottom axes
-    assert labels == ["mode=conventional\nt_z_s=40", "mode=conventional\nt_z_s=60",
-                      "mode=full-cycle\nt_z_s=40", "mode=full-cycle\nt_z_s=60"]
+    assert labels == ["mode=conventional\ncompensation=none",
+                      "mode=conventional\ncompensation=continued",
+                      "mode=full-cycle\ncompensation=none",
+                      "mode=full-cycle\ncompensation=continued"]
     scalar = figs["batch_equivalent_s"]
     assert len(scalar.axes) == 1 and len(scalar.axes[0].patches) == 4
     assert scalar.axes[0].get_ylabel() == "equivalent_s (s)"
+
+
+def test_sweep_figure_median_against_the_numeric_key(sweep_file):
+    """A numeric grid key gives lines instead of boxes: x = its values (sorted), y = the
+    median over seeds of |metric| of each variant, read back from /batch/runs; one line
+    per other grid value (mode), one column per case, one row per component."""
+    figs = plots.figures_for(sweep_file)
+    assert set(figs) == {"batch_error_t3_deg_2_vs_t_z_s", "batch_error_t3_deg_vs_t_z_s"}
+    with results.open_results(sweep_file) as f:
+        r = f["batch/runs"]
+        variant, yaw = r["variant"][()], r["metrics"]["error_t3_deg.2"][()]
+        summary = json.loads(f.attrs["summary_json"])
+    expected: dict[tuple[str, str], dict[float, float]] = {}
+    for v in summary["variants"]:
+        o = v["overrides"]
+        key = (o["case"], o["align.mode"])
+        expected.setdefault(key, {})[o["align.stages.0.t_z_s"]] = float(
+            np.median(np.abs(yaw[variant == v["index"]])))
+    fig = figs["batch_error_t3_deg_2_vs_t_z_s"]
+    assert len(fig.axes) == 2  # one row (a scalar metric) × two cases
+    for ax, case in zip(fig.axes, ("noisy", "quiet"), strict=True):
+        assert ax.get_title() == f"case: {case}"
+        lines = data_series(ax)
+        assert [ln.get_label() for ln in lines] == ["mode=conventional", "mode=full-cycle"]
+        for ln, mode in zip(lines, ("conventional", "full-cycle"), strict=True):
+            np.testing.assert_allclose(ln.get_xdata(), [40, 50, 60])
+            np.testing.assert_allclose(ln.get_ydata(),
+                                       [expected[(case, mode)][t] for t in (40, 50, 60)])
+        assert len(ax.collections) == 2  # the 25-75 % bands
+        assert ax.get_xlabel() == "align.stages.0.t_z_s (s)"
+    assert fig.axes[0].get_ylabel() == "median |error_t3_deg yaw| (deg)"
+    assert fig.axes[0].get_ylim() == fig.axes[1].get_ylim()  # one scale per row
+    vec = figs["batch_error_t3_deg_vs_t_z_s"]
+    assert len(vec.axes) == 6  # pitch, roll, yaw rows × two cases
+    assert [ax.get_ylabel() for ax in vec.axes[::2]] == [
+        f"median |error_t3_deg {c}| (deg)" for c in ("pitch", "roll", "yaw")]
+    np.testing.assert_allclose(data_series(vec.axes[4])[0].get_ydata(),
+                               data_series(fig.axes[0])[0].get_ydata())
+
+
+def test_sweep_figure_cases_are_lines_when_nothing_else_is():
+    """Cases and one numeric key: the cases draw the lines of one panel; a row's y axis is
+    logarithmic when its medians span more than a factor 30."""
+    from gcalign.app.batch.plots import numeric_axes, sweep_figure
+
+    overrides = [{"case": c, "x": x} for c in ("a", "b") for x in (1, 2)]
+    values = np.array([[1e-3], [2e-3], [0.5], [1.0]]).repeat(3, axis=0)
+    variant = np.arange(4).repeat(3)
+    assert numeric_axes({"case": ["a", "b"], "x": [1, 2], "m": ["u", "v"], "y": [3]}) == ["x"]
+    fig = sweep_figure("err_deg", values, variant, overrides, "x", units="deg")
+    assert len(fig.axes) == 1
+    ax = fig.axes[0]
+    assert [ln.get_label() for ln in data_series(ax)] == ["case=a", "case=b"]
+    assert ax.get_yscale() == "log"
+    np.testing.assert_allclose(data_series(ax)[1].get_ydata(), [0.5, 1.0])
 
 
 def test_plot_command_writes_pngs_next_to_the_file(align_files, batch_file, tmp_path):

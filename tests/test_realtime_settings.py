@@ -5,48 +5,57 @@ from __future__ import annotations
 
 import pytest
 
-from gcalign.realtime import Case, FilterSettings, PulseSettings, Settings, TrackerSettings
+from gcalign.realtime import (
+    FilterSettings,
+    PulseSettings,
+    Settings,
+    TrackerSettings,
+    accel_case,
+    swing_case,
+)
 from gcalign.realtime.cases import check_case
 from gcalign.units import DEG
 
 
 def _swing(f):
-    return Case(name="s", kind="swing", amplitude=DEG, frequency=f)
+    return swing_case("s", DEG, f, 12.0)
 
 
 BAD = [
     ("pulse rate above the solution rate", lambda: Settings(pulses=PulseSettings(rate_hz=2000.0)),
-     "pulses.rate_hz must be ≤ solution_hz = 1000 Hz"),
+     "pulses.rate_hz: must be ≤ solution_hz = 1000 Hz"),
     ("async pulse rate above the solution rate",
      lambda: Settings(pulses=PulseSettings(mode="async", rate_hz=1500.0)),
-     "pulses.rate_hz must be ≤ solution_hz"),
+     "pulses.rate_hz: must be ≤ solution_hz"),
     ("filter order < 1", lambda: FilterSettings(nav_order=0),
-     "filter.nav_order must be an integer ≥ 1"),
+     "filter.nav_order: must be an integer ≥ 1"),
     ("alignment order < 1", lambda: FilterSettings(align_order=-3),
-     "filter.align_order must be an integer ≥ 1"),
+     "filter.align_order: must be an integer ≥ 1"),
     ("notch at Nyquist", lambda: FilterSettings(notch_hz=2500.0),
-     "filter.notch_hz must be in (0, 2500) Hz"),
+     "filter.notch_hz: must be in (0, 2500) Hz"),
     ("notch above Nyquist", lambda: FilterSettings(notch_hz=3000.0), "filter.notch_hz"),
     ("sample rate not a multiple of the solution rate",
      lambda: Settings(filter=FilterSettings(fs_hz=4800.0)),
-     "filter.fs_hz must be a whole multiple of solution_hz = 1000 Hz, got 4800 Hz"),
+     "filter.fs_hz: must be a whole multiple of solution_hz = 1000 Hz, got 4800 Hz"),
     ("solution rate above the sample rate", lambda: Settings(solution_hz=10000.0),
-     "filter.fs_hz must be a whole multiple"),
-    ("Qc = 0", lambda: TrackerSettings(qc=0.0), "tracker.qc must be a finite number > 0"),
-    ("Qc < 0", lambda: TrackerSettings(qc=-1.0), "tracker.qc must be a finite number > 0"),
-    ("R = 0", lambda: TrackerSettings(r=0.0), "tracker.r must be a finite number > 0"),
-    ("R < 0", lambda: TrackerSettings(r=-1e-12), "tracker.r must be a finite number > 0"),
+     "filter.fs_hz: must be a whole multiple"),
+    ("Qc = 0", lambda: TrackerSettings(qc=0.0), "tracker.qc: must be a finite number > 0"),
+    ("Qc < 0", lambda: TrackerSettings(qc=-1.0), "tracker.qc: must be a finite number > 0"),
+    ("R = 0", lambda: TrackerSettings(r=0.0), "tracker.r: must be a finite number > 0"),
+    ("R < 0", lambda: TrackerSettings(r=-1e-12), "tracker.r: must be a finite number > 0"),
     ("swing frequency above Nyquist", lambda: check_case(_swing(600.0), Settings()),
-     "swing frequency must be below the Nyquist frequency of the 1000 Hz attitude solution"),
-    ("swing frequency zero", lambda: _swing(0.0), "swing frequency must be > 0 Hz"),
+     "steps.0.frequency_hz: a swing must be below the Nyquist frequency of the 1000 Hz "
+     "attitude solution (500 Hz), got 600 Hz"),
+    ("swing frequency zero", lambda: _swing(0.0), "swing: frequency must be > 0"),
+    ("settle time longer than the case",
+     lambda: check_case(_swing(1.0), Settings(settle_s=12.0)), "settle_s: must be shorter"),
     ("cut-off above Nyquist", lambda: FilterSettings(nav_cutoff_hz=2600.0),
-     "filter.nav_cutoff_hz must be in (0, 2500) Hz"),
+     "filter.nav_cutoff_hz: must be in (0, 2500) Hz"),
     ("pulses not on solution instants", lambda: Settings(pulses=PulseSettings(rate_hz=300.0)),
-     "pulses.rate_hz must divide solution_hz"),
-    ("unknown predictor", lambda: Settings(predictors=("kalman",)), "predictors must be"),
+     "pulses.rate_hz: must divide solution_hz"),
+    ("unknown predictor", lambda: Settings(predictors=("kalman",)), "predictors: must be"),
     ("ramp that cannot reach its rate",
-     lambda: check_case(Case(name="r", kind="accel", accel=0.1 * DEG, rate=15 * DEG),
-                        Settings()), "ramp: reaching"),
+     lambda: accel_case("r", 0.1 * DEG, 15 * DEG, 12.0), "ramp: reaching"),
 ]
 
 

@@ -8,8 +8,16 @@ import math
 import numpy as np
 import pytest
 
-from gcalign.realtime import TABLE1, Settings, run_case, seed_semi_physical, summarise, table1
-from gcalign.units import ARCSEC
+from gcalign.realtime import (
+    TABLE1,
+    Settings,
+    rate_case,
+    run_case,
+    seed_semi_physical,
+    summarise,
+    table1,
+)
+from gcalign.units import ARCSEC, DEG
 
 LIMIT = {"rate": 1.0, "accel": 1.0, "swing": 3.0}  # ″, must-show 5 (rate: hard requirement)
 SEED_AFTER = {"rate": 0.3, "accel": 0.4, "swing": 1.0}  # ″, seed Table 1, semi-physical
@@ -56,15 +64,15 @@ def test_seed_semi_physical_claims_on_its_own_metric():
 
 
 def test_each_case_draws_from_its_own_generator():
-    s = Settings(duration_s=3.0)
-    cases = TABLE1[:3]
+    s = Settings()
+    cases = [rate_case(f"rate {v}°/s", v * DEG, 3.0) for v in (5, 10, 15)]
     rows = table1(s, np.random.default_rng(4), cases)
     alone = run_case(cases[2], s, np.random.default_rng(4).spawn(3)[2])
     np.testing.assert_array_equal(rows[2].predicted["kalman-ls"], alone.predicted["kalman-ls"])
 
 
 def test_summary_without_the_none_predictor_still_reports_before():
-    s = Settings(duration_s=3.0, predictors=("kalman-ls",))
-    row = summarise(run_case(TABLE1[1], s, np.random.default_rng(0)))
+    s = Settings(predictors=("kalman-ls",))
+    row = summarise(run_case(rate_case("rate 10°/s", 10 * DEG, 3.0), s, np.random.default_rng(0)))
     assert set(row.stats) == {"kalman-ls"}
     assert row.before["truth"] == pytest.approx(row.before_theory["truth"], rel=0.01)

@@ -92,6 +92,35 @@ def run_block(state, block: Block, lo: int, hi: int, reverse: bool, gains, mode,
                         earth.params(), gains, mode, q_out)
 
 
+CHUNK = 1 << 16  #: steps per kernel call of a pass (bounds the full-rate attitude buffer)
+
+
+def run_stored(state, block: Block, lo: int, hi: int, reverse: bool, gains, mode,
+               stride: int, earth: EarthModel = WGS84):
+    """:func:`run_block` in chunks, keeping the attitude at the block samples that are
+    multiples of `stride` from the block's start, and at both ends of the range.
+
+    Returns (block sample indices in processing order, q_nb there (m, 4)).
+    """
+    idx, qs = [], []
+    order = range(hi, lo, -CHUNK) if reverse else range(lo, hi, CHUNK)
+    first = True
+    for a in order:
+        c_lo, c_hi = (max(a - CHUNK, lo), a) if reverse else (a, min(a + CHUNK, hi))
+        q = np.empty((c_hi - c_lo + 1, 4))
+        run_block(state, block, c_lo, c_hi, reverse, gains, mode, q, earth)
+        samples = np.arange(c_hi, c_lo - 1, -1) if reverse else np.arange(c_lo, c_hi + 1)
+        keep = samples % stride == 0
+        keep[-1] = True  # the end of the chunk: the next chunk's start, or the range's end
+        keep[0] = first  # a chunk's start is the previous chunk's end
+        first = False
+        idx.append(samples[keep])
+        qs.append(q[keep])
+    if not idx:  # an empty range: the state as it is
+        return np.array([hi if reverse else lo]), state[K.ATT][None].copy()
+    return np.concatenate(idx), np.concatenate(qs)
+
+
 def run_passes(
     state0: np.ndarray,
     block: Block,
@@ -101,13 +130,14 @@ def run_passes(
     azimuth_poles: str,
     level_s: float,
     earth: EarthModel = WGS84,
+    stride: int = 1,
 ) -> tuple[np.ndarray, list[PassRecord]]:
     """Run the passes of a mode over the block from the kernel state at its start.
 
     The first forward pass begins with `level_s` seconds of level-only loops (azimuth free),
     then switches to the compass loop with the loop states carried over.
     Returns the final kernel state (at the end of the block, after the last forward pass)
-    and one record per pass.
+    and one record per pass, its attitude kept every `stride` samples (and at its ends).
     """
     state = state0.copy()
     n = len(block.dtheta)
@@ -122,17 +152,18 @@ def run_passes(
             state[K.FLIP] *= -1.0
         direction_prev = direction
         gains = gains_by_stage[stage_idx[i]]
-        q_out = np.empty((n + 1, 4))
         if kind == "attitude":
-            run_block(state, block, 0, n, reverse, gains, K.ATTITUDE, q_out, earth)
+            idx, q = run_stored(state, block, 0, n, reverse, gains, K.ATTITUDE, stride, earth)
         elif i == 0 and level_s > 0:
             n_level = min(int(round(level_s / block.ts)), n)
-            run_block(state, block, 0, n_level, False, gains, K.LEVEL, q_out[: n_level + 1], earth)
-            run_block(state, block, n_level, n, False, gains, K.COMPASS, q_out[n_level:], earth)
+            i_a, q_a = run_stored(state, block, 0, n_level, False, gains, K.LEVEL, stride, earth)
+            i_b, q_b = run_stored(state, block, n_level, n, False, gains, K.COMPASS, stride,
+                                  earth)
+            idx, q = np.concatenate([i_a, i_b[1:]]), np.concatenate([q_a, q_b[1:]])
         else:
-            run_block(state, block, 0, n, reverse, gains, K.COMPASS, q_out, earth)
-        t = block.t[::-1] if reverse else block.t
-        records.append(PassRecord(i, direction, kind, stage_idx[i], gains, t, q_out))
+            idx, q = run_stored(state, block, 0, n, reverse, gains, K.COMPASS, stride, earth)
+        t = block.t[idx]
+        records.append(PassRecord(i, direction, kind, stage_idx[i], gains, t, q))
     if direction_prev == "reverse":
         state[K.FLIP] *= -1.0
     return state, records

@@ -113,7 +113,7 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, E, gai
         if vref_body:
             ne, nn, nu = qrot(q0, q1, q2, q3, ne, nn, nu)
         lat_new, lon, h_new = position_update(
-            E, lat, lon, h, 0.5 * (re + ne), 0.5 * (rn + nn), 0.5 * (ru + nu), ts
+            E, lat, lon, h, 0.5 * (re + ne), 0.5 * (rn + nn), 0.5 * (ru + nu), ts, r_m, sl, cl
         )
 
         if mode != ATTITUDE:

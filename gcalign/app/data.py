@@ -143,43 +143,11 @@ def _simulation(scenario: Scenario):
 def scenario_stream(scenario: Scenario, seed: int | None = None,
                     block: int | None = None) -> Stream:
     """The scenario's data as blocks (simulated with its sensor errors, or recorded)."""
-    from gcalign.sim.ideal import BLOCK, ideal_blocks, initial_truth
+    from gcalign.sim.ideal import ideal_blocks, initial_truth
 
     earth = scenario.earth_model
     if scenario.imu_file is not None:
-        data = _recorded(scenario)
-        imu, truth = data.imu, data.truth
-        size = block or BLOCK
-
-        def recorded_blocks() -> Iterator[DataBlock]:
-            for k0 in range(0, len(imu), size):
-                sl = slice(k0, k0 + size)
-                tr = None
-                if truth is not None:
-                    seg = (np.zeros(len(imu.t[sl]), np.int64) if truth.segment is None
-                           else truth.segment[1:][sl])
-                    att = truth.att[1:][sl]
-                    tr = BlockTruth(att, euler_to_quat(att), truth.v_n[1:][sl],
-                                    truth.pos[1:][sl], seg)
-                yield DataBlock(k0, imu.t[sl], imu.dtheta[sl], imu.dv[sl], tr,
-                                None if imu.q_bs is None else imu.q_bs[sl])
-
-        t0 = None if truth is None else Truth(truth.t[:1], truth.att[:1], truth.v_n[:1],
-                                              truth.pos[:1], None if truth.segment is None
-                                              else truth.segment[:1])
-        header = replace(imu, t=imu.t[:1], dtheta=imu.dtheta[:0], dv=imu.dv[:0],
-                         q_bs=None if imu.q_bs is None else imu.q_bs[:0])
-        q_bs0 = imu.meta.get("q_bs0")
-
-        def recorded_at(k: int):
-            q = None if imu.q_bs is None else (q_bs0 if k == 0 else imu.q_bs[k - 1])
-            if truth is None:
-                return None, None, None, q
-            return truth.att[k], truth.v_n[k], truth.pos[k], q
-
-        at = recorded_at if truth is not None or imu.q_bs is not None else None
-        return Stream(imu.ts, len(imu), data.site, earth, None, imu.source, t0,
-                      recorded_blocks, header, imu.q_bs is not None, at)
+        return stream_of(_recorded(scenario), earth, block)
 
     motion, mech, site = _simulation(scenario)
     seed = scenario.imu.seed if seed is None else seed
@@ -189,7 +157,7 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
 
     def simulated_blocks() -> Iterator[DataBlock]:
         stream = ErrorStream(errors, ts, np.random.default_rng(seed), n)
-        for b in ideal_blocks(motion, site, ts, earth, mech, block=block or BLOCK):
+        for b in ideal_blocks(motion, site, ts, earth, mech, block=block):
             dtheta, dv = stream.apply(b.dtheta, b.dv)
             yield DataBlock(b.k0, b.t, dtheta, dv,
                             BlockTruth(b.att, b.q_nb, b.v_n, b.pos, b.segment), b.q_bs)
@@ -209,6 +177,45 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
 
     return Stream(ts, n, site, earth, seed, "simulated", initial_truth(motion, site, earth),
                   simulated_blocks, has_mechanism=mech is not None, at=simulated_at)
+
+
+def stream_of(data: RunData, earth: EarthModel | None = None,
+              block: int | None = None) -> Stream:
+    """A whole run held in memory (recorded data, a batch's cached simulation) as a Stream."""
+    from gcalign.sim.ideal import BLOCK
+
+    imu, truth = data.imu, data.truth
+    size = block or BLOCK
+
+    def blocks() -> Iterator[DataBlock]:
+        for k0 in range(0, len(imu), size):
+            sl = slice(k0, k0 + size)
+            tr = None
+            if truth is not None:
+                seg = (np.zeros(len(imu.t[sl]), np.int64) if truth.segment is None
+                       else truth.segment[1:][sl])
+                att = truth.att[1:][sl]
+                tr = BlockTruth(att, euler_to_quat(att), truth.v_n[1:][sl], truth.pos[1:][sl],
+                                seg)
+            yield DataBlock(k0, imu.t[sl], imu.dtheta[sl], imu.dv[sl], tr,
+                            None if imu.q_bs is None else imu.q_bs[sl])
+
+    t0 = None if truth is None else Truth(truth.t[:1], truth.att[:1], truth.v_n[:1],
+                                          truth.pos[:1], None if truth.segment is None
+                                          else truth.segment[:1])
+    header = replace(imu, t=imu.t[:1], dtheta=imu.dtheta[:0], dv=imu.dv[:0],
+                     q_bs=None if imu.q_bs is None else imu.q_bs[:0])
+    q_bs0 = imu.meta.get("q_bs0")
+
+    def at(k: int):
+        q = None if imu.q_bs is None else (q_bs0 if k == 0 else imu.q_bs[k - 1])
+        if truth is None:
+            return None, None, None, q
+        return truth.att[k], truth.v_n[k], truth.pos[k], q
+
+    return Stream(imu.ts, len(imu), data.site, earth or data.earth, data.seed, imu.source, t0,
+                  blocks, header, imu.q_bs is not None,
+                  at if truth is not None or imu.q_bs is not None else None)
 
 
 def gather(stream: Stream) -> RunData:

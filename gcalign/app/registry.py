@@ -65,6 +65,9 @@ COMMANDS: dict[str, Command] = {
                 "seed000_moving_full_cycle.yaml", ("error_t3_deg",)),
         Command("northfind", "northfind", "Multi-position north-finding (seed 001).",
                 "northfind", "seed001_simulation.yaml", ("methods.coordinate.rms_error_deg",)),
+        Command("realtime", "realtime", "Attitude at sync pulses: filter delay and prediction "
+                "(seed 003).", "realtime", "seed003_table1.yaml",
+                ("cases.0.after_max_arcsec.kalman-ls",)),
         Command("modulate", "modulate", "Rotation modulation: navigation on a turning IMU, "
                 "schemes compared on the same data (seed 004).", "modulate",
                 "seed004_modulation.yaml", ("max_horizontal_error_m",), streams=True),

@@ -1,4 +1,5 @@
-"""Linear Kalman filter steps (filterpy style: plain functions on arrays) and discretisation.
+"""Linear Kalman filter steps (filterpy style: plain functions on arrays), discretisation and
+the RTS smoother.
 
 Shapes: state x (n,), covariance P (n, n), transition Φ (n, n), process noise Q_d (n, n),
 measurement z (m,), H (m, n), R (m, m). Nothing is modified in place.
@@ -76,7 +77,36 @@ def update(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.nda
                   nis=float(w @ w), standardized=w)
 
 
+def solve_spd(P: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """``P⁻¹ B`` for a covariance P whose diagonal spans many decades (an INS error state
+    mixes rad² and m²): solved on the correlation matrix ``D⁻¹ P D⁻¹``, D = √diag P."""
+    P, B = np.asarray(P, dtype=float), np.asarray(B, dtype=float)
+    d = np.sqrt(np.diag(P))
+    dd = d[:, None] if B.ndim == 2 else d
+    return np.linalg.solve(P / np.outer(d, d), B / dd) / dd
+
+
 def nees(error: np.ndarray, P: np.ndarray) -> float:
     """Normalised estimation error squared ``eᵀ P⁻¹ e`` (χ²_n for a consistent filter)."""
     e = np.asarray(error, dtype=float)
-    return float(e @ np.linalg.solve(P, e))
+    return float(e @ solve_spd(P, e))
+
+
+def rts(Phis: np.ndarray, P_prior: np.ndarray, x_prior: np.ndarray, P_post: np.ndarray,
+        x_post: np.ndarray):
+    """Rauch–Tung–Striebel smoother over K filter steps.
+
+    Phis (K, n, n): transition from epoch k to k+1; x_prior, P_prior (K, …): the prediction
+    at epoch k+1; x_post, P_post (K+1, …): the posterior at epoch k (epoch 0: the prior).
+    ``C_k = P⁺_k Φ_kᵀ (P⁻_{k+1})⁻¹``, ``x^s_k = x⁺_k + C_k (x^s_{k+1} − x⁻_{k+1})``,
+    ``P^s_k = P⁺_k + C_k (P^s_{k+1} − P⁻_{k+1}) C_kᵀ``. A closed-loop (error-state) filter
+    whose state is reset after each update smooths with the same recursion: the reset is a
+    known input, its x⁻ is zero. Returns ``(x_s (K+1, n), P_s (K+1, n, n))``.
+    """
+    xs, Ps = np.array(x_post, dtype=float), np.array(P_post, dtype=float)
+    for k in range(len(Phis) - 1, -1, -1):
+        C = solve_spd(P_prior[k], Phis[k] @ P_post[k]).T
+        xs[k] = x_post[k] + C @ (xs[k + 1] - x_prior[k])
+        Pk = P_post[k] + C @ (Ps[k + 1] - P_prior[k]) @ C.T
+        Ps[k] = 0.5 * (Pk + Pk.T)
+    return xs, Ps

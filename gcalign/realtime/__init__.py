@@ -12,58 +12,52 @@ Modules
 - :mod:`~gcalign.realtime.settings` -- validated settings (SI), the spec's [O] defaults.
 - :mod:`~gcalign.realtime.filters` -- FIR order 180 / notch + FIR order 40, group delays,
   streamed filtering (seed §2, eq. 1).
-- :mod:`~gcalign.realtime.sensor` -- the gyro channel: increments, noise, dither, counts.
+- :mod:`~gcalign.realtime.sensor` -- the gyro triad: noise, dither, counts.
 - :mod:`~gcalign.realtime.pulses` -- sync pulses, latch index, Δt (seed §2.2).
 - :mod:`~gcalign.realtime.predict` -- tracker (numba), least squares, the seed's
   prediction (reconstructed eq. 13), ``taylor``, ``none``; frequency response (seed §2.3).
 - :mod:`~gcalign.realtime.cases` -- turntable motions, the seed's Table 1 cases.
-- :mod:`~gcalign.realtime.chain` -- :func:`run_case`: one case end to end.
+- :mod:`~gcalign.realtime.chain` -- :func:`run_case`: one case end to end on the core
+  (ideal increments, sensor, filter, attitude-only strapdown with coning correction).
 - :mod:`~gcalign.realtime.table` -- :func:`table1`, :func:`summarise`: our Table 1.
 
 Angles are radians, times seconds, Euler angles ``[pitch, roll, yaw]`` (PSINS order).
+
+The names below are loaded on first use (PEP 562), so that the scenario layer can read
+:mod:`~gcalign.realtime.settings` and :mod:`~gcalign.realtime.cases` without importing
+scipy or numba (``gcalign validate`` and ``show`` must stay light).
 """
 
-from gcalign.realtime.cases import ASYNC_CASE, TABLE1, Case, check_case
-from gcalign.realtime.chain import CaseResult, Series, run_case
-from gcalign.realtime.filters import FilterChain, alignment_chain, navigation_chain
-from gcalign.realtime.predict import TrackerModel, steady_state, swing_residual
-from gcalign.realtime.pulses import Pulses, make_pulses
-from gcalign.realtime.settings import (
-    PREDICTORS,
-    FilterSettings,
-    PulseSettings,
-    SensorSettings,
-    Settings,
-    TrackerSettings,
-    seed_semi_physical,
-)
-from gcalign.realtime.table import CaseSummary, PredictorStats, summarise, table1
+from __future__ import annotations
 
-__all__ = [
-    "ASYNC_CASE",
-    "PREDICTORS",
-    "TABLE1",
-    "Case",
-    "CaseResult",
-    "CaseSummary",
-    "FilterChain",
-    "FilterSettings",
-    "PredictorStats",
-    "PulseSettings",
-    "Pulses",
-    "SensorSettings",
-    "Series",
-    "Settings",
-    "TrackerModel",
-    "TrackerSettings",
-    "alignment_chain",
-    "check_case",
-    "make_pulses",
-    "navigation_chain",
-    "run_case",
-    "seed_semi_physical",
-    "steady_state",
-    "summarise",
-    "swing_residual",
-    "table1",
-]
+import importlib
+from typing import Any
+
+_WHERE = {
+    "ASYNC_CASE": "cases", "TABLE1": "cases", "Case": "cases", "check_case": "cases",
+    "accel_case": "cases", "rate_case": "cases", "swing_case": "cases",
+    "table1_cases": "cases", "async_case": "cases",
+    "CaseResult": "chain", "Series": "chain", "run_case": "chain", "SITE": "chain",
+    "FilterChain": "filters", "alignment_chain": "filters", "navigation_chain": "filters",
+    "TrackerModel": "predict", "steady_state": "predict", "swing_residual": "predict",
+    "Pulses": "pulses", "make_pulses": "pulses",
+    "PREDICTORS": "settings", "FilterSettings": "settings", "PulseSettings": "settings",
+    "SensorSettings": "settings", "Settings": "settings", "TrackerSettings": "settings",
+    "seed_semi_physical": "settings",
+    "CaseSummary": "table", "PredictorStats": "table", "summarise": "table",
+    "table1": "table",
+}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name: str) -> Any:
+    try:
+        module = _WHERE[name]
+    except KeyError:
+        raise AttributeError(f"module 'gcalign.realtime' has no attribute {name!r}") from None
+    return getattr(importlib.import_module(f"gcalign.realtime.{module}"), name)
+
+
+def __dir__() -> list[str]:
+    return __all__

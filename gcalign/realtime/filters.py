@@ -13,8 +13,8 @@ The cut-off frequencies, window, notch frequency and Q are not in the seed: they
 settings (:class:`gcalign.realtime.settings.FilterSettings`) with the spec's [O] defaults.
 
 Streaming: :meth:`FilterChain.apply` filters one chunk and returns the carried state
-(``lfilter`` ``zi``), so a long run is filtered in pieces with the same numbers as in one
-piece (tested).
+(the notch's ``lfilter`` ``zi``, the FIR's last N inputs), so a long run is filtered in
+pieces with the same numbers as in one piece (tested).
 
 >>> from gcalign.realtime.settings import FilterSettings
 >>> nav = navigation_chain(FilterSettings())
@@ -85,7 +85,8 @@ def notch_dc_delay(b: np.ndarray, a: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class ChainState:
-    """Carried filter state between chunks: notch ``zi`` (2, m) or None, FIR ``zi`` (N, m)."""
+    """Carried filter state between chunks: notch ``zi`` (2, m) or None; the FIR's last N
+    inputs (N, m), oldest first."""
 
     notch: np.ndarray | None
     fir: np.ndarray
@@ -156,8 +157,7 @@ class FilterChain:
         notch = None
         if self.notch_ba is not None:
             notch = signal.lfilter_zi(*self.notch_ba)[:, None] * x0[None, :]
-        fir = signal.lfilter_zi(self.h, [1.0])[:, None] * x0[None, :]
-        return ChainState(notch=notch, fir=fir)
+        return ChainState(notch=notch, fir=np.tile(x0, (self.order, 1)))
 
     def apply(self, x: np.ndarray, state: ChainState) -> tuple[np.ndarray, ChainState]:
         """Filter one chunk `x` (n, m) along axis 0 from `state`; returns ``(y, new_state)``."""
@@ -165,8 +165,13 @@ class FilterChain:
         zn = state.notch
         if self.notch_ba is not None:
             x, zn = signal.lfilter(*self.notch_ba, x, axis=0, zi=zn)
-        y, zf = signal.lfilter(self.h, [1.0], x, axis=0, zi=state.fir)
-        return y, ChainState(notch=zn, fir=zf)
+        # FIR y_i = Σ_k h_k x_{i−k} over the carried inputs and this chunk (direct
+        # convolution per channel: lfilter's FIR path loops over channels in Python)
+        buf = np.concatenate([state.fir, x])
+        y = np.empty_like(x)
+        for j in range(x.shape[1]):
+            y[:, j] = np.convolve(buf[:, j], self.h, mode="valid")
+        return y, ChainState(notch=zn, fir=buf[len(buf) - self.order:])
 
 
 def navigation_chain(fs: FilterSettings) -> FilterChain:

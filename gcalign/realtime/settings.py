@@ -2,8 +2,8 @@
 
 The seed leaves most numbers open (spec 003 §2–§4): cut-off frequencies, notch frequency
 and Q, Qc, R, P0, the noise model. Each is a setting here with the spec's [O] default, and
-each bad value raises ``ValueError`` naming the setting, the value and what is allowed (the
-command layer turns it into one line and exit code 2).
+each bad value raises ``ValueError("setting: what is allowed, got value")`` (the scenario
+layer turns it into one line and exit code 2).
 
 >>> s = Settings()
 >>> s.samples_per_solution, s.tau, s.filter.nav_order, round(s.tracker.r ** 0.5 / ARCSEC, 3)
@@ -11,7 +11,7 @@ command layer turns it into one line and exit code 2).
 >>> Settings(pulses=PulseSettings(rate_hz=2000.0))  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-ValueError: pulses.rate_hz must be ≤ solution_hz = 1000 Hz (a pulse latches ...), got 2000
+ValueError: pulses.rate_hz: must be ≤ solution_hz = 1000 Hz (a pulse latches ...), got 2000
 """
 
 from __future__ import annotations
@@ -40,12 +40,12 @@ PULSE_MODES = ("solution", "async")  #: pulses on the solution instants, or asyn
 
 def _positive(name: str, value: float) -> None:
     if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+        raise ValueError(f"{name}: must be a finite number > 0, got {value!r}")
 
 
 def _non_negative(name: str, value: float) -> None:
     if not (math.isfinite(value) and value >= 0):
-        raise ValueError(f"{name} must be a finite number ≥ 0, got {value!r}")
+        raise ValueError(f"{name}: must be a finite number ≥ 0, got {value!r}")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -86,20 +86,20 @@ class FilterSettings:
         for name in ("align_order", "nav_order"):
             v = getattr(self, name)
             if not (isinstance(v, int) and v >= 1):
-                raise ValueError(f"filter.{name} must be an integer ≥ 1 (FIR order = taps − 1), "
+                raise ValueError(f"filter.{name}: must be an integer ≥ 1 (FIR order = taps − 1), "
                                  f"got {v!r}")
         for name in ("align_cutoff_hz", "nav_cutoff_hz"):
             v = getattr(self, name)
             if not (math.isfinite(v) and 0 < v < nyq):
-                raise ValueError(f"filter.{name} must be in (0, {nyq:g}) Hz (below the Nyquist "
+                raise ValueError(f"filter.{name}: must be in (0, {nyq:g}) Hz (below the Nyquist "
                                  f"frequency fs_hz/2), got {v!r}")
         if self.notch_hz is not None and not (math.isfinite(self.notch_hz)
                                               and 0 < self.notch_hz < nyq):
-            raise ValueError(f"filter.notch_hz must be in (0, {nyq:g}) Hz (below the Nyquist "
+            raise ValueError(f"filter.notch_hz: must be in (0, {nyq:g}) Hz (below the Nyquist "
                              f"frequency fs_hz/2) or null for no notch, got {self.notch_hz!r}")
         _positive("filter.notch_q", self.notch_q)
         if self.chain not in CHAINS:
-            raise ValueError(f"filter.chain must be one of {CHAINS}, got {self.chain!r}")
+            raise ValueError(f"filter.chain: must be one of {CHAINS}, got {self.chain!r}")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -169,14 +169,14 @@ class PulseSettings:
 
     def __post_init__(self) -> None:
         if self.mode not in PULSE_MODES:
-            raise ValueError(f"pulses.mode must be one of {PULSE_MODES}, got {self.mode!r}")
+            raise ValueError(f"pulses.mode: must be one of {PULSE_MODES}, got {self.mode!r}")
         _positive("pulses.rate_hz", self.rate_hz)
         if self.offset_s is not None:
             _non_negative("pulses.offset_s", self.offset_s)
         _non_negative("pulses.jitter_s", self.jitter_s)
         _non_negative("pulses.resolution_s", self.resolution_s)
         if not math.isfinite(self.drift_ppm) or abs(self.drift_ppm) >= 1e6:
-            raise ValueError(f"pulses.drift_ppm must be finite and in (−1e6, 1e6), "
+            raise ValueError(f"pulses.drift_ppm: must be finite and in (−1e6, 1e6), "
                              f"got {self.drift_ppm!r}")
 
 
@@ -203,7 +203,7 @@ class TrackerSettings:
         _positive("tracker.qc", self.qc)
         _positive("tracker.r", self.r)
         if len(self.sigma0) != 3:
-            raise ValueError(f"tracker.sigma0 must have 3 entries (θ, ω, α), got {self.sigma0!r}")
+            raise ValueError(f"tracker.sigma0: must have 3 entries (θ, ω, α), got {self.sigma0!r}")
         for v in self.sigma0:
             _positive("tracker.sigma0", v)
 
@@ -219,9 +219,9 @@ class Settings:
     delay_s : float or None, s
         T used by the predictors: None = the chain's low-frequency group delay; the seed
         uses 4 ms (its FIR alone).
-    duration_s, settle_s : float, s
-        Length of a run (seed: 12 s cases [O]) and the start excluded from the metrics
-        (the table is at rest before t = 0; filter and tracker start there).
+    settle_s : float, s
+        The start of a case excluded from the metrics (the table is at rest before t = 0;
+        filter and tracker start there); a case lasts longer (its own duration).
     warmup_s : float, s
         The gyro channel and the filters run this long at rest before t = 0, so that they
         start in steady state with the dither and the noise (an INS aligned and running).
@@ -239,7 +239,6 @@ class Settings:
     pulses: PulseSettings = field(default_factory=PulseSettings)
     tracker: TrackerSettings = field(default_factory=TrackerSettings)
     delay_s: float | None = None
-    duration_s: float = 12.0
     settle_s: float = 1.0
     warmup_s: float = 0.2
     corner_s: float = 0.05
@@ -250,23 +249,19 @@ class Settings:
         _positive("solution_hz", self.solution_hz)
         ratio = self.filter.fs_hz / self.solution_hz
         if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
-            raise ValueError(f"filter.fs_hz must be a whole multiple of solution_hz = "
+            raise ValueError(f"filter.fs_hz: must be a whole multiple of solution_hz = "
                              f"{self.solution_hz:g} Hz, got {self.filter.fs_hz:g} Hz "
                              f"(ratio {ratio:g})")
         check_pulses(self.pulses, self.solution_hz)
         if self.delay_s is not None:
             _non_negative("delay_s", self.delay_s)
-        _positive("duration_s", self.duration_s)
         _non_negative("settle_s", self.settle_s)
         _non_negative("warmup_s", self.warmup_s)
         _non_negative("corner_s", self.corner_s)
         _positive("chunk_s", self.chunk_s)
-        if self.settle_s >= self.duration_s:
-            raise ValueError(f"settle_s must be < duration_s = {self.duration_s:g} s, "
-                             f"got {self.settle_s:g}")
         bad = [p for p in self.predictors if p not in PREDICTORS]
         if bad or not self.predictors:
-            raise ValueError(f"predictors must be a non-empty selection of {PREDICTORS}, "
+            raise ValueError(f"predictors: must be a non-empty selection of {PREDICTORS}, "
                              f"got {self.predictors!r}")
 
     @property
@@ -283,16 +278,16 @@ class Settings:
 def check_pulses(p: PulseSettings, solution_hz: float) -> None:
     """Checks of a pulse train against the solution rate (also for per-case overrides)."""
     if p.rate_hz > solution_hz * (1 + 1e-12):
-        raise ValueError(f"pulses.rate_hz must be ≤ solution_hz = {solution_hz:g} Hz (a pulse "
+        raise ValueError(f"pulses.rate_hz: must be ≤ solution_hz = {solution_hz:g} Hz (a pulse "
                          f"latches the latest solution), got {p.rate_hz:g}")
     if p.mode == "solution":
         m = solution_hz / p.rate_hz
         if abs(m - round(m)) > 1e-9:
-            raise ValueError(f"pulses.rate_hz must divide solution_hz = {solution_hz:g} Hz in "
+            raise ValueError(f"pulses.rate_hz: must divide solution_hz = {solution_hz:g} Hz in "
                              f"mode 'solution' (pulses on solution instants), got "
                              f"{p.rate_hz:g}")
         if p.offset_s is None or not p.offset_s < 1.0 / solution_hz:
-            raise ValueError(f"pulses.offset_s must be in [0, {1.0 / solution_hz:g}) s in mode "
+            raise ValueError(f"pulses.offset_s: must be in [0, {1.0 / solution_hz:g}) s in mode "
                              f"'solution', got {p.offset_s!r}")
 
 

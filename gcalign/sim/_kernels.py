@@ -13,29 +13,42 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from gcalign.nav._kernels import qmul, qrot, rv2q
 
 
 @njit(cache=True, inline="always")
-def schedule_quat(tab, t):
-    """Quaternion of the schedule's rotation at time t (see :class:`Schedule`)."""
-    t0, kind, coef, step, theta0, axis, before, cyc, q0, period, repeat = tab
+def schedule_quat(t0, kind, coef, step, theta0, axis, before, cyc, q0, period, repeat, t, memo):
+    """Quaternion of the schedule's rotation at time t (see :class:`Schedule`); the
+    arguments before t are :meth:`Schedule.kernel_tables` (passed one by one: a tuple of
+    arrays handed to an inlined function costs a reference count per array and call).
+
+    `memo` (7,) = [piece, cycle, q, last piece] remembers the last rest piece (zero
+    coefficients): a dwell, most of a modulation cycle, costs a comparison instead of a
+    rotation; times that move forward find their piece from the last one.
+    """
     if repeat:
         k = math.floor(t / period)
         tau = t - k * period
     else:
         k = 0.0
         tau = min(max(t, 0.0), period)
-    lo, hi = 0, t0.shape[0] - 1
-    while lo < hi:  # last piece with t0 <= tau
-        mid = (lo + hi + 1) // 2
-        if t0[mid] <= tau:
-            lo = mid
-        else:
-            hi = mid - 1
-    j = lo
+    last = t0.shape[0] - 1
+    j = int(memo[6])
+    if not (0 <= j <= last and t0[j] <= tau and (j == last or tau < t0[j + 1])):
+        lo, hi = 0, last
+        while lo < hi:  # last piece with t0 <= tau
+            mid = (lo + hi + 1) // 2
+            if t0[mid] <= tau:
+                lo = mid
+            else:
+                hi = mid - 1
+        j = lo
+        memo[6] = j
+    if memo[0] == j and memo[1] == k:
+        return memo[2], memo[3], memo[4], memo[5]
     x = tau - t0[j]
     c0, c1, c2 = coef[j, 0], coef[j, 1], coef[j, 2]
     if kind[j] == 1:
@@ -49,23 +62,12 @@ def schedule_quat(tab, t):
     if repeat and k != 0.0:
         cw, cx, cy, cz = rv2q(k * cyc[0], k * cyc[1], k * cyc[2])
         bw, bx, by, bz = qmul(cw, cx, cy, cz, bw, bx, by, bz)
-    return qmul(q0[0], q0[1], q0[2], q0[3], bw, bx, by, bz)
-
-
-@njit(cache=True, inline="always")
-def _sensor(q_nb0, body, has_body, mech, has_mech, mech_nav, t):
-    """q_nb and q_ns at time t."""
-    bw, bx, by, bz = q_nb0[0], q_nb0[1], q_nb0[2], q_nb0[3]
-    if has_body:
-        sw, sx, sy, sz = schedule_quat(body, t)
-        bw, bx, by, bz = qmul(bw, bx, by, bz, sw, sx, sy, sz)
-    if not has_mech:
-        return bw, bx, by, bz, bw, bx, by, bz
-    mw, mx, my, mz = schedule_quat(mech, t)
-    if mech_nav:
-        return bw, bx, by, bz, mw, mx, my, mz
-    nw, nx, ny, nz = qmul(bw, bx, by, bz, mw, mx, my, mz)
-    return bw, bx, by, bz, nw, nx, ny, nz
+    rw, rx, ry, rz = qmul(q0[0], q0[1], q0[2], q0[3], bw, bx, by, bz)
+    if kind[j] == 0 and c0 == 0.0 and c1 == 0.0 and c2 == 0.0:
+        memo[0], memo[1], memo[2], memo[3], memo[4], memo[5] = j, k, rw, rx, ry, rz
+    else:
+        memo[0] = -1.0
+    return rw, rx, ry, rz
 
 
 @njit(cache=True)
@@ -81,6 +83,9 @@ def fixed_site_block(k0, n, ts, m, omega_ie, q_en, f_n, q_nb0, body, has_body, m
     """
     h = ts / m
     t_ref = k0 * ts
+    memo = np.full((2, 7), -1.0)
+    b0, b1, b2, b3, b4, b5, b6, b7, b8, b9, b10 = body
+    m0, m1, m2, m3, m4, m5, m6, m7, m8, m9, m10 = mech
     pw = px = py = pz = 0.0  # q_is at the start of the sample
     gx = gy = gz = 0.0  # f_s at the start of the sample
     for i in range(n):
@@ -89,8 +94,20 @@ def fixed_site_block(k0, n, ts, m, omega_ie, q_en, f_n, q_nb0, body, has_body, m
         ax, ay, az = gx, gy, gz
         for j in range(j0, m + 1):
             t = (k * m + j) * h
-            bw, bx, by, bz, sw, sx, sy, sz = _sensor(q_nb0, body, has_body, mech, has_mech,
-                                                     mech_nav, t)
+            # body attitude (a turntable turns it) and sensor attitude (a mechanism)
+            bw, bx, by, bz = q_nb0[0], q_nb0[1], q_nb0[2], q_nb0[3]
+            if has_body:
+                uw, ux, uy, uz = schedule_quat(b0, b1, b2, b3, b4, b5, b6, b7, b8, b9, b10, t,
+                                               memo[0])
+                bw, bx, by, bz = qmul(bw, bx, by, bz, uw, ux, uy, uz)
+            sw, sx, sy, sz = bw, bx, by, bz
+            if has_mech:
+                uw, ux, uy, uz = schedule_quat(m0, m1, m2, m3, m4, m5, m6, m7, m8, m9, m10, t,
+                                               memo[1])
+                if mech_nav:
+                    sw, sx, sy, sz = uw, ux, uy, uz
+                else:
+                    sw, sx, sy, sz = qmul(bw, bx, by, bz, uw, ux, uy, uz)
             fx, fy, fz = qrot(sw, -sx, -sy, -sz, f_n[0], f_n[1], f_n[2])
             wgt = 1.0 if (j == 0 or j == m) else (4.0 if j % 2 == 1 else 2.0)
             ax += wgt * fx

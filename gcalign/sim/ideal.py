@@ -33,7 +33,8 @@ from gcalign.sim.mechanism import Mechanism
 from gcalign.sim.motions import MotionType, Moving, Static, Truth, Turntable, sample_count
 from gcalign.sim.schedule import AngleProfile, Schedule, Step
 
-BLOCK = 1 << 16  #: samples per block
+BLOCK = 1 << 16  #: samples per block of the numba route (fixed site)
+GENERIC_BLOCK = 1 << 14  #: of the NumPy route: ~1.4 KB of temporaries per sample
 
 
 @dataclass(frozen=True)
@@ -72,7 +73,7 @@ def initial_truth(motion: MotionType, site, earth: EarthModel = WGS84) -> Truth:
 
 
 def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
-                 mechanism: Mechanism | None = None, block: int = BLOCK,
+                 mechanism: Mechanism | None = None, block: int | None = None,
                  substeps: int = 2) -> Iterator[SimBlock]:
     """The ideal increments of `motion` at `site` ``[lat, lon, h]`` in blocks."""
     if substeps % 2:
@@ -85,9 +86,10 @@ def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
     weights *= h / 3.0
     site = np.asarray(site, dtype=float)
     if isinstance(motion, Static | Turntable):
-        yield from _fixed_site_blocks(motion, site, ts, earth, mechanism, block, m, n_total)
+        yield from _fixed_site_blocks(motion, site, ts, earth, mechanism, block or BLOCK, m,
+                                      n_total)
         return
-    static = isinstance(motion, Static)
+    block = block or GENERIC_BLOCK
     for k0 in range(0, n_total, block):
         n = min(block, n_total - k0)
         # Sub-point times from integers, so a boundary is the same number in both rows.
@@ -101,51 +103,44 @@ def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
             seg = motion.segment_index(grid, side="right")
             seg[:, -1] = motion.segment_index(grid[:, -1], side="left")
             seg = seg.ravel()
-            kin = motion.kinematics(grid.ravel(), site, earth, segment=seg)
+            kin = motion.grid_kinematics(grid, seg, site, earth)
         else:
             kin = motion.kinematics(grid.ravel(), site, earth)
-        if static:
-            q_nb = np.broadcast_to(dcm_to_quat(kin.C_nb[0]), (n * (m + 1), 4))
-        else:
-            q_nb = dcm_to_quat(kin.C_nb)
-        q_ns = q_nb if mechanism is None else mechanism.q_ns(grid.ravel(), q_nb)
         lat, height = kin.pos[:, 0], kin.pos[:, 2]
-        if static:
-            w = 2.0 * earth.omega_ie_n(lat[:1]) + earth.omega_en_n(lat[:1], height[:1],
-                                                                  kin.v_n[:1])
-            f_n = np.broadcast_to(kin.a_n[:1] + np.cross(w, kin.v_n[:1]), kin.v_n.shape).copy()
-            f_n[:, 2] += earth.gravity(lat[0], height[0])
+        w = 2.0 * earth.omega_ie_n(lat) + earth.omega_en_n(lat, height, kin.v_n)
+        f_n = kin.a_n + np.cross(w, kin.v_n)
+        f_n[:, 2] += earth.gravity(lat, height)
+        # Sample points: each row's start, then the last row's end.
+        sp = np.r_[np.arange(n) * (m + 1), n * (m + 1) - 1]
+        if mechanism is None:  # f_b = C_bn f_n at every sub-point, quaternions at samples
+            f_s = np.einsum("kji,kj->ki", kin.C_nb, f_n).reshape(n, m + 1, 3)
+            q_ns = q_nb = dcm_to_quat(kin.C_nb[sp])
         else:
-            w = 2.0 * earth.omega_ie_n(lat) + earth.omega_en_n(lat, height, kin.v_n)
-            f_n = kin.a_n + np.cross(w, kin.v_n)
-            f_n[:, 2] += earth.gravity(lat, height)
-        f_s = _rotate(quat_conj(q_ns), f_n).reshape(n, m + 1, 3)
+            q_all = dcm_to_quat(kin.C_nb)
+            q_ns_all = mechanism.q_ns(grid.ravel(), q_all)
+            f_s = _rotate(quat_conj(q_ns_all), f_n).reshape(n, m + 1, 3)
+            q_nb, q_ns = q_all[sp], q_ns_all[sp]
         dv = np.einsum("j,kjc->kc", weights, f_s)
         if isinstance(motion, Moving):
             _split_at_boundaries(dv, motion, mechanism, site, earth, k0, n, ts, m)
         if mechanism is not None and mechanism.lever is not None:
             dv += mechanism.lever_dv(k0, n, ts)
 
-        # Sample points: each row's start, then the last row's end.
-        sp = np.r_[np.arange(n) * (m + 1), n * (m + 1) - 1]
         t_s = grid.ravel()[sp]
         half = 0.5 * earth.omega_ie * (t_s - t_s[0])
         q_ie = np.stack([np.cos(half), 0 * half, 0 * half, np.sin(half)], -1)
         pos_s = kin.pos[sp]
-        if static:
-            q_en = np.broadcast_to(dcm_to_quat(C_en(site[0], site[1])), q_ie.shape)
-        else:
-            q_en = dcm_to_quat(C_en(pos_s[:, 0], pos_s[:, 1]))
-        q_is = quat_mult(quat_mult(q_ie, q_en), q_ns[sp])
+        q_en = dcm_to_quat(C_en(pos_s[:, 0], pos_s[:, 1]))
+        q_is = quat_mult(quat_mult(q_ie, q_en), q_ns)
         dtheta = quat_to_rotvec(quat_mult(quat_conj(q_is[:-1]), q_is[1:]))
 
         # Truth at the end of each increment (the row's end: the increment's own segment).
         ends = np.arange(n) * (m + 1) + m
         q_bs = None
         if mechanism is not None:
-            q_bs = mechanism.q_bs(grid.ravel()[ends], q_nb[ends])
+            q_bs = mechanism.q_bs(grid.ravel()[ends], q_nb[1:])
         yield SimBlock(k0=k0, t=grid.ravel()[ends], dtheta=dtheta, dv=dv,
-                       att=np.array(kin.att[ends]), q_nb=np.array(q_nb[ends]),
+                       att=np.array(kin.att[ends]), q_nb=np.array(q_nb[1:]),
                        v_n=np.array(kin.v_n[ends]),
                        pos=np.array(kin.pos[ends]),
                        segment=(np.zeros(n, np.int64) if seg is None else seg[ends]),

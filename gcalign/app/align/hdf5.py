@@ -3,16 +3,27 @@
 from __future__ import annotations
 
 import h5py
+import numpy as np
 
 from gcalign.io.results import ATT_FRAME, PHI_FRAME, put
 
 GAIN_NAMES = "K_E1, K_E2, K_E3, K_N1, K_N2, K_N3, K_U1, K_U2, K_U3, K_U4"
 
 
-def write_alignment(f: h5py.File, run) -> None:
-    """/align/pass_NN (attitude and error per pass), /align/result, /align/gains."""
+def write_alignment(f: h5py.File, run, stream=None) -> None:
+    """/align/pass_NN (attitude and error per pass), /align/result, /align/gains, and the
+    true attitude at the stored samples under /truth (t, att)."""
     from gcalign.nav.rotation import quat_to_euler
 
+    if run.pass_truth is not None:
+        rows = {}
+        for rec, tr in zip(run.passes, run.pass_truth, strict=True):
+            for t, a in zip(rec.t, tr, strict=True):
+                rows[float(t)] = a
+        t = np.array(sorted(rows))
+        tg = f.create_group("truth")
+        put(tg, "t", t, "s", description="the samples the passes stored (output rate)")
+        put(tg, "att", np.array([rows[x] for x in t]), "rad", ATT_FRAME)
     g = f.create_group("align")
     g.attrs["mode"] = run.cfg.mode
     g.attrs["azimuth_poles"] = run.azimuth_poles

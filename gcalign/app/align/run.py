@@ -17,12 +17,12 @@ from gcalign.align import coarse as coarse_mod
 from gcalign.align import kernel as K
 from gcalign.align.compensate import compensate
 from gcalign.align.cycles import Block, PassRecord, run_passes
-from gcalign.app.data import RunData, scenario_data
+from gcalign.app.data import RunData, Stream, scenario_data, scenario_stream, stream_of
 from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import AlignConfig
-from gcalign.nav.earth import WGS84
+from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import (
     attitude_error,
     euler_to_dcm,
@@ -104,56 +104,148 @@ def _phi(att_est, att_true):
     return misalignment(euler_to_dcm(att_est), euler_to_dcm(att_true))
 
 
-def _index(data: RunData, cfg: AlignConfig, t: float, field: str) -> int:
+MEASURED_MAX_S = 600.0  #: data kept after T2 for a 'measured' T3 (the computing latency)
+
+
+@dataclass(frozen=True)
+class AlignInputs:
+    """The part of a run's data an alignment needs, collected from a stream in one go (SI).
+
+    Samples lo .. hi-1 of the increments, the reference velocity at samples lo .. hi, the
+    true attitude at the samples in `truth_idx` (every stored pass row, T1, T2, T3) and the
+    true position at T1; the rest of the run is never held in memory.
+    """
+
+    ts: float
+    t0: float  # data time of sample 0
+    samples: int
+    lo: int
+    dtheta: np.ndarray
+    dv: np.ndarray
+    vref: np.ndarray
+    vref_body: bool
+    truth_idx: np.ndarray | None
+    truth_att: np.ndarray | None
+    pos_t1: np.ndarray
+    site: np.ndarray
+    earth: EarthModel
+    seed: int | None
+    source: str
+    motion_kind: str | None
+
+    def att_at(self, k) -> np.ndarray:
+        """True attitude at sample indices k (they must be among `truth_idx`)."""
+        assert self.truth_idx is not None and self.truth_att is not None
+        j = np.searchsorted(self.truth_idx, k)
+        return self.truth_att[j]
+
+    def block(self, a: int, b: int) -> Block:
+        """Increments a .. b-1 and the reference at samples a .. b, as the passes take them."""
+        i, j = a - self.lo, b - self.lo
+        return Block(t=self.t0 + np.arange(a, b + 1) * self.ts, dtheta=self.dtheta[i:j],
+                     dv=self.dv[i:j], vref=self.vref[i:j + 1], vref_body=self.vref_body,
+                     ts=self.ts)
+
+
+def _index(stream: Stream, cfg: AlignConfig, t: float, field: str) -> int:
     """Data sample index of alignment time t (s); ScenarioError if outside the data."""
-    ts = data.imu.ts
-    k = int(round((cfg.start_s + t) / ts))
-    end = len(data.imu) * ts
-    if k > len(data.imu):
+    k = int(round((cfg.start_s + t) / stream.ts))
+    if k > stream.samples:
         raise ScenarioError(
             f"align.{field}: {t} s (+ start_s {cfg.start_s} s) is past the end of the data "
-            f"({end:.2f} s); lengthen motion.duration_s or choose an earlier time"
+            f"({stream.samples * stream.ts:.2f} s); lengthen motion.duration_s or choose an "
+            f"earlier time"
         )
     return k
 
 
-def reference_velocity(data: RunData, cfg: AlignConfig, rng: np.random.Generator):
-    """Reference velocity at every sample, (N+1, 3), and whether it is in the body frame.
+def _reference(cfg: AlignConfig, att, v_n, rng: np.random.Generator, body: bool):
+    """Reference velocity of samples with true attitude att and velocity v_n (n, 3).
 
-    none: zero (static or swing base). nav: the true ENU velocity plus white noise.
-    odometer: the body-frame forward speed plus white noise (seed §1: converted to the
-    navigation frame with the computed attitude inside the loop).
+    nav: the true ENU velocity plus white noise. odometer: the body-frame forward speed
+    plus white noise (seed §1: converted to the navigation frame with the computed attitude
+    inside the loop). The noise of successive blocks continues one stream.
     """
-    n = len(data.imu) + 1
-    source, noise = cfg.aiding.source, cfg.aiding.noise_mps
-    if source == "none":
-        return np.zeros((n, 3)), False
-    if data.truth is None:
+    noise = cfg.aiding.noise_mps
+    if not body:
+        return v_n + noise * rng.standard_normal(v_n.shape)
+    speed = np.einsum("kji,kj->ki", euler_to_dcm(att), v_n)[:, 1]
+    speed = speed + noise * rng.standard_normal(len(speed))
+    z = np.zeros_like(speed)
+    return np.stack([z, speed, z], -1)
+
+
+def collect(stream: Stream, cfg: AlignConfig, lo: int, hi: int, truth_rows) -> AlignInputs:
+    """One pass over the stream: increments lo .. hi-1, reference velocity at lo .. hi,
+    true attitude where `truth_rows(k)` (sample indices, bool array) says, position at T1."""
+    source = cfg.aiding.source
+    has_truth = stream.truth0 is not None
+    if source != "none" and not has_truth:
         raise ScenarioError(
             f"align.aiding.source: {source!r} needs a simulated motion (truth); "
             "recorded data supports 'none'"
         )
-    v_n = data.truth.v_n
-    if source == "nav":
-        return v_n + noise * rng.standard_normal(v_n.shape), False
-    v_b = np.einsum("kji,kj->ki", euler_to_dcm(data.truth.att), v_n)
-    speed = v_b[:, 1] + noise * rng.standard_normal(n)
-    return np.stack([np.zeros(n), speed, np.zeros(n)], -1), True
+    body = source == "odometer"
+    rng = np.random.default_rng([0 if stream.seed is None else stream.seed, 1])
+    m = hi - lo
+    dtheta, dv = np.empty((m, 3)), np.empty((m, 3))
+    vref = np.zeros((m + 1, 3))
+    idx_parts, att_parts = [], []
+    i1 = _index(stream, cfg, cfg.t1_s, "t1_s")
+    pos_t1 = stream.site.copy()
+
+    def take(k0: int, att, v_n, pos):
+        """Truth rows of samples k0 .. k0+len-1: reference velocity, stored attitudes."""
+        nonlocal pos_t1
+        k = k0 + np.arange(len(att))
+        if source != "none":
+            ref = _reference(cfg, att, v_n, rng, body)
+            sel = (k >= lo) & (k <= hi)
+            vref[k[sel] - lo] = ref[sel]
+        keep = truth_rows(k)
+        idx_parts.append(k[keep])
+        att_parts.append(att[keep])
+        if k[0] <= i1 <= k[-1]:
+            pos_t1 = pos[i1 - k[0]].copy()
+
+    if has_truth:
+        tr0 = stream.truth0
+        assert tr0 is not None
+        take(0, tr0.att, tr0.v_n, tr0.pos)
+    for b in stream.blocks():
+        n = len(b.t)
+        a, c = max(lo - b.k0, 0), min(hi - b.k0, n)
+        if a < c:
+            dtheta[b.k0 + a - lo:b.k0 + c - lo] = b.dtheta[a:c]
+            dv[b.k0 + a - lo:b.k0 + c - lo] = b.dv[a:c]
+        if b.truth is not None:
+            take(b.k0 + 1, b.truth.att, b.truth.v_n, b.truth.pos)
+        if b.k0 + n >= hi and (source == "none" or b.k0 + 1 + n > hi):
+            break  # everything needed is in; the rest of the run is never generated
+    kind = stream.header.meta.get("motion_kind") if stream.header is not None else None
+    return AlignInputs(
+        ts=stream.ts, t0=stream.t0, samples=stream.samples, lo=lo, dtheta=dtheta, dv=dv,
+        vref=vref, vref_body=body,
+        truth_idx=np.concatenate(idx_parts) if has_truth else None,
+        truth_att=np.concatenate(att_parts) if has_truth else None,
+        pos_t1=pos_t1, site=stream.site, earth=stream.earth, seed=stream.seed,
+        source=stream.source, motion_kind=kind)
 
 
-def coarse_attitude(data: RunData, cfg: AlignConfig, i0: int, i1: int):
+def coarse_attitude(data: AlignInputs, cfg: AlignConfig, i0: int, i1: int):
     """Attitude at T1 from the coarse method, plus the configured offset (rad)."""
     c = cfg.coarse
     offset = np.radians(c.offset_deg)
     if c.method == "given":
-        if data.truth is None:
+        if data.truth_idx is None:
             raise ScenarioError(
                 "align.coarse.method: 'given' needs truth; use 'analytic' or "
                 "'inertial' for recorded data"
             )
-        return data.truth.att[i1] + np.radians(c.error_deg) + offset
-    lo = i1 - int(round(c.duration_s / data.imu.ts)) if c.duration_s else i0
-    dth, dv, ts, site = data.imu.dtheta[lo:i1], data.imu.dv[lo:i1], data.imu.ts, data.site
+        return data.att_at(i1) + np.radians(c.error_deg) + offset
+    lo = _coarse_start(cfg, i0, i1, data.ts)
+    dth, dv = data.dtheta[lo - data.lo:i1 - data.lo], data.dv[lo - data.lo:i1 - data.lo]
+    ts, site = data.ts, data.site
     try:
         if c.method == "analytic":
             return coarse_mod.analytic_coarse(dth, dv, ts, site[0], data.earth) + offset
@@ -166,17 +258,9 @@ def coarse_attitude(data: RunData, cfg: AlignConfig, i0: int, i1: int):
         ) from None
 
 
-def _block(data: RunData, vref, body: bool, lo: int, hi: int) -> Block:
-    imu = data.imu
-    t = (imu.t[0] - imu.ts) + np.arange(lo, hi + 1) * imu.ts
-    return Block(
-        t=t,
-        dtheta=imu.dtheta[lo:hi],
-        dv=imu.dv[lo:hi],
-        vref=vref[lo : hi + 1],
-        vref_body=body,
-        ts=imu.ts,
-    )
+def _coarse_start(cfg: AlignConfig, i0: int, i1: int, ts: float) -> int:
+    c = cfg.coarse
+    return i1 - int(round(c.duration_s / ts)) if c.duration_s else i0
 
 
 def warm_up() -> None:
@@ -187,17 +271,21 @@ def warm_up() -> None:
                         np.empty((2, 4)))
 
 
-def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
-    """Coarse alignment, the passes of the mode, and the T2 → T3 compensation."""
+def run_alignment(sc: Scenario, stream: Stream | RunData) -> AlignRun:
+    """Coarse alignment, the passes of the mode, and the T2 → T3 compensation, on a stream
+    of the run's data (or the whole run in memory)."""
+    if isinstance(stream, RunData):
+        stream = stream_of(stream)
     cfg = sc.align or AlignConfig()
     warm_up()
-    if abs(data.site[0]) > math.radians(85.0):
+    if abs(stream.site[0]) > math.radians(85.0):
         raise ScenarioError(
             f"site.lat_deg: gyrocompassing needs |latitude| < 85°, got "
-            f"{math.degrees(data.site[0]):.4f}° (the horizontal earth rate vanishes)"
+            f"{math.degrees(stream.site[0]):.4f}° (the horizontal earth rate vanishes)"
         )
     # The motion kind picks the default pole set; data simulated earlier carry it along.
-    kind = sc.motion.kind if sc.motion else data.imu.meta.get("motion_kind")
+    kind = sc.motion.kind if sc.motion else (
+        stream.header.meta.get("motion_kind") if stream.header is not None else None)
     poles = cfg.poles_for(kind)
     warnings = []
     if kind == "moving" and cfg.aiding.source == "none":
@@ -205,57 +293,64 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
             "a moving base with align.aiding.source 'none': the loops take the "
             "vehicle's accelerations for tilt; expect degrees of error"
         )
-    ts = data.imu.ts
-    i0 = _index(data, cfg, 0.0, "start_s")
-    i1 = _index(data, cfg, cfg.t1_s, "t1_s")
-    i2 = _index(data, cfg, cfg.t2_s, "t2_s")
-    rng = np.random.default_rng([0 if data.seed is None else data.seed, 1])
-    vref, body = reference_velocity(data, cfg, rng)
+    ts = stream.ts
+    i0 = _index(stream, cfg, 0.0, "start_s")
+    i1 = _index(stream, cfg, cfg.t1_s, "t1_s")
+    i2 = _index(stream, cfg, cfg.t2_s, "t2_s")
+    realtime = cfg.mode == "conventional" and cfg.realtime
+    if cfg.t3_s == "measured":
+        i3 = i2 if realtime else None
+        hi = i2 if realtime else min(stream.samples, i2 + int(round(MEASURED_MAX_S / ts)))
+    else:
+        i3 = _index(stream, cfg, cfg.t3_s, "t3_s")
+        hi = i3
+    try:
+        stride = sc.output.stride(1.0 / ts, stream.samples * ts)
+    except ValueError as err:
+        raise ScenarioError(str(err)) from None
+    lo = min(i1, _coarse_start(cfg, i0, i1, ts)) if cfg.coarse.method != "given" else i1
+    ends = {i1, i2, hi} | ({i3} if i3 is not None else set())
+
+    def truth_rows(k):
+        """Samples whose true attitude is kept: the stored pass rows and the ends."""
+        return ((k >= i1) & (k <= hi) & ((k - i1) % stride == 0)) | np.isin(k, list(ends))
+
+    data = collect(stream, cfg, lo, hi, truth_rows)
     att1 = coarse_attitude(data, cfg, i0, i1)
     q1 = euler_to_quat(att1)
-    v1 = quat_to_dcm(q1) @ vref[i1] if body else vref[i1]
-    pos1 = data.truth.pos[i1] if data.truth is not None else data.site
-    state0 = K.new_state(q1, v1, pos1)
+    v1 = quat_to_dcm(q1) @ data.vref[i1 - lo] if data.vref_body else data.vref[i1 - lo]
+    state0 = K.new_state(q1, v1, data.pos_t1)
 
     # Real-time conventional: one forward pass over live data to T3, no latency to
     # compensate ('measured' then means T3 = T2). Otherwise the passes run over the stored
     # block [T1, T2] and the compensation carries the attitude on to T3.
-    realtime = cfg.mode == "conventional" and cfg.realtime
-    if realtime:
-        i3 = i2 if cfg.t3_s == "measured" else _index(data, cfg, cfg.t3_s, "t3_s")
     t_start = time.perf_counter()
     state_end, records = run_passes(
-        state0,
-        _block(data, vref, body, i1, i3 if realtime else i2),
-        cfg.mode,
-        cfg.pass_count,
-        [s.to_stage() for s in cfg.stages],
-        poles,
-        cfg.level_phase_s,
-        data.earth,
+        state0, data.block(i1, i3 if realtime else i2),  # type: ignore[arg-type]
+        cfg.mode, cfg.pass_count, [s.to_stage() for s in cfg.stages], poles,
+        cfg.level_phase_s, data.earth, stride,
     )
     compute = time.perf_counter() - t_start
     if realtime:
-        q2, q3 = records[0].q_nb[i2 - i1], state_end[K.ATT].copy()
+        assert i3 is not None
+        rec = records[0]
+        q2 = rec.q_nb[np.searchsorted(rec.t, data.t0 + i2 * ts - 1e-9 * ts)]
+        q3 = state_end[K.ATT].copy()
         equivalent = (i3 - i0) * ts
     else:
-        if cfg.t3_s == "measured":
+        if i3 is None:
             i3 = i2 + math.ceil(compute / ts)
-            if i3 > len(data.imu):
+            if i3 > hi:
                 raise ScenarioError("align.t3_s: 'measured' latency runs past the end of the data")
-        else:
-            i3 = _index(data, cfg, cfg.t3_s, "t3_s")
         q2 = state_end[K.ATT].copy()
-        q3 = compensate(cfg.compensation, state_end, _block(data, vref, body, i2, i3), data.earth)
+        q3 = compensate(cfg.compensation, state_end, data.block(i2, i3), data.earth)
         equivalent = (i1 - i0) * ts + cfg.pass_count * (i2 - i1) * ts
 
-    truth = data.truth
-    start = data.imu.t[0] - ts  # data time of sample 0
-    pass_truth = (
-        None
-        if truth is None
-        else [truth.att[np.rint((rec.t - start) / ts).astype(int)] for rec in records]
-    )
+    has_truth = data.truth_idx is not None
+    pass_truth = None
+    if has_truth:
+        pass_truth = [data.att_at(np.rint((rec.t - data.t0) / ts).astype(int))
+                      for rec in records]
     return AlignRun(
         cfg=cfg,
         azimuth_poles=poles,
@@ -267,8 +362,9 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
         pass_truth=pass_truth,
         att_t2=quat_to_euler(q2),
         att_t3=quat_to_euler(q3),
-        truth_t2=None if truth is None else truth.att[i2],
-        truth_t3=None if truth is None else truth.att[i3],
+        truth_t2=data.att_at(i2) if has_truth else None,
+        truth_t3=data.att_at(i3) if has_truth and i3 in ends else (
+            _truth_at(stream, i3) if has_truth else None),
         compute_s=compute,
         equivalent_s=equivalent,
         index_offset=i0,
@@ -277,23 +373,30 @@ def run_alignment(sc: Scenario, data: RunData) -> AlignRun:
     )
 
 
+def _truth_at(stream: Stream, k: int):
+    tr = stream.truth_at(k)
+    return None if tr is None else np.asarray(tr[0], float)
+
+
 def _deg(x):
     return None if x is None else np.degrees(x).tolist()
 
 
-def alignment_summary(run: AlignRun, data: RunData, name: str) -> dict:
+def alignment_summary(run: AlignRun, stream: Stream | RunData, name: str) -> dict:
     """Plain-number summary (degrees, seconds): the JSON contract of `gcalign align --json`."""
+    if isinstance(stream, RunData):
+        stream = stream_of(stream)
     cfg = run.cfg
     realtime = cfg.mode == "conventional" and cfg.realtime
-    start = data.imu.t[0] - data.imu.ts  # data time of sample 0
+    start, ts = stream.t0, stream.ts  # data time of sample 0
 
     def aligned_time(t_data: float) -> float:
-        return (round((t_data - start) / data.imu.ts) - run.index_offset) * data.imu.ts
+        return (round((t_data - start) / ts) - run.index_offset) * ts
 
     return {
         "scenario": name,
-        "seed": data.seed,
-        "source": data.imu.source,
+        "seed": stream.seed,
+        "source": stream.source,
         "mode": cfg.mode,
         "compensation": "real time" if realtime else cfg.compensation,
         "azimuth_poles": run.azimuth_poles,
@@ -334,7 +437,10 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None)
     """Simulate (or read) the data, align, summarise; the registry's entry point."""
     from gcalign.app.align.hdf5 import write_alignment
 
-    data = scenario_data(sc, seed, cache_key)
-    run = run_alignment(sc, data)
-    return Outcome(alignment_summary(run, data, sc.name), lambda f: write_alignment(f, run),
-                   data.truth, data.seed, run.warnings)
+    if cache_key is not None:  # a batch: the noise-free simulation is shared by the seeds
+        stream = stream_of(scenario_data(sc, seed, cache_key))
+    else:
+        stream = scenario_stream(sc, seed)
+    run = run_alignment(sc, stream)
+    return Outcome(alignment_summary(run, stream, sc.name),
+                   lambda f: write_alignment(f, run, stream), None, stream.seed, run.warnings)

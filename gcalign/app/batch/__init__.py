@@ -48,7 +48,6 @@ from gcalign.app.batch.engine import (
 from gcalign.app.batch.engine import _tasks as _tasks  # the tests build tasks with it
 from gcalign.app.batch.overrides import apply_override
 from gcalign.app.batch.runs import (
-    WARM_SCENARIO,
     MetricError,
     kernel_cache_stats,
     metric_value,
@@ -100,7 +99,6 @@ __all__ = [
     "SCHEDULER_TIMEOUT_S",
     "STATS",
     "SWEEP_KEYS",
-    "WARM_SCENARIO",
     "BatchResult",
     "DaskBackend",
     "Journal",

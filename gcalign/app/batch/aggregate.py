@@ -36,8 +36,22 @@ def components(command: str, metric: str, k: int | None) -> list[str] | None:
     return [str(i) for i in range(k)]
 
 
+def metric_label(command: str, metric: str) -> str:
+    """A metric's name for figures: the command's room may name a picked component
+    (``error_t3_deg.2`` -> ``error_t3_deg yaw`` in align)."""
+    from gcalign.app.registry import COMMANDS
+
+    room = COMMANDS[command].load() if command in COMMANDS else None
+    return room.label(metric) if room is not None and hasattr(room, "label") else metric
+
+
 def metric_units(metric: str) -> str:
-    last = metric.rsplit(".", 1)[-1]
+    """Units from the name's suffix; a trailing index (``error_t3_deg.2``, one component of
+    a vector metric) has the units of its vector."""
+    parts = metric.split(".")
+    while len(parts) > 1 and parts[-1].isdigit():
+        parts.pop()
+    last = parts[-1]
     for suffix, units in (("_deg", "deg"), ("_s", "s"), ("_dph", "deg/h"), ("_m", "m"),
                           ("_mps", "m/s"), ("_arcsec", "arcsec")):
         if last.endswith(suffix):
@@ -110,6 +124,7 @@ def batch_summary(sweep: Sweep, records: dict, *, output: Path | None = None,
         "seed_start": sweep.seed_start,
         "metrics": list(sweep.metrics),
         "grid": sweep.grid,
+        "cases": sweep.cases,
         "runs": len(keys),
         "finished": len(finished),
         "ok": len(finished) - len(failed),

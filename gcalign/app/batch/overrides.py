@@ -34,6 +34,17 @@ def _is_model(tp) -> bool:
     return isinstance(tp, type) and issubclass(tp, BaseModel)
 
 
+def _arm(tp, node):
+    """The member of a union of models (the motion kinds) that `node`'s ``kind`` names."""
+    if get_origin(tp) not in (Union, types.UnionType) or not isinstance(node, dict):
+        return tp
+    for arm in get_args(tp):
+        field = getattr(arm, "model_fields", {}).get("kind")
+        if field is not None and node.get("kind") in get_args(field.annotation):
+            return arm
+    return tp
+
+
 def _dump(value):
     """A model value as plain YAML types (only what the user set, so defaults stay defaults)."""
     from pydantic import BaseModel
@@ -66,6 +77,7 @@ def apply_override(data: dict, key: str, value, base_model=None) -> None:
     for depth, part in enumerate(parts):
         here = ".".join(parts[:depth]) or "the scenario"
         path = ".".join(parts[: depth + 1])
+        tp = _arm(tp, node)
         if _is_model(tp):
             fields = tp.model_fields
             if part not in fields:

@@ -1,5 +1,12 @@
-"""Batch figures: the distribution over seeds of each metric per variant (box plots), one
-figure per metric, one subplot per vector component."""
+"""Batch figures, one per metric (and per numeric grid key).
+
+- A grid with a numeric key (``align.stages.0.t_z_s: [100, 120, …]``): the median over
+  seeds of |metric| against that key, one line per combination of the other grid values,
+  one column per case of the sweep (when other grid values draw the lines), one row per
+  vector component (:func:`sweep_figure`).
+- Otherwise: box plots of the distribution over seeds, one box per variant, one subplot per
+  vector component (:func:`batch_figure`).
+"""
 
 from __future__ import annotations
 
@@ -8,15 +15,39 @@ import json
 import numpy as np
 from matplotlib.figure import Figure
 
+from gcalign.app.batch.aggregate import metric_label, metric_units
+from gcalign.app.batch.sweep import CASE_KEY
 from gcalign.app.plots import _s, new_figure
 
 
+def _short_keys(keys: list[str]) -> dict[str, str]:
+    """The last part of each dotted key where it is unique (``t_z_s``), else the key."""
+    tails = [k.rsplit(".", 1)[-1] for k in keys]
+    return {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
+
+
+def _pairs(overrides: dict, keys: list[str], sep: str) -> str:
+    """``key=value`` of the given override keys, short key names, floats as ``%g``."""
+    short = _short_keys(keys)
+    return sep.join(f"{short[k]}={overrides[k]:g}" if isinstance(overrides[k], float) else
+                    f"{short[k]}={overrides[k]}" for k in keys if k in overrides)
+
+
 def _variant_label(overrides: dict, grid_keys: list[str]) -> str:
-    tails = [k.rsplit(".", 1)[-1] for k in grid_keys]
-    short = {k: (t if tails.count(t) == 1 else k)
-             for k, t in zip(grid_keys, tails, strict=True)}
-    return "\n".join(f"{short.get(k, k)}={v:g}" if isinstance(v, float) else
-                     f"{short.get(k, k)}={v}" for k, v in overrides.items()) or "base"
+    return _pairs(overrides, [*grid_keys, *(k for k in overrides if k not in grid_keys)],
+                  "\n") or "base"
+
+
+def _values_and_components(values, components: list[str] | None):
+    """Values as (R, k) and the names of the panels: the components, or one pooled panel
+    for more than 3 of them."""
+    values = np.asarray(values, float)
+    if values.ndim == 1:
+        values = values[:, None]
+    k = values.shape[1]
+    if k > 3:
+        return values, ["all components pooled"], True
+    return values, components or ([""] if k == 1 else [str(i) for i in range(k)]), False
 
 
 def batch_figure(metric: str, values: np.ndarray, variant: np.ndarray, labels: list[str],
@@ -28,14 +59,7 @@ def batch_figure(metric: str, values: np.ndarray, variant: np.ndarray, labels: l
     labels : one per variant (its overrides). More than 3 components (e.g. the errors at
     every azimuth of a north-finding sweep) are pooled into one subplot.
     """
-    values = np.asarray(values, float)
-    if values.ndim == 1:
-        values = values[:, None]
-    k = values.shape[1]
-    pooled = k > 3
-    comps = ["all components pooled"] if pooled else (components or
-                                                      ([""] if k == 1 else [str(i) for i in
-                                                                           range(k)]))
+    values, comps, pooled = _values_and_components(values, components)
     n_var = len(labels)
     fig, axes = new_figure(len(comps), width=max(6.0, 1.1 * n_var + 3.0),
                            height=2.8 * len(comps) + 1.4)
@@ -57,6 +81,95 @@ def batch_figure(metric: str, values: np.ndarray, variant: np.ndarray, labels: l
     return fig
 
 
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def numeric_axes(grid: dict) -> list[str]:
+    """Grid keys whose values are all numbers, at least two of them distinct: the x axes of
+    :func:`sweep_figure`."""
+    return [k for k, vals in grid.items()
+            if k != CASE_KEY and all(map(_is_number, vals)) and len(set(vals)) >= 2]
+
+
+def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides: list[dict],
+                 x_key: str, components: list[str] | None = None, units: str = "",
+                 title: str | None = None, name: str | None = None) -> Figure:
+    """Median over seeds of |metric| against the numeric grid key `x_key`.
+
+    values : (R,) or (R, k) for the R successful runs; variant : (R,) variant index of each;
+    overrides : the overrides of every variant (by index). One line per combination of the
+    other grid values; when the sweep has cases (``case`` in the overrides) and other grid
+    values too, one column per case, else one line per case. One row per component (more
+    than 3 are pooled); the band spans 25-75 % of |metric| over the seeds.
+    A row shares one y scale, logarithmic when its medians span more than a factor 30 and
+    are all > 0.
+    """
+    values, comps, pooled = _values_and_components(values, components)
+    values = np.abs(values)
+    keys = [key for key in dict.fromkeys(key for o in overrides for key in o) if key != x_key]
+    other = [key for key in keys if key != CASE_KEY]
+    # Cases get a column each when other grid values draw the lines; else they are the lines.
+    by_column = CASE_KEY in keys and bool(other)
+    cases = list(dict.fromkeys(o.get(CASE_KEY) for o in overrides)) if by_column else [None]
+    if not by_column and CASE_KEY in keys:
+        other = [CASE_KEY]
+    def line_of(o: dict) -> str:
+        return _pairs(o, other, ", ") or "median"
+
+    lines = list(dict.fromkeys(line_of(o) for o in overrides))
+    fig, axes = new_figure(len(comps), len(cases), width=4.3 * len(cases) + 1.5,
+                           height=2.9 * len(comps) + 1.3)
+    name = name or metric
+    x_units = metric_units(x_key)
+    for j, comp in enumerate(comps):
+        row = axes[j * len(cases):(j + 1) * len(cases)]
+        medians, spans = [], []
+        for ax, case in zip(row, cases, strict=True):
+            for li, line in enumerate(lines):
+                pts = []
+                for vi, o in enumerate(overrides):
+                    if (by_column and o.get(CASE_KEY) != case) or line_of(o) != line:
+                        continue
+                    sel = values[variant == vi]
+                    x = sel.ravel() if pooled else sel[:, j]
+                    x = x[np.isfinite(x)]
+                    if x.size:
+                        pts.append((float(o[x_key]), *np.percentile(x, [50, 25, 75])))
+                if not pts:
+                    continue
+                xs, med, lo, hi = np.array(sorted(pts)).T
+                color = f"C{li % 10}"
+                ax.plot(xs, med, marker="o", ms=3.5, color=color, label=line)
+                ax.fill_between(xs, lo, hi, color=color, alpha=0.12, lw=0, label="_25-75 %")
+                medians.extend(med)
+                spans.extend([*lo, *hi])
+        # One y scale per row, so that the cases compare at a glance.
+        med_arr, span = np.asarray(medians), np.asarray(spans)
+        log = bool(med_arr.size) and bool(np.all(med_arr > 0)) and (
+            med_arr.max() > 30 * med_arr.min())
+        for c, (ax, case) in enumerate(zip(row, cases, strict=True)):
+            if log:
+                ax.set_yscale("log")
+                pos = span[span > 0]
+                ax.set_ylim(min(pos.min(), med_arr.min()) / 1.5,
+                            max(pos.max(), med_arr.max()) * 1.5)
+            elif span.size:
+                ax.set_ylim(0.0, 1.05 * max(span.max(), med_arr.max()))
+            ax.grid(True, which="both", alpha=0.3)
+            if j == 0 and case is not None:
+                ax.set_title(f"{CASE_KEY}: {case}", fontsize="medium")
+            if c == 0:
+                label = f"median |{name}{' ' + comp if comp else ''}|"
+                ax.set_ylabel(f"{label} ({units})" if units else label)
+            if j == len(comps) - 1:
+                ax.set_xlabel(f"{x_key} ({x_units})" if x_units else x_key)
+    axes[0].legend(loc="best", fontsize="small")
+    fig.suptitle(title or f"median |{name}| over seeds against {x_key} "
+                          "(band: 25-75 % of the seeds)")
+    return fig
+
+
 def read_batch(f) -> tuple[dict, dict[str, np.ndarray], np.ndarray, np.ndarray]:
     summary = json.loads(_s(f.attrs["summary_json"]))
     r = f["batch/runs"]
@@ -72,14 +185,26 @@ def figures(f, name: str) -> dict[str, Figure]:
     if "batch" not in f:
         return figs
     summary, metrics, variant, _ = read_batch(f)
-    grid_keys = list(summary.get("grid") or {})
-    labels = [_variant_label(v["overrides"], grid_keys) for v in summary["variants"]]
+    grid = summary.get("grid") or {}
+    grid_keys = list(grid)
+    overrides = [v["overrides"] for v in summary["variants"]]
+    labels = [_variant_label(o, grid_keys) for o in overrides]
+    x_keys = numeric_axes(grid)
+    short = _short_keys(x_keys)
     for m in summary["metrics"]:
         st = next((v["stats"].get(m) for v in summary["variants"]
                    if v["stats"].get(m, {}).get("components")), None) or {}
         units = next((v["stats"][m].get("units", "") for v in summary["variants"]
                       if m in v["stats"]), "")
-        figs[f"batch_{m.replace('.', '_')}"] = batch_figure(
-            m, metrics[m], variant, labels, st.get("components"), units,
-            title=f"{summary['sweep']}: {m} over {summary['seeds']} seed(s) per variant")
+        name = metric_label(summary["command"], m)
+        stem = f"batch_{m.replace('.', '_')}"
+        for x_key in x_keys:
+            figs[f"{stem}_vs_{short[x_key].replace('.', '_')}"] = sweep_figure(
+                m, metrics[m], variant, overrides, x_key, st.get("components"), units,
+                title=f"{summary['sweep']}: median |{name}| over {summary['seeds']} seed(s) "
+                      f"against {short[x_key]} (band: 25-75 % of the seeds)", name=name)
+        if not x_keys:
+            figs[stem] = batch_figure(
+                m, metrics[m], variant, labels, st.get("components"), units,
+                title=f"{summary['sweep']}: {name} over {summary['seeds']} seed(s) per variant")
     return figs

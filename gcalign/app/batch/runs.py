@@ -2,8 +2,9 @@
 
 Everything here is a top-level, picklable function that never imports rich: a task
 (a plain dict) goes in, a record (a plain dict) comes out, and a failing run is recorded,
-never raised. Each worker process caches the parsed scenario and the noise-free
-simulation of a variant, so successive seeds only add their sensor errors.
+never raised. Each worker process caches the parsed scenario of a variant and the
+noise-free simulation of a site and motion, so successive runs only add their sensor
+errors (and variants that differ only in errors or algorithm settings share it).
 """
 
 from __future__ import annotations
@@ -36,10 +37,22 @@ def _scenario(task: dict):
     return sc
 
 
+def noise_free_key(sc) -> str | None:
+    """What the noise-free part of a simulation depends on (site, earth, motion, mechanism,
+    IMU rate: :func:`gcalign.app.data.noise_free`), as a cache key: variants that differ only
+    in sensor errors or algorithm settings (a T_z × mode sweep) share one simulation."""
+    if sc.motion is None or sc.site is None:
+        return None
+    mech = "" if sc.mechanism is None else sc.mechanism.model_dump_json()
+    return "|".join((sc.site.model_dump_json(), sc.earth, sc.motion.model_dump_json(), mech,
+                     repr(float(sc.imu.rate_hz))))
+
+
 def run_summary(command: str, sc, seed: int, cache_key: str | None = None) -> dict:
     """The summary dict a single run of `command` would print (through its room).
 
-    `cache_key` (the variant) lets successive seeds share the noise-free simulation.
+    `cache_key` (:func:`noise_free_key`) lets successive runs share the noise-free
+    simulation.
     """
     from gcalign.app.registry import command as lookup
 
@@ -89,7 +102,8 @@ def run_task(task: dict) -> dict:
     rec = {"variant": task["variant"], "vkey": task["vkey"], "seed": task["seed"],
            "status": "ok", "metrics": {}, "error": ""}
     try:
-        summary = run_summary(task["command"], _scenario(task), task["seed"], task["vkey"])
+        sc = _scenario(task)
+        summary = run_summary(task["command"], sc, task["seed"], noise_free_key(sc))
         rec["metrics"] = {m: metric_value(summary, m) for m in task["metrics"]}
     except MetricError as err:
         rec.update(status="bad-metric", error=str(err), metrics={})
@@ -107,39 +121,35 @@ def run_chunk(tasks: list[dict]) -> list[dict]:
 
 
 def kernel_cache_stats() -> dict:
-    """Numba dispatchers of gcalign loaded in this process: cache hits and misses.
-
-    A miss means the kernel was compiled here instead of loaded from the on-disk cache.
-    """
+    """Numba dispatchers of gcalign loaded in this process: cache hits and misses, and the
+    dispatchers that missed (a miss means the kernel was compiled here instead of loaded
+    from the on-disk cache)."""
     hits = misses = 0
-    for name in ("gcalign.nav._kernels", "gcalign.align.kernel", "gcalign.northfind._kernel"):
-        mod = sys.modules.get(name)
-        for obj in vars(mod).values() if mod else ():
+    missed = []
+    for name, mod in list(sys.modules.items()):
+        if not name.startswith("gcalign.") or mod is None:
+            continue
+        for attr, obj in vars(mod).items():
             stats = getattr(obj, "stats", None)
             if stats is not None and hasattr(stats, "cache_misses"):
                 hits += sum(stats.cache_hits.values())
-                misses += sum(stats.cache_misses.values())
-    return {"pid": os.getpid(), "cache_hits": hits, "cache_misses": misses}
-
-
-WARM_SCENARIO = {
-    "name": "warm-up",
-    "site": {"lat_deg": 45.0, "lon_deg": 126.0},
-    "imu": {"gyro": {"bias_dph": [0.01, 0.01, 0.01]}, "accel": {"bias_ug": [50, 50, 50]}},
-    "motion": {"kind": "moving", "attitude_deg": [0, 0, 30], "duration_s": 3,
-               "segments": [{"duration_s": 1}, {"duration_s": 2, "accel_mps2": 0.5}]},
-    "align": {"t1_s": 1, "t2_s": 2, "t3_s": 2.5, "passes": 3, "level_s": 0.1,
-              "aiding": {"source": "odometer"}},
-}
+                m = sum(stats.cache_misses.values())
+                misses += m
+                if m:
+                    missed.append(f"{name}.{attr}")
+    return {"pid": os.getpid(), "cache_hits": hits, "cache_misses": misses,
+            "missed": sorted(set(missed))}
 
 
 def warm_up(command: str = "align") -> dict:
-    """Load the numba kernels (from the on-disk JIT cache) with a tiny run, once per process."""
-    if command == "align":
-        from gcalign.io.scenario import parse_scenario
+    """Load the numba kernels a command runs (from the on-disk JIT cache) with a tiny run of
+    its room's ``warm_up()``, if it has one; once per process."""
+    from gcalign.app.registry import COMMANDS
 
+    room = COMMANDS[command].load() if command in COMMANDS else None
+    if room is not None and hasattr(room, "warm_up"):
         try:
-            run_summary("align", parse_scenario(copy.deepcopy(WARM_SCENARIO), "warm-up"), 1)
+            room.warm_up()
         except Exception:  # noqa: BLE001 - warming is an optimisation only
             pass
     return kernel_cache_stats()

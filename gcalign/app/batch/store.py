@@ -120,6 +120,7 @@ def write_batch_h5(output: Path, sweep: Sweep, records: dict, summary: dict) -> 
         b.attrs["seeds"], b.attrs["seed_start"] = sweep.seeds, sweep.seed_start
         b.attrs["metrics"] = json.dumps(list(sweep.metrics))
         b.attrs["grid_json"] = json.dumps(sweep.grid, default=str)
+        b.attrs["cases_json"] = json.dumps(sweep.cases, default=str)
         b.attrs["base_yaml"] = sweep.base_text
         b.attrs["fingerprint"] = sweep.fingerprint
         b.attrs["complete"] = bool(summary["complete"])

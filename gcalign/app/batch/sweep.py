@@ -3,11 +3,13 @@
 The sweep format is described in ``docs/batch.md``.
 
 A *sweep* is a base scenario (a path relative to the sweep file, or an inline mapping), a
-*grid* of overrides by dotted key (``align.stages.0.t_z_s: [100, 150, 200]``), a seed count
-and the *metrics* to aggregate (dotted paths into the run summary, e.g. ``error_t3_deg``).
-A *variant* is one point of the Cartesian product of the grid; a *run* is a variant and a
-seed. Every variant runs the same seeds ``seed_start .. seed_start + seeds - 1`` (common
-random numbers), so differences between variants are not masked by different noise.
+*grid* of overrides by dotted key (``align.stages.0.t_z_s: [100, 150, 200]``), optional
+named *cases* (settings that change several keys together, e.g. an IMU grade and its
+aiding), a seed count and the *metrics* to aggregate (dotted paths into the run summary,
+e.g. ``error_t3_deg``). A *variant* is one point of the Cartesian product cases × grid; a
+*run* is a variant and a seed. Every variant runs the same seeds
+``seed_start .. seed_start + seeds - 1`` (common random numbers), so differences between
+variants are not masked by different noise.
 """
 
 from __future__ import annotations
@@ -25,12 +27,14 @@ from gcalign.errors import ScenarioError
 
 COMMANDS = tuple(batchable())
 DEFAULT_METRICS = {name: c.batch_metrics for name, c in batchable().items()}
-SWEEP_KEYS = ("name", "base", "command", "grid", "seeds", "seed_start", "metrics")
+SWEEP_KEYS = ("name", "base", "command", "cases", "grid", "seeds", "seed_start", "metrics")
+CASE_KEY = "case"  # the pseudo grid key of a variant's case (not a scenario key)
 
 
 @dataclass(frozen=True)
 class Variant:
-    """One grid point: its overrides (dotted key -> value) and the resulting scenario."""
+    """One grid point: its overrides (dotted key -> value; ``case`` -> the case's name when
+    the sweep has cases) and the resulting scenario."""
 
     index: int
     overrides: dict
@@ -54,7 +58,8 @@ class Sweep:
     text: str
     base_source: str
     base_text: str
-    grid: dict
+    grid: dict  # with cases: {"case": [names], **grid}, the axes in variant order
+    cases: dict  # case name -> its overrides (dotted key -> value); {} without cases
     seeds: int
     seed_start: int
     metrics: tuple[str, ...]
@@ -177,11 +182,15 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     if not isinstance(grid, dict):
         raise ScenarioError(f"{source}: grid: must be a mapping of dotted key -> list of values, "
                             f"got {type(grid).__name__}")
+    cases = _cases(data.get("cases"), source)
     axes: dict[str, list] = {}
     for key, values in grid.items():
         if not isinstance(key, str) or not key:
             raise ScenarioError(f"{source}: grid: {key!r}: keys must be dotted paths "
                                 "(e.g. align.mode)")
+        if key == CASE_KEY:
+            raise ScenarioError(f"{source}: grid: {CASE_KEY}: reserved for the names of the "
+                                "sweep's cases; give settings under 'cases:'")
         if not isinstance(values, list):
             values = [values]  # one fixed value
         if not values:
@@ -193,7 +202,17 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
                 raise ScenarioError(f"{source}: grid: {key}: value {values[i]!r} appears twice")
         axes[key] = values
 
-    # Each key and value alone against the base: a message that names exactly that pair.
+    # Each case alone, then each grid key and value alone against the base: a message that
+    # names exactly that case or pair.
+    for case, over in cases.items():
+        trial = copy.deepcopy(base_data)
+        where = f"{source}: cases: {case}"
+        for key, value in over.items():
+            try:
+                apply_override(trial, key, value, base_model)
+            except ScenarioError as err:
+                raise ScenarioError(f"{where}: {key} = {value!r}: {err}") from None
+        _check_section(parse_scenario(trial, where), command, where)
     for key, values in axes.items():
         for value in values:
             trial = copy.deepcopy(base_data)
@@ -204,15 +223,20 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
             where = f"{source}: grid: {key} = {value!r}"
             _check_section(parse_scenario(trial, where), command, where)
 
-    # Then every combination (a value may be valid alone but not with another one).
+    # Then every combination (a value may be valid alone but not with another one). A case's
+    # overrides are applied first, then the grid's.
+    if cases:
+        axes = {CASE_KEY: list(cases), **axes}
     keys = list(axes)
     variants = []
     for i, combo in enumerate(itertools.product(*(axes[k] for k in keys))):
         overrides = dict(zip(keys, combo, strict=True))
         scenario = copy.deepcopy(base_data)
         label = ", ".join(f"{k} = {v!r}" for k, v in overrides.items())
+        applied = [*cases.get(str(overrides.get(CASE_KEY)), {}).items(),
+                   *((k, v) for k, v in overrides.items() if k != CASE_KEY)]
         try:
-            for k, v in overrides.items():
+            for k, v in applied:
                 apply_override(scenario, k, v, base_model)
         except ScenarioError as err:
             raise ScenarioError(f"{source}: grid: variant {label}: {err}") from None
@@ -221,8 +245,33 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
         variants.append(Variant(i, overrides, scenario,
                                 _hash(command, list(metrics), scenario)))
     return Sweep(name=name, command=command, source=source, text=text,
-                 base_source=base_source, base_text=base_text, grid=axes, seeds=seeds,
+                 base_source=base_source, base_text=base_text, grid=axes, cases=cases,
+                 seeds=seeds,
                  seed_start=seed_start, metrics=tuple(metrics), variants=tuple(variants))
+
+
+def _cases(cases, source: str) -> dict[str, dict]:
+    """The ``cases:`` mapping checked for shape: name -> mapping of dotted key -> value."""
+    if cases is None:
+        return {}
+    if not isinstance(cases, dict) or not cases:
+        raise ScenarioError(f"{source}: cases: must be a non-empty mapping of case name -> "
+                            f"overrides (dotted key -> value), got {cases!r}")
+    out: dict[str, dict] = {}
+    for name, over in cases.items():
+        if not isinstance(name, str) or not name.strip():
+            raise ScenarioError(f"{source}: cases: {name!r}: a case name must be a non-empty "
+                                "string")
+        over = {} if over is None else over
+        if not isinstance(over, dict):
+            raise ScenarioError(f"{source}: cases: {name}: must be a mapping of dotted key -> "
+                                f"value (or empty), got {over!r}")
+        for key in over:
+            if not isinstance(key, str) or not key:
+                raise ScenarioError(f"{source}: cases: {name}: {key!r}: keys must be dotted "
+                                    "paths (e.g. imu.gyro.arw_dprh)")
+        out[name] = dict(over)
+    return out
 
 
 def _check_section(sc, command: str, where: str) -> None:

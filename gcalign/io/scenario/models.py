@@ -15,6 +15,7 @@ from gcalign.io.scenario.modulate import ModulateConfig
 from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
+from gcalign.io.scenario.realtime import RealtimeConfig
 from gcalign.nav.earth import MODELS, EarthModel
 from gcalign.sim.errors import ImuErrors, SensorErrors
 
@@ -140,6 +141,7 @@ class Scenario(Model):
     output: OutputConfig = Field(default_factory=OutputConfig)
     align: AlignConfig | None = None
     northfind: NorthfindConfig | None = None
+    realtime: RealtimeConfig | None = None
     modulate: ModulateConfig | None = None
 
     @property

@@ -1,0 +1,198 @@
+"""Real-time attitude output of a scenario (seed 003; spec 003): every case through the
+chain on the core, summarised per the JSON contract of ``gcalign realtime --json``.
+
+``run_realtime(sc, seed)`` turns the ``realtime`` section into core settings and cases and
+runs them (:func:`gcalign.realtime.table.table1`: each case on its own child generator);
+``realtime_summary(run, sc)`` is the plain dict that ``--json`` prints, the results file
+stores and ``gcalign show`` reprints.
+
+Summary (arc-seconds, milliseconds, degrees). Top level: ``filter_delay_ms`` (the T the
+predictors use), ``chain_delay_ms`` (the designed chain's own low-frequency group delay),
+``reference`` (``seed``: errors against the INS's own output T later, the seed's
+semi-physical metric; ``truth``: against the true attitude at the pulse time), the noise
+model and tracker tuning (``model``), ``cases``. Per case: ``name``, ``motion``
+(``rate | accel | swing | turntable``), the parameters that apply (``rate_dps``,
+``accel_dps2``, ``jerk_dps3``, ``amplitude_deg``, ``frequency_hz``), ``pulses``
+(``synchronous | asynchronous``), ``before_max_arcsec`` (the latched attitude's peak error),
+``before_slope_arcsec_per_s`` (accel), ``before_theory_*`` (the closed form), per predictor
+``after_max_arcsec`` and ``after_rms_arcsec`` (and ``corner_max_arcsec`` on ramps), all on
+the reference; the same against the truth under ``truth``; ``lag_ms`` at uniform rate
+(seed Fig. 4). Errors are those of the Euler angle the turn moves (``component``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from gcalign import units as u
+from gcalign.app.registry import Outcome
+from gcalign.errors import ScenarioError
+from gcalign.io.scenario import Scenario
+from gcalign.io.scenario.realtime import RealtimeConfig
+from gcalign.realtime.cases import Case
+from gcalign.realtime.chain import CaseResult, build_chain
+from gcalign.realtime.filters import FilterChain
+from gcalign.realtime.settings import Settings
+from gcalign.realtime.table import CaseSummary, summarise, table1
+
+__all__ = ["RealtimeRun", "execute", "realtime_summary", "run_realtime"]
+
+COMPONENTS = ("pitch", "roll", "yaw")
+
+
+@dataclass(frozen=True)
+class RealtimeRun:
+    """A run: configuration, SI settings, the filter chain, per case its result and its
+    row of the table, the seed and the compute time."""
+
+    cfg: RealtimeConfig
+    settings: Settings
+    chain: FilterChain
+    results: list[CaseResult]
+    rows: list[CaseSummary]
+    seed: int
+    compute_s: float
+
+
+def run_realtime(sc: Scenario, seed: int | None = None) -> RealtimeRun:
+    """Run every case of the scenario's ``realtime`` section.
+
+    Raises
+    ------
+    ScenarioError
+        Missing section or a value the chain cannot use (names the field).
+    """
+    cfg = sc.realtime
+    if cfg is None:
+        raise ScenarioError("realtime: missing; the scenario needs a 'realtime' section "
+                            "(cases or a turntable motion, filter, sensor, tracker, pulses)")
+    cases = cfg.cases_of(sc)
+    settings = cfg.to_settings()
+    seed = sc.imu.seed if seed is None else int(seed)
+    if seed < 0:
+        raise ScenarioError(f"imu.seed (--seed): must be ≥ 0, got {seed}")
+    assert sc.site is not None  # checked by cases_of
+    t0 = time.perf_counter()
+    results = table1(settings, np.random.default_rng(seed), cases, site=sc.site.to_si(),
+                     earth=sc.earth_model)
+    rows = [summarise(r) for r in results]
+    return RealtimeRun(cfg=cfg, settings=settings, chain=build_chain(settings),
+                       results=results, rows=rows, seed=seed,
+                       compute_s=time.perf_counter() - t0)
+
+
+def _as(x: float) -> float | None:
+    """rad → arc-seconds; nan → None (JSON null)."""
+    return None if not math.isfinite(x) else float(x) / u.ARCSEC
+
+
+def _user(x: float, unit: float = 1.0) -> float:
+    """SI → user units, without the round trip's last-digit noise (15 °/s, not 14.999…)."""
+    return float(f"{x / unit:.12g}")
+
+
+def _motion(case: Case) -> dict:
+    s = case.shape
+    d = u.DEG
+    out: dict = {"motion": s.kind, "axis": None if s.axis is None else list(s.axis),
+                 "component": COMPONENTS[case.component], "duration_s": case.duration,
+                 "attitude_deg": [_user(a, d) for a in case.att0]}
+    if s.kind in ("rate", "accel"):
+        out["rate_dps"] = _user(s.rate, d)
+    if s.kind == "accel":
+        out["accel_dps2"] = _user(s.accel, d)
+        out["jerk_dps3"] = None if s.jerk is None else _user(s.jerk, d)
+    if s.kind == "swing":
+        out["amplitude_deg"] = _user(s.amplitude, d)
+        out["frequency_hz"] = _user(s.frequency)
+    return out
+
+
+def _errors(row: CaseSummary, metric: str, kind: str) -> dict:
+    out = {
+        "before_max_arcsec": _as(row.before_max[metric]),
+        "after_max_arcsec": {p: _as(st.max[metric]) for p, st in row.stats.items()},
+        "after_rms_arcsec": {p: _as(st.rms[metric]) for p, st in row.stats.items()},
+    }
+    if kind == "accel":
+        out["before_slope_arcsec_per_s"] = _as(row.before[metric])
+        out["before_theory_arcsec_per_s"] = _as(row.before_theory[metric])
+        out["corner_max_arcsec"] = {p: _as(st.corner_max[metric])
+                                    for p, st in row.stats.items()}
+    else:
+        out["before_theory_arcsec"] = _as(row.before_theory[metric])
+    return out
+
+
+def case_summary(res: CaseResult, row: CaseSummary, reference: str) -> dict:
+    """One case of the summary (see the module docstring)."""
+    case, p = res.case, res.pulses
+    train = case.pulses or res.settings.pulses
+    entry = {"name": case.name, **_motion(case),
+             "pulses": "synchronous" if train.mode == "solution" else "asynchronous",
+             "pulse_rate_hz": train.rate_hz, "n_pulses": row.n_pulses,
+             "dt_us": {"min": float(np.min(p.dt_true)) * 1e6 if len(p) else None,
+                       "max": float(np.max(p.dt_true)) * 1e6 if len(p) else None},
+             **_errors(row, reference, case.kind),
+             "truth": _errors(row, "truth", case.kind),
+             "lag_ms": None if not math.isfinite(row.lag) else row.lag * 1e3,
+             "seed_before": case.seed_before, "seed_after": case.seed_after}
+    return entry
+
+
+def realtime_summary(run: RealtimeRun, sc: Scenario) -> dict:
+    """Plain-number summary: the JSON contract of ``gcalign realtime --json``."""
+    s, chain, cfg = run.settings, run.chain, run.cfg
+    T = chain.delay if s.delay_s is None else float(s.delay_s)
+    site = sc.site
+    assert site is not None
+    f, sen, tr = s.filter, s.sensor, s.tracker
+    return {
+        "scenario": sc.name,
+        "seed": run.seed,
+        "semi_physical": cfg.semi_physical,
+        "reference": cfg.reference,
+        "filter_delay_ms": T * 1e3,
+        "delay_intervals": T / s.tau,
+        "chain_delay_ms": chain.delay * 1e3,
+        "fir_delay_ms": chain.fir_delay * 1e3,
+        "notch_delay_us": chain.notch_delay * 1e6,
+        "fs_hz": f.fs_hz,
+        "solution_hz": s.solution_hz,
+        "predictors": list(s.predictors),
+        "site": {"lat_deg": site.lat_deg, "lon_deg": site.lon_deg, "height_m": site.height_m},
+        "earth": sc.earth,
+        "model": {
+            "chain": f.chain,
+            "fir_order": f.nav_order if f.chain == "navigation" else f.align_order,
+            "fir_cutoff_hz": f.nav_cutoff_hz if f.chain == "navigation" else f.align_cutoff_hz,
+            "window": f.window,
+            "notch_hz": f.notch_hz if f.chain == "navigation" else None,
+            "notch_q": f.notch_q,
+            "quantum_arcsec": sen.quantum / u.ARCSEC,
+            "arw_dprh": sen.arw / u.DPSH,
+            "dither_arcsec": sen.dither_amplitude / u.ARCSEC,
+            "dither_hz": sen.dither_hz,
+            "qc_rad2ps5": tr.qc,
+            "r_std_arcsec": math.sqrt(tr.r) / u.ARCSEC,
+            "p0_std": [tr.sigma0[0] / u.ARCSEC, tr.sigma0[1] / u.DEG, tr.sigma0[2] / u.DEG],
+        },
+        "settle_s": s.settle_s,
+        "corner_ms": s.corner_s * 1e3,
+        "cases": [case_summary(r, row, cfg.reference)
+                  for r, row in zip(run.results, run.rows, strict=True)],
+        "compute_s": run.compute_s,
+    }
+
+
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Outcome:
+    """Run, summarise; the registry's entry point."""
+    from gcalign.app.realtime.hdf5 import write_realtime
+
+    run = run_realtime(sc, seed)
+    return Outcome(realtime_summary(run, sc), lambda f: write_realtime(f, run), None,
+                   run.seed)

@@ -1,0 +1,167 @@
+"""The seed's observability table (Table 1 analogue) on a trajectory (seed 002 §3–4, spec §4).
+
+Each manoeuvre (segment) is cut into pieces of ``piece_s`` (1 s; the last piece of a
+segment may be shorter) with F from the truth at the middle of the piece. Per segment:
+the SOM of its pieces, the SVD degree η (states unscaled by default, as the paper), the
+rank, the TOM rank, and the null-space condition ``null(O_j) ⊂ null(F_j)`` under which the
+two ranks must agree (seed eq. 12). Cumulative: the SOM from the start of the run to the
+end of each segment. Beside them, the covariance degree σ_k(0)/σ_k(t) (PSINS ``kfstat``)
+from :func:`gcalign.calibrate.filter.covariance_run`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from gcalign.calibrate.data import Span, Trajectory
+from gcalign.calibrate.filter import Settings, covariance_run
+from gcalign.errors import ScenarioError
+from gcalign.estimation import ins_error as ie
+from gcalign.estimation import observability as ob
+
+SCALINGS = ("none", "p0")
+
+
+@dataclass(frozen=True)
+class ObservabilityTable:
+    """Degrees of observability per segment and cumulative (S segments, 21 states).
+
+    eta, sigma_state : (S, 21) per-segment SOM degree η = σ_(k)/σ_0 and the state's σ.
+    rank, tom_rank : (S,) per-segment SOM and TOM ranks.
+    null_residual : (S,) the largest ``‖F_j N_j‖/‖F_j‖`` over the segment's pieces
+        (N_j = null(O_j)); condition : (S,) whether it is ≤ null_tol.
+    eta_cum, rank_cum, tom_rank_cum : the same from the start of the run to each segment end.
+    cov_degree : (S, 21) σ_k(0)/σ_k(t_end); cov_degree_segment : σ_k(t_start)/σ_k(t_end);
+        None without the covariance run.
+    """
+
+    segments: tuple[str, ...]
+    measure: str
+    scaling: str
+    rtol: float
+    piece_s: float
+    eta: np.ndarray
+    sigma_state: np.ndarray
+    rank: np.ndarray
+    tom_rank: np.ndarray
+    null_residual: np.ndarray
+    condition: np.ndarray
+    eta_cum: np.ndarray
+    rank_cum: np.ndarray
+    tom_rank_cum: np.ndarray
+    cov_degree: np.ndarray | None
+    cov_degree_segment: np.ndarray | None
+    names: tuple[str, ...] = field(default=ie.STATE_NAMES)
+
+
+@dataclass(frozen=True)
+class Pieces:
+    """PWCS pieces of a run: F (J, 21, 21) at the piece midpoints, duration (J,) s,
+    segment (J,) index of the segment each piece belongs to."""
+
+    F: np.ndarray
+    duration: np.ndarray
+    segment: np.ndarray
+
+
+def pieces(truth: Trajectory, segments, piece_s: float = 1.0) -> Pieces:
+    """Cut each segment into pieces of `piece_s` and evaluate F at their midpoints."""
+    if not (np.isfinite(piece_s) and piece_s > 0):
+        raise ScenarioError(f"piece_s: must be a positive number of seconds, got {piece_s!r}")
+    t0, t1 = float(truth.t[0]), float(truth.t[-1])
+    mids, durs, seg = [], [], []
+    for i, sp in enumerate(segments):
+        if not (t0 - 1e-9 <= sp.start < sp.end <= t1 + 1e-9):
+            raise ScenarioError(f"segments[{i}] ({sp.name!r}): [{sp.start:g}, {sp.end:g}] s "
+                                f"is not a non-empty part of the run [{t0:g}, {t1:g}] s")
+        edges = np.r_[np.arange(sp.start, sp.end - 1e-9, piece_s), sp.end]
+        mids.append(0.5 * (edges[1:] + edges[:-1]))
+        durs.append(np.diff(edges))
+        seg.append(np.full(len(edges) - 1, i))
+    mid = np.concatenate(mids)
+    k = np.clip(np.floor((mid - t0) / truth.ts + 1e-9).astype(int), 0, len(truth.f_b) - 1)
+    F = ie.error_matrix(*truth.midpoints(k))
+    return Pieces(F=F, duration=np.concatenate(durs), segment=np.concatenate(seg))
+
+
+def _stack_r(R: np.ndarray | None, rows: np.ndarray) -> np.ndarray:  # (≤ n, n)
+    """Triangular factor of ``[R; rows]``: the SVD of a stack only needs it."""
+    return ob.r_factor(rows if R is None else np.vstack([R, rows]))
+
+
+def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: str = "velocity",
+                        scaling: str = "none", rtol: float = ob.RANK_RTOL_DEFAULT,
+                        piece_s: float = 1.0, null_tol: float = 1e-9,
+                        settings: Settings | None = None,
+                        covariance: bool = True) -> ObservabilityTable:
+    """The per-segment and cumulative observability table of `truth` (spec 002 §4).
+
+    measure : "velocity" | "position" | "both"; σ_0 is the largest σ of the directly
+        measured states (the non-zero columns of H).
+    scaling : "none" (the paper) or "p0" (columns scaled by the initial σ of `settings`).
+    rtol : relative rank tolerance (singular values ≤ rtol·σ_max are zero).
+    null_tol : the null-space condition holds where the residual is at most this.
+    settings : filter settings for P0 (scaling p0) and the covariance degree (its measure
+        is replaced by `measure`); default :class:`Settings`.
+    """
+    if scaling not in SCALINGS:
+        raise ScenarioError(f"scaling: got {scaling!r}, allowed: {', '.join(SCALINGS)}")
+    if not (0.0 < rtol < 1.0):
+        raise ScenarioError(f"rtol: must lie in (0, 1), got {rtol!r}")
+    s = replace(settings or Settings(), measure=measure)
+    H = ie.measurement_matrix(measure, truth.pos[0])
+    measured = np.flatnonzero(np.any(H != 0.0, axis=0))
+    scale = np.sqrt(np.diag(s.covariances(truth.pos[0])[0])) if scaling == "p0" else None
+    sc = np.ones(ie.N_STATES) if scale is None else scale
+    pc = pieces(truth, segments, piece_s)
+    # O_j = Q_j R_j: every stack of O_j (SOM) or O_j M (TOM) has the singular values and
+    # right vectors of the same stack of R_j, half the rows
+    O = ob.piece_matrix(pc.F, H)
+    Rp = np.asarray(np.linalg.qr(O, mode="r"))
+    Phi = ob.expm_stack(pc.F * pc.duration[:, None, None])
+    # condition of seed eq. (12), in the coordinates the ranks are taken in (x = diag(sc) y)
+    resid_piece = ob.null_space_residual(Rp * sc, pc.F * sc / sc[:, None], rtol)
+
+    n_seg = len(segments)
+    eta, sig = np.zeros((n_seg, ie.N_STATES)), np.zeros((n_seg, ie.N_STATES))
+    eta_c = np.zeros((n_seg, ie.N_STATES))
+    rank, tom_rank, rank_c, tom_c = (np.zeros(n_seg, int) for _ in range(4))
+    resid = np.zeros(n_seg)
+    R_cum: np.ndarray | None = None
+    R_tom_cum: np.ndarray | None = None
+    M_cum = np.eye(ie.N_STATES)
+    for i in range(n_seg):
+        js = np.flatnonzero(pc.segment == i)
+        R_seg = _stack_r(None, ob.som(Rp[js]))
+        d = ob.degree(R_seg, measured, scale, rtol)
+        eta[i], sig[i], rank[i] = d.eta, d.sigma_state, d.rank
+        # TOM of the segment alone (from its first piece) and from the start of the run
+        M = np.eye(ie.N_STATES)
+        rows, rows_cum = [], []
+        for j in js:
+            rows.append(Rp[j] @ M)
+            rows_cum.append(Rp[j] @ M_cum)
+            M, M_cum = Phi[j] @ M, Phi[j] @ M_cum
+        tom_rank[i] = ob.degree(_stack_r(None, np.vstack(rows)), measured, scale, rtol).rank
+        R_tom_cum = _stack_r(R_tom_cum, np.vstack(rows_cum))
+        tom_c[i] = ob.degree(R_tom_cum, measured, scale, rtol).rank
+        R_cum = _stack_r(R_cum, R_seg)
+        dc = ob.degree(R_cum, measured, scale, rtol)
+        eta_c[i], rank_c[i] = dc.eta, dc.rank
+        resid[i] = resid_piece[js].max()
+
+    cov = cov_seg = None
+    if covariance:
+        run = covariance_run(truth, s)
+        P_end = np.array([run.at(sp.end) for sp in segments])
+        P_start = np.array([run.at(sp.start) for sp in segments])
+        cov = ob.covariance_degree(run.P[0], P_end)
+        cov_seg = np.sqrt(np.diagonal(P_start, axis1=1, axis2=2)
+                          / np.diagonal(P_end, axis1=1, axis2=2))
+    return ObservabilityTable(
+        segments=tuple(sp.name for sp in segments), measure=measure, scaling=scaling, rtol=rtol,
+        piece_s=piece_s, eta=eta, sigma_state=sig, rank=rank, tom_rank=tom_rank,
+        null_residual=resid, condition=resid <= null_tol, eta_cum=eta_c, rank_cum=rank_c,
+        tom_rank_cum=tom_c, cov_degree=cov, cov_degree_segment=cov_seg)

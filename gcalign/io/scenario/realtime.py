@@ -1,0 +1,334 @@
+"""The `realtime` section of a scenario (seed 003; spec 003): attitude at external sync
+pulses, the filter delay, and its prediction.
+
+Either a list of turntable cases (the seed's Table 1 is one file,
+``configs/seed003_table1.yaml``) or one case from the scenario's own turntable motion
+(``motion.kind: turntable``; ``configs/seed003_rate20_async.yaml``)::
+
+    name: seed003-table1
+    site: {lat_deg: 34.25, lon_deg: 108.9, height_m: 400}   # sets the earth rate sensed
+    imu: {seed: 2027}                 # only the seed: the gyro model is realtime.sensor
+    realtime:
+      semi_physical: true             # the seed's §3.2 setting (see below)
+      solution_hz: 1000               # attitude solution rate f2
+      delay_ms: null                  # T the predictors use; null: the chain's group delay
+      predictors: [none, taylor, kalman-ls]
+      filter: {fs_hz: 5000, chain: navigation, nav_order: 40, nav_cutoff_hz: 200,
+               align_order: 180, align_cutoff_hz: 100, notch_hz: 400, notch_q: 10,
+               window: hamming}
+      sensor: {quantum_arcsec: 0.1, arw_dprh: 0.0005, dither_arcsec: 100, dither_hz: 400}
+      tracker: {qc_rad2ps5: 1, r_std_arcsec: 0.03, p0_theta_arcsec: 0.03,
+                p0_omega_dps: 20, p0_alpha_dps2: 20}
+      pulses: {mode: solution, rate_hz: 1000, offset_us: 0}   # or mode: async (below)
+      settle_s: 1                     # start of each case not scored
+      warmup_s: 0.2                   # gyros and filters run at rest before t = 0
+      corner_ms: 50                   # ± window around steps in α, reported apart
+      cases:
+        - name: rate 5°/s
+          seed_before: 72″            # the seed's Table 1 entries, shown beside ours
+          seed_after: < 0.3″
+          steps: [{axis: z, profile: rate, rate_dps: 5, duration_s: 12}]
+        - name: accel 5°/s²
+          steps: [{profile: rest, duration_s: 1},
+                  {axis: z, profile: ramp, accel_dps2: 5, rate_dps: 15, duration_s: 11}]
+        - name: swing 10° 0.1 Hz
+          steps: [{axis: z, profile: swing, amplitude_deg: 10, frequency_hz: 0.1,
+                   duration_s: 12}]
+        - name: rate 20°/s async      # a case may bring its own pulse train
+          steps: [{axis: z, profile: rate, rate_dps: 20, duration_s: 12}]
+          pulses: {mode: async, rate_hz: 100, offset_us: null, jitter_us: 2,
+                   drift_ppm: 100, resolution_us: 1}
+
+Rules
+-----
+* ``semi_physical: true`` is the seed's semi-physical setting: T fixed at 4 ms (n = 4
+  solution intervals), pulses on every solution instant (Δt = 0), and the reference of the
+  reported errors is the INS's own output T later (the seed's metric). ``delay_ms`` and
+  ``pulses`` then do not apply (an error if given); a case's own ``pulses`` still does.
+  ``false``: T = ``delay_ms`` or the chain's low-frequency group delay, pulses as given,
+  errors against the true attitude at the pulse time. Both references are always in the
+  summary.
+* Rows are the turntable rows of ``motion.kind: turntable`` (``rate | ramp (jerk_dps3) |
+  swing | trapezoid | rest``, any axis, each about an axis of the body itself); a case
+  lasts its rows' total (or ``duration_s``), from ``attitude_deg`` at rest before t = 0.
+* ``pulses.offset_us``: ``solution`` mode, the pulse's fixed distance after each solution
+  instant (Δt, < 1/solution_hz); ``async``, the first edge (null: uniform random in
+  [0, 1/rate_hz)). ``resolution_us``: the Δt counter's resolution (0: exact).
+* ``site`` is required (the earth rate the gyros sense, removed by the INS). The ``imu``
+  section gives only ``seed``: its error terms must be zero and ``imu.rate_hz``, if given,
+  equal to ``filter.fs_hz``. No ``mechanism``, no ``imu_file``.
+
+Converted once to :class:`gcalign.realtime.settings.Settings` and
+:class:`gcalign.realtime.cases.Case` (SI) by :meth:`RealtimeConfig.to_settings` and
+:meth:`RealtimeConfig.cases_of`.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from gcalign import units as u
+from gcalign.errors import ScenarioError
+from gcalign.io.scenario.base import Model, Vec3
+from gcalign.io.scenario.schedule import RowModel
+from gcalign.realtime.cases import Case, check_case
+from gcalign.realtime.settings import (
+    FilterSettings,
+    PulseSettings,
+    SensorSettings,
+    Settings,
+    TrackerSettings,
+    seed_semi_physical,
+)
+from gcalign.sim.schedule import Step
+
+PredictorName = Literal["none", "taylor", "kalman-ls"]
+DEFAULT_PREDICTORS: list[PredictorName] = ["none", "taylor", "kalman-ls"]  # = core PREDICTORS
+SEED_DELAY_MS = 4.0  #: the seed's T (§3.2: n = 4 solution intervals of 1 ms)
+MAX_CASES = 100
+MAX_SAMPLES = 50_000_000  #: sensor samples of all cases together (a run holds its pulses)
+
+
+def _us(x: float | None) -> float | None:
+    return None if x is None else x * 1e-6
+
+
+class FilterConfig(Model):
+    fs_hz: float = Field(5000.0, gt=0, description="sensor sampling and filter rate f1")
+    chain: Literal["navigation", "alignment"] = "navigation"
+    nav_order: int = Field(40, description="FIR order (taps − 1) of the navigation chain")
+    nav_cutoff_hz: float = 200.0
+    align_order: int = Field(180, description="FIR order of the alignment chain")
+    align_cutoff_hz: float = 100.0
+    notch_hz: float | None = Field(400.0, description="IIR notch (null: none)")
+    notch_q: float = Field(10.0, gt=0)
+    window: str = "hamming"
+
+    def to_settings(self) -> FilterSettings:
+        return FilterSettings(fs_hz=self.fs_hz, align_order=self.align_order,
+                              align_cutoff_hz=self.align_cutoff_hz, nav_order=self.nav_order,
+                              nav_cutoff_hz=self.nav_cutoff_hz, notch_hz=self.notch_hz,
+                              notch_q=self.notch_q, window=self.window, chain=self.chain)
+
+
+class SensorConfig(Model):
+    quantum_arcsec: float = Field(0.1, ge=0, description="angle per count (0: none)")
+    arw_dprh: float = Field(0.0005, ge=0, description="angle random walk, °/√h")
+    dither_arcsec: float = Field(100.0, ge=0, description="dither peak in the sensed angle")
+    dither_hz: float = Field(400.0, gt=0)
+
+    def to_settings(self) -> SensorSettings:
+        return SensorSettings(quantum=self.quantum_arcsec * u.ARCSEC,
+                              arw=self.arw_dprh * u.DPSH,
+                              dither_amplitude=self.dither_arcsec * u.ARCSEC,
+                              dither_hz=self.dither_hz)
+
+
+class TrackerConfig(Model):
+    qc_rad2ps5: float = Field(1.0, gt=0, description="white-jerk intensity Qc, rad²/s⁵")
+    r_std_arcsec: float = Field(0.03, gt=0, description="σ of the attitude observation, R = σ²")
+    p0_theta_arcsec: float = Field(0.03, gt=0)
+    p0_omega_dps: float = Field(20.0, gt=0)
+    p0_alpha_dps2: float = Field(20.0, gt=0)
+
+    def to_settings(self) -> TrackerSettings:
+        return TrackerSettings(qc=self.qc_rad2ps5, r=(self.r_std_arcsec * u.ARCSEC) ** 2,
+                               sigma0=(self.p0_theta_arcsec * u.ARCSEC,
+                                       self.p0_omega_dps * u.DEG, self.p0_alpha_dps2 * u.DEG))
+
+
+class PulsesConfig(Model):
+    mode: Literal["solution", "async"] = "solution"
+    rate_hz: float = Field(1000.0, gt=0)
+    offset_us: float | None = Field(0.0, ge=0, description="null: random first edge (async)")
+    jitter_us: float = Field(0.0, ge=0)
+    drift_ppm: float = 0.0
+    resolution_us: float = Field(0.0, ge=0, description="Δt counter resolution (0: exact)")
+
+    def to_settings(self) -> PulseSettings:
+        return PulseSettings(mode=self.mode, rate_hz=self.rate_hz,
+                             offset_s=_us(self.offset_us), jitter_s=self.jitter_us * 1e-6,
+                             drift_ppm=self.drift_ppm, resolution_s=self.resolution_us * 1e-6)
+
+
+class CaseConfig(Model):
+    name: str = Field(min_length=1)
+    attitude_deg: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0],
+                               description="[pitch, roll, yaw] at rest before t = 0")
+    steps: list[RowModel] = Field(min_length=1)
+    duration_s: float | None = Field(None, gt=0, description="default: the rows' total")
+    pulses: PulsesConfig | None = None
+    seed_before: str = ""
+    seed_after: str = ""
+
+    def to_case(self) -> Case:
+        return case_of(self.name, self.steps, self.attitude_deg, self.duration_s,
+                       None if self.pulses is None else self.pulses.to_settings(),
+                       self.seed_before, self.seed_after)
+
+
+def case_of(name: str, rows: list[RowModel], attitude_deg, duration_s: float | None,
+            pulses: PulseSettings | None = None, seed_before: str = "",
+            seed_after: str = "") -> Case:
+    """A core :class:`Case` from validated rows (ValueError names the row)."""
+    steps: list[Step] = []
+    for i, r in enumerate(rows):
+        try:
+            steps.append(r.to_step())
+        except ValueError as err:
+            raise ValueError(f"steps.{i}: {err}") from None
+    a = np.radians(np.asarray(attitude_deg, dtype=float))
+    return Case(name=name, steps=tuple(steps), att0=(float(a[0]), float(a[1]), float(a[2])),
+                duration_s=duration_s, pulses=pulses, seed_before=seed_before,
+                seed_after=seed_after)
+
+
+class RealtimeConfig(Model):
+    """Real-time attitude at sync pulses (seed 003); see the module docstring."""
+
+    semi_physical: bool = False
+    solution_hz: float = Field(1000.0, gt=0)
+    delay_ms: float | None = Field(None, ge=0, description="T used; null: the chain's delay")
+    predictors: list[PredictorName] = Field(default_factory=lambda: list(DEFAULT_PREDICTORS),
+                                            min_length=1)
+    filter: FilterConfig = Field(default_factory=FilterConfig)
+    sensor: SensorConfig = Field(default_factory=SensorConfig)
+    tracker: TrackerConfig = Field(default_factory=TrackerConfig)
+    pulses: PulsesConfig = Field(default_factory=PulsesConfig)
+    settle_s: float = Field(1.0, ge=0)
+    warmup_s: float = Field(0.2, ge=0)
+    corner_ms: float = Field(50.0, ge=0)
+    cases: list[CaseConfig] | None = Field(None, min_length=1, max_length=MAX_CASES)
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if len(set(self.predictors)) != len(self.predictors):
+            raise ValueError(f"predictors: each at most once, got {self.predictors}")
+        if self.semi_physical and self.delay_ms is not None:
+            raise ValueError(f"delay_ms: semi_physical: true fixes T at the seed's "
+                             f"{SEED_DELAY_MS:g} ms; remove delay_ms or set semi_physical: "
+                             f"false, got {self.delay_ms:g}")
+        if self.semi_physical and "pulses" in self.model_fields_set:
+            raise ValueError("pulses: semi_physical: true puts the pulses on every solution "
+                             "instant (Δt = 0); remove realtime.pulses (a case may still "
+                             "bring its own) or set semi_physical: false")
+        settings = self.to_settings()  # the core's checks, one line naming the setting
+        for i, c in enumerate(self.cases or ()):
+            try:
+                check_case(c.to_case(), settings)
+            except ValueError as err:
+                raise ValueError(f"cases.{i}.{err}") from None
+        return self
+
+    # ---------------------------------------------------------------- resolved values
+
+    @property
+    def reference(self) -> str:
+        """What the reported errors are against: ``seed`` (the INS's output T later, the
+        seed's semi-physical metric) or ``truth`` (the attitude at the pulse time)."""
+        return "seed" if self.semi_physical else "truth"
+
+    def to_settings(self) -> Settings:
+        """The core's :class:`Settings` (SI); ValueError from its checks."""
+        s = Settings(solution_hz=self.solution_hz, filter=self.filter.to_settings(),
+                     sensor=self.sensor.to_settings(), pulses=self.pulses.to_settings(),
+                     tracker=self.tracker.to_settings(),
+                     delay_s=None if self.delay_ms is None else self.delay_ms * 1e-3,
+                     settle_s=self.settle_s, warmup_s=self.warmup_s,
+                     corner_s=self.corner_ms * 1e-3, predictors=tuple(self.predictors))
+        if self.semi_physical:
+            s = seed_semi_physical(s)
+            assert s.delay_s == SEED_DELAY_MS * 1e-3
+        return s
+
+    def cases_of(self, sc) -> list[Case]:
+        """The cases to run (runs :meth:`check`)."""
+        self.check(sc)
+        return self._cases(sc)
+
+    def _cases(self, sc) -> list[Case]:
+        if self.cases is not None:
+            return [c.to_case() for c in self.cases]
+        mo = sc.motion
+        return [case_of(sc.name, mo.steps, mo.attitude_deg, mo.duration_s)]
+
+    def check(self, sc) -> None:
+        """Checks that need the rest of the scenario; ScenarioError naming the field."""
+        if sc.site is None:
+            raise ScenarioError("site: missing; the turntable's site sets the earth rate the "
+                                "gyros sense (site: {lat_deg, lon_deg, height_m})")
+        if sc.imu_file is not None:
+            raise ScenarioError(f"imu_file: realtime simulates the turntable; recorded data is "
+                                f"not supported, got {str(sc.imu_file)!r} (remove imu_file)")
+        if sc.mechanism is not None:
+            raise ScenarioError("mechanism: the realtime chain has its gyros fixed to the "
+                                "body (remove mechanism)")
+        mo = sc.motion
+        if self.cases is not None and mo is not None:
+            raise ScenarioError("realtime.cases: give the cases either as realtime.cases or "
+                                "as one turntable motion (motion.kind: turntable), not both")
+        if self.cases is None:
+            if mo is None or mo.kind != "turntable":
+                raise ScenarioError(
+                    f"motion.kind: realtime needs turntable cases: realtime.cases, or a "
+                    f"turntable motion; got {'no motion' if mo is None else repr(mo.kind)}")
+            if mo.repeat:
+                raise ScenarioError("motion.repeat: a realtime case runs its rows once; "
+                                    "allowed: false, got true")
+            try:
+                check_case(case_of(sc.name, mo.steps, mo.attitude_deg, mo.duration_s),
+                           self.to_settings())
+            except ValueError as err:
+                raise ScenarioError(f"motion.{err}") from None
+        imu = sc.imu
+        if "rate_hz" in imu.model_fields_set and imu.rate_hz != self.filter.fs_hz:
+            raise ScenarioError(f"imu.rate_hz: the realtime gyros are sampled at "
+                                f"realtime.filter.fs_hz = {self.filter.fs_hz:g} Hz; omit "
+                                f"imu.rate_hz or set it equal, got {imu.rate_hz:g}")
+        for name, sensor in (("gyro", imu.gyro), ("accel", imu.accel)):
+            for key, value in sensor.model_dump().items():
+                if value is not None and np.any(np.asarray(value, dtype=float) != 0):
+                    raise ScenarioError(
+                        f"imu.{name}.{key}: not used by realtime (its gyro model is "
+                        f"realtime.sensor: quantum, ARW, dither); allowed: 0, got {value}")
+        n = sum(round(c.duration * self.filter.fs_hz) for c in self._cases(sc))
+        if n > MAX_SAMPLES:
+            raise ScenarioError(f"realtime.cases: {n} sensor samples in all, at most "
+                                f"{MAX_SAMPLES} allowed (shorten the cases)")
+
+    def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
+        """Rows for `gcalign validate` (runs the cross-section checks too)."""
+        cases = self.cases_of(sc)
+        s = self.to_settings()
+        f = s.filter
+        t_text = (f"{SEED_DELAY_MS:g} ms (the seed's, semi-physical)" if self.semi_physical
+                  else f"{self.delay_ms:g} ms" if self.delay_ms is not None
+                  else "the chain's low-frequency group delay")
+        chain = (f"notch {f.notch_hz:g} Hz Q {f.notch_q:g} + " if f.notch_hz and
+                 f.chain == "navigation" else "") + (
+            f"FIR order {f.nav_order} at {f.nav_cutoff_hz:g} Hz" if f.chain == "navigation"
+            else f"FIR order {f.align_order} at {f.align_cutoff_hz:g} Hz")
+        rows = [
+            ("realtime.semi_physical", str(self.semi_physical),
+             f"errors against {'the INS T later' if self.semi_physical else 'the truth'}"),
+            ("realtime.rates", f"{f.fs_hz:g} Hz sensor, {s.solution_hz:g} Hz solution",
+             f"{s.samples_per_solution} sub-increments per update"),
+            ("realtime.delay (T)", t_text, ""),
+            ("realtime.filter", f"{f.chain}: {chain}", f"window {f.window}"),
+            ("realtime.sensor", f"quantum {self.sensor.quantum_arcsec:g} ″, ARW "
+             f"{self.sensor.arw_dprh:g} °/√h, dither {self.sensor.dither_arcsec:g} ″ @ "
+             f"{self.sensor.dither_hz:g} Hz", f"ARW {s.sensor.arw:.4g} rad/√s"),
+            ("realtime.tracker", f"Qc {s.tracker.qc:g} rad²/s⁵, R = "
+             f"({self.tracker.r_std_arcsec:g} ″)²", f"R {s.tracker.r:.4g} rad²"),
+            ("realtime.pulses", f"{s.pulses.mode}, {s.pulses.rate_hz:g} Hz", ""),
+            ("realtime.predictors", ", ".join(s.predictors), ""),
+        ]
+        for i, c in enumerate(cases):
+            rows.append((f"realtime.cases.{i}", f"{c.name}: {c.kind}, {c.duration:g} s"
+                         + (f", pulses {c.pulses.mode} {c.pulses.rate_hz:g} Hz"
+                            if c.pulses else ""),
+                         f"{round(c.duration * f.fs_hz)} samples"))
+        return rows
