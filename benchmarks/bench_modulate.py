@@ -37,8 +37,8 @@ TARGET_ALL_S, TARGET_ONE_S, TARGET_RSS_MB = 60.0, 20.0, 800.0
 
 def _gcalign(args: list[str], out: Path) -> tuple[float, float]:
     """Wall time (s) and peak RSS (MB) of one `gcalign` subprocess."""
-    cmd = ["/usr/bin/time", "-v", sys.executable, "-m", "gcalign", *args, "-o", str(out),
-           "--json"]
+    exe = Path(sys.executable).parent / "gcalign"  # the console script of this environment
+    cmd = ["/usr/bin/time", "-v", str(exe), *args, "-o", str(out), "--json"]
     t0 = time.perf_counter()
     res = subprocess.run(cmd, capture_output=True, text=True,
                          env=dict(os.environ, NUMBA_NUM_THREADS="1"))

@@ -68,6 +68,9 @@ class Series:
     def __init__(self, group: h5py.Group, spec: dict[str, tuple[int | None, str, str | None]],
                  chunk_rows: int = 4096, **attrs):
         self.group = group
+        # Held open: a dataset opened anew for every append gets a fresh chunk cache, so
+        # its partial last chunk would be compressed and read back each time (10× slower).
+        self._ds: dict[str, h5py.Dataset] = {}
         for name, (width, units, frame) in spec.items():
             shape = (0,) if width is None else (0, width)
             ds = group.create_dataset(
@@ -77,12 +80,13 @@ class Series:
             ds.attrs["units"] = units
             if frame:
                 ds.attrs["frame"] = frame
+            self._ds[name] = ds
         for k, v in attrs.items():
             group.attrs[k] = v
 
     def append(self, **arrays) -> None:
         for name, a in arrays.items():
-            ds = self.group[name]
+            ds = self._ds[name]
             a = np.asarray(a, dtype=float)
             n = ds.shape[0]
             ds.resize(n + a.shape[0], axis=0)
