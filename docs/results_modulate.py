@@ -226,8 +226,10 @@ ordering a large one ({h_impr:.0f} %): {res}. The warning fires for both (amplit
 The net scale-factor term is zero per cycle for every indexing scheme (< 1e-9 rad per unit
 δk), but within the cycle the computed attitude is off by up to 2π·δk (seed-12) and on
 average by a standing offset (cycle mean), which the loops turn into Schuler and
-earth-rate oscillations of a few hundred metres. Continuous rotation about z turns δk into
-an up-gyro drift δk·ω_m (0.216 °/h for 10 ppm at 6 °/s), hence its large error.
+earth-rate oscillations of a few hundred metres. Without rotation (`fixed`,
+`single-4` about z) δk only scales the earth rate the gyros sense (δk·Ω: 841 m at 72 h).
+Continuous rotation about z turns δk into an up-gyro drift δk·ω_m (0.216 °/h for 10 ppm
+at 6 °/s), hence its large error.
 
 ### Noise (ARW 0.001 °/√h, no biases): 1σ position error (m)
 
@@ -266,6 +268,9 @@ def claim_table(lit72: float, fix72: float, fp72: float, nav72: dict) -> str:
          "cycle mean π·δk·(−1, 1, 1)"),
         ("gyro misalignment × mechanism rate", "not discussed",
          "net 0 per cycle (each edge is run both ways)"),
+        ("asymmetric gyro scale factor × mechanism rate", "not discussed",
+         "does not cancel: the ccw and cw halves add, 4π·δk·diag(−1, 1, 1) per cycle, a drift "
+         "of 0.0069 °/h for 10 ppm (55 km at 72 h); `four-position-12` cancels it"),
         ("a scheme that does cancel", "—",
          f"`four-position-12` [P]: a fourth position D = Rx(π); mean C = 0, δk net 0; "
          f"72 h error {fp72:,.0f} m"),
