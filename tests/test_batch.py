@@ -297,9 +297,11 @@ def test_numba_cache_is_loaded_not_compiled_in_fresh_processes():
     parent = B.kernel_cache_stats()
     try:
         for s in backend.run_on_workers(B.warm_up):
-            assert s["cache_misses"] == 0, s
-            if backend.start_method == "fork":  # inherited: nothing new was loaded
-                assert s["cache_hits"] == parent["cache_hits"], (s, parent)
+            if backend.start_method == "fork":  # inherited: nothing new loaded or compiled
+                assert (s["cache_hits"], s["cache_misses"]) == (
+                    parent["cache_hits"], parent["cache_misses"]), (s, parent)
+            else:  # a fresh interpreter: loaded from the cache
+                assert s["cache_misses"] == 0, s
     finally:
         backend.close()
 
