@@ -211,3 +211,28 @@ def test_batch_over_modulate_scenarios(tmp_path):
         assert one.exit_code == 0, one.output
         assert value == pytest.approx(
             json.loads(one.stdout)["schemes"]["dual-16"]["max_horizontal_error_m"], rel=1e-12)
+
+
+def test_figures_read_over_72_hours():
+    """The seed's Fig. 4 analogue: one solid line per scheme (the linear model dashed, out of
+    the legend but for one shared entry), log scale, hour ticks every 12 h, the title whole;
+    the mechanism legends sit above the panels, not over the dwell levels."""
+    from gcalign.app.modulate.plots import mechanism_figure, position_error_figure
+
+    t = np.linspace(0.0, 72 * 3600.0, 2001)
+    series = {n: (t, (i + 1) * 100 * (1 + t / 3600), (t, (i + 1) * 100 * (1 + t / 3600)),
+                  [1, 4, 12, 24, 72]) for i, n in enumerate(DEFAULT)}
+    fig = position_error_figure(series, "case: horizontal position error")
+    (ax,) = fig.axes
+    data = [ln.get_label() for ln in ax.lines if not ln.get_label().startswith("_")]
+    assert data == DEFAULT
+    assert ax.get_yscale() == "log" and ax.get_xlabel() == "time (h)"
+    ticks = [x for x in ax.get_xticks() if 0 <= x <= 72]
+    assert ticks == [0, 12, 24, 36, 48, 60, 72]
+    legend = [x.get_text() for x in ax.get_legend().get_texts()]
+    assert legend == DEFAULT + ["linear model (same errors)", "report hours"]
+    cyc = {"seed-12": (np.linspace(0, 3744, 50), np.zeros((50, 3)), np.ones((50, 3)),
+                       "navigation")}
+    mfig = mechanism_figure(cyc, "case: the mechanism over one cycle")
+    for a in mfig.axes[:2]:
+        assert a.get_legend().get_bbox_to_anchor().y0 >= a.get_window_extent().y1 - 1

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.ticker import MultipleLocator
 
 from gcalign.app.navigate.plots import angle_scale
 from gcalign.app.plots import ENU, new_figure
@@ -24,8 +26,23 @@ def _names(g) -> list[str]:
     return [_s(n) for n in g.attrs.get("compare", list(g))]
 
 
+def hour_axis(ax, t_end_s: float) -> None:
+    """Time in hours with ticks every 12 h over runs of a day or more (6 h over half a day,
+    the default below): the report hours 12, 24 and 72 fall on ticks."""
+    hours = t_end_s / 3600.0
+    if hours >= 24:
+        ax.xaxis.set_major_locator(MultipleLocator(12.0))
+    elif hours >= 12:
+        ax.xaxis.set_major_locator(MultipleLocator(6.0))
+    ax.set_xlim(0.0, hours * 1.01)  # the last report-hour dot whole
+    ax.set_xlabel("time (h)")
+
+
 def position_error_figure(series: dict, title: str) -> Figure:
-    """`series`: name -> (t s, horizontal m, linear (t, horizontal) or None, report hours)."""
+    """`series`: name -> (t s, horizontal m, linear (t, horizontal) or None, report hours).
+    One colour per scheme, the navigation solid, the linear model dashed (one legend entry
+    for all: where the two agree the dashed line lies under the solid one), dots at the
+    report hours."""
     fig, (ax,) = new_figure(1, height=6.0)
     top = max((float(np.max(h)) for _, h, _, _ in series.values() if len(h)), default=1.0)
     for i, (name, (t, h, lin, hours)) in enumerate(series.items()):
@@ -36,15 +53,23 @@ def position_error_figure(series: dict, title: str) -> Figure:
             lt, lh = lin
             k = lt > 0
             ax.plot(lt[k] / 3600.0, lh[k], color=c, linewidth=0.9, linestyle="--",
-                    label=f"{name} (linear model)")
+                    label=f"_{name} (linear model)")
         at = [np.argmin(np.abs(t - x * 3600.0)) for x in hours]
         ax.plot(t[at] / 3600.0, h[at], "o", color=c, markersize=4, label="_hours")
     ax.set_yscale("log")
-    ax.set_ylim(max(top * 1e-4, 1e-3), top * 2.0)
-    ax.set_xlabel("time (h)")
+    ax.set_ylim(max(top * 1e-4, 1e-3), top * 10.0)  # a decade above the curves: the legend
+    end = max((float(t[-1]) for t, _, _, _ in series.values() if len(t)), default=3600.0)
+    hour_axis(ax, end)
     ax.set_ylabel("horizontal position error (m)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize="small", ncols=4)
+    handles, _ = ax.get_legend_handles_labels()
+    extra = [Line2D([], [], color="0.3", linewidth=0.9, linestyle="--",
+                    label="linear model (same errors)")]
+    if any(lin is not None for _, _, lin, _ in series.values()):
+        handles += extra
+    handles.append(Line2D([], [], color="0.3", marker="o", markersize=4, linestyle="",
+                          label="report hours"))
+    ax.legend(handles=handles, loc="upper left", fontsize="small", ncols=3, framealpha=0.9)
     fig.suptitle(title)
     return fig
 
@@ -62,7 +87,8 @@ def attitude_error_figure(series: dict, title: str) -> Figure:
         ax.set_ylabel(f"φ {ENU[j]} ({unit})")
         ax.grid(True, alpha=0.3)
     axes[0].legend(loc="upper left", fontsize="small", ncols=4)
-    axes[-1].set_xlabel("time (h)")
+    end = max((float(t[-1]) for t, _ in series.values() if len(t)), default=3600.0)
+    hour_axis(axes[-1], end)
     fig.suptitle(title)
     return fig
 
@@ -74,19 +100,20 @@ def mechanism_figure(cycles: dict, title: str) -> Figure:
     for i, (name, (t, angle, diag, ref)) in enumerate(cycles.items()):
         a, d = axes[2 * i], axes[2 * i + 1]
         for j in range(3):
-            a.plot(t / 60.0, np.degrees(angle[:, j]), label=f"about {AXES[j]}")
-            d.plot(t / 60.0, diag[:, j] + 0.06 * (j - 1), label=f"C_{AXES[j]}{AXES[j]}")
+            a.plot(t / 60.0, np.degrees(angle[:, j]), label=f"about sensor {AXES[j]}")
+            d.plot(t / 60.0, diag[:, j] + 0.06 * (j - 1), label=f"$C_{{{AXES[j]}{AXES[j]}}}$")
         a.set_ylabel(f"{name}\nangle (deg)")
         d.set_ylabel(f"diag $C_s^{ref[0]}$ (offset ±0.06)")
         d.set_ylim(-1.3, 1.3)
         for ax in (a, d):
             ax.grid(True, alpha=0.3)
             ax.set_xlim(0, t[-1] / 60.0)
-        if i == 0:
-            a.legend(loc="upper left", fontsize="small", ncols=3)
-            d.legend(loc="upper left", fontsize="small", ncols=3)
     axes[-2].set_xlabel("time in the cycle (min)")
     axes[-1].set_xlabel("time in the cycle (min)")
+    # one legend per column above the panels: inside, it hides the dwell levels (±1, 180°)
+    for ax in axes[:2]:
+        ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), fontsize="small", ncols=3,
+                  frameon=False, borderaxespad=0.0)
     fig.suptitle(title)
     return fig
 
@@ -113,8 +140,7 @@ def figures(f, name: str) -> dict:
             cyc[s] = (m["t"][()], m["angle"][()], m["C_diag"][()], _s(g.attrs["reference"]))
     out = {
         "modulate_position_error": position_error_figure(
-            pos, f"{name}: horizontal position error, navigation (solid) and linear model "
-            "(dashed: hidden where they agree)"),
+            pos, f"{name}: horizontal position error"),
         "modulate_attitude_error": attitude_error_figure(
             att, f"{name}: misalignment φ (ENU)"),
     }

@@ -54,16 +54,17 @@ def modulate_table(s: dict) -> Group:
                 f"{s['seed']}", style="bold")
     pos = Table(title="horizontal position error (m)", title_justify="left",
                 header_style="bold", box=box.SIMPLE_HEAD)
-    pos.add_column("scheme")
+    width = max((len(n) for n in s["compare"]), default=6)  # names whole, never "four-posit…"
+    pos.add_column("scheme", no_wrap=True, min_width=width)
     for h in hours:
         pos.add_column(f"{h:g} h", justify="right")
     pos.add_column("max", justify="right")
-    pos.add_column(f"linear {hours[-1]:g} h" if hours else "linear", justify="right")
+    pos.add_column(f"lin. {hours[-1]:g} h" if hours else "linear", justify="right")
     inv = Table(title="attitude error and invariants", title_justify="left",
                 header_style="bold", box=box.SIMPLE_HEAD)
-    for col, just in (("scheme", "left"), ("ref", "left"), ("T (min)", "right"),
-                      ("diag C̄", "right"), ("φ max (″)", "right"),
-                      ("Schuler", "center")):
+    inv.add_column("scheme", no_wrap=True, min_width=width)
+    for col, just in (("ref", "left"), ("T (min)", "right"), ("diag C̄", "right"),
+                      ("φ max (″)", "right"), ("Schuler", "center")):
         inv.add_column(col, justify=just)  # type: ignore[arg-type]
     for name in s["compare"]:
         r = s["schemes"][name]
@@ -81,7 +82,7 @@ def modulate_table(s: dict) -> Group:
                      for x in r["max_misalignment_arcsec"]),
             "warn" if r["schuler_warnings"] else "–"]))
     notes = [
-        "navigation against truth at each hour; max: over every sample; linear: the linear "
+        "navigation against truth at each hour; max: over every sample; lin.: the linear "
         "error model (static base) for the same errors; φ max: largest misalignment, E N U; "
         "T: cycle; diag C̄: mean of C_s^r over the cycle (* off-diagonal terms too)",
         _errors_line(s["errors"]),
