@@ -147,8 +147,9 @@ def _bad_table(tmp_path):
     (["--hours", -2], "modulate.hours"),
     ("turn", "mechanism.turn_s: the turn (6 s) is shorter than its acceleration plus "
              "deceleration (4 + 4 s)"),
-    ("axis", "mechanism.steps.0.axis"),
-    ("table", "mechanism.steps: the table does not return the IMU to its start"),
+    ("axis", "mechanism.steps.0.axis: must be a unit vector (norm 1), got [1.0, 1.0, 0.0]"),
+    ("table", "mechanism.steps: the table does not return the IMU to its start: after the "
+              "last row it is turned by 90 deg about [0.0, 0.0, 1.0]"),
     (["--compare", "fixed,fixed"], "modulate.compare"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, args, field):

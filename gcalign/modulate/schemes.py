@@ -298,8 +298,8 @@ def scheme_from_rows(rows: Sequence[Row] | Sequence[Mapping], *, name: str = "us
     if ang > tol:
         raise ScenarioError(
             f"scheme rows: the table does not return the IMU to its start: after the last row "
-            f"it is turned by {ang / DEG:.6g} deg about {np.round(rv / ang, 6).tolist()}; add "
-            "rows that bring it back")
+            f"it is turned by {ang / DEG:.6g} deg about "
+            f"{(np.round(rv / ang, 6) + 0.0).tolist()}; add rows that bring it back")
     return Scheme(name, si, schedule, reference, description)
 
 

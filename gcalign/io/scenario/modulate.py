@@ -163,4 +163,4 @@ def _check_cycle(mech: MechanismConfig) -> None:
         raise ScenarioError(
             f"mechanism.steps: the table does not return the IMU to its start: after the "
             f"last row it is turned by {math.degrees(ang):.6g} deg about "
-            f"{np.round(rv / ang, 6).tolist()}; add rows that bring it back")
+            f"{(np.round(rv / ang, 6) + 0.0).tolist()}; add rows that bring it back")
