@@ -474,13 +474,22 @@ def error_term_table() -> str:
     return "\n".join(rows)
 
 
-def dwell_sweep() -> str:
+def dwell_runs() -> dict:
+    """The dwell sweep of configs/sweeps/seed004_dwell.yaml (its grid of Ts), run in process
+    (the same scenarios as `gcalign batch` on that file): Ts -> summary."""
+    import yaml
+
+    sweep = yaml.safe_load((ROOT / "configs/sweeps/seed004_dwell.yaml").read_text())
+    return {dwell: nav(["dual-16", "dual-16-improved"],
+                       mechanism={"scheme": "dual-16", "dwell_s": dwell})
+            for dwell in sweep["grid"]["mechanism.dwell_s"]}
+
+
+def dwell_sweep(runs: dict) -> str:
     rows = ["| Ts (s) | cycle (min) | `dual-16` 72 h | `dual-16-improved` 72 h | improved, max "
             "| warning |",
             "| --- " * 6 + "|"]
-    for dwell in (100, 200, 250, 275, 300, 305, 325, 350, 400):
-        s = nav(["dual-16", "dual-16-improved"], mechanism={"scheme": "dual-16",
-                                                           "dwell_s": dwell})
+    for dwell, s in runs.items():
         a, b = s["schemes"]["dual-16"], s["schemes"]["dual-16-improved"]
         rows.append(f"| {dwell} | {a['cycle_s'] / 60:.1f} "
                     f"| {a['horizontal_error_m']['72h']:,.0f} "
@@ -616,6 +625,127 @@ where it meets 84.46 min.
 """
 
 
+SPEC_CLOSED = {"a_peak": 1272.0, "a_time": 42.2, "a_v": 0.789, "b_1h": -1353.0,
+               "b_phi": 8.1, "c_n": 542.4, "c_u": 557.4, "c_amp": 4234.0, "c_head": 6.55}
+
+# Must-show 6 is a measurement of this machine, not a computed result: the record of the
+# last `python benchmarks/bench_modulate.py` (median of 5 interleaved runs), kept here.
+BENCHMARK = ("2026-12-01, 2 cores shared with other agents, load 1.2–1.4: the built-in "
+             "four-scheme 72 h run 36.8 s (33.9–40.1 s), peak RSS 243 MB; one scheme "
+             "(`--scheme seed-12`) 10.6 s (9.8–12.2 s), 238 MB; in process one 72 h scheme "
+             "is 25.9 M samples in 8.9 s (strapdown 47 %, errors against truth 35 %, ideal "
+             "increments 11 %, sensor errors 6 %)")
+
+BAD_INPUT = (["--scheme", "seed-13"], ["--dwell", "-1"], ["--hours", "0"])
+
+
+def invariant_checks() -> dict:
+    """Must-show 1 and 4 from the schedules: the worst deviations the tests bound."""
+    from gcalign.modulate.schemes import Turn
+
+    parity = np.diag([-1.0, 1.0, 1.0])
+    lit = 0.0
+    for dwell, turn in ((300.0, Turn(4.0, 4.0, 4.0)), (200.0, Turn(2.0, 8.0, 2.0)),
+                        (60.0, Turn(6.0, 0.0, 6.0)), (17.3, Turn(0.5, 11.0, 0.5)),
+                        (0.0, Turn(3.0, 1.0, 3.0))):
+        r = invariant_report(builtin_scheme("seed-12", dwell=dwell, turn=turn))
+        full = 4 * (dwell + turn.t_accel + turn.t_const + turn.t_decel)
+        lit = max(lit, float(np.abs(r.integral_C - full * parity).max()) / full)
+    zero = max(float(np.abs(invariant_report(builtin_scheme(n)).integral_C).max())
+               / builtin_scheme(n).period for n in ("dual-16", "four-position-12"))
+    unit = ErrorTerms(gyro_scale=np.ones(3))
+    indexing = ("single-4", "dual-16", "dual-16-improved", "seed-12", "four-position-12",
+                "four-position-24")
+    net = max(float(np.abs(invariant_report(builtin_scheme(n), unit).scale_factor_net).max())
+              for n in indexing)
+    peaks = {n: invariant_report(builtin_scheme(n), unit).scale_factor_peak / math.pi
+             for n in ("seed-12", "four-position-12", "single-4")}
+    cont = invariant_report(builtin_scheme("continuous"), unit).scale_factor_net[2] / math.pi
+    single = np.diag(invariant_report(builtin_scheme("single-4")).mean_C)
+    return {"lit_dev": lit, "zero_dev": zero, "sf_net": net, "cont": cont,
+            "single": _vec(single, 1.0, "{:.0f}"),
+            **{f"pk_{k.split('-')[0]}": _multiples_of_pi(v) for k, v in peaks.items()}}
+
+
+def _multiples_of_pi(v) -> str:
+    """(2, 1, 0) -> "(2π, π, 0)"."""
+    names = {0: "0", 1: "π"}
+    return "(" + ", ".join(names.get(int(round(x)), f"{round(x):.0f}π") for x in v) + ")"
+
+
+def bad_input_lines() -> str:
+    """Must-show 7: what `gcalign modulate` prints (exit 2, one line) for some bad input."""
+    from typer.testing import CliRunner
+
+    from gcalign.cli import app
+
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for args in BAD_INPUT:
+            res = CliRunner().invoke(app, ["modulate", *args, "-o", f"{tmp}/x.h5"])
+            lines = [x for x in res.output.splitlines() if x.strip()]
+            assert res.exit_code == 2 and len(lines) == 1, res.output
+            out.append(f"`gcalign modulate {' '.join(args)}` → exit 2, "
+                       f"`{lines[0].replace('<built-in seed004_modulation.yaml>: ', '')}`")
+    return "\n".join(f"- {x}" for x in out)
+
+
+MUST_ROWS = (  # (item, checked by, measured: a format string of the values)
+    ("∫_cycle C dt of `seed-12` = 4(Ts + Tz)·diag(−1, 1, 1) for several Ts, Tz, profiles; "
+     "`dual-16`, `four-position-12` 0; net δk term 0; `single-4` diag(0, 0, 1)",
+     "`test_modulate_invariants.py`: `test_seed12_integral_is_four_Ts_plus_Tz_times_parity`, "
+     "`test_cancelling_schemes_have_zero_mean`, "
+     "`test_scale_factor_returns_to_zero_with_the_implied_peaks`, "
+     "`test_dual_schemes_cancel_scale_factor_too`, `test_schemes_that_leave_an_axis`",
+     "worst relative deviation {lit_dev:.1e} over five (Ts, profile) pairs; cancelling "
+     "schemes {zero_dev:.1e}·T; net δk term ≤ {sf_net:.1e} rad per unit δk; `single-4` "
+     "diag {single}"),
+    ("`seed-12` = unrotated with diag(−1, 1, 1)/3 × the biases, within 5 % at 24 h, 72 h",
+     "`test_modulate_navigation.py::"
+     "test_literal_scheme_is_an_unrotated_ins_with_a_third_of_the_biases`",
+     "{d24:.1f} % and {d72:.1f} %"),
+    ("unrotated: spec §5 (a)–(c) within 5 %; `four-position-12` ≥ 50× below at 72 h, "
+     "gyro-bias attitude ≤ 15″; spec table within 10 % for `fixed`, `seed-12`",
+     "`test_unrotated_navigation_follows_the_closed_forms`, "
+     "`test_spec_table_and_the_four_position_gain`",
+     "closed forms within {cf_dev:.1f} %; {gain:.0f}×; {fp_phi:.1f}″; table within "
+     "{spec_fixed:.1f} % and {spec_lit:.1f} %"),
+    ("open-loop δk term back to 0 each cycle (< 1e-9 rad), peaks as implied, `continuous` "
+     "2π·δk per turn; in navigation δk excites the loops; with ARW the error grows as the "
+     "random walk",
+     "`test_scale_factor_returns_to_zero_with_the_implied_peaks`, "
+     "`test_continuous_rotation_accumulates_two_pi_per_turn`, "
+     "`test_open_loop_term_is_the_gyro_only_attitude_error`, "
+     "`test_scale_factor_excites_the_schuler_and_earth_rate_loops`, "
+     "`test_noise_grows_as_the_random_walk_not_as_the_bias` (slow)",
+     "peaks per unit δk: `seed-12` {pk_seed}, `four-position-12` {pk_four}, `single-4` "
+     "{pk_single}; `continuous` {cont:.0f}π per turn; `seed-12` at 10 ppm: φ {sf_phi:.0f}″ "
+     "and {sf_max:,.0f} m beside the 13″ open-loop peak; noise RMS ∝ t^{slope:.2f}"),
+    ("Schuler warning for `dual-16` at the seed's timing, not at Ts = 200 s; then 72 h "
+     "< 500 m",
+     "`test_schuler_warning_fires_for_dual16_at_the_seed_timing_only`, "
+     "`test_dual16_needs_a_cycle_away_from_the_schuler_period`",
+     "{w300} at {c300:.1f} min (Ts = 300 s), {w200} at {c200:.1f} min (Ts = 200 s); "
+     "Ts = 200 s: `dual-16` {d200:,.0f} m, `dual-16-improved` {i200:,.0f} m"),
+    ("72 h four schemes ≤ 60 s and ≤ 800 MB, one scheme ≤ 20 s",
+     "`benchmarks/bench_modulate.py`", "{bench}"),
+    ("bad input exits 2 with one line: unknown scheme, dwell < 0, a turn shorter than its "
+     "acceleration plus deceleration, an axis not a unit vector, a table that does not "
+     "return, hours ≤ 0",
+     "`test_cli_modulate.py::test_bad_input_exits_2_with_one_line`", "for example:"),
+)
+
+
+def must_show(values: dict) -> str:
+    rows = ["### Issue 10's must-show items: where each is checked, what it measured", "",
+            "| # | item | checked by | measured |", "| --- " * 4 + "|"]
+    for k, (item, tests, measured) in enumerate(MUST_ROWS, 1):
+        rows.append(f"| {k} | {item} | {tests} | {measured.format(**values)} |")
+    return "\n".join(rows) + "\n\n" + values["bad"] + "\n"
+
+
+
+
 def navigation_section(main: dict, wall: float) -> str:
     sch = main["schemes"]
     third = [x / 3 for x in (-0.01, 0.01, 0.01)]
@@ -628,19 +758,32 @@ def navigation_section(main: dict, wall: float) -> str:
     spec = {n: 100 * np.max(np.abs(_h(sch[n]) / np.array(SPEC_TABLE[n]) - 1))
             for n in ("fixed", "seed-12")}
     noise = noise_numbers()
-    return NAV_TEMPLATE.format(
-        wall=wall, nav_table=nav_table(main), agreement=agreement(main),
+    cf = nav_closed_forms()
+    dwell = dwell_runs()
+    sf = nav(["seed-12"], gyro={"scale_ppm": [10, 10, 10]}, accel={})["schemes"]["seed-12"]
+    values = dict(
         spec_fixed=spec["fixed"], spec_lit=spec["seed-12"],
-        fp24=sch["four-position-12"]["horizontal_error_m"]["24h"],
-        lit24=lit["24h"], lit72=lit["72h"], eq24=eq["horizontal_error_m"]["24h"],
-        eq72=eq["horizontal_error_m"]["72h"],
         d24=100 * abs(lit["24h"] / eq["horizontal_error_m"]["24h"] - 1),
         d72=100 * abs(lit["72h"] / eq["horizontal_error_m"]["72h"] - 1),
         gain=sch["fixed"]["horizontal_error_m"]["72h"]
-        / sch["four-position-12"]["horizontal_error_m"]["72h"],
-        fp_phi=fp_phi, rate_rows=rate_rows(main), error_terms=error_term_table(),
-        dwell=dwell_sweep(), **noise,
-        **nav_closed_forms())
+        / sch["four-position-12"]["horizontal_error_m"]["72h"], fp_phi=fp_phi)
+    must = must_show(dict(
+        values, **invariant_checks(), slope=noise["slope"], bench=BENCHMARK,
+        cf_dev=max(100 * abs(cf[k] / v - 1) for k, v in SPEC_CLOSED.items()),
+        sf_phi=max(sf["max_misalignment_arcsec"]), sf_max=sf["max_horizontal_error_m"],
+        **{f"{k}{ts}": v for ts in (200, 300) for k, v in (
+            ("w", "warned" if dwell[ts]["schemes"]["dual-16"]["schuler_warnings"] else
+             "no warning"), ("c", dwell[ts]["schemes"]["dual-16"]["cycle_s"] / 60))},
+        d200=dwell[200]["schemes"]["dual-16"]["horizontal_error_m"]["72h"],
+        i200=dwell[200]["schemes"]["dual-16-improved"]["horizontal_error_m"]["72h"],
+        bad=bad_input_lines()))
+    return NAV_TEMPLATE.format(
+        wall=wall, nav_table=nav_table(main), agreement=agreement(main),
+        fp24=sch["four-position-12"]["horizontal_error_m"]["24h"],
+        lit24=lit["24h"], lit72=lit["72h"], eq24=eq["horizontal_error_m"]["24h"],
+        eq72=eq["horizontal_error_m"]["72h"], rate_rows=rate_rows(main),
+        error_terms=error_term_table(), dwell=dwell_sweep(dwell), **values, **noise,
+        **cf) + "\n" + must
 
 
 def section() -> str:

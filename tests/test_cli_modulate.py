@@ -69,6 +69,9 @@ def test_builtin_run_json_contract_show_and_plot(tmp_path):
     # spec §5 table at 1 h: 2085, 915, 99, 174 m (within 10 %)
     for name, ref in zip(DEFAULT, (2085, 915, 99, 174), strict=True):
         assert s["schemes"][name]["horizontal_error_m"]["1h"] == pytest.approx(ref, rel=0.10)
+    # the running integral ∫_0^t C e_j dt ends the cycle at 4(Ts + Tz) = 1248 s on every
+    # sensor axis (the parity identity), so its peak is at least that
+    assert np.all(np.array(s["schemes"]["seed-12"]["peak_integral_C_s"]) >= 1248 - 1e-9)
     assert s["schemes"]["dual-16-improved"]["schuler_warnings"]
     assert "Schuler" in res.stderr
     with h5py.File(out) as f:
@@ -81,6 +84,7 @@ def test_builtin_run_json_contract_show_and_plot(tmp_path):
         assert g["mechanism/t"][-1] == pytest.approx(3744.0)
     shown = runner.invoke(app, ["show", str(out)])
     assert shown.exit_code == 0 and "four-position-12" in shown.output
+    assert "peak ∫C dt" in shown.output and "Schuler" in shown.output
     plots = runner.invoke(app, ["plot", str(out), "-o", str(tmp_path / "p"), "--json"])
     assert plots.exit_code == 0, plots.output
     names = {Path(p).name for p in json.loads(plots.stdout)["figures"]}

@@ -150,6 +150,7 @@ def invariants_summary(r: InvariantReport) -> dict:
                                    / DPH).tolist(),
         "residual_accel_bias_ug": (_clean(r.residual_accel_bias, np.abs(e.accel_bias).sum())
                                    / UG).tolist(),
+        "peak_integral_C_s": np.asarray(r.peak_integral_C, dtype=float).tolist(),
         "gyro_bias_excursion_arcsec": _arcsec(r.gyro_bias_excursion),
         "scale_factor_net_arcsec": _arcsec(r.scale_factor_net),
         "scale_factor_peak_arcsec": _arcsec(r.scale_factor_peak),

@@ -22,6 +22,15 @@ def _diag(C) -> str:
     return text + ("*" if off > 1e-9 else "")
 
 
+def _triple(v, fmt: str) -> str:
+    """Three numbers, "0" for exact zeros; one "0" when all are (the cancelled terms)."""
+    if v is None:
+        return "—"
+    if all(x == 0 for x in v):
+        return "0"
+    return " ".join("0" if x == 0 else fmt.format(x) for x in v)
+
+
 def _errors_line(e: dict) -> str:
     parts = []
     for key, label, unit in (("gyro_bias_dph", "ε", "°/h"), ("accel_bias_ug", "∇", "µg"),
@@ -40,6 +49,21 @@ def _errors_line(e: dict) -> str:
     if e.get("lever_arm_cm"):
         parts.append(f"lever arm {', '.join(f'{x:g}' for x in e['lever_arm_cm'])} cm")
     return "sensor errors (sensor frame): " + ("; ".join(parts) or "none")
+
+
+def _terms_table(rows: list[list[str]]) -> Table:
+    """The invariant terms per scheme; each column at least as wide as its numbers (the
+    headers wrap instead)."""
+    t = Table(title="invariants over one cycle, for these errors", title_justify="left",
+              header_style="bold", box=box.SIMPLE_HEAD)
+    heads = ("scheme", "peak ∫C dt (s)", "ε excursion (″)", "δk net / peak (″)",
+             "M net (″)")
+    for k, col in enumerate(heads):
+        t.add_column(col, justify="left" if k == 0 else "right",
+                     min_width=max(len(r[k]) for r in rows))
+    for r in rows:
+        t.add_row(*map(Text, r))
+    return t
 
 
 def modulate_table(s: dict) -> Group:
@@ -66,6 +90,7 @@ def modulate_table(s: dict) -> Group:
     for col, just in (("ref", "left"), ("T (min)", "right"), ("diag C̄", "right"),
                       ("φ max (″)", "right"), ("Schuler", "center")):
         inv.add_column(col, justify=just)  # type: ignore[arg-type]
+    term_rows: list[list[str]] = []
     for name in s["compare"]:
         r = s["schemes"][name]
         lin = r.get("linear")
@@ -81,10 +106,20 @@ def modulate_table(s: dict) -> Group:
             " ".join(f"{x:.0f}" if x >= 10 else f"{x:.2g}"
                      for x in r["max_misalignment_arcsec"]),
             "warn" if r["schuler_warnings"] else "–"]))
+        if r["mechanism"]:
+            term_rows.append([
+                name, _triple(r.get("peak_integral_C_s"), "{:.0f}"),
+                _triple(r["gyro_bias_excursion_arcsec"], "{:.2g}"),
+                f"{_triple(r['scale_factor_net_arcsec'], '{:.2g}')} / "
+                f"{_triple(r['scale_factor_peak_arcsec'], '{:.2g}')}",
+                _triple(r["misalignment_net_arcsec"], "{:.2g}")])
     notes = [
         "navigation against truth at each hour; max: over every sample; lin.: the linear "
         "error model (static base) for the same errors; φ max: largest misalignment, E N U; "
-        "T: cycle; diag C̄: mean of C_s^r over the cycle (* off-diagonal terms too)",
+        "T: cycle; diag C̄: mean of C_s^r over the cycle (* off-diagonal terms too); "
+        "invariants, open loop: peak of |∫C e_j dt| per sensor axis, attitude excursion "
+        "from the gyro bias, scale-factor term (net over the cycle / peak in it) and gyro "
+        "misalignment M × rate term (net), E N U",
         _errors_line(s["errors"]),
     ]
     for name in s["compare"]:
@@ -99,4 +134,5 @@ def modulate_table(s: dict) -> Group:
         for w in r["schuler_warnings"]:
             notes.append(f"{name}: {w}")
     notes.append(f"output {s.get('output') or '—'}; {s['wall_s']:.1f} s")
-    return Group(head, pos, inv, Text("\n".join(notes), style="dim"))
+    tables = [head, pos, inv] + ([_terms_table(term_rows)] if term_rows else [])
+    return Group(*tables, Text("\n".join(notes), style="dim"))
