@@ -4,7 +4,7 @@ and its maximum, the linear model beside it, the attitude-error maxima and the i
 from __future__ import annotations
 
 from rich import box
-from rich.console import Group
+from rich.console import Group, RenderableType
 from rich.table import Table
 from rich.text import Text
 
@@ -134,5 +134,7 @@ def modulate_table(s: dict) -> Group:
         for w in r["schuler_warnings"]:
             notes.append(f"{name}: {w}")
     notes.append(f"output {s.get('output') or '—'}; {s['wall_s']:.1f} s")
-    tables = [head, pos, inv] + ([_terms_table(term_rows)] if term_rows else [])
+    tables: list[RenderableType] = [head, pos, inv]
+    if term_rows:
+        tables.append(_terms_table(term_rows))
     return Group(*tables, Text("\n".join(notes), style="dim"))

@@ -22,7 +22,6 @@ not repeat the same positions): it is refused with a line that says where it end
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated
 
@@ -152,15 +151,9 @@ def plan_of(sc) -> Plan:
 
 
 def _check_cycle(mech: MechanismConfig) -> None:
-    from gcalign.nav.rotation import quat_to_rotvec
+    from gcalign.modulate.schemes import check_cycle_closes
 
     if not mech.repeat:
         raise ScenarioError("mechanism.repeat: gcalign modulate runs a table as a cycle; set "
                             "repeat: true")
-    rv = quat_to_rotvec(mech.schedule().cycle_rotation)
-    ang = float(np.linalg.norm(rv))
-    if ang > CYCLE_TOL:
-        raise ScenarioError(
-            f"mechanism.steps: the table does not return the IMU to its start: after the "
-            f"last row it is turned by {math.degrees(ang):.6g} deg about "
-            f"{(np.round(rv / ang, 6) + 0.0).tolist()}; add rows that bring it back")
+    check_cycle_closes(mech.schedule(), "mechanism.steps", CYCLE_TOL)
