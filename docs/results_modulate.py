@@ -330,29 +330,16 @@ def spec_deviation() -> str:
 
 # ----------------------------------------------------------- the navigation (gcalign modulate)
 
-BUILTIN = ROOT / "configs" / "seed004_modulation.yaml"
 DEFAULT = ["fixed", "seed-12", "four-position-12", "dual-16-improved"]
 KEYS = ("1h", "4h", "12h", "24h", "72h")
 FIGURES = ("modulate_position_error", "modulate_attitude_error", "modulate_mechanism")
 
 
-def scenario(compare, *, rate=10.0, hours=72.0, gyro=None, accel=None, mechanism=None,
-             seed=1, linear=True):
+def scenario(compare, **kw):
     """The built-in seed 004 scenario with the given changes (errors in user units)."""
-    import yaml
+    from gcalign.app.modulate.run import seed_scenario
 
-    from gcalign.io.scenario import parse_scenario
-
-    d = yaml.safe_load(BUILTIN.read_text())
-    d["imu"].update(rate_hz=rate, seed=seed)
-    if gyro is not None:
-        d["imu"]["gyro"] = gyro
-    if accel is not None:
-        d["imu"]["accel"] = accel
-    if mechanism is not None:
-        d["mechanism"] = mechanism
-    d["modulate"] = {"compare": list(compare), "hours": hours, "linear": linear}
-    return parse_scenario(d, "docs")
+    return seed_scenario(compare, source="docs", **kw)
 
 
 def nav(compare, sink=None, **kw) -> dict:
@@ -546,7 +533,8 @@ and the same noise seed; the increments are exact through every turn (sensor fra
 errors are applied in the sensor frame, the strapdown update integrates the sensor frame
 and the body attitude comes through the mechanism angles; errors against truth at every
 sample. Beside each run the invariant report and the linear model for the same errors.
-This run took {wall:.0f} s on one core of a shared machine.
+This run took {wall:.0f} s on one core of a shared machine (the benchmark's
+median is in the must-show table at the end).
 
 Horizontal position error (m), navigation (linear model in brackets), and the largest
 misalignment:

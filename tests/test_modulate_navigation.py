@@ -15,46 +15,28 @@ against 100 Hz, then run the 72 h cases at 10 Hz (a run without rotation at 1 Hz
 
 from __future__ import annotations
 
-import copy
 import math
 
 import h5py
 import numpy as np
 import pytest
-import yaml
 from seed004 import EPS, NABLA, OMEGA, PARITY, R_M, R_N, SPEC_TABLE, WS, G, L, R
 
 from gcalign.app.data import scenario_stream
-from gcalign.app.modulate.run import run_modulate, variant
-from gcalign.cli.common import builtin_text
-from gcalign.io.scenario import parse_scenario
+from gcalign.app.modulate.run import run_modulate, seed_scenario, variant
 from gcalign.io.scenario.modulate import plan_of
 from gcalign.modulate import ErrorTerms, builtin_scheme, linear_errors
 from gcalign.modulate.linear import gyro_increment_response
 from gcalign.units import ARCMIN, ARCSEC, DEG, DPH, DPSH, HOUR, UG
 
-BASE = yaml.safe_load(builtin_text("seed004_modulation.yaml"))
 DEFAULT = ["fixed", "seed-12", "four-position-12", "dual-16-improved"]
 NABLA_UG = NABLA / UG
 HOURS = ("1h", "4h", "12h", "24h", "72h")
 
 
-def scenario(compare, hours=72.0, rate=10.0, gyro=None, accel=None, mechanism=None,
-             navigation=None, seed=1, linear=True):
+def scenario(compare, hours=72.0, rate=10.0, **kw):
     """The built-in seed 004 scenario with the given changes (errors in user units)."""
-    d = copy.deepcopy(BASE)
-    d["imu"]["rate_hz"] = rate
-    d["imu"]["seed"] = seed
-    if gyro is not None:
-        d["imu"]["gyro"] = gyro
-    if accel is not None:
-        d["imu"]["accel"] = accel
-    if mechanism is not None:
-        d["mechanism"] = mechanism
-    if navigation is not None:
-        d["navigation"] = navigation
-    d["modulate"] = {"compare": list(compare), "hours": hours, "linear": linear}
-    return parse_scenario(d, "test")
+    return seed_scenario(compare, hours=hours, rate=rate, source="test", **kw)
 
 
 def run(*args, **kw) -> dict:

@@ -54,6 +54,32 @@ def default_rate_hz(duration_s: float, imu_rate_hz: float) -> float:
     return min(imu_rate_hz, 1.0 if duration_s <= 4 * HOUR else 0.1)
 
 
+def seed_scenario(compare, *, rate: float = 10.0, hours: float = 72.0, gyro=None, accel=None,
+                  mechanism=None, navigation=None, seed: int = 1, linear: bool = True,
+                  source: str = "seed004") -> Scenario:
+    """The built-in seed 004 scenario (gcalign/scenarios/seed004_modulation.yaml) with the
+    given changes, errors in user units (``imu.gyro``/``imu.accel`` sections replace the
+    seed's): the cases of the tests and of docs/results_modulate.py. Default 10 Hz, which
+    gives the seed's 100 Hz numbers on a static base (tests/test_modulate_navigation.py)."""
+    from importlib import resources
+
+    import yaml
+
+    from gcalign.io.scenario import parse_scenario
+
+    text = resources.files("gcalign.scenarios").joinpath("seed004_modulation.yaml").read_text(
+        encoding="utf-8")
+    d = yaml.safe_load(text)
+    d["imu"].update(rate_hz=rate, seed=seed)
+    for key, section, value in (("gyro", "imu", gyro), ("accel", "imu", accel),
+                                ("mechanism", None, mechanism),
+                                ("navigation", None, navigation)):
+        if value is not None:
+            (d[section] if section else d)[key] = value
+    d["modulate"] = {"compare": list(compare), "hours": hours, "linear": linear}
+    return parse_scenario(d, source)
+
+
 def variant(sc: Scenario, entry: Entry, plan: Plan) -> Scenario:
     """The scenario one scheme runs: its mechanism, the plan's duration (a static base lasts
     that long), and the stored-series rate."""
