@@ -1,11 +1,14 @@
 """Regenerate docs/results.md: the seeds' numbers beside ours.
 
-Run from the repository root:  python docs/make_results.py [--workers 2] [--resume]
+Run from the repository root:  python docs/make_results.py [--workers 2] [--resume] [--all]
 
-The document is the section files below, in this order; a missing file is skipped. A
-section with a generator is written first from its sweeps (configs/sweeps/, run by the
-batch engine with a local pool into runs/); the others are kept as written. Adding a
-capability's results is one line in SECTIONS (and, if generated, one in GENERATORS).
+The document is the section files below, in this order; a missing file is skipped. The
+seed-000 section is written first from its sweeps (configs/sweeps/, run by the batch engine
+with a local pool into runs/); with --all the real-time and modulation sections are
+rewritten by their generators too (docs/results_realtime.py, docs/results_modulate.py:
+several minutes more, the 72 h runs); the others are kept as written (the calibration
+tables come from docs/make_results_calibrate.py). Adding a capability's results is one line
+in SECTIONS (and, if generated, one in GENERATORS or SLOW_GENERATORS).
 """
 
 from __future__ import annotations
@@ -34,7 +37,20 @@ def _seed000(args) -> str:
     return seed000_results.section(args.workers, ROOT / "runs", args.resume)
 
 
+def _realtime(args) -> str:
+    import results_realtime
+
+    return results_realtime.section(figure_dir=DOCS / "figures")
+
+
+def _modulate(args) -> str:
+    import results_modulate
+
+    return results_modulate.section()
+
+
 GENERATORS = {"results_seed000.md": _seed000}
+SLOW_GENERATORS = {"results_realtime.md": _realtime, "results_modulate.md": _modulate}
 
 
 def assemble() -> Path:
@@ -50,12 +66,15 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2, help="local worker processes")
     ap.add_argument("--resume", action="store_true",
                     help="reuse finished runs of earlier batches in runs/ (same scenarios)")
+    ap.add_argument("--all", action="store_true",
+                    help="also rewrite the real-time and modulation sections")
     ap.add_argument("--assemble-only", action="store_true",
                     help="only join the section files (no runs)")
     args = ap.parse_args()
     sys.path.insert(0, str(DOCS))
     if not args.assemble_only:
-        for name, generate in GENERATORS.items():
+        generators = GENERATORS | (SLOW_GENERATORS if args.all else {})
+        for name, generate in generators.items():
             t0 = time.perf_counter()
             (DOCS / name).write_text(generate(args).rstrip() + "\n")
             print(f"wrote {DOCS / name} ({time.perf_counter() - t0:.0f} s)")

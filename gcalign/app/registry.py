@@ -90,6 +90,9 @@ COMMANDS: dict[str, Command] = {
         Command("realtime", "realtime", "Attitude at sync pulses: filter delay and prediction "
                 "(seed 003).", "realtime", "seed003_table1.yaml",
                 ("cases.0.after_max_arcsec.kalman-ls",)),
+        Command("modulate", "modulate", "Rotation modulation: navigation on a turning IMU, "
+                "schemes compared on the same data (seed 004).", "modulate",
+                "seed004_modulation.yaml", ("max_horizontal_error_m",), streams=True),
         Command("batch", "batch", "Sweeps and Monte Carlo over any batchable command."),
     )
 }

@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 
+from rich.console import Group, RenderableType
 from rich.table import Table
 from rich.text import Text
 
@@ -149,10 +150,14 @@ def kv_table(title: str, rows: Iterable[Sequence], headers: Sequence[str] = ("",
     return table
 
 
-def with_warnings(table: Table, warnings: Sequence[str]) -> Table:
-    """The run's warnings under the caption, one line each."""
+def with_warnings(table: RenderableType, warnings: Sequence[str]) -> RenderableType:
+    """The run's warnings under the caption, one line each (under the whole output when a
+    command prints more than one table)."""
     if not warnings:
         return table
+    if not isinstance(table, Table):
+        return Group(table, Text("\n".join(f"warning: {w}" for w in warnings),
+                                 style="yellow"))
     caption = table.caption
     text = Text() if caption is None else (
         caption.copy() if isinstance(caption, Text) else Text.from_markup(str(caption)))
@@ -163,7 +168,7 @@ def with_warnings(table: Table, warnings: Sequence[str]) -> Table:
     return table
 
 
-def summary_table(kind: str, summary: dict) -> Table:
+def summary_table(kind: str, summary: dict) -> RenderableType:
     """The table a command prints, from its summary (also for `gcalign show`), with the
     run's warnings."""
     from gcalign.app.registry import COMMANDS

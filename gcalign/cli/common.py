@@ -202,7 +202,7 @@ def load_with_overrides(
     in results files records the overrides.
     """
     if data is not None:
-        source = str(path)
+        source = str(path) if path is not None else f"<built-in {builtin}>"
         text = text or yaml.safe_dump(data, sort_keys=False)
     elif path is None:
         text, source = builtin_text(builtin), f"<built-in {builtin}>"

@@ -16,6 +16,12 @@ enters the reference frame as follows (open loop: no earth rate, no navigation l
   the net over the seed's 12 steps is ``Σ ±π δk_u C_before u = 0`` (its ccw and cw halves
   cancel), and within the cycle it reaches 2π·δk on each axis.
 
+* asymmetric scale factor × mechanism rate, ``δk_asym ⊙ |ω|``: the sense of a turn does not
+  change its sign, so the ccw and cw halves of a scheme add instead of cancelling. Per
+  cycle it leaves ``asym_net = A δk_asym`` with ``A[:, j] = ∫_cycle C e_j |ω_j| dt`` (rad):
+  for a turn about u, π·C_before u per 180° whatever its sense. Divided by the period it is
+  a residual drift, like C̄ ε.
+
 A term that returns to zero every cycle still has a cycle mean (``*_offset``): the
 computed attitude is off by −m(t), on average by −m̄, a standing tilt and heading error
 that the navigation loops see as if it were an initial attitude error (it starts the
@@ -94,6 +100,9 @@ class InvariantReport:
         term m(T), per axis max |m(t)|, and the cycle mean of m(t).
     misalignment_net, misalignment_peak, misalignment_offset : (3,) rad, the same for the
         misalignment term.
+    abs_rate_integral : (3, 3) rad, ``A[:, j] = ∫_cycle C e_j |ω_j| dt``.
+    asym_net : (3,) rad, ``A δk_asym``: the asymmetric scale-factor term over a cycle
+        (``asym_net / period`` acts as a residual gyro drift).
     schuler_period : s, 2π/ω_s at the site.
     harmonics : the harmonics of C(t) within ±20 % of the Schuler period (any amplitude).
     warnings : human-readable warnings (Schuler resonance).
@@ -119,6 +128,8 @@ class InvariantReport:
     misalignment_net: np.ndarray
     misalignment_peak: np.ndarray
     misalignment_offset: np.ndarray
+    abs_rate_integral: np.ndarray
+    asym_net: np.ndarray
     schuler_period: float
     harmonics: tuple[Harmonic, ...]
     warnings: tuple[str, ...]
@@ -219,6 +230,9 @@ def invariant_report(scheme: Scheme | Schedule, errors: ErrorTerms | None = None
     m_mis = np.einsum("kaij,ij->ka", run_W, M)
     # cycle mean of ∫_0^t (C − C̄) ε ds: (1/T)∫(T − s) C ds ε − (T/2) C̄ ε
     offset = run.mean_C @ eps - 0.5 * T * (mean_C @ eps)
+    g = cycle_grid(schedule, max_span=PEAK_SPAN)
+    tt = g.t.ravel()
+    A = g.integrals(schedule.dcm(tt) * np.abs(schedule.rate(tt))[:, None, :]).sum(0)
     omega_s = earth.schuler_rate(lat)
     harmonics = schuler_harmonics(schedule, omega_s)
     warnings = tuple(
@@ -235,5 +249,6 @@ def invariant_report(scheme: Scheme | Schedule, errors: ErrorTerms | None = None
         scale_factor_offset=np.einsum("aij,ij->a", run.mean_W, K), misalignment_net=m_mis[-1],
         misalignment_peak=np.abs(m_mis).max(0),
         misalignment_offset=np.einsum("aij,ij->a", run.mean_W, M),
+        abs_rate_integral=A, asym_net=A @ errors.gyro_asym,
         schuler_period=2 * math.pi / omega_s,
         harmonics=harmonics, warnings=warnings, t=t, running_C=run_C, running_rate=run_W)

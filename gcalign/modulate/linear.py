@@ -14,10 +14,17 @@ m/s, rad). With ω_ie^n = Ω [0, cos L, sin L] = [0, Ω_N, Ω_U], f^n = [0, 0, g
     δv̇_N =  g φ_E − 2 Ω_U δv_E + (C(t) ∇)_N
     δL̇  = δv_N / R_M,      δλ̇ = δv_E / (R_N cos L)
 
-with the sensor-frame gyro error ``δω^s = ε + (diag δk + M) ω_m(t) + w`` (ω_m the mechanism
-rate, w white noise of density ``arw``), accelerometer error ``∇ + w_a`` (density ``vrw``),
-and ``C(t) = C_s^n(t) = C0 · S(t)`` (S the scheme's schedule, C0 = I: body = ENU, spec
-§4). The earth rate seen by a scale-factor error (δk·Ω ≈ 1e-5·Ω) is left out.
+with ``C(t) = C_s^n(t) = C0 · S(t)`` (S the scheme's schedule, C0 = I: body = ENU, spec
+§4), the sensed rate ``ω^s = ω_m(t) + Cᵀ ω_ie^n`` (ω_m the mechanism rate) and specific
+force ``f^s = Cᵀ [0, 0, g]``, and the sensor-frame errors (:class:`ErrorTerms`)
+
+.. code-block:: text
+
+    δω^s = ε + (diag δk + M) ω^s + δk_asym ⊙ |ω^s| + w                (w: density arw)
+    δf^s = ∇ + (diag δk_a + M_a) f^s + δk_a,asym ⊙ |f^s| + ω̇_m × r + ω_m × (ω_m × r) + w_a
+
+(r the lever arm of the accelerometers from the rotation centre, w_a of density vrw): the
+same terms the simulation puts into the increments.
 
 The system matrix F is constant (static base); only the forcing turns with the IMU. So
 each interval between knots (piece ends and output times) is integrated exactly:
@@ -43,7 +50,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gcalign.estimation.kalman import van_loan
 from gcalign.modulate._quadrature import gauss_legendre, pieces, split_count
 from gcalign.modulate.schemes import Scheme
 from gcalign.modulate.terms import SEED004_LAT, ErrorTerms
@@ -202,8 +208,9 @@ class _Propagator:
     """Interval maps ``x(b) = Φ x(a) + w`` of the model for one schedule and error set."""
 
     def __init__(self, F: np.ndarray, schedule: Schedule, C0: np.ndarray, errors: ErrorTerms,
-                 vel_scale: float):
+                 vel_scale: float, omega_ie_n: np.ndarray, f_n: np.ndarray):
         self.F, self.schedule, self.C0, self.errors = F, schedule, C0, errors
+        self.omega_ie_n, self.f_n = omega_ie_n, f_n
         self.p = pieces(schedule)
         scale = np.ones(F.shape[0])
         scale[DV] = 1.0 / vel_scale
@@ -221,10 +228,17 @@ class _Propagator:
         """u(t) (n, 7) at cycle times `tt` (n,)."""
         C = self.C0 @ self.schedule.dcm(tt)
         e = self.errors
-        d_omega = e.gyro_bias + self.schedule.rate(tt) @ e.gyro_matrix.T
+        w_m = self.schedule.rate(tt)
+        w_s = w_m + np.einsum("nji,j->ni", C, self.omega_ie_n)  # what the gyros sense
+        d_omega = e.gyro_bias + w_s @ e.gyro_matrix.T + e.gyro_asym * np.abs(w_s)
+        f_s = np.einsum("nji,j->ni", C, self.f_n)
+        d_f = e.accel_bias + f_s @ e.accel_matrix.T + e.accel_asym * np.abs(f_s)
+        if np.any(e.lever != 0):  # ω̇ × r + ω × (ω × r), mechanism rate
+            a_m = self.schedule.angular_accel(tt)
+            d_f = d_f + np.cross(a_m, e.lever) + np.cross(w_m, np.cross(w_m, e.lever))
         u = np.zeros((len(tt), 7))
         u[:, PHI] = -np.einsum("nij,nj->ni", C, d_omega)
-        u[:, DV] = (C @ e.accel_bias)[:, :2]
+        u[:, DV] = np.einsum("nij,nj->ni", C, d_f)[:, :2]
         return u
 
     def phi_gamma(self, h: float) -> tuple[np.ndarray, np.ndarray]:
@@ -260,6 +274,8 @@ class _Propagator:
         """Van Loan noise covariance Q_d over h and a square root L (L Lᵀ = Q_d)."""
         key = round(h, 9)
         if key not in self._q:
+            from gcalign.estimation.kalman import van_loan  # scipy: only with noise
+
             Q = van_loan(self.F, np.eye(self.F.shape[0]), self.Qc, h)[1]
             self._q[key] = (Q, _sqrt_psd(Q))
         return self._q[key]
@@ -319,8 +335,10 @@ def linear_errors(scheme: Scheme | Schedule, errors: ErrorTerms, *,
     F = error_matrix(lat, earth)
     r_m, r_n = earth.radii(lat)
     vel_scale = float(np.sqrt(r_m * r_n)) * earth.schuler_rate(lat)  # R ω_s, m/s per rad
+    omega_ie_n = earth.omega_ie * np.array([0.0, math.cos(lat), math.sin(lat)])
+    f_n = np.array([0.0, 0.0, float(earth.gravity(lat))])
     prop = _Propagator(F, schedule, np.eye(3) if C0 is None else np.asarray(C0, float), errors,
-                       vel_scale)
+                       vel_scale, omega_ie_n, f_n)
     knots = _knots(schedule, t_out, float(t_out[-1]))
     out_k = np.searchsorted(knots, t_out - _TOL)  # knot of each output time
     is_out = np.full(len(knots), -1)
@@ -353,3 +371,38 @@ def linear_errors(scheme: Scheme | Schedule, errors: ErrorTerms, *,
             if paths is not None:
                 paths[:, m] = x[:, 1:].T
     return LinearErrors(name, t_out, X, Ps, paths, float(lat), float(r_m), float(r_n))
+
+
+def gyro_increment_response(scheme: Scheme | Schedule, dtheta: np.ndarray, ts: float, *,
+                            lat: float = SEED004_LAT, earth: EarthModel = SEED004,
+                            C0: np.ndarray | None = None, window: float = 10.0,
+                            block: int = 1 << 17) -> tuple[np.ndarray, np.ndarray]:
+    """The model's response to given sensor-frame gyro error increments, one path.
+
+    ``dtheta`` (n, 3) rad: the error of each increment (say the noise a simulation drew),
+    sample k over ``[k ts, (k+1) ts]``. Each enters φ as the impulse ``−C(t_k) dθ_k``
+    (C = C0 · S at the sample's middle); impulses are summed over windows of `window` s
+    (a whole number of samples) and applied at the window's middle, which is exact to
+    O((ω_s · window/2)²) of the response. Returns the times (0, window, 2·window, …) and
+    the states there, (m,), (m, 7) (order :data:`STATES`).
+    """
+    from scipy.linalg import expm
+
+    schedule = scheme.schedule if isinstance(scheme, Scheme) else scheme
+    per = int(round(window / ts))
+    if per < 1 or abs(per * ts - window) > 1e-9 * window:
+        raise ValueError(f"window {window} s is not a whole number of samples of {ts} s")
+    n = (len(dtheta) // per) * per
+    F = error_matrix(lat, earth)
+    Phi, half = expm(F * window), expm(F * window / 2)[:, PHI]
+    C0 = np.eye(3) if C0 is None else np.asarray(C0, dtype=float)
+    step = max(per, (block // per) * per)
+    x, out = np.zeros(7), [np.zeros(7)]
+    for k0 in range(0, n, step):
+        k1 = min(n, k0 + step)
+        C = C0 @ schedule.dcm((np.arange(k0, k1) + 0.5) * ts)
+        u = -np.einsum("nij,nj->ni", C, dtheta[k0:k1]).reshape(-1, per, 3).sum(1)
+        for uj in u:
+            x = Phi @ x + half @ uj
+            out.append(x)
+    return window * np.arange(len(out)), np.array(out)

@@ -293,14 +293,21 @@ def scheme_from_rows(rows: Sequence[Row] | Sequence[Mapping], *, name: str = "us
         si = tuple(cast(Sequence[Row], rows))
     steps = [_checked_step(i, r) for i, r in enumerate(si)]
     schedule = Schedule(tuple(steps), repeat=True, q0=q0)
+    check_cycle_closes(schedule, "scheme rows", tol)
+    return Scheme(name, si, schedule, reference, description)
+
+
+def check_cycle_closes(schedule: Schedule, field: str, tol: float = 1e-9) -> None:
+    """ScenarioError naming `field` unless the schedule's cycle rotation is within `tol` rad
+    of the identity (a table that does not return the IMU to its start would not repeat its
+    positions); the message says where the last row leaves it."""
     rv = quat_to_rotvec(schedule.cycle_rotation)
     ang = float(np.linalg.norm(rv))
     if ang > tol:
         raise ScenarioError(
-            f"scheme rows: the table does not return the IMU to its start: after the last row "
-            f"it is turned by {ang / DEG:.6g} deg about {np.round(rv / ang, 6).tolist()}; add "
-            "rows that bring it back")
-    return Scheme(name, si, schedule, reference, description)
+            f"{field}: the table does not return the IMU to its start: after the last row it "
+            f"is turned by {ang / DEG:.6g} deg about {(np.round(rv / ang, 6) + 0.0).tolist()}; "
+            "add rows that bring it back")
 
 
 # ---------------------------------------------------------------------------- built-ins
@@ -340,7 +347,7 @@ def builtin_rows(name: str, *, dwell: float | None = None, turn: Turn = SEED_TUR
     turns at `rate` (rad/s) about `axis`."""
     if name not in _DESCRIPTIONS:
         raise ScenarioError(f"scheme: unknown scheme {name!r}; built-in: "
-                            f"{', '.join(BUILTIN_NAMES)} (or give rows)")
+                            f"{', '.join(BUILTIN_NAMES)} (or a table of rows)")
     if dwell is not None and not dwell >= 0:
         raise ScenarioError(f"scheme dwell_s: must be ≥ 0, got {dwell!r}")
     if name == "fixed":

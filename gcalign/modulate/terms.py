@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from gcalign.sim.errors import SensorErrors
 from gcalign.units import DPH
 
 SEED004_LAT = math.radians(45.7796)  # seed 004 §4: 45.7796°N, 126.6705°E
@@ -28,12 +29,19 @@ def _vec(v, shape) -> np.ndarray:
 
 @dataclass(frozen=True)
 class ErrorTerms:
-    """Constant sensor errors in the sensor frame and white noise (SI).
+    """Constant sensor errors in the sensor frame and white noise (SI), as
+    :mod:`gcalign.sim.errors` applies them to the increments.
 
     gyro_bias : (3,) rad/s. accel_bias : (3,) m/s².
     gyro_scale : (3,) scale-factor errors δk (fraction).
     gyro_misalignment : (3, 3) small-angle non-orthogonality, zero diagonal; the gyro
-        measures ``(I + diag(gyro_scale) + gyro_misalignment) ω + gyro_bias + noise``.
+        measures ``(I + diag(gyro_scale) + gyro_misalignment) ω + gyro_asym ⊙ |ω| +
+        gyro_bias + noise``.
+    gyro_asym : (3,) asymmetric scale factor (added for positive input, subtracted for
+        negative: ``asym ⊙ |ω|``).
+    accel_scale, accel_misalignment, accel_asym : the same for the accelerometers.
+    lever : (3,) m, position of the accelerometers from the mechanism's rotation centre,
+        sensor frame: they sense ``ω̇ × r + ω × (ω × r)`` from the mechanism's rate ω.
     arw : angle random walk, rad/√s (the same on every axis).
     vrw : velocity random walk, m/s/√s (the same on every axis).
     """
@@ -44,14 +52,22 @@ class ErrorTerms:
     gyro_misalignment: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
     arw: float = 0.0
     vrw: float = 0.0
+    gyro_asym: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    accel_scale: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    accel_misalignment: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    accel_asym: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    lever: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self):
         for name, shape in (("gyro_bias", (3,)), ("accel_bias", (3,)), ("gyro_scale", (3,)),
-                            ("gyro_misalignment", (3, 3))):
+                            ("gyro_misalignment", (3, 3)), ("gyro_asym", (3,)),
+                            ("accel_scale", (3,)), ("accel_misalignment", (3, 3)),
+                            ("accel_asym", (3,)), ("lever", (3,))):
             object.__setattr__(self, name, _vec(getattr(self, name), shape))
-        if np.any(np.diag(self.gyro_misalignment) != 0):
-            raise ValueError("gyro_misalignment must have a zero diagonal (the diagonal is "
-                             "gyro_scale)")
+        for name in ("gyro", "accel"):
+            if np.any(np.diag(getattr(self, f"{name}_misalignment")) != 0):
+                raise ValueError(f"{name}_misalignment must have a zero diagonal (the "
+                                 f"diagonal is {name}_scale)")
         if not (self.arw >= 0 and self.vrw >= 0):
             raise ValueError(f"arw and vrw must be ≥ 0, got {self.arw}, {self.vrw}")
 
@@ -59,6 +75,26 @@ class ErrorTerms:
     def gyro_matrix(self) -> np.ndarray:
         """``diag(gyro_scale) + gyro_misalignment``: the gyro error per unit rate, (3, 3)."""
         return np.diag(self.gyro_scale) + self.gyro_misalignment
+
+    @property
+    def accel_matrix(self) -> np.ndarray:
+        """``diag(accel_scale) + accel_misalignment``, (3, 3)."""
+        return np.diag(self.accel_scale) + self.accel_misalignment
+
+    @classmethod
+    def of_sensors(cls, gyro: SensorErrors, accel: SensorErrors,
+                   lever=(0.0, 0.0, 0.0)) -> ErrorTerms:
+        """The terms of the simulation's error model (:class:`gcalign.sim.errors.SensorErrors`,
+        SI). Noise densities that differ between axes enter as their RMS (the model's noise
+        is isotropic); quantisation is left out."""
+        def rms(v) -> float:
+            return float(np.sqrt(np.mean(np.square(v))))
+
+        return cls(gyro_bias=gyro.bias, accel_bias=accel.bias, gyro_scale=gyro.scale,
+                   gyro_misalignment=gyro.misalignment, arw=rms(gyro.noise),
+                   vrw=rms(accel.noise), gyro_asym=gyro.asym, accel_scale=accel.scale,
+                   accel_misalignment=accel.misalignment, accel_asym=accel.asym,
+                   lever=np.asarray(lever, dtype=float))
 
     @classmethod
     def seed004(cls, *, gyro: bool = True, accel: bool = True, **kw) -> ErrorTerms:

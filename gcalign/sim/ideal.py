@@ -129,6 +129,8 @@ def _numpy_blocks(motion: MotionType, site, ts, earth, mechanism, block, m,
         dv = np.einsum("j,kjc->kc", weights, f_s)
         if isinstance(motion, Moving):
             _split_at_boundaries(dv, motion, mechanism, site, earth, k0, n, ts, m)
+        if mechanism is not None and mechanism.lever is not None:
+            dv += mechanism.lever_dv(k0, n, ts)
 
         t_s = grid.ravel()[sp]
         half = 0.5 * earth.omega_ie * (t_s - t_s[0])
@@ -204,6 +206,8 @@ def _fixed_site_blocks(motion: Static | Turntable, site, ts, earth, mechanism, b
         fixed_site_block(k0, n, ts, m, earth.omega_ie, q_en, f_n, q_nb0, body_tab,
                          body is not None, mech_tab, mechanism is not None, mech_nav,
                          dtheta, dv, q_nb, q_bs)
+        if mechanism is not None and mechanism.lever is not None:
+            dv += mechanism.lever_dv(k0, n, ts)
         t = (k0 + 1 + np.arange(n)) * ts
         att = np.broadcast_to(np.asarray(motion.att0, float), (n, 3)) if body is None else \
             quat_to_euler(q_nb)

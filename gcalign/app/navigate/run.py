@@ -90,12 +90,14 @@ def vertical_of(cfg: NavigationConfig, sc: Scenario, motion_kind: str | None = N
 
 
 def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
-                    duration_s: float | None = None, sink=None, progress=None) -> dict:
+                    duration_s: float | None = None, sink=None, on_rows=None,
+                    progress=None) -> dict:
     """Navigate from `start` to the end of the data (or for `duration_s`), compare with the
     truth at every sample (:func:`gcalign.nav._kernels.error_block`), write every
-    `stride`-th row to `sink` (an h5py group), and return the plain-number pieces of the
-    summary (SI, radians). `progress(done_s, total_s, what)`, if given, hears of every
-    block (seconds of data navigated)."""
+    `stride`-th row to `sink` (an h5py group) and hand it to `on_rows` (called with the
+    dict of arrays appended to the series, block by block), and return the plain-number
+    pieces of the summary (SI, radians). `progress(done_s, total_s, what)`, if given,
+    hears of every block (seconds of data navigated)."""
     from gcalign.io.results import ATT_FRAME, PHI_FRAME, Series
 
     ts, earth = stream.ts, stream.earth
@@ -157,7 +159,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
                              none if tr is None else np.ascontiguousarray(tr.v_n[lo:hi]),
                              none if tr is None else np.ascontiguousarray(tr.pos[lo:hi]),
                              tr is not None, E, pos0, b.k0 + lo - start.k, stride, acc, out)
-        if series is not None and rows:
+        if (series is not None or on_rows is not None) and rows:
             keep = np.flatnonzero((b.k0 + np.arange(lo, hi) + 1 - start.k) % stride == 0)
             r = out[:rows]
             data = {"t": b.t[lo:hi][keep], "att": r[:, 0:3], "v_n": r[:, 3:6],
@@ -165,7 +167,10 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
             if has_truth:
                 data |= {"error/att": r[:, 9:12], "error/v_n": r[:, 12:15],
                          "error/pos": r[:, 15:18], "error/phi": r[:, 18:21]}
-            series.append(**data)
+            if series is not None:
+                series.append(**data)
+            if on_rows is not None:
+                on_rows(data)
         last = (states[-1], None if b.q_bs is None else b.q_bs[hi - 1])
         if progress is not None:
             progress((b.k0 + hi - start.k) * ts, (k_end - start.k) * ts, "navigating (data s)")
@@ -197,8 +202,9 @@ def _qmul(a, b):
 
 
 def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | None = None,
-                   sink=None, progress=None) -> tuple[dict, Stream]:
-    """Navigate a scenario's data; the summary (plain numbers, degrees/m) and the stream."""
+                   sink=None, on_rows=None, progress=None) -> tuple[dict, Stream]:
+    """Navigate a scenario's data; the summary (plain numbers, degrees/m) and the stream.
+    `sink`, `on_rows` and `progress` as :func:`navigate_stream`."""
     cfg = sc.navigation or NavigationConfig()
     stream = scenario_stream(sc, seed)
     kind = None if stream.header is None else stream.header.meta.get("motion_kind")
@@ -233,7 +239,8 @@ def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | Non
             v0 = hd.v0_n if hd.v0_n is not None else np.zeros(3)
             state = NavState.from_euler(hd.att0, v0, stream.site)
         start = Start(k, state, source)
-    part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink, progress)
+    part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink, on_rows,
+                           progress)
     return _summary(sc, stream, start, vertical, stride, part), stream
 
 
@@ -286,5 +293,5 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None, sink=None
     """Navigate (streamed); the registry's entry point. With `sink` (an open results file)
     the decimated series go into its /navigate group as they are computed."""
     group = None if sink is None else sink.create_group("navigate")
-    summary, stream = run_navigation(sc, seed, init, group, progress)
+    summary, stream = run_navigation(sc, seed, init, group, progress=progress)
     return Outcome(summary, lambda f: None, None, stream.seed)

@@ -36,7 +36,8 @@ def scenario_errors(err: ValidationError, source: str = "") -> str:
         msg = e["msg"].removeprefix("Value error, ")
         m = _FIELD_PREFIX.match(msg)
         if m:
-            loc.append(m.group(1))
+            if not loc or loc[-1] != m.group(1):  # a field validator names its own field
+                loc.append(m.group(1))
             msg = msg[m.end() :]
         where = ".".join(loc) or "scenario"
         if e["type"] == "extra_forbidden":

@@ -12,6 +12,7 @@ from gcalign import units as u
 from gcalign.io.scenario.align import AlignConfig
 from gcalign.io.scenario.base import Model, NonNegVec3, Vec3
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
+from gcalign.io.scenario.modulate import ModulateConfig
 from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
@@ -154,6 +155,7 @@ class Scenario(Model):
     calibrate: CalibrateConfig | None = None
     observability: ObservabilityConfig | None = None
     realtime: RealtimeConfig | None = None
+    modulate: ModulateConfig | None = None
 
     @property
     def earth_model(self) -> EarthModel:

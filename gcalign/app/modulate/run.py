@@ -1,0 +1,307 @@
+"""`gcalign modulate`: strapdown navigation on a turning IMU, the same data with and without
+modulation (seed 004; spec 004 §4–§6).
+
+For each scheme of the plan (:func:`gcalign.io.scenario.modulate.plan_of`) the scenario's
+motion is simulated with the IMU on that scheme's mechanism (``fixed``: on the body), with
+the same sensor errors and the same noise seed, and navigated by
+:func:`gcalign.app.navigate.run.run_navigation`: increments exact through every turn, errors
+in the sensor frame, the body attitude through the mechanism angles, height held (vertical
+``auto``), errors against truth at every sample. Beside each run: the scheme's invariant
+report (:mod:`gcalign.modulate.invariants`) and, on a static base, the linear error model
+(:mod:`gcalign.modulate.linear`) for the same errors, so that the two routes can be
+compared number by number.
+
+Stored series (HDF5, ``/modulate/<scheme>``) are decimated: 1 Hz up to 4 h, 0.1 Hz beyond,
+unless ``output.rate_hz`` says otherwise; the horizontal error at the report hours is read
+from the stored rows, so the rate must put each report hour on its grid.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from gcalign.app.navigate.run import run_navigation
+from gcalign.app.registry import Outcome
+from gcalign.errors import ScenarioError
+from gcalign.io.scenario import Scenario
+from gcalign.io.scenario.modulate import Entry, Plan, plan_of
+from gcalign.io.scenario.navigation import NavigationConfig, OutputConfig
+from gcalign.modulate.invariants import InvariantReport, invariant_report
+from gcalign.modulate.linear import REPORT_HOURS, LinearErrors, linear_errors
+from gcalign.modulate.terms import ErrorTerms
+from gcalign.nav.rotation import euler_to_dcm, quat_to_dcm
+from gcalign.units import ARCSEC, DPH, DPSH, HOUR, PPM, UG, UGPSHZ
+
+LINEAR_DT_S = 60.0  # output interval of the linear model (its report hours are exact)
+CYCLE_DT_S = 0.25  # mechanism angles over one cycle: sample interval (at most)
+Progress = Callable[[str, int, int], None]  # (scheme, index, count)
+
+
+def hour_key(h: float) -> str:
+    return f"{h:g}h"
+
+
+def report_hours(hours: float) -> list[float]:
+    return [h for h in REPORT_HOURS if h <= hours + 1e-9]
+
+
+def default_rate_hz(duration_s: float, imu_rate_hz: float) -> float:
+    """Stored-series rate without ``output.rate_hz``: 1 Hz up to 4 h, 0.1 Hz beyond."""
+    return min(imu_rate_hz, 1.0 if duration_s <= 4 * HOUR else 0.1)
+
+
+def seed_scenario(compare, *, rate: float = 10.0, hours: float = 72.0, gyro=None, accel=None,
+                  mechanism=None, navigation=None, seed: int = 1, linear: bool = True,
+                  source: str = "seed004") -> Scenario:
+    """The built-in seed 004 scenario (gcalign/scenarios/seed004_modulation.yaml) with the
+    given changes, errors in user units (``imu.gyro``/``imu.accel`` sections replace the
+    seed's): the cases of the tests and of docs/results_modulate.py. Default 10 Hz, which
+    gives the seed's 100 Hz numbers on a static base (tests/test_modulate_navigation.py)."""
+    from importlib import resources
+
+    import yaml
+
+    from gcalign.io.scenario import parse_scenario
+
+    text = resources.files("gcalign.scenarios").joinpath("seed004_modulation.yaml").read_text(
+        encoding="utf-8")
+    d = yaml.safe_load(text)
+    d["imu"].update(rate_hz=rate, seed=seed)
+    for key, section, value in (("gyro", "imu", gyro), ("accel", "imu", accel),
+                                ("mechanism", None, mechanism),
+                                ("navigation", None, navigation)):
+        if value is not None:
+            (d[section] if section else d)[key] = value
+    d["modulate"] = {"compare": list(compare), "hours": hours, "linear": linear}
+    return parse_scenario(d, source)
+
+
+def variant(sc: Scenario, entry: Entry, plan: Plan) -> Scenario:
+    """The scenario one scheme runs: its mechanism, the plan's duration (a static base lasts
+    that long), and the stored-series rate."""
+    v = sc.model_copy(deep=True)
+    assert v.motion is not None
+    if v.motion.kind == "static":
+        v.motion = v.motion.model_copy(update={"duration_s": plan.duration_s})
+    v.mechanism = entry.mechanism
+    nav = v.navigation or NavigationConfig()
+    v.navigation = nav.model_copy(update={"duration_s": plan.duration_s, "start_s": 0.0})
+    if v.output.rate_hz is None:
+        v.output = OutputConfig(rate_hz=default_rate_hz(plan.duration_s, sc.imu.rate_hz))
+    return v
+
+
+def _stride_checked(v: Scenario, hours: list[float]) -> int:
+    try:
+        stride = v.output.stride(v.imu.rate_hz, 0.0)
+    except ValueError as err:
+        raise ScenarioError(str(err)) from None
+    for h in hours:
+        n = h * HOUR * v.imu.rate_hz
+        if abs(n - round(n)) > 1e-6 or round(n) % stride:
+            raise ScenarioError(f"output.rate_hz: {v.output.rate_hz} Hz does not store a row at "
+                                f"{h:g} h; modulate needs a rate whose period divides 1 h")
+    return stride
+
+
+class HourProbe:
+    """Collects, from the stored rows as they stream by, the horizontal position error at the
+    report hours (m)."""
+
+    def __init__(self, hours: list[float]):
+        self.t = np.array([h * HOUR for h in hours])
+        self.keys = [hour_key(h) for h in hours]
+        self.value: dict[str, float] = {}
+
+    def __call__(self, rows: dict) -> None:
+        t, pos = rows["t"], rows["error/pos"]
+        k = np.searchsorted(t, self.t - 1e-6)
+        for key, tk, i in zip(self.keys, self.t, k, strict=True):
+            if i < len(t) and abs(t[i] - tk) < 1e-6:
+                self.value[key] = float(np.hypot(pos[i, 0], pos[i, 1]))
+
+
+def error_terms(sc: Scenario, entry: Entry) -> ErrorTerms:
+    """The sensor errors of the scenario as the linear model and the invariants take them."""
+    e = sc.imu.errors()
+    lever = entry.mechanism.lever() if entry.mechanism is not None else None
+    return ErrorTerms.of_sensors(e.gyro, e.accel, (0.0, 0.0, 0.0) if lever is None else lever)
+
+
+def linear_C0(sc: Scenario, entry: Entry) -> np.ndarray:
+    """C_s^n = C0 · S(t) of the linear model: the schedule S starts at its own q0 (the body's
+    attitude for a navigation-referenced scheme), so C0 is I there and C_b^n otherwise."""
+    if entry.scheme.reference == "navigation":
+        return np.eye(3)
+    assert sc.motion is not None
+    return euler_to_dcm(np.radians(sc.motion.attitude_deg))
+
+
+def mechanism_cycle(schedule, dt: float = CYCLE_DT_S) -> dict[str, np.ndarray]:
+    """One cycle of the schedule: t (s), the angle turned about each sensor axis since the
+    start of the cycle (rad, exact: completed steps plus the current one), the diagonal of
+    C(t) (where each sensor axis points) and q (C(t))."""
+    T = schedule.period
+    n = max(2, int(math.ceil(T / min(dt, T / 2000.0))) + 1)
+    t = np.linspace(0.0, T, n)
+    t[-1] = np.nextafter(T, 0.0)  # the end of the cycle, not the start of the next
+    theta, _, _, step = schedule.angle_rate_accel(t)
+    tb = schedule.tables()
+    done = np.cumsum([[0.0, 0.0, 0.0]] + [np.asarray(tb["axis"][i]) * st.profile.angle
+                                          for i, st in enumerate(schedule.steps)], axis=0)
+    angle = done[step] + tb["axis"][step] * theta[:, None]
+    q = schedule.quat(t)
+    return {"t": t, "angle": angle, "C_diag": np.einsum("nii->ni", quat_to_dcm(q)), "q": q}
+
+
+def _arcsec(v) -> list[float]:
+    return (np.asarray(v, dtype=float) / ARCSEC).tolist()
+
+
+def _clean(v: np.ndarray, scale: float) -> np.ndarray:
+    """Entries below 1e-12 of `scale` (round-off of a cancelling sum) as 0."""
+    return np.where(np.abs(v) <= 1e-12 * scale, 0.0, v)
+
+
+def invariants_summary(r: InvariantReport) -> dict:
+    e = r.errors
+    return {
+        "cycle_s": r.period,
+        "cycle_mean": _clean(r.mean_C, 1.0).tolist(),
+        "residual_gyro_bias_dph": (_clean(r.residual_gyro_bias, np.abs(e.gyro_bias).sum())
+                                   / DPH).tolist(),
+        "residual_accel_bias_ug": (_clean(r.residual_accel_bias, np.abs(e.accel_bias).sum())
+                                   / UG).tolist(),
+        "peak_integral_C_s": np.asarray(r.peak_integral_C, dtype=float).tolist(),
+        "gyro_bias_excursion_arcsec": _arcsec(r.gyro_bias_excursion),
+        "scale_factor_net_arcsec": _arcsec(r.scale_factor_net),
+        "scale_factor_peak_arcsec": _arcsec(r.scale_factor_peak),
+        "scale_factor_offset_arcsec": _arcsec(r.scale_factor_offset),
+        "misalignment_net_arcsec": _arcsec(r.misalignment_net),
+        "asym_drift_dph": (r.asym_net / r.period / DPH).tolist(),
+        "schuler_period_s": r.schuler_period,
+        "schuler_warnings": list(r.warnings),
+    }
+
+
+def linear_summary(lin: LinearErrors, hours: list[float]) -> dict:
+    return {
+        "horizontal_error_m": {hour_key(h): float(lin.at(h)[0]) for h in hours},
+        "max_horizontal_error_m": float(lin.horizontal.max()),
+        "final_horizontal_error_m": float(lin.horizontal[-1]),
+        "max_misalignment_arcsec": _arcsec(np.abs(lin.phi).max(0)),
+        "sigma_horizontal_final_m": float(lin.sigma_horizontal[-1]),
+    }
+
+
+def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group=None,
+               linear: bool = True) -> dict:
+    """Navigate one scheme (and its linear model); its summary. `group`: an h5py group for
+    the series, the invariants, the mechanism cycle and the linear model."""
+    from gcalign.app.modulate.hdf5 import write_scheme
+
+    hours = report_hours(plan.hours)
+    v = variant(sc, entry, plan)
+    _stride_checked(v, hours)
+    probe = HourProbe(hours)
+    nav, stream = run_navigation(v, seed, None, group, on_rows=probe)
+    terms = error_terms(sc, entry)
+    assert sc.site is not None
+    lat = float(sc.site.to_si()[0])
+    report = invariant_report(entry.scheme, terms, earth=sc.earth_model, lat=lat)
+    lin = None
+    if linear and sc.motion is not None and sc.motion.kind == "static":
+        lin = linear_errors(entry.scheme.schedule, terms,
+                            duration=plan.duration_s, dt_out=LINEAR_DT_S, lat=lat,
+                            earth=sc.earth_model, C0=linear_C0(sc, entry), name=entry.name)
+    me, fe = nav["max_error"], nav["final_error"]
+    s = entry.scheme
+    out = {
+        "description": s.description,
+        "reference": s.reference,
+        "mechanism": entry.mechanism is not None,
+        **invariants_summary(report),
+        "horizontal_error_m": {k: probe.value[k] for k in probe.keys},
+        "max_horizontal_error_m": nav["max_horizontal_error_m"],
+        "final_horizontal_error_m": float(math.hypot(*fe["position_m"][:2])),
+        "max_misalignment_arcsec": [3600.0 * x for x in me["misalignment_deg"]],
+        "max_attitude_error_arcsec": [3600.0 * x for x in me["attitude_deg"]],
+        "final_misalignment_arcsec": [3600.0 * x for x in fe["misalignment_deg"]],
+        "max_velocity_error_mps": me["velocity_mps"],
+        "linear": None if lin is None else linear_summary(lin, hours),
+        "compute_s": nav["compute_s"],
+    }
+    if group is not None:
+        cycle = mechanism_cycle(s.schedule)
+        write_scheme(group, entry, report, lin, cycle, stream.ts)
+    return out
+
+
+def errors_summary(sc: Scenario, lever_cm) -> dict:
+    e = sc.imu.errors()
+    g, a = e.gyro, e.accel
+    return {
+        "gyro_bias_dph": (g.bias / DPH).tolist(), "accel_bias_ug": (a.bias / UG).tolist(),
+        "gyro_scale_ppm": (g.scale / PPM).tolist(), "accel_scale_ppm": (a.scale / PPM).tolist(),
+        "gyro_asym_ppm": (g.asym / PPM).tolist(), "accel_asym_ppm": (a.asym / PPM).tolist(),
+        "gyro_misalignment_arcsec": (g.misalignment / ARCSEC).tolist(),
+        "accel_misalignment_arcsec": (a.misalignment / ARCSEC).tolist(),
+        "arw_dprh": (g.noise / DPSH).tolist(), "vrw_ugrhz": (a.noise / UGPSHZ).tolist(),
+        "lever_arm_cm": lever_cm,
+    }
+
+
+def run_modulate(sc: Scenario, seed: int | None = None, sink=None,
+                 progress: Progress | None = None) -> tuple[dict, tuple[str, ...]]:
+    """Every scheme of the plan; the summary (plain numbers) and the warnings."""
+    t0 = time.perf_counter()
+    plan = plan_of(sc)
+    cfg = sc.modulate
+    linear = True if cfg is None else cfg.linear
+    root = None if sink is None else sink.create_group("modulate")
+    schemes: dict[str, dict] = {}
+    warnings: list[str] = []
+    for i, entry in enumerate(plan.entries):
+        if progress is not None:
+            progress(entry.name, i, len(plan.entries))
+        group = None if root is None else root.create_group(entry.name)
+        schemes[entry.name] = r = run_scheme(sc, entry, plan, seed, group, linear)
+        warnings += [f"{entry.name}: {w}" for w in r["schuler_warnings"]]
+    assert sc.site is not None and sc.motion is not None
+    if linear and sc.motion.kind != "static":
+        warnings.append(f"linear model: static base only; motion {sc.motion.kind!r} runs the "
+                        "navigation alone")
+    lever = next((e.mechanism.lever_arm_cm for e in plan.entries
+                  if e.mechanism is not None and e.mechanism.lever_arm_cm is not None), None)
+    names = [e.name for e in plan.entries]
+    if root is not None:
+        root.attrs["compare"] = names
+        root.attrs["hours"] = plan.hours
+    summary = {
+        "scenario": sc.name,
+        "seed": sc.imu.seed if seed is None else seed,
+        "earth": sc.earth,
+        "site_deg_m": [sc.site.lat_deg, sc.site.lon_deg, sc.site.height_m],
+        "motion": sc.motion.kind,
+        "rate_hz": sc.imu.rate_hz,
+        "hours": plan.hours,
+        "report_hours": report_hours(plan.hours),
+        "errors": errors_summary(sc, lever),
+        "compare": names,
+        "schemes": schemes,
+        "max_horizontal_error_m": [schemes[n]["max_horizontal_error_m"] for n in names],
+        "wall_s": time.perf_counter() - t0,
+    }
+    return summary, tuple(warnings)
+
+
+def execute(sc, seed: int | None = None, cache_key: str | None = None, sink=None,
+            progress: Progress | None = None) -> Outcome:
+    """The registry's entry point: with `sink` (an open results file) the series go into
+    its /modulate group as they are computed."""
+    summary, warnings = run_modulate(sc, seed, sink, progress)
+    return Outcome(summary, lambda f: None, None, summary["seed"], warnings)

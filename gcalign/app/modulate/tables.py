@@ -1,0 +1,138 @@
+"""The `gcalign modulate` table: per scheme the horizontal position error at the report hours
+and its maximum, the linear model beside it, the attitude-error maxima and the invariants."""
+
+from __future__ import annotations
+
+from rich import box
+from rich.console import Group, RenderableType
+from rich.table import Table
+from rich.text import Text
+
+
+def metres(x: float | None) -> str:
+    if x is None:
+        return "—"
+    return f"{x:,.1f}" if abs(x) < 10 else f"{x:,.0f}"
+
+
+def _diag(C) -> str:
+    d = [C[i][i] for i in range(3)]
+    off = max(abs(C[i][j]) for i in range(3) for j in range(3) if i != j)
+    text = " ".join(f"{x:.2g}" if abs(x) > 1e-9 else "0" for x in d)
+    return text + ("*" if off > 1e-9 else "")
+
+
+def _triple(v, fmt: str) -> str:
+    """Three numbers, "0" for exact zeros; one "0" when all are (the cancelled terms)."""
+    if v is None:
+        return "—"
+    if all(x == 0 for x in v):
+        return "0"
+    return " ".join("0" if x == 0 else fmt.format(x) for x in v)
+
+
+def _errors_line(e: dict) -> str:
+    parts = []
+    for key, label, unit in (("gyro_bias_dph", "ε", "°/h"), ("accel_bias_ug", "∇", "µg"),
+                             ("gyro_scale_ppm", "δk_g", "ppm"), ("gyro_asym_ppm", "δk_g,asym",
+                                                                 "ppm"),
+                             ("accel_scale_ppm", "δk_a", "ppm"), ("accel_asym_ppm", "δk_a,asym",
+                                                                  "ppm"),
+                             ("arw_dprh", "ARW", "°/√h"), ("vrw_ugrhz", "VRW", "µg/√Hz")):
+        v = e.get(key)
+        if v and any(x != 0 for x in v):
+            parts.append(f"{label} {', '.join(f'{x:g}' for x in v)} {unit}")
+    for key, label in (("gyro_misalignment_arcsec", "gyro misalignment"),
+                       ("accel_misalignment_arcsec", "accel misalignment")):
+        if any(x != 0 for row in e.get(key) or [] for x in row):
+            parts.append(f"{label} (″) {e[key]}")
+    if e.get("lever_arm_cm"):
+        parts.append(f"lever arm {', '.join(f'{x:g}' for x in e['lever_arm_cm'])} cm")
+    return "sensor errors (sensor frame): " + ("; ".join(parts) or "none")
+
+
+def _terms_table(rows: list[list[str]]) -> Table:
+    """The invariant terms per scheme; each column at least as wide as its numbers (the
+    headers wrap instead)."""
+    t = Table(title="invariants over one cycle, for these errors", title_justify="left",
+              header_style="bold", box=box.SIMPLE_HEAD)
+    heads = ("scheme", "peak ∫C dt (s)", "ε excursion (″)", "δk net / peak (″)",
+             "M net (″)")
+    for k, col in enumerate(heads):
+        t.add_column(col, justify="left" if k == 0 else "right",
+                     min_width=max(len(r[k]) for r in rows))
+    for r in rows:
+        t.add_row(*map(Text, r))
+    return t
+
+
+def modulate_table(s: dict) -> Group:
+    """Two tables: the horizontal position error per scheme and hour (navigation, its
+    maximum over every sample, the linear model at the last hour), then the attitude-error
+    maxima and the invariants; notes below."""
+    lat, lon, _ = s["site_deg_m"]
+    hours = s["report_hours"]
+    key = f"{hours[-1]:g}h" if hours else None
+    head = Text(f"gcalign modulate: {s['scenario']} — {s['hours']:g} h at {s['rate_hz']:g} Hz, "
+                f"{s['motion']} base at {lat:g}°, {lon:g}°, earth {s['earth']}, seed "
+                f"{s['seed']}", style="bold")
+    pos = Table(title="horizontal position error (m)", title_justify="left",
+                header_style="bold", box=box.SIMPLE_HEAD)
+    width = max((len(n) for n in s["compare"]), default=6)  # names whole, never "four-posit…"
+    pos.add_column("scheme", no_wrap=True, min_width=width)
+    for h in hours:
+        pos.add_column(f"{h:g} h", justify="right")
+    pos.add_column("max", justify="right")
+    pos.add_column(f"lin. {hours[-1]:g} h" if hours else "linear", justify="right")
+    inv = Table(title="attitude error and invariants", title_justify="left",
+                header_style="bold", box=box.SIMPLE_HEAD)
+    inv.add_column("scheme", no_wrap=True, min_width=width)
+    for col, just in (("ref", "left"), ("T (min)", "right"), ("diag C̄", "right"),
+                      ("φ max (″)", "right"), ("Schuler", "center")):
+        inv.add_column(col, justify=just)  # type: ignore[arg-type]
+    term_rows: list[list[str]] = []
+    for name in s["compare"]:
+        r = s["schemes"][name]
+        lin = r.get("linear")
+        lin_v = None if lin is None else (lin["horizontal_error_m"].get(key) if key else
+                                          lin["final_horizontal_error_m"])
+        pos.add_row(*map(Text, [name] + [metres(r["horizontal_error_m"].get(f"{h:g}h"))
+                                         for h in hours]
+                         + [metres(r["max_horizontal_error_m"]), metres(lin_v)]))
+        inv.add_row(*map(Text, [
+            name, {"navigation": "nav"}.get(r["reference"], r["reference"])
+            if r["mechanism"] else "—",
+            f"{r['cycle_s'] / 60:.1f}" if r["mechanism"] else "—", _diag(r["cycle_mean"]),
+            " ".join(f"{x:.0f}" if x >= 10 else f"{x:.2g}"
+                     for x in r["max_misalignment_arcsec"]),
+            "warn" if r["schuler_warnings"] else "–"]))
+        if r["mechanism"]:
+            term_rows.append([
+                name, _triple(r.get("peak_integral_C_s"), "{:.0f}"),
+                _triple(r["gyro_bias_excursion_arcsec"], "{:.2g}"),
+                f"{_triple(r['scale_factor_net_arcsec'], '{:.2g}')} / "
+                f"{_triple(r['scale_factor_peak_arcsec'], '{:.2g}')}",
+                _triple(r["misalignment_net_arcsec"], "{:.2g}")])
+    notes = [
+        "navigation against truth at each hour; max: over every sample; lin.: the linear "
+        "error model (static base) for the same errors; φ max: largest misalignment, E N U; "
+        "T: cycle; diag C̄: mean of C_s^r over the cycle (* off-diagonal terms too); "
+        "invariants, open loop: peak of |∫C e_j dt| per sensor axis, attitude excursion "
+        "from the gyro bias, scale-factor term (net over the cycle / peak in it) and gyro "
+        "misalignment M × rate term (net), E N U",
+        _errors_line(s["errors"]),
+    ]
+    for name in s["compare"]:
+        r = s["schemes"][name]
+        if not r["mechanism"]:
+            continue
+        res = r["residual_gyro_bias_dph"]
+        if any(abs(x) > 1e-12 for x in res):
+            notes.append(f"{name}: residual drift C̄ε = ({', '.join(f'{x:.3g}' for x in res)}) "
+                         f"°/h, C̄∇ = ({', '.join(f'{x:.3g}' for x in r['residual_accel_bias_ug'])}"
+                         f") µg")
+    notes.append(f"output {s.get('output') or '—'}; {s['wall_s']:.1f} s")
+    tables: list[RenderableType] = [head, pos, inv]
+    if term_rows:
+        tables.append(_terms_table(term_rows))
+    return Group(*tables, Text("\n".join(notes), style="dim"))
