@@ -99,6 +99,18 @@ class Stream:
         return 0.0 if self.header is None else float(self.header.t[0] - self.ts)
 
 
+def check_finite_block(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray) -> None:
+    """ScenarioError naming the sensor and the time if simulated increments are not finite
+    (sensor errors far beyond any instrument, e.g. ``bias_dph: [1e308, 0, 0]``)."""
+    for name, a in (("gyro", dtheta), ("accel", dv)):
+        ok = np.isfinite(a).all(1)
+        if not ok.all():
+            k = int(np.argmin(ok))
+            raise ScenarioError(f"imu.{name}: the sensor errors make the simulated increments "
+                                f"non-finite at t = {float(t[k]):g} s ({a[k].tolist()}); "
+                                "check the biases, scale factors and noise")
+
+
 def read_data_file(path: Path) -> tuple[ImuData, Truth | None]:
     """IMU (and truth, if the file has it) from our HDF5, a PSINS .imu or a CSV/text file."""
     from gcalign.io import results
@@ -159,6 +171,7 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
         stream = ErrorStream(errors, ts, np.random.default_rng(seed), n)
         for b in ideal_blocks(motion, site, ts, earth, mech, block=block):
             dtheta, dv = stream.apply(b.dtheta, b.dv)
+            check_finite_block(b.t, dtheta, dv)
             yield DataBlock(b.k0, b.t, dtheta, dv,
                             BlockTruth(b.att, b.q_nb, b.v_n, b.pos, b.segment), b.q_bs)
 

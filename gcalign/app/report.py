@@ -33,7 +33,14 @@ def kv_table(title: str, rows: Iterable[Sequence], headers: Sequence[str] = ("",
 def summary_table(kind: str, summary: dict) -> Table:
     """The table a command printed, rebuilt from its summary (for `gcalign show`)."""
     from gcalign.app.registry import COMMANDS
+    from gcalign.errors import ScenarioError
 
     if kind not in COMMANDS:
-        return kv_table(f"gcalign {kind}", ((k, str(v)) for k, v in summary.items()))
-    return COMMANDS[kind].load().table(summary)
+        raise ScenarioError(f"kind: {kind!r} is not a gcalign command ({', '.join(COMMANDS)}); "
+                            "a results file from another version, or a damaged one")
+    try:
+        return COMMANDS[kind].load().table(summary)
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError) as err:
+        raise ScenarioError(f"summary_json: not the summary of a {kind!r} run "
+                            f"({type(err).__name__}: {str(err)[:60]}); a damaged results "
+                            "file, or one from another version") from None

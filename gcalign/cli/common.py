@@ -74,15 +74,14 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
     from gcalign.cli import default_output
 
     cmd = command(name)
-    room = cmd.load()
     run_seed = None if sc.imu_file is not None else (sc.imu.seed if seed is None else seed)
     out = output or default_output(sc.name, name, run_seed)
     try:
         with results.atomic_h5(out) as f:
             if cmd.streams:
-                outcome = room.execute(sc, seed, sink=f, **options)
+                outcome = cmd.execute(sc, seed, sink=f, **options)
             else:
-                outcome = room.execute(sc, seed, **options)
+                outcome = cmd.execute(sc, seed, **options)
             for line in outcome.warnings:
                 sys.stderr.write(f"warning: {line}\n")
             summary = outcome.summary

@@ -8,6 +8,7 @@ from pathlib import Path
 import typer
 import yaml
 
+from gcalign.app.preflight import preflight
 from gcalign.app.report import kv_table, summary_table
 from gcalign.cli import app, consoles, emit_json, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
@@ -104,6 +105,7 @@ def validate(
 ):
     """Check a scenario and print its resolved values in user units and SI."""
     sc, _ = load_scenario(scenario)
+    preflight(sc)  # the checks every command runs first, for every section
     rows = resolved_rows(sc)
     consoles(as_json).print(kv_table(f"{scenario}: valid", rows, ("field", "value", "SI")))
     if as_json:

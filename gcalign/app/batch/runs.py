@@ -57,10 +57,10 @@ def run_summary(command: str, sc, seed: int, cache_key: str | None = None) -> di
     from gcalign.app.registry import command as lookup
 
     try:
-        room = lookup(command).load()
+        cmd = lookup(command)
     except KeyError as err:
         raise GcalignError(str(err.args[0])) from None
-    return room.execute(sc, seed, cache_key).summary
+    return cmd.execute(sc, seed, cache_key).summary
 
 
 def metric_value(summary: dict, path: str):
