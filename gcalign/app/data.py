@@ -101,14 +101,18 @@ class Stream:
 
 def check_finite_block(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray) -> None:
     """ScenarioError naming the sensor and the time if simulated increments are not finite
-    (sensor errors far beyond any instrument, e.g. ``bias_dph: [1e308, 0, 0]``)."""
-    for name, a in (("gyro", dtheta), ("accel", dv)):
-        ok = np.isfinite(a).all(1)
+    or beyond what recorded data may hold (:data:`gcalign.io.imu_files.MAX_DTHETA_RAD`,
+    ``MAX_DV_MPS`` per sample): sensor errors far beyond any instrument, e.g.
+    ``bias_dph: [1e308, 0, 0]``."""
+    from gcalign.io.imu_files import MAX_DTHETA_RAD, MAX_DV_MPS
+
+    for name, a, bound in (("gyro", dtheta, MAX_DTHETA_RAD), ("accel", dv, MAX_DV_MPS)):
+        ok = (np.abs(a) <= bound).all(1)  # False for NaN too
         if not ok.all():
             k = int(np.argmin(ok))
             raise ScenarioError(f"imu.{name}: the sensor errors make the simulated increments "
-                                f"non-finite at t = {float(t[k]):g} s ({a[k].tolist()}); "
-                                "check the biases, scale factors and noise")
+                                f"{a[k].tolist()} at t = {float(t[k]):g} s, beyond {bound:g} "
+                                "per sample; check the biases, scale factors and noise")
 
 
 def read_data_file(path: Path) -> tuple[ImuData, Truth | None]:
@@ -297,6 +301,7 @@ def with_errors(scenario: Scenario, ideal: RunData, seed: int | None = None) -> 
     stream = ErrorStream(scenario.imu.errors(), ideal.imu.ts, np.random.default_rng(seed),
                          len(ideal.imu))
     dtheta, dv = stream.apply(ideal.imu.dtheta, ideal.imu.dv)
+    check_finite_block(ideal.imu.t, dtheta, dv)
     return RunData(imu=replace(ideal.imu, dtheta=dtheta, dv=dv), truth=ideal.truth,
                    site=ideal.site.copy(), seed=seed, earth=ideal.earth)
 

@@ -71,8 +71,10 @@ def metric_value(summary: dict, path: str):
         here = ".".join(parts[:depth]) or "the run summary"
         if isinstance(node, dict):
             if part not in node:
-                raise MetricError(f"metric {path!r}: {here} has no {part!r}; it has: "
-                                  f"{', '.join(map(str, node))}")
+                names = [str(k) for k in node]
+                more = f", … ({len(names) - 12} more)" if len(names) > 12 else ""
+                raise MetricError(f"metric {path[:60]!r}: {here} has no {part[:40]!r}; it has: "
+                                  f"{', '.join(names[:12])}{more}")
             node = node[part]
         elif isinstance(node, list):
             if not part.isdigit() or int(part) >= len(node):

@@ -65,7 +65,7 @@ def scenario_errors(err: ValidationError, source: str = "") -> str:
             where = ".".join([*loc, key])
             allowed = str(ctx.get("expected_tags", "")).replace("'", "") or ", ".join(
                 MOTION_KINDS)
-            msg = (f"allowed: {allowed}, got {ctx['tag']!r}" if "tag" in ctx
+            msg = (f"allowed: {allowed}, got {_cut(ctx['tag'])}" if "tag" in ctx
                    else f"missing; allowed: {allowed}")
             by_field.setdefault(where, [])
             if msg not in by_field[where]:
