@@ -129,36 +129,89 @@ def _from_h5py(err: BaseException) -> bool:
     return last is not None and f"{os.sep}h5py{os.sep}" in last
 
 
+class _GuardedFile:
+    """The temporary file as HDF5 sees it (h5py's ``fileobj`` driver): a refused write
+    (full disk, ``ulimit -f``) is recorded and reported as success, so HDF5 never meets an
+    error halfway, which it reports only while freeing objects, or by crashing when the file
+    is closed. :func:`atomic_h5` raises the recorded error once HDF5 is done. Writing through
+    the descriptor that mkstemp created also means no other file can be written instead."""
+
+    def __init__(self, raw):
+        self.raw = raw
+        self.error: OSError | None = None
+
+    def write(self, b) -> int:
+        if self.error is None:
+            try:
+                return self.raw.write(b)
+            except OSError as err:
+                self.error = err
+        return len(b)
+
+    def truncate(self, size=None):
+        try:
+            return self.raw.truncate(size)
+        except OSError as err:
+            self.error = self.error or err
+            return size
+
+    def flush(self) -> None:
+        try:
+            self.raw.flush()
+        except OSError as err:
+            self.error = self.error or err
+
+    def read(self, n=-1):
+        return self.raw.read(n)
+
+    def readinto(self, b):
+        return self.raw.readinto(b)
+
+    def seek(self, offset, whence=0):
+        return self.raw.seek(offset, whence)
+
+    def tell(self):
+        return self.raw.tell()
+
+
 @contextmanager
 def atomic_h5(path: Path) -> Iterator[h5py.File]:
     """Open `path` for writing under a temporary name; rename on success, delete on failure.
 
     An interrupted or failed run therefore never leaves a truncated file under the final
     name, and never a temporary file either (a SIGKILL's is removed by the next run into
-    that folder). The temporary file is created exclusively (:func:`make_temp`) and h5py is
-    checked to have opened that very file. A write refused by the file system (full disk,
-    ``ulimit -f``) becomes one line (:func:`write_error`).
+    that folder). The temporary file is created exclusively (:func:`make_temp`) and written
+    through its own descriptor; a write refused by the file system (full disk, ``ulimit
+    -f``) becomes one line (:func:`write_error`).
     """
     path = check_output(path)
     fd, tmp = make_temp(path)
+    raw = os.fdopen(fd, "w+b")
+    guard = _GuardedFile(raw)
+    f = None
     try:
-        try:
-            f = h5py.File(tmp, "w")
-            mine = os.fstat(fd)
-            opened = os.fstat(f.id.get_vfd_handle())
-            if (mine.st_dev, mine.st_ino) != (opened.st_dev, opened.st_ino):
-                f.close()
-                raise GcalignError(f"{tmp}: replaced while being opened; not written")
-        finally:
-            os.close(fd)
-        with f:
-            yield f
+        f = h5py.File(guard, "w")
+        yield f
+        f.close()
+        f = None
+        guard.flush()
+        raw.close()
+        if guard.error is not None:
+            raise guard.error
         os.replace(tmp, path)
     except BaseException as err:
+        for closing in (f, raw):
+            try:
+                if closing is not None:
+                    closing.close()
+            except Exception:  # noqa: BLE001 - the file is deleted anyway
+                pass
         tmp.unlink(missing_ok=True)
-        if isinstance(err, (OSError, RuntimeError)) and (
-                _from_h5py(err) or getattr(err, "errno", None) in _WRITE_ERRNOS):
-            raise write_error(path, err) from None
+        refused = guard.error if guard.error is not None else err
+        if guard.error is not None or (isinstance(err, OSError) and (
+                _from_h5py(err) or err.errno in _WRITE_ERRNOS)):
+            if not isinstance(err, (KeyboardInterrupt, SystemExit)):
+                raise write_error(path, refused) from None
         raise
 
 
@@ -198,6 +251,8 @@ class Series:
     def __init__(self, group: h5py.Group, spec: dict[str, tuple[int | None, str, str | None]],
                  chunk_rows: int = 4096, **attrs):
         self.group = group
+        self._ds: dict[str, h5py.Dataset] = {}  # kept open: HDF5 then reports a refused
+        # write in append() or in the file's flush, not while freeing a dataset object
         for name, (width, units, frame) in spec.items():
             shape = (0,) if width is None else (0, width)
             ds = group.create_dataset(
@@ -207,12 +262,13 @@ class Series:
             ds.attrs["units"] = units
             if frame:
                 ds.attrs["frame"] = frame
+            self._ds[name] = ds
         for k, v in attrs.items():
             group.attrs[k] = v
 
     def append(self, **arrays) -> None:
         for name, a in arrays.items():
-            ds = self.group[name]
+            ds = self._ds[name] if name in self._ds else self.group[name]
             a = np.asarray(a, dtype=float)
             n = ds.shape[0]
             ds.resize(n + a.shape[0], axis=0)

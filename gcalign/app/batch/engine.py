@@ -97,13 +97,15 @@ def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
         clean_stale_temps(output.parent)
         records: dict[tuple[int, int], dict] = {}
         reused = 0
+        notes: list[str] = []  # shown once the scheduler has answered: a failure is one line
         if resume:
-            records, where = previous_records(sweep, output, log)
+            records, where = previous_records(sweep, output, notes.append)
             reused = len(records)
             if where:
-                log(f"resuming from {where}: {reused} of {len(keys)} run(s) already finished")
+                notes.append(f"resuming from {where}: {reused} of {len(keys)} run(s) already "
+                             "finished")
             else:
-                log(f"nothing to resume at {output}: starting afresh")
+                notes.append(f"nothing to resume at {output}: starting afresh")
         todo = [k for k in keys if k not in records]
         budget_check(sweep, n_workers if not scheduler else 1)
 
@@ -111,6 +113,8 @@ def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
         # a new batch leaves no file behind.
         if backend is None and todo:
             backend = make_backend(sweep.command, min(n_workers, len(todo)), scheduler)
+        for note in notes:
+            log(note)
         if not resume and jpath.is_file():
             n_old = len(read_journal(jpath))
             if n_old:
