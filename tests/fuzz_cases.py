@@ -425,6 +425,11 @@ def fixed_cases() -> list[Case]:
         cases.append(C(3, f"batch {what}", ("batch", "SW.yaml", "-o", out, "-w", "1"),
                        (("S.yaml", s), ("SW.yaml", sw)), frozenset({1, 2}),
                        dirs=("adir", "ro")))
+    align_file = results_file("")  # any results file with figures: plot's -o is checked first
+    for out, what in (("afile", "-o existing file"), ("afile/figs", "-o under a file"),
+                      ("", "empty -o")):
+        cases.append(C(3, f"plot {what}", ("plot", "d.h5", "-o", out),
+                       (("d.h5", align_file), ("afile", b"x")), frozenset({2}), outputs=()))
     return cases
 
 

@@ -336,3 +336,14 @@ def test_resume_rejects_damaged_records_and_reruns_them(tmp_path, uninterrupted)
     assert "skipped 4 line(s)" in res.stderr
     assert aggregate_of(tmp_path / "b.h5") == uninterrupted
     assert np.isfinite(np.asarray(aggregate_of(tmp_path / "b.h5")["runs"])).all()
+
+
+def test_plot_into_an_existing_file_or_under_one_is_one_line(tmp_path):
+    scenario(tmp_path)
+    assert cli(["align", "S.yaml", "-o", "s.h5"], tmp_path).returncode == 0
+    (tmp_path / "afile").write_text("x")
+    for out in ("afile", "afile/figs"):
+        res = cli(["plot", "s.h5", "-o", out], tmp_path)
+        assert res.returncode == 2, res.stderr
+        assert "--output" in one_error_line(res.stderr)
+    assert (tmp_path / "afile").read_text() == "x"

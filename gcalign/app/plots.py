@@ -89,11 +89,16 @@ def default_plot_dir(path: Path) -> Path:
 def plot_file(path: Path, out_dir: Path | None = None) -> list[Path]:
     """Write every figure of a results file as PNG; the paths written."""
     figs = figures_for(path)
-    out_dir = Path(out_dir) if out_dir is not None else default_plot_dir(path)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    from gcalign.io.results import check_output_dir, write_error
+
+    out_dir = check_output_dir(out_dir if out_dir is not None else default_plot_dir(path))
     written = []
     for stem, fig in figs.items():
         p = out_dir / f"{stem}.png"
-        fig.savefig(p, dpi=DPI)
+        try:
+            fig.savefig(p, dpi=DPI)
+        except OSError as err:  # a full disk: one line, not a traceback
+            p.unlink(missing_ok=True)
+            raise write_error(p, err) from None
         written.append(p)
     return written

@@ -61,6 +61,27 @@ def check_output(path, what: str = "--output") -> Path:
     return p
 
 
+def check_output_dir(path, what: str = "--output") -> Path:
+    """`path` as a folder for figures (made if missing); ScenarioError (exit 2) if it, or a
+    folder above it, exists and is not a folder, or it cannot be made."""
+    p = Path(path)
+    if not str(path).strip():
+        raise ScenarioError(f"{what}: an empty path; give a folder for the figures")
+    if p.exists() and not p.is_dir():
+        raise ScenarioError(f"{what}: {p} exists and is not a folder; give a folder for the "
+                            "figures")
+    parent = p
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ScenarioError(f"{what}: {parent} is not a folder, so {p} cannot be made")
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise write_error(p, err) from None
+    return p
+
+
 def _alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
@@ -74,7 +95,7 @@ def _alive(pid: int) -> bool:
 def clean_stale_temps(folder: Path) -> list[Path]:
     """Remove our temporary files in `folder` whose process is gone (SIGKILL, power loss);
     files of live processes are kept. Returns what was removed."""
-    removed = []
+    removed: list[Path] = []
     try:
         entries = list(Path(folder).iterdir())
     except OSError:

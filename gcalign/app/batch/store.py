@@ -18,6 +18,7 @@ import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
+from typing import TextIO
 
 import numpy as np
 
@@ -59,7 +60,7 @@ class Journal:
         self.path = Path(path)
         self.header = header
         self.keep = [_signed(r) for r in keep]
-        self._f = None
+        self._f: TextIO | None = None
         if self.keep:
             self._open()
 
