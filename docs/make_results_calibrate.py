@@ -1,60 +1,58 @@
-"""Regenerate the tables of docs/results_calibrate.md (seed 002, phase 1: moving-motion stand-ins
-for the flight trajectories).
+"""Regenerate the tables of docs/results_calibrate.md (seed 002) from the scenarios the
+commands run: configs/seed002_designed.yaml (the 590 s designed take-off; the conventional
+take-off is its first 6 segments) and configs/lasergyro_calibrate.yaml (real data).
 
 Run from the repository root:  python docs/make_results_calibrate.py [--runs 100]
-It prints every table as Markdown; docs/results_calibrate.md quotes them with the text.
+It prints every table as Markdown (about 4 minutes, most of it the Monte Carlo);
+docs/results_calibrate.md quotes them with the text. Figures: ``gcalign calibrate
+--compare -o runs/cmp.h5 && gcalign plot runs/cmp.h5`` (and ``gcalign observability``),
+copied to docs/figures/calibrate_*.png.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import sys
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
+import yaml  # noqa: E402
 from scipy.stats import chi2  # noqa: E402
 
-from gcalign.calibrate import (  # noqa: E402
-    Settings,
-    calibrate,
-    covariance_run,
-    draw_truth,
-    flight_from_ideal,
-    observability_table,
-    proposed_truth,
-    simulate_flight,
-    zero_velocity_data,
+from gcalign.app.calibrate.run import (  # noqa: E402
+    compare_runs,
+    recorded_case,
+    run_filter,
+    simulated_case,
 )
-from gcalign.calibrate.trajectories import (  # noqa: E402
-    CONVENTIONAL,
-    DESIGNED,
-    SECTION_41,
-    moving_motion,
-)
+from gcalign.calibrate import Settings, calibrate, covariance_run, observability_table  # noqa: E402
 from gcalign.estimation import ins_error as ie  # noqa: E402
-from gcalign.sim.imu import ideal_imu  # noqa: E402
+from gcalign.io.scenario import load_scenario, parse_scenario  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-SITE = np.array([np.radians(38.0), np.radians(110.0), 0.0])
-TS = 0.04
+DESIGNED = ROOT / "configs" / "seed002_designed.yaml"
 NAMES = ie.STATE_NAMES
 # the seed's P0 list (before ×10) in display units: results are quoted in multiples of it
 LISTED = np.array([20, 20, 30, 0.2, 0.2, 0.2, 1, 1, 1] + [0.01] * 3 + [50] * 3 + [100] * 6,
                   dtype=float)
 
 
-def flight(stages, x=None, arw=0.0, vrw=0.0, seed=0):
-    motion, names = moving_motion(stages)
-    return simulate_flight(motion, SITE, TS, np.zeros(21) if x is None else x, arw, vrw,
-                           np.random.default_rng(seed), names)
+def scenario(noise: bool = True, **calibrate):
+    """The designed scenario with `calibrate` keys changed (and without sensor noise)."""
+    data = yaml.safe_load(DESIGNED.read_text(encoding="utf-8"))
+    data["calibrate"] |= calibrate
+    if not noise:
+        data["imu"]["gyro"]["arw_dprh"] = data["imu"]["accel"]["vrw_ugrhz"] = 0
+    return parse_scenario(data, "designed")
 
 
-def listed_units(sigma: np.ndarray) -> np.ndarray:
+def listed_units(sigma: np.ndarray, pos) -> np.ndarray:
     """σ in multiples of the seed's listed value (P0 starts at 10)."""
-    return sigma * ie.display_scale(SITE[0]) / LISTED
+    return sigma * ie.display_scale(float(pos[0]), float(pos[2])) / LISTED
 
 
 def fmt(v: float) -> str:
@@ -64,34 +62,44 @@ def fmt(v: float) -> str:
 
 
 def table1(data, scaling: str) -> list[str]:
-    tab = observability_table(data.truth, data.segments, "velocity", scaling)
-    cols = list(NAMES)
-    out = ["| segment | " + " | ".join(cols) + " | rank | TOM | rank cum. |",
-           "|---" * (len(cols) + 4) + "|"]
+    tab = observability_table(data.truth, data.segments, "velocity", scaling, covariance=False)
+    out = ["| # | segment | " + " | ".join(NAMES) + " | rank | TOM | rank cum. |",
+           "|---" * (len(NAMES) + 5) + "|"]
     for i, seg in enumerate(tab.segments):
         cells = " | ".join(fmt(v) for v in tab.eta[i])
-        out.append(f"| {seg} | {cells} | {tab.rank[i]} | {tab.tom_rank[i]} | {tab.rank_cum[i]} |")
+        out.append(f"| {i + 1} | {seg} | {cells} | {tab.rank[i]} | {tab.tom_rank[i]} | "
+                   f"{tab.rank_cum[i]} |")
+    cells = " | ".join(fmt(v) for v in tab.eta_cum[-1])
+    out.append(f"| | whole run | {cells} | {tab.rank_cum[-1]} | {tab.tom_rank_cum[-1]} | |")
+    res = tab.null_residual
+    out.append("")
+    out.append(f"eq. 12 residual ‖F N‖/‖F‖ per segment: {res.min():.0e} … {res.max():.0e}; "
+               f"condition (≤ 1e-9) holds in segments "
+               f"{[int(i) + 1 for i in np.flatnonzero(tab.condition)]};"
+               f" SOM ≠ TOM rank in {int(np.sum(tab.rank != tab.tom_rank))} of "
+               f"{len(tab.rank)} segments")
     return out
 
 
 def covariance_degree_table(data) -> list[str]:
     tab = observability_table(data.truth, data.segments, "velocity", "none")
     cols = list(NAMES[9:]) + ["phiU"]
-    out = ["| after | " + " | ".join(cols) + " |", "|---" * (len(cols) + 1) + "|"]
+    out = ["| # | after | " + " | ".join(cols) + " |", "|---" * (len(cols) + 2) + "|"]
     assert tab.cov_degree is not None
     for i, seg in enumerate(tab.segments):
         vals = list(tab.cov_degree[i, 9:]) + [tab.cov_degree[i, 2]]
-        out.append(f"| {seg} | " + " | ".join(f"{v:.1f}" for v in vals) + " |")
+        out.append(f"| {i + 1} | {seg} | " + " | ".join(f"{v:.1f}" for v in vals) + " |")
     return out
 
 
-def final_sigma_table() -> list[str]:
+def final_sigma_table(data) -> list[str]:
+    conv = data.between(0.0, data.segments[5].end)
     rows = []
-    for label, stages in (("conventional (first 6 stages, 238 s)", CONVENTIONAL),
-                          ("designed (21 stages, 590 s)", DESIGNED)):
-        truth = flight(stages).truth
+    for label, d in (("conventional (first 6 stages, 238 s)", conv),
+                     ("designed (21 stages, 590 s)", data)):
         for m in ie.MEASUREMENTS:
-            s = listed_units(covariance_run(truth, Settings(measure=m)).sigma[-1])
+            s = listed_units(covariance_run(d.truth, Settings(measure=m)).sigma[-1],
+                             d.start.pos)
             rows.append((label, m, s))
     cols = list(NAMES[9:])
     out = ["| trajectory | measure | " + " | ".join(cols) + " |", "|---" * (len(cols) + 2) + "|"]
@@ -100,45 +108,41 @@ def final_sigma_table() -> list[str]:
     return out
 
 
-def crossover_table() -> list[str]:
-    truth = flight(DESIGNED).truth
-    v = covariance_run(truth, Settings(measure="velocity")).sigma[-1, 9:]
+def crossover_table(data) -> list[str]:
+    v = covariance_run(data.truth, Settings(measure="velocity")).sigma[-1, 9:]
     out = ["| σ_p (m) | sensor errors where position beats velocity (of 12) |", "|---|---|"]
     for sp in (1.0, 3.0, 10.0, 30.0):
-        p = covariance_run(truth, Settings(measure="position", sigma_p=sp)).sigma[-1, 9:]
+        p = covariance_run(data.truth, Settings(measure="position", sigma_p=sp)).sigma[-1, 9:]
         out.append(f"| {sp:g} | {int(np.sum(p < v))} |")
     return out
 
 
-def monte_carlo(runs: int) -> list[str]:
-    stages = SECTION_41
-    motion, names = moving_motion(stages)
-    segments = flight(stages).segments
-    truth, ideal = ideal_imu(motion, SITE, TS, substeps=4)
-    out = ["| measure | runs | ANEES min…max (χ²₂₁ 95 % band) | epochs inside | mean NIS/m | "
-           "whitened innovation mean, variance |", "|---|---|---|---|---|---|"]
-    P0 = ie.initial_covariance(SITE, 1.0)
-    for m in ie.MEASUREMENTS:
-        rng = np.random.default_rng(1)
-        nees, nis, white = [], [], []
-        for _ in range(runs):
-            data = flight_from_ideal(truth, ideal, draw_truth(P0, rng), ie.ARW_DEFAULT,
-                                     ie.VRW_DEFAULT, rng, segments)
-            r = calibrate(data, Settings(measure=m, p0_scale=1.0), rng)
-            nees.append(r.nees)
-            nis.append(r.nis)
-            white.append(r.standardized)
-        a = np.mean(nees, 0)
-        lo, hi = chi2.ppf([0.025, 0.975], 21 * runs) / runs
-        w = np.concatenate(white)
-        out.append(f"| {m} | {runs} | {a.min():.2f}…{a.max():.2f} ({lo:.2f}…{hi:.2f}) | "
-                   f"{np.mean((a > lo) & (a < hi)):.0%} | {np.mean(nis) / w.shape[1]:.3f} | "
-                   f"{np.abs(w.mean(0)).max():.3f}, {w.var(0).min():.3f}…{w.var(0).max():.3f} |")
+def table3() -> list[str]:
+    """One run of ``gcalign calibrate --compare`` (the scenario's injected errors, seed 1)."""
+    sc = scenario()
+    case = simulated_case(sc)
+    runs = compare_runs(case, 6)
+    pos = case.data.start.pos
+    k = ie.display_scale(float(pos[0]), float(pos[2]))
+    units = dict(zip(NAMES, ie.DISPLAY_UNITS, strict=True))
+    heads = [f"{'des.' if r.label == 'designed' else 'conv.'} {r.result.settings.measure}"
+             for r in runs]
+    out = ["| state | unit | injected | " + " | ".join(heads) + " |",
+           "|---" * (len(heads) + 3) + "|"]
+    for i in [2, *range(9, 21)]:
+        cells = []
+        for r in runs:
+            e = (r.result.estimate[-1, i] - r.result.truth[-1, i]) * k[i]
+            cells.append(f"{e:.2g} ({r.result.sigma[-1, i] * k[i]:.2g})")
+        out.append(f"| {NAMES[i]} | {units[NAMES[i]]} | {case.data.x_true[i] * k[i]:.3g} | "
+                   + " | ".join(cells) + " |")
+    nees = ", ".join(f"{h} {r.result.nees[-1]:.1f}" for h, r in zip(heads, runs, strict=True))
+    out += ["", f"final NEES: {nees}"]
     return out
 
 
 def noise_free() -> list[str]:
-    data = flight(DESIGNED, proposed_truth())
+    data = simulated_case(scenario(noise=False, gnss_noise=False)).data
     out = ["| measure | max \\|error\\|/σ | sensor errors with σ(0)/σ(end) ≥ 2: remaining "
            "error / injected |", "|---|---|---|"]
     for m in ie.MEASUREMENTS:
@@ -151,33 +155,91 @@ def noise_free() -> list[str]:
     return out
 
 
+def monte_carlo(runs: int, first: int = 1) -> list[str]:
+    """Truth from P0 at p0_scale 1 (calibrate.truth: draw), sensor noise and DGNSS noise,
+    seeds first … first + runs − 1, the three measurements on the same data."""
+    sc = scenario(truth="draw", p0_scale=1)
+    out = ["| seeds | measure | ANEES min…max (χ²₂₁ 95 % band) | epochs inside | mean NIS/m | "
+           "whitened innovation mean, variance |", "|---|---|---|---|---|---|"]
+    store: dict[str, tuple[list, list, list]] = {m: ([], [], []) for m in ie.MEASUREMENTS}
+    for seed in range(first, first + runs):
+        case = simulated_case(sc, seed, cache_key="mc")
+        for m in ie.MEASUREMENTS:
+            r = run_filter(case, m).result
+            for lst, v in zip(store[m], (r.nees, r.nis, r.standardized), strict=True):
+                lst.append(v)
+    for m, (nees, nis, white) in store.items():
+        a = np.mean(nees, 0)
+        lo, hi = chi2.ppf([0.025, 0.975], 21 * runs) / runs
+        w = np.concatenate(white)
+        out.append(f"| {first}…{first + runs - 1} | {m} | {a.min():.2f}…{a.max():.2f} "
+                   f"({lo:.2f}…{hi:.2f}) | "
+                   f"{np.mean((a > lo) & (a < hi)):.0%} | {np.mean(nis) / w.shape[1]:.3f} | "
+                   f"{np.abs(w.mean(0)).max():.3f}, {w.var(0).min():.3f}…{w.var(0).max():.3f} |")
+    return out
+
+
+def smoother() -> list[str]:
+    case = simulated_case(scenario(smoother=True))
+    r = run_filter(case).result
+    s = r.smoothed
+    assert s is not None
+    k = ie.display_scale(float(case.data.start.pos[0]), 0.0)
+    out = ["| state | unit | σ at t = 0 filtered (P0) | smoothed | smoothed error at t = 0 | "
+           "σ at the end |", "|---|---|---|---|---|---|"]
+    for i in (0, 1, 2, 3, 4):
+        out.append(f"| {NAMES[i]} | {ie.DISPLAY_UNITS[i]} | {r.sigma[0, i] * k[i]:.3g} | "
+                   f"{s.sigma[0, i] * k[i]:.3g} | "
+                   f"{(s.estimate[0, i] - r.truth[0, i]) * k[i]:.3g} | "
+                   f"{r.sigma[-1, i] * k[i]:.3g} |")
+    gain = np.max(np.abs(s.sigma[:, 9:] / r.sigma[-1, 9:] - 1))
+    out += ["", f"sensor errors: smoothed σ at every epoch = final filtered σ to {gain:.0e}"]
+    return out
+
+
 def lasergyro() -> list[str]:
-    from gcalign.align.coarse import inertial_frame_coarse
     from gcalign.app.align.run import run_alignment
     from gcalign.app.data import scenario_data
-    from gcalign.io.imu_files import read_imu_file
-    from gcalign.io.scenario import load_scenario
-    from gcalign.nav.strapdown import NavState
 
-    path = (ROOT / "../shared/data/lasergyro.imu").resolve()
-    if not path.is_file():
+    if not (ROOT / "../shared/data/lasergyro.imu").resolve().is_file():
         return ["(lasergyro.imu not found)"]
-    imu = read_imu_file(path)
     out = ["| window start (s) | KF ZUPT yaw (°) | gyrocompass yaw (°) | KF pitch, roll (°) | "
            "gyrocompass pitch, roll (°) | KF σ yaw (′) |", "|---|---|---|---|---|---|"]
     for start_s in (0.0, 600.0, 1200.0):
-        i0 = int(round(start_s / imu.ts))
-        i1, i2 = i0 + int(round(60 / imu.ts)), i0 + int(round(400 / imu.ts))
-        att1 = inertial_frame_coarse(imu.dtheta[i0:i1], imu.dv[i0:i1], imu.ts, imu.site[0])
-        data = zero_velocity_data(np.arange(i2 - i1 + 1) * imu.ts, imu.dtheta[i1:i2],
-                                  imu.dv[i1:i2], NavState.from_euler(att1, np.zeros(3), imu.site))
-        r = calibrate(data, Settings(gnss_noise=False))
-        sc, _ = load_scenario(ROOT / "configs/lasergyro_align.yaml")
-        sc.align.start_s = start_s
-        g = np.degrees(run_alignment(sc, scenario_data(sc)).att_t2)
+        sc, _ = load_scenario(ROOT / "configs/lasergyro_calibrate.yaml")
+        assert sc.calibrate is not None
+        sc.calibrate.start_s = start_s
+        r = run_filter(recorded_case(sc)).result
+        ga, _ = load_scenario(ROOT / "configs/lasergyro_align.yaml")
+        assert ga.align is not None
+        ga.align.start_s = start_s
+        g = np.degrees(run_alignment(ga, scenario_data(ga)).att_t2)
         k = np.degrees(r.att[-1])
         out.append(f"| {start_s:g} | {k[2]:.3f} | {g[2]:.3f} | {k[0]:.3f}, {k[1]:.3f} | "
                    f"{g[0]:.3f}, {g[1]:.3f} | {np.degrees(r.sigma[-1, 2]) * 60:.1f} |")
+    return out
+
+
+def f_check() -> list[str]:
+    """F against the nonlinear mechanisation on the designed flight (the windows of
+    tests/test_ins_error.py)."""
+    sys.path.insert(0, str(ROOT / "tests"))
+    from calibrate_cases import TS, motion, site
+    from test_ins_error import WINDOWS, _relative_errors
+
+    from gcalign.sim.imu import ideal_imu
+
+    flight = ideal_imu(motion(), site(), TS, substeps=4)
+    out = ["| second | accumulated Φ: response | change (worst state but δL) | δL change | "
+           "Van Loan on mean F: response | change |", "|---|---|---|---|---|---|"]
+    for name, t in WINDOWS.items():
+        incr, lit, _ = _relative_errors(flight, t, "accumulated")
+        incr_v, lit_v, _ = _relative_errors(flight, t, "van_loan")
+        others = np.delete(incr, ie.IDX["dL"])
+        j = int(np.argmax(others))
+        worst = [n for n in NAMES if n != "dL"][j]
+        out.append(f"| {name} ({t:g} s) | {lit.max():.1e} | {others.max():.1e} ({worst}) | "
+                   f"{incr[ie.IDX['dL']]:.1e} | {lit_v.max():.1e} | {incr_v.max():.1e} |")
     return out
 
 
@@ -185,17 +247,21 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=100)
     args = ap.parse_args()
-    d41 = flight(SECTION_41)
+    data = simulated_case(scenario()).data
     sections = [
-        ("Table 1 analogue, §4.1 set, velocity matching, unscaled (the paper's η)",
-         table1(d41, "none")),
-        ("Table 1 analogue, scaled by the initial σ (option --scaling p0)", table1(d41, "p0")),
-        ("Covariance degree σ(0)/σ(t), §4.1 set, velocity (PSINS kfstat)",
-         covariance_degree_table(d41)),
-        ("Final σ in multiples of the listed value (P0 = 10)", final_sigma_table()),
-        ("Position vs velocity as the position noise grows (designed)", crossover_table()),
-        ("Noise-free DGNSS on the designed trajectory", noise_free()),
-        (f"Monte Carlo, §4.1 set, {args.runs} runs", monte_carlo(args.runs)),
+        ("Table 1 analogue, designed flight, velocity matching, unscaled (the paper's η)",
+         table1(data, "none")),
+        ("Table 1 analogue, scaled by the initial σ (--scaling p0)", table1(data, "p0")),
+        ("Covariance degree σ(0)/σ(t), velocity (PSINS kfstat)", covariance_degree_table(data)),
+        ("Final σ in multiples of the listed value (P0 = 10)", final_sigma_table(data)),
+        ("Position vs velocity as the position noise grows (designed)", crossover_table(data)),
+        ("Table 3 analogue: gcalign calibrate --compare (seed 1)", table3()),
+        ("Noise-free DGNSS and sensors, designed flight", noise_free()),
+        ("RTS smoother, designed flight, velocity", smoother()),
+        ("F against the nonlinear mechanisation", f_check()),
+        (f"Monte Carlo, designed flight, {args.runs} runs per seed set",
+         monte_carlo(args.runs) + monte_carlo(args.runs, 1 + args.runs)[2:]
+         + monte_carlo(args.runs, 1 + 2 * args.runs)[2:]),
         ("lasergyro.imu: zero-velocity KF vs gyrocompass", lasergyro()),
     ]
     for title, lines in sections:

@@ -12,7 +12,6 @@ import pytest
 from gcalign.nav.rotation import quat_conj, quat_mult, quat_to_rotvec, rotvec_to_quat
 from gcalign.nav.strapdown import integrate_attitude
 
-
 TAU, OMEGA, ALPHA = 2e-4, 2 * math.pi * 10, math.radians(1.0)  # 5 kHz, 10 Hz, 1° cone
 N = 12000  # 2.4 s: a multiple of 1 … 5 sub-samples
 

@@ -197,3 +197,49 @@ def test_navigate_from_an_alignment_of_the_real_file(tmp_path):
     other.write_bytes(REAL.read_bytes())
     res = runner.invoke(app, ["navigate", str(other), "--init", str(aligned)])
     assert res.exit_code == 2 and "align the same data" in res.output
+
+
+def test_long_runs_are_stored_at_the_output_rate_and_summed_increments_are_refused(tmp_path):
+    """Beyond an hour the series are stored at 1 Hz: truth decimated, increments summed over
+    each second (exact sums, row by row: noise makes every second differ), which navigation
+    refuses; 'full' keeps every sample."""
+    sc = {"name": "two-hours", "site": SCENARIO["site"],
+          "imu": {"rate_hz": 20, "gyro": {"arw_dprh": 0.01}, "accel": {"vrw_ugrhz": 50}},
+          "motion": {"kind": "static", "attitude_deg": [1, 2, 30], "duration_s": 7200}}
+    sim = tmp_path / "sim.h5"
+    res = runner.invoke(app, ["simulate", str(write(tmp_path, sc)), "-o", str(sim), "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["output_rate_hz"] == 1.0
+    with h5py.File(sim) as f:
+        assert f["truth/t"].shape == (7201,) and f["imu/dtheta"].shape == (7200, 3)
+        assert f["imu"].attrs["ts"] == 1.0 and f["imu"].attrs["summed_from_ts"] == 0.05
+        assert f["imu/dtheta"].chunks is not None and f["imu/dtheta"].compression == "gzip"
+        dth = f["imu/dtheta"][()]
+    from gcalign.app.data import scenario_stream
+    from gcalign.io.scenario import parse_scenario
+
+    total = sum(b.dtheta.sum(0) for b in scenario_stream(parse_scenario(sc)).blocks())
+    np.testing.assert_allclose(dth.sum(0), total, rtol=1e-12)
+    res = runner.invoke(app, ["navigate", str(sim)])
+    assert res.exit_code == 2 and "summed to 1 Hz" in res.output and "rate_hz: full" in res.output
+    sc["output"] = {"rate_hz": "full"}
+    full = tmp_path / "full.h5"
+    res = runner.invoke(app, ["simulate", str(write(tmp_path, sc)), "-o", str(full)])
+    assert res.exit_code == 0, res.output
+    with h5py.File(full) as f:
+        assert f["imu/dtheta"].shape == (144000, 3) and "summed_from_ts" not in f["imu"].attrs
+        every = {n: f[f"imu/{n}"][()] for n in ("dtheta", "dv")}
+    with h5py.File(sim) as f:
+        for n, inc in every.items():
+            np.testing.assert_allclose(f[f"imu/{n}"][()], inc.reshape(7200, 20, 3).sum(1),
+                                       rtol=1e-12, atol=1e-16)
+    res = runner.invoke(app, ["navigate", str(full), "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["vertical"] == "hold"
+
+
+def test_output_rate_must_divide_the_imu_rate(tmp_path):
+    sc = dict(SCENARIO, output={"rate_hz": 3})
+    res = runner.invoke(app, ["navigate", str(write(tmp_path, sc)), "-o", str(tmp_path / "n.h5")])
+    assert res.exit_code == 2 and "output.rate_hz: 3 Hz does not divide" in res.output
+    assert not (tmp_path / "n.h5").exists()

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from calibrate_cases import SITE, TS, section_41_set
+from calibrate_cases import TS, motion, site
 
 from gcalign.calibrate.data import perturb
 from gcalign.errors import ScenarioError
@@ -25,17 +25,19 @@ from gcalign.nav.strapdown import NavState, navigate
 from gcalign.sim.imu import ideal_imu
 from gcalign.units import ARCMIN, ARCSEC, DPH, PPM, UG
 
+SITE = site()
+
 
 @pytest.fixture(scope="module")
 def flight():
-    motion, _ = section_41_set()
-    return ideal_imu(motion, SITE, TS, substeps=4)
+    """The designed flight (configs/seed002_designed.yaml) sampled at the seed's 25 Hz."""
+    return ideal_imu(motion(), SITE, TS, substeps=4)
 
 
-# One second inside each manoeuvre of the §4.1 set (segment starts: ground roll 60,
-# pitch-up 73.84, climb 88.84, roll left 233.84, bank hold 242.84, turn right 281.84).
+# One second inside each manoeuvre of the designed flight (segment starts: ground roll 60,
+# pitch-up 73.85, climb 103.85, left turn 180 247.85 (9°/s at 165 m/s), roll left 297.85).
 WINDOWS = {"static": 30.0, "ground roll": 66.0, "pitch-up": 80.0, "climb": 120.0,
-           "roll": 236.0, "turn": 285.0}
+           "roll": 300.0, "turn": 250.0}
 
 
 def _block(flight, t_start: float, n: int = 25):

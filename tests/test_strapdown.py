@@ -46,6 +46,9 @@ def seed_motion(kind: str, duration: float = 400.0):
             period=(10.0, 10.0, 20.0),
             phase=(0.0, 0.0, 0.0),
         )
+    if kind == "climb":  # to 25 m/s, pitch up to 30° at 3 °/s, climb at 12.5 m/s
+        return Moving(att0, 60.0, (Segment(5.0, accel=5.0), Segment(10.0, rate=(3 * DEG, 0, 0)),
+                                   Segment(45.0)))
     right, left = (0.0, 0.0, -1.0 * DEG), (0.0, 0.0, 1.0 * DEG)
     segments = (
         Segment(10.0),  # still
@@ -184,8 +187,9 @@ def reference_step(q, v, p, dth, dvb, ts, earth_sign):
     Where the docstring leaves a choice open, the choice made here (stated on the line)
     is the only one available without iterating: the specific-force rotation needs
     ω_in before v_mid is known, so it takes ω_en(v_{k-1}); v_mid is predicted from the
-    specific-force increment and gravity (Coriolis is second order there); earth
-    quantities are those of the start of the step.
+    specific-force increment and gravity (Coriolis is second order there); gravity in
+    the velocity update is taken at the height v_mid gives at mid-interval; the other
+    earth quantities are those of the start of the step.
     """
     lat, lon, h = p
     r_m, r_n = earth.radii(lat)
@@ -196,7 +200,8 @@ def reference_step(q, v, p, dth, dvb, ts, earth_sign):
     dv_n = _rodrigues(-0.5 * w_in0 * ts) @ _q2dcm(q) @ _rodrigues(0.5 * dth) @ dvb
     v_mid = v + 0.5 * (dv_n + g_n * ts)  # predicted mid-interval velocity
     w_en = earth.omega_en_n(lat, h, v_mid)
-    v_new = v + dv_n + (g_n - np.cross(2.0 * w_ie + w_en, v_mid)) * ts
+    g_mid = np.array([0.0, 0.0, -earth.gravity(lat, h + 0.5 * v_mid[2] * ts)])  # at mid height
+    v_new = v + dv_n + (g_mid - np.cross(2.0 * w_ie + w_en, v_mid)) * ts
     # q_k = q(-ω_in T) ⊗ q_{k-1} ⊗ q(Δθ_k), renormalised.
     q_new = _qmul(_rv2q(-(w_ie + w_en) * ts), _qmul(q, _rv2q(dth)))
     q_new = q_new / np.linalg.norm(q_new)
@@ -281,8 +286,10 @@ def reverse_block(kind, k0, k1):
 
 # Blocks of a few thousand steps: the moving base through its acceleration and both
 # turns (5-45 s, speeds to 10 m/s), the swing (|Δθ| > 1e-4 rad: the kernel's exact
-# rotation-vector branch), and the static base (|Δθ| < 1e-4 rad: its series branch).
-KERNEL_BLOCKS = [("moving", 500, 4500), ("swing", 0, 3000), ("static", 0, 3000)]
+# rotation-vector branch), the static base (|Δθ| < 1e-4 rad: its series branch), and a
+# climb (pitch-up to a vertical velocity of 12.5 m/s: gravity at the mid-step height).
+KERNEL_BLOCKS = [("moving", 500, 4500), ("climb", 1000, 4000), ("swing", 0, 3000),
+                 ("static", 0, 3000)]
 
 
 @pytest.mark.parametrize("direction", ["forward", "reverse"])
@@ -304,7 +311,7 @@ def test_kernel_matches_numpy_reference(kind, k0, k1, direction):
 
 
 @pytest.mark.parametrize("direction", ["forward", "reverse"])
-@pytest.mark.parametrize("kind, k0, k1", KERNEL_BLOCKS[:2])
+@pytest.mark.parametrize("kind, k0, k1", KERNEL_BLOCKS[:3])
 def test_kernel_step_matches_reference_step(kind, k0, k1, direction):
     """Single steps from the same state (every 10th state of the reference block): no
     accumulation, so the formulas agree to round-off of one step. Scales: |q| = 1; the

@@ -78,6 +78,11 @@ COMMANDS: dict[str, Command] = {
                 "seed000_moving_full_cycle.yaml", ("error_t3_deg",)),
         Command("northfind", "northfind", "Multi-position north-finding (seed 001).",
                 "northfind", "seed001_simulation.yaml", ("methods.coordinate.rms_error_deg",)),
+        Command("calibrate", "calibrate", "In-flight calibration, 21-state Kalman filter "
+                "(seed 002).", "calibrate", "seed002_designed.yaml",
+                ("nees.final", "normalized_error")),
+        Command("observability", "observability", "PWCS/SVD observability table of a flight "
+                "(seed 002).", "observability", "seed002_designed.yaml", ("rank_final",)),
         Command("realtime", "realtime", "Attitude at sync pulses: filter delay and prediction "
                 "(seed 003).", "realtime", "seed003_table1.yaml",
                 ("cases.0.after_max_arcsec.kalman-ls",)),

@@ -9,7 +9,8 @@ observability table of the seed's §3–4.
 Modules
 -------
 - :mod:`gcalign.calibrate.data` -- inputs as plain arrays (:class:`FlightData`,
-  :class:`Trajectory`, :class:`Span`), simulation from a motion, zero-velocity data.
+  :class:`Trajectory`, :class:`Span`) from a motion's truth and ideal increments with the
+  injected errors (navigation increments combined from IMU ones), zero-velocity data.
 - :mod:`gcalign.calibrate.filter` -- :func:`calibrate`, :func:`covariance_run` (the RTS
   smoother is :func:`gcalign.estimation.kalman.rts`).
 - :mod:`gcalign.calibrate.observability` -- :func:`observability_table`.
@@ -22,11 +23,16 @@ from gcalign.calibrate.data import (
     FlightData,
     Span,
     Trajectory,
+    combine_increments,
     draw_truth,
     flight_from_ideal,
+    imu_errors,
+    motion_spans,
     perturb,
     proposed_truth,
-    simulate_flight,
+    sampled_truth,
+    trajectory,
+    white_noise,
     zero_velocity_data,
 )
 from gcalign.calibrate.filter import (
@@ -40,7 +46,7 @@ from gcalign.calibrate.observability import ObservabilityTable, observability_ta
 
 __all__ = [
     "CalibrationResult", "CovarianceRun", "FlightData", "ObservabilityTable", "Settings", "Span",
-    "Trajectory", "calibrate", "covariance_run", "draw_truth", "flight_from_ideal",
-    "observability_table", "perturb", "proposed_truth",
-    "simulate_flight", "zero_velocity_data",
+    "Trajectory", "calibrate", "combine_increments", "covariance_run", "draw_truth",
+    "flight_from_ideal", "imu_errors", "motion_spans", "observability_table", "perturb",
+    "proposed_truth", "sampled_truth", "trajectory", "white_noise", "zero_velocity_data",
 ]

@@ -1,20 +1,34 @@
 """Inputs of a calibration run as plain arrays: truth, measured increments, segments.
 
-Any motion source fills these: the ``moving`` motion of :mod:`gcalign.sim.motions` today
-(:func:`simulate_flight`), a flight motion or recorded data (:func:`zero_velocity_data`)
-later. Times run from ``t[0]`` (the navigation start); increment k covers
-``(t[k], t[k+1]]`` (PSINS layout).
+A flight (:func:`gcalign.sim.motions.flight`) or any other motion fills these through
+:func:`flight_from_ideal` (its truth and ideal increments at the IMU rate, the injected
+errors, the navigation rate); recorded data on a parked vehicle through
+:func:`zero_velocity_data`. Times run from ``t[0]`` (the navigation start); increment k
+covers ``(t[k], t[k+1]]`` (PSINS layout).
+
+The navigation may run slower than the IMU: ``n`` IMU increments become one navigation
+increment (:func:`combine_increments`: the strapdown step's rotation and rotation
+compensation chained over the group), as the seed's 25 Hz navigation of a 100 Hz IMU.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from gcalign.estimation.ins_error import DB, DKA, DKG, DP, DV, EB, N_STATES, PHI
-from gcalign.nav.rotation import euler_to_quat, quat_mult, quat_to_dcm, rotvec_to_quat
+from gcalign.nav.earth import WGS84, EarthModel
+from gcalign.nav.rotation import (
+    euler_to_quat,
+    quat_mult,
+    quat_to_dcm,
+    quat_to_rotvec,
+    rotvec_to_quat,
+)
 from gcalign.nav.strapdown import NavState
+from gcalign.sim.errors import ImuErrors, SensorErrors
+from gcalign.sim.motions import Truth
 from gcalign.units import ARCMIN, ARCSEC, DPH, PPM, UG
 
 
@@ -33,7 +47,9 @@ class Trajectory:
 
     t (N+1,) s; att (N+1, 3) ``[pitch, roll, yaw]`` rad; v_n (N+1, 3) ENU m/s;
     pos (N+1, 3) ``[L, λ, h]`` rad, rad, m; f_b (N, 3) m/s² and omega_ib_b (N, 3) rad/s:
-    the mean specific force and body rate over each increment (ideal Δv/ts, Δθ/ts).
+    the mean specific force and body rate over each increment (ideal Δv/ts, Δθ/ts of the
+    navigation increments, combined from IMU ones when the navigation runs slower);
+    earth: the model the truth was simulated in.
     """
 
     t: np.ndarray
@@ -42,6 +58,7 @@ class Trajectory:
     pos: np.ndarray
     f_b: np.ndarray
     omega_ib_b: np.ndarray
+    earth: EarthModel = WGS84
 
     @property
     def ts(self) -> float:
@@ -57,6 +74,17 @@ class Trajectory:
         return (quat_to_dcm(q), self.f_b[k], self.omega_ib_b[k],
                 0.5 * (self.v_n[k] + self.v_n[k + 1]), 0.5 * (self.pos[k] + self.pos[k + 1]))
 
+    def index(self, t: float) -> int:
+        """The last sample not after `t` (s)."""
+        return int(np.searchsorted(self.t, t + 1e-9 * self.ts, side="right")) - 1
+
+    def between(self, t0: float, t1: float) -> Trajectory:
+        """The samples from the last one not after `t0` to the last one not after `t1`."""
+        a, b = self.index(t0), self.index(t1) + 1
+        return replace(self, t=self.t[a:b], att=self.att[a:b], v_n=self.v_n[a:b],
+                       pos=self.pos[a:b], f_b=self.f_b[a:b - 1],
+                       omega_ib_b=self.omega_ib_b[a:b - 1])
+
 
 @dataclass(frozen=True)
 class FlightData:
@@ -70,6 +98,7 @@ class FlightData:
     truth : the true trajectory (observability, NEES), or None for recorded data.
     x_true : (21,) the true initial navigation errors and IMU errors (state order of
         :data:`gcalign.estimation.ins_error.STATE_NAMES`), or None when unknown.
+    earth : the earth model the INS navigates in.
     """
 
     t: np.ndarray
@@ -81,10 +110,34 @@ class FlightData:
     segments: tuple[Span, ...] = ()
     truth: Trajectory | None = None
     x_true: np.ndarray | None = None
+    earth: EarthModel = field(default=WGS84)
 
     @property
     def ts(self) -> float:
         return float(self.t[1] - self.t[0])
+
+    def between(self, t0: float, t1: float) -> FlightData:
+        """The data from the last sample not after `t0` to the last one not after `t1` (s):
+        the same flight, shorter (the seed's conventional take-off is the first 6 stages of
+        the designed one). A simulated run starts again from the truth there with the
+        initial errors of ``x_true``."""
+        dt = self.ts
+        a = int(np.searchsorted(self.t, t0 + 1e-9 * dt, side="right")) - 1
+        b = int(np.searchsorted(self.t, t1 + 1e-9 * dt, side="right"))
+        start = self.start
+        if a > 0 and self.truth is not None and self.x_true is not None:
+            k = self.truth.index(float(self.t[a]))
+            true = NavState.from_euler(self.truth.att[k], self.truth.v_n[k], self.truth.pos[k])
+            start = perturb(true, self.x_true)
+        elif a > 0:
+            raise ValueError("between: a later start needs the truth to start from")
+        lo, hi = float(self.t[a]), float(self.t[b - 1])
+        segs = tuple(Span(s.name, max(s.start, lo), min(s.end, hi))
+                     for s in self.segments if s.end > lo + 1e-9 and s.start < hi - 1e-9)
+        return replace(self, t=self.t[a:b], dtheta=self.dtheta[a:b - 1], dv=self.dv[a:b - 1],
+                       start=start, ref_v_n=self.ref_v_n[a:b], ref_pos=self.ref_pos[a:b],
+                       segments=segs,
+                       truth=None if self.truth is None else self.truth.between(lo, hi))
 
 
 def proposed_truth() -> np.ndarray:
@@ -113,55 +166,139 @@ def perturb(state: NavState, x: np.ndarray) -> NavState:
     return NavState(q, state.v_n + x[DV], state.pos + x[DP])
 
 
-def simulate_flight(motion, site, ts: float, x_true: np.ndarray, arw: float, vrw: float,
-                    rng: np.random.Generator, names=None, substeps: int = 4) -> FlightData:
-    """Truth, ideal and measured increments of `motion` with the errors `x_true` (SI).
-
-    The IMU errors of `x_true` enter :func:`gcalign.sim.imu.apply_errors` as constant bias
-    and diagonal scale factor (``ω̃ = (I + diag δKg) ω + ε + w_g``, likewise f̃), with white
-    noise of density `arw` (rad/√s) and `vrw` (m/s/√s); the INS starts from the truth
-    perturbed by ``x_true[:9]``. Segments follow ``motion.segments`` (named by `names`).
-    """
-    from gcalign.sim.imu import ideal_imu
-
-    truth, ideal = ideal_imu(motion, site, ts, substeps=substeps)
-    segs = motion.segments or ()
-    # the last segment is held to the end of the motion; segments past the end are dropped
-    bounds = np.minimum(np.concatenate([[0.0], np.cumsum([s.duration for s in segs])]),
-                        motion.duration)
-    if len(segs):
-        bounds[-1] = motion.duration
-    names = names or [f"segment {i + 1}" for i in range(len(segs))]
-    spans = tuple(Span(str(n), float(a), float(b))
-                  for n, a, b in zip(names, bounds[:-1], bounds[1:], strict=True) if b > a)
-    return flight_from_ideal(truth, ideal, x_true, arw, vrw, rng, spans)
-
-
-def flight_from_ideal(truth, ideal, x_true: np.ndarray, arw: float, vrw: float,
-                      rng: np.random.Generator, segments: tuple[Span, ...] = ()) -> FlightData:
-    """:class:`FlightData` from a truth and its ideal increments (``ideal_imu``'s pair) with
-    the errors `x_true`: the Monte Carlo path (simulate the motion once, corrupt per run)."""
-    from gcalign.sim.imu import ImuErrors, SensorErrors, apply_errors
-
-    ts = ideal.ts
-    errors = ImuErrors(
-        gyro=SensorErrors(bias=x_true[EB], noise=np.full(3, arw), scale=x_true[DKG]),
-        accel=SensorErrors(bias=x_true[DB], noise=np.full(3, vrw), scale=x_true[DKA]),
+def imu_errors(x_true: np.ndarray, base: ImuErrors | None = None) -> ImuErrors:
+    """The sensor errors of `x_true` (biases and diagonal scale factors, the filter's model
+    ``ω̃ = (I + diag δKg) ω + ε + w_g``, likewise f̃) on top of `base`, whose noise,
+    misalignment, asymmetry and quantisation are kept (errors the filter does not model)."""
+    base = base or ImuErrors()
+    return ImuErrors(
+        gyro=replace(base.gyro, bias=np.array(x_true[EB], float),
+                     scale=np.array(x_true[DKG], float)),
+        accel=replace(base.accel, bias=np.array(x_true[DB], float),
+                      scale=np.array(x_true[DKA], float)),
     )
-    measured = apply_errors(ideal, errors, rng)
-    traj = Trajectory(t=truth.t, att=truth.att, v_n=truth.v_n, pos=truth.pos,
-                      f_b=ideal.dv / ts, omega_ib_b=ideal.dtheta / ts)
-    start = NavState.from_euler(truth.att[0], truth.v_n[0], truth.pos[0])
-    return FlightData(t=truth.t, dtheta=measured.dtheta, dv=measured.dv,
-                      start=perturb(start, x_true), ref_v_n=truth.v_n, ref_pos=truth.pos,
-                      segments=segments, truth=traj, x_true=np.array(x_true, dtype=float))
 
 
-def zero_velocity_data(t, dtheta, dv, start: NavState) -> FlightData:
+def white_noise(arw: float, vrw: float) -> ImuErrors:
+    """Only white noise: ARW (rad/√s) on every gyro, VRW (m/s/√s) on every accelerometer."""
+    return ImuErrors(gyro=SensorErrors(noise=np.full(3, arw)),
+                     accel=SensorErrors(noise=np.full(3, vrw)))
+
+
+def _rotate(r: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """R(r) v for rotation vectors r and vectors v (..., 3) (Rodrigues)."""
+    return np.einsum("...ij,...j->...i", quat_to_dcm(rotvec_to_quat(r)), v)
+
+
+def combine_increments(dtheta: np.ndarray, dv: np.ndarray, n: int):
+    """Groups of `n` increments (N, 3) as one navigation increment each ((N // n, 3) twice):
+    the strapdown step's own body-frame algebra chained over the group, so that one step
+    with the result does in the body frame exactly what n steps would.
+
+    Attitude: ``q(φ) = q(θ_1) ⊗ … ⊗ q(θ_n)`` (the step turns the body by ``q(Δθ)``).
+    Velocity: the step resolves ``R(Δθ/2) Δv`` in its start frame, so the group's increment
+    in the first frame is ``ΔV = Σ_i R(θ_1) ⋯ R(θ_{i−1}) R(θ_i/2) Δv_i`` and the combined
+    ``Δv = R(−φ/2) ΔV``. What changes against n steps is only the navigation-frame part
+    (earth rate, transport rate, gravity and Coriolis per ``n·ts``).
+
+    Why not PSINS ``cnscl``'s cone and sculling factors: they correct *raw* increments
+    (``∫ω dt``) for the coning within the group; gcalign's simulated gyro increments are the
+    exact rotation vectors between samples (a one-sample step reproduces the truth), for
+    which the composition is exact and the cone factors over-correct by θ_i × θ_j / 6
+    (``tests/test_calibrate.py``). A trailing incomplete group is dropped.
+    """
+    if n < 1:
+        raise ValueError(f"subsamples: at least 1 IMU increment per navigation step, got {n}")
+    k = len(dtheta) // n
+    w = np.asarray(dtheta, float)[: k * n].reshape(k, n, 3)
+    v = np.asarray(dv, float)[: k * n].reshape(k, n, 3)
+    if n == 1:
+        return w[:, 0].copy(), v[:, 0].copy()
+    q = np.zeros((k, 4))
+    q[:, 0] = 1.0
+    V = np.zeros((k, 3))
+    for i in range(n):
+        V += np.einsum("kij,kj->ki", quat_to_dcm(q), _rotate(0.5 * w[:, i], v[:, i]))
+        q = quat_mult(q, rotvec_to_quat(w[:, i]))
+    phi = quat_to_rotvec(q)
+    return phi, _rotate(-0.5 * phi, V)
+
+
+def trajectory(t, att, v_n, pos, dtheta, dv, earth: EarthModel = WGS84,
+               subsamples: int = 1) -> Trajectory:
+    """The :class:`Trajectory` at the navigation rate from a truth (N+1 samples) and its
+    ideal increments (N, 3) at the IMU rate, `subsamples` IMU increments per step."""
+    n = subsamples
+    dth, dvb = combine_increments(dtheta, dv, n)
+    k = len(dth)
+    t = np.asarray(t, float)[: k * n + 1 : n]
+    T = float(t[1] - t[0])
+    return Trajectory(t=t, att=np.asarray(att)[: k * n + 1 : n],
+                      v_n=np.asarray(v_n)[: k * n + 1 : n], pos=np.asarray(pos)[: k * n + 1 : n],
+                      f_b=dvb / T, omega_ib_b=dth / T, earth=earth)
+
+
+def flight_from_ideal(truth, ideal, x_true: np.ndarray, errors: ImuErrors,
+                      rng: np.random.Generator, segments: tuple[Span, ...] = (),
+                      subsamples: int = 1, earth: EarthModel = WGS84) -> FlightData:
+    """:class:`FlightData` from a truth (``Truth``, N+1 samples) and its ideal increments
+    (``ImuData``, N) at the IMU rate with the errors `x_true`: its biases and scale factors
+    replace those of `errors` (whose noise and unmodelled terms stay), the measured
+    increments are combined `subsamples` to a navigation step, and the INS starts from the
+    truth perturbed by ``x_true[:9]``. The Monte Carlo path: simulate once, corrupt per run.
+    """
+    from gcalign.sim.errors import ErrorStream
+
+    stream = ErrorStream(imu_errors(x_true, errors), ideal.ts, rng, len(ideal.dtheta))
+    dtheta, dv = combine_increments(*stream.apply(ideal.dtheta, ideal.dv), subsamples)
+    traj = trajectory(truth.t, truth.att, truth.v_n, truth.pos, ideal.dtheta, ideal.dv,
+                      earth, subsamples)
+    start = NavState.from_euler(traj.att[0], traj.v_n[0], traj.pos[0])
+    return FlightData(t=traj.t, dtheta=dtheta, dv=dv, start=perturb(start, x_true),
+                      ref_v_n=traj.v_n, ref_pos=traj.pos, segments=segments, truth=traj,
+                      x_true=np.array(x_true, dtype=float), earth=earth)
+
+
+def motion_spans(motion, t_end: float | None = None) -> tuple[Span, ...]:
+    """The manoeuvres of a motion as :class:`Span` s: one per segment of a moving base (a
+    flight target reached early and held, ``"X (held)"``, stays part of manoeuvre X;
+    unnamed segments are ``"segment i"``), the whole run for the other kinds. `t_end`
+    (the last sample time, s) clips them to the data: a flight of 590.00015 s sampled at
+    100 Hz ends at 590 s."""
+    end_all = float(motion.duration) if t_end is None else min(float(t_end), motion.duration)
+    segs = getattr(motion, "segments", None) or ()
+    if not segs:
+        return (Span(getattr(motion, "kind", "run"), 0.0, end_all),)
+    spans: list[Span] = []
+    t = 0.0
+    for i, s in enumerate(segs):
+        end = min(t + s.duration, end_all)
+        if i == len(segs) - 1:
+            end = end_all  # the last segment is held to the end
+        name = s.name or f"segment {i + 1}"
+        if end > t + 1e-9:
+            if name.endswith(" (held)") and spans and spans[-1].name == name[:-7]:
+                spans[-1] = Span(spans[-1].name, spans[-1].start, float(end))
+            else:
+                spans.append(Span(name, float(t), float(end)))
+        t = end
+    return tuple(spans)
+
+
+def sampled_truth(traj: Trajectory, spans) -> Truth:
+    """The trajectory as a :class:`gcalign.sim.motions.Truth` with the span of each sample
+    (a sample on a boundary ends the earlier span's last increment, so belongs to it)."""
+    seg = np.zeros(len(traj.t), np.int64)
+    for i, sp in enumerate(spans):
+        seg[(traj.t > sp.start + 1e-9) & (traj.t <= sp.end + 1e-9)] = i
+    return Truth(traj.t, traj.att, traj.v_n, traj.pos, seg)
+
+
+def zero_velocity_data(t, dtheta, dv, start: NavState, earth: EarthModel = WGS84) -> FlightData:
     """Recorded increments on a parked vehicle: the aiding measures zero velocity at the
     start position (zero-velocity fine alignment). `t` (N+1,) from the navigation start."""
     n = len(t)
     return FlightData(t=np.asarray(t, float), dtheta=np.asarray(dtheta, float),
                       dv=np.asarray(dv, float), start=start, ref_v_n=np.zeros((n, 3)),
                       ref_pos=np.tile(np.asarray(start.pos, float), (n, 1)),
-                      segments=(Span("static", float(t[0]), float(t[-1])),))
+                      segments=(Span("static", float(t[0]), float(t[-1])),), earth=earth)

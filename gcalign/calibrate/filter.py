@@ -37,7 +37,7 @@ from gcalign.estimation import ins_error as ie
 from gcalign.estimation.ins_error import DB, DKA, DKG, DP, DV, EB, IMU, N_STATES, NAV, PHI
 from gcalign.estimation.kalman import nees as nees_of
 from gcalign.estimation.kalman import predict, rts, update, van_loan
-from gcalign.nav.earth import WGS84
+from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import (
     euler_to_quat,
     quat_conj,
@@ -49,7 +49,6 @@ from gcalign.nav.rotation import (
 from gcalign.nav.strapdown import NavState, navigate
 
 DISCRETIZATIONS = ("accumulated", "van_loan")
-_EARTH = WGS84.params()  # the strapdown kernel's earth (WGS-84)
 
 
 @dataclass(frozen=True)
@@ -100,10 +99,10 @@ class Settings:
                                 f" got {self.filter_rate:g}")
         return int(round(ratio))
 
-    def covariances(self, pos):
+    def covariances(self, pos, earth: EarthModel = WGS84):
         """``(P0, Qc, R)`` at the start position `pos`."""
         sigma = None if self.p0_sigma is None else np.asarray(self.p0_sigma, dtype=float)
-        return (ie.initial_covariance(pos, self.p0_scale, sigma),
+        return (ie.initial_covariance(pos, self.p0_scale, sigma, earth),
                 ie.process_noise_density(self.arw, self.vrw),
                 ie.measurement_noise(self.measure, self.sigma_v, self.sigma_p))
 
@@ -156,30 +155,43 @@ class CalibrationResult:
         return None if self.truth is None else self.estimate - self.truth
 
 
-def _transition(q_nb, v_n, pos, dtheta, dv, ts: float, Qc: np.ndarray, method: str):
+def _transition(q_nb, v_n, pos, dtheta, dv, ts: float, Qc: np.ndarray, method: str,
+                E: np.ndarray):
     """Φ, Q_d over one filter step from the navigation states (S+1, …) and the compensated
-    increments (S, 3) (numba kernel; the NumPy route is ``ins_error.accumulate``)."""
+    increments (S, 3) (numba kernel; the NumPy route is ``ins_error.accumulate``); `E` is
+    ``EarthModel.params()``."""
     from gcalign.estimation._ins_kernel import transition_block
 
     Phi, Qd = np.empty((N_STATES, N_STATES)), np.empty((N_STATES, N_STATES))
     F_mean, G_mean = np.empty((N_STATES, N_STATES)), np.empty((N_STATES, 6))
     transition_block(q_nb, v_n, pos, dtheta, dv, ts, np.ascontiguousarray(np.diag(Qc)),
-                     _EARTH, Phi, Qd, F_mean, G_mean)
+                     E, Phi, Qd, F_mean, G_mean)
     if method == "van_loan":
         return van_loan(F_mean, G_mean, Qc, len(dtheta) * ts)
     return Phi, Qd
 
 
+def warm_up() -> None:
+    """Load the compiled kernels (numba cache) of a filter step before anything is timed."""
+    one = np.zeros((1, 3))
+    q = np.array([[1.0, 0.0, 0.0, 0.0]] * 2)
+    pos = np.array([[0.7, 0.0, 0.0]] * 2)
+    _transition(q, np.zeros((2, 3)), pos, one, one, 0.04, np.eye(6), "accumulated",
+                WGS84.params())
+    navigate(np.array([0.04]), one, one, 0.04, NavState(q[0], np.zeros(3), pos[0]))
+
+
 def _imu_residual(x_true: np.ndarray, imu: np.ndarray) -> np.ndarray:
-    """Error of the compensation in force (IMU part of the state, (12,)): with
-    ``ω̃ = (1 + δKg) ω + ε`` and ``ω_c = (ω̃ − ε̂)/(1 + δK̂g)``, ``ω_c = (1 + x_δKg) ω + x_ε``
-    holds exactly for ``x_ε = (ε − ε̂)/(1 + δK̂g)``, ``x_δKg = (1 + δKg)/(1 + δK̂g) − 1``."""
-    r = np.zeros(N_STATES)
-    r[EB] = (x_true[EB] - imu[EB]) / (1.0 + imu[DKG])
-    r[DB] = (x_true[DB] - imu[DB]) / (1.0 + imu[DKA])
-    r[DKG] = (1.0 + x_true[DKG]) / (1.0 + imu[DKG]) - 1.0
-    r[DKA] = (1.0 + x_true[DKA]) / (1.0 + imu[DKA]) - 1.0
-    return r[IMU]
+    """Error of the compensation in force (IMU part of the state, (..., 12) for `imu`
+    (..., 21)): with ``ω̃ = (1 + δKg) ω + ε`` and ``ω_c = (ω̃ − ε̂)/(1 + δK̂g)``,
+    ``ω_c = (1 + x_δKg) ω + x_ε`` holds exactly for ``x_ε = (ε − ε̂)/(1 + δK̂g)``,
+    ``x_δKg = (1 + δKg)/(1 + δK̂g) − 1``."""
+    r = np.zeros(np.shape(imu))
+    r[..., EB] = (x_true[EB] - imu[..., EB]) / (1.0 + imu[..., DKG])
+    r[..., DB] = (x_true[DB] - imu[..., DB]) / (1.0 + imu[..., DKA])
+    r[..., DKG] = (1.0 + x_true[DKG]) / (1.0 + imu[..., DKG]) - 1.0
+    r[..., DKA] = (1.0 + x_true[DKA]) / (1.0 + imu[..., DKA]) - 1.0
+    return r[..., IMU]
 
 
 def _compose(imu: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -193,17 +205,17 @@ def _compose(imu: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def _phi(q_est: np.ndarray, q_true: np.ndarray) -> np.ndarray:
-    """Misalignment φ (3,) with ``C_nb,est = exp(−[φ×]) C_nb,true``: the rotation vector of
-    ``q_true ⊗ q_est*`` (as :func:`gcalign.nav.rotation.misalignment`, on quaternions)."""
+    """Misalignment φ (..., 3) with ``C_nb,est = exp(−[φ×]) C_nb,true``: the rotation vector
+    of ``q_true ⊗ q_est*`` (as :func:`gcalign.nav.rotation.misalignment`, on quaternions)."""
     return quat_to_rotvec(quat_mult(q_true, quat_conj(q_est)))
 
 
-def _measurement(measure: str, v_n, pos, ref_v, ref_pos, noise) -> np.ndarray:
+def _measurement(measure: str, v_n, pos, ref_v, ref_pos, noise, earth: EarthModel) -> np.ndarray:
     """z = INS − reference − noise (seed eqs. 5–7); position in metres north, east."""
     dv = v_n[:2] - ref_v[:2]
     if measure == "velocity":
         return dv - noise
-    r_m, r_n = WGS84.radii(pos[0])
+    r_m, r_n = earth.radii(pos[0])
     dp = np.array([(pos[0] - ref_pos[0]) * (r_m + pos[2]),
                    (pos[1] - ref_pos[1]) * (r_n + pos[2]) * np.cos(pos[0])])
     return (dp if measure == "position" else np.concatenate([dv, dp])) - noise
@@ -247,7 +259,9 @@ def calibrate(data: FlightData, settings: Settings | None = None,
     if K < 1:
         raise ScenarioError(f"data: {len(data.dtheta)} navigation steps are fewer than one "
                             f"filter step ({S})")
-    P0, Qc, R = s.covariances(data.start.pos)
+    earth = data.earth
+    E = earth.params()
+    P0, Qc, R = s.covariances(data.start.pos, earth)
     m = R.shape[0]
     noise = np.zeros((K, m))
     if s.gnss_noise:
@@ -259,9 +273,13 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         truth = x_true = None
 
     est, sig = np.zeros((K + 1, N_STATES)), np.zeros((K + 1, N_STATES))
-    tru, nees = np.zeros((K + 1, N_STATES)), np.zeros(K + 1)
     innov, stdz, nis = np.zeros((K, m)), np.zeros((K, m)), np.zeros(K)
     quat, vel, posn = np.zeros((K + 1, 4)), np.zeros((K + 1, 3)), np.zeros((K + 1, 3))
+    # what the errors against the truth need, evaluated after the loop in whole arrays:
+    # the INS solution before each correction, the compensation in force, x⁺ and P⁺
+    pre_q, pre_v, pre_p = np.zeros((K + 1, 4)), np.zeros((K + 1, 3)), np.zeros((K + 1, 3))
+    in_force, x_all = np.zeros((K + 1, N_STATES)), np.zeros((K + 1, N_STATES))
+    P_all = np.zeros((K + 1, N_STATES, N_STATES))
     hist = _History.empty(K, P0) if s.smoother else None
 
     q, v, p = (np.asarray(data.start.q_nb, float), np.asarray(data.start.v_n, float),
@@ -269,11 +287,8 @@ def calibrate(data: FlightData, settings: Settings | None = None,
     x, P = np.zeros(N_STATES), P0
     imu = np.zeros(N_STATES)  # sensor parameters in force (closed loop), states 9–20
     sig[0] = np.sqrt(np.diag(P0))
-    quat[0], vel[0], posn[0] = q, v, p
-    if truth is not None and x_true is not None:
-        q_true = euler_to_quat(truth.att[::S][: K + 1])
-        tru[0] = x_true
-        nees[0] = nees_of(x_true, P0)
+    quat[0], vel[0], posn[0] = pre_q[0], pre_v[0], pre_p[0] = q, v, p
+    P_all[0] = P0
 
     for k in range(K):
         blk = slice(k * S, (k + 1) * S)
@@ -281,21 +296,20 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         # 1–2. compensate with the parameters in force, navigate S steps
         dth = (data.dtheta[blk] - imu[EB] * ts) / (1.0 + imu[DKG])
         dvb = (data.dv[blk] - imu[DB] * ts) / (1.0 + imu[DKA])
-        sol = navigate(data.t[blk.start + 1: j + 1], dth, dvb, ts, NavState(q, v, p))
+        sol = navigate(data.t[blk.start + 1: j + 1], dth, dvb, ts, NavState(q, v, p),
+                       earth=earth)
         q, v, p = sol.q_nb[-1], sol.v_n[-1], sol.pos[-1]
         # 3–4. Φ, Q_d along the navigation; predict; Joseph update
-        Phi, Qd = _transition(sol.q_nb, sol.v_n, sol.pos, dth, dvb, ts, Qc, s.discretization)
+        Phi, Qd = _transition(sol.q_nb, sol.v_n, sol.pos, dth, dvb, ts, Qc, s.discretization,
+                              E)
         x_prior, P_prior = predict(x, P, Phi, Qd)
-        z = _measurement(s.measure, v, p, data.ref_v_n[j], data.ref_pos[j], noise[k])
-        u = update(x_prior, P_prior, z, ie.measurement_matrix(s.measure, p), R)
+        z = _measurement(s.measure, v, p, data.ref_v_n[j], data.ref_pos[j], noise[k], earth)
+        u = update(x_prior, P_prior, z, ie.measurement_matrix(s.measure, p, earth), R)
         innov[k], stdz[k], nis[k] = u.innovation, u.standardized, u.nis
         sig[k + 1], P = np.sqrt(np.diag(u.P)), u.P
         est[k + 1, NAV] = u.x[NAV]
-        if truth is not None and x_true is not None:
-            e = np.concatenate([_phi(q, q_true[k + 1]), v - truth.v_n[j], p - truth.pos[j],
-                                _imu_residual(x_true, imu)])
-            nees[k + 1] = nees_of(e - u.x, u.P)
-            tru[k + 1, NAV], tru[k + 1, IMU] = e[NAV], x_true[IMU]
+        pre_q[k + 1], pre_v[k + 1], pre_p[k + 1] = q, v, p
+        in_force[k + 1], x_all[k + 1], P_all[k + 1] = imu, u.x, u.P
         if hist is not None:
             hist.Phi[k], hist.P_prior[k], hist.x_prior[k] = Phi, P_prior, x_prior
             hist.P_post[k + 1], hist.x_post[k + 1], hist.imu_pre[k + 1] = u.P, u.x, imu
@@ -313,10 +327,21 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         quat[k + 1], vel[k + 1], posn[k + 1] = q_c, v_c, p_c
 
     smoothed = None if hist is None else _smooth(hist, s.feedback)
-    known = truth is not None
+    tru = nees = None
+    if truth is not None and x_true is not None:
+        # the true filter state at every epoch: the error of the INS solution before the
+        # correction and of the compensation in force; epoch 0 is x_true itself
+        tru = np.empty((K + 1, N_STATES))
+        tru[:, PHI] = _phi(pre_q, euler_to_quat(truth.att[::S][: K + 1]))
+        tru[:, DV] = pre_v - truth.v_n[::S][: K + 1]
+        tru[:, DP] = pre_p - truth.pos[::S][: K + 1]
+        tru[:, IMU] = _imu_residual(x_true, in_force)
+        tru[0] = x_true
+        nees = nees_of(tru - x_all, P_all)
+        tru[:, IMU] = x_true[IMU]  # reported: the sensor errors themselves
     return CalibrationResult(
-        t=data.t[::S][: K + 1], estimate=est, sigma=sig, truth=tru if known else None,
-        nees=nees if known else None, innovation=innov, standardized=stdz, nis=nis,
+        t=data.t[::S][: K + 1], estimate=est, sigma=sig, truth=tru,
+        nees=nees, innovation=innov, standardized=stdz, nis=nis,
         att=quat_to_euler(quat), v_n=vel, pos=posn,
         measure_names=ie.MEASUREMENT_NAMES[s.measure], settings=s, smoothed=smoothed)
 
@@ -355,7 +380,9 @@ def covariance_run(truth: Trajectory, settings: Settings | None = None) -> Covar
     ts = truth.ts
     S = s.steps_per_update(ts)
     K = len(truth.f_b) // S
-    P0, Qc, R = s.covariances(truth.pos[0])
+    earth = truth.earth
+    E = earth.params()
+    P0, Qc, R = s.covariances(truth.pos[0], earth)
     q_nb = euler_to_quat(truth.att)
     dtheta, dv = truth.omega_ib_b * ts, truth.f_b * ts
     P_all = np.zeros((K + 1, N_STATES, N_STATES))
@@ -364,10 +391,10 @@ def covariance_run(truth: Trajectory, settings: Settings | None = None) -> Covar
     for k in range(K):
         b, e = k * S, (k + 1) * S
         Phi, Qd = _transition(q_nb[b:e + 1], truth.v_n[b:e + 1], truth.pos[b:e + 1], dtheta[b:e],
-                              dv[b:e], ts, Qc, s.discretization)
+                              dv[b:e], ts, Qc, s.discretization, E)
         P = Phi @ P @ Phi.T + Qd
         P = update(zero_x, 0.5 * (P + P.T), zero_z,
-                   ie.measurement_matrix(s.measure, truth.pos[(k + 1) * S]), R).P
+                   ie.measurement_matrix(s.measure, truth.pos[(k + 1) * S], earth), R).P
         P_all[k + 1] = P
     return CovarianceRun(t=truth.t[::S][: K + 1],
                          sigma=np.sqrt(np.diagonal(P_all, axis1=1, axis2=2)),

@@ -82,7 +82,8 @@ def pieces(truth: Trajectory, segments, piece_s: float = 1.0) -> Pieces:
         seg.append(np.full(len(edges) - 1, i))
     mid = np.concatenate(mids)
     k = np.clip(np.floor((mid - t0) / truth.ts + 1e-9).astype(int), 0, len(truth.f_b) - 1)
-    F = ie.error_matrix(*truth.midpoints(k))
+    C_nb, f_b, omega_ib_b, v_n, pos = truth.midpoints(k)
+    F = ie.error_matrix(C_nb, f_b, omega_ib_b, v_n, pos, earth=truth.earth)
     return Pieces(F=F, duration=np.concatenate(durs), segment=np.concatenate(seg))
 
 
@@ -111,9 +112,10 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
     if not (0.0 < rtol < 1.0):
         raise ScenarioError(f"rtol: must lie in (0, 1), got {rtol!r}")
     s = replace(settings or Settings(), measure=measure)
-    H = ie.measurement_matrix(measure, truth.pos[0])
+    H = ie.measurement_matrix(measure, truth.pos[0], truth.earth)
     measured = np.flatnonzero(np.any(H != 0.0, axis=0))
-    scale = np.sqrt(np.diag(s.covariances(truth.pos[0])[0])) if scaling == "p0" else None
+    scale = (np.sqrt(np.diag(s.covariances(truth.pos[0], truth.earth)[0])) if scaling == "p0"
+             else None)
     sc = np.ones(ie.N_STATES) if scale is None else scale
     pc = pieces(truth, segments, piece_s)
     # O_j = Q_j R_j: every stack of O_j (SOM) or O_j M (TOM) has the singular values and

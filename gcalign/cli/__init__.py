@@ -158,6 +158,7 @@ def main() -> None:
 # Commands register themselves on `app`.
 from gcalign.cli import align as _align  # noqa: E402,F401
 from gcalign.cli import batch as _batch  # noqa: E402,F401
+from gcalign.cli import calibrate as _calibrate  # noqa: E402,F401
 from gcalign.cli import data as _data  # noqa: E402,F401
 from gcalign.cli import northfind as _northfind  # noqa: E402,F401
 from gcalign.cli import plot as _plot  # noqa: E402,F401

@@ -65,31 +65,41 @@ def update(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.nda
     """Kalman update in Joseph form: ``P = (I − K H) P⁻ (I − K H)ᵀ + K R Kᵀ`` (stays
     symmetric positive semi-definite for any gain), ``K = P⁻ Hᵀ S⁻¹``."""
     y = np.asarray(z, dtype=float) - H @ x
-    S = H @ P @ H.T + R
-    L = np.linalg.cholesky(0.5 * (S + S.T))
-    # K = P Hᵀ S⁻¹ through the Cholesky factor (no explicit inverse)
     PHt = P @ H.T
-    K = np.linalg.solve(L.T, np.linalg.solve(L, PHt.T)).T
+    S = H @ PHt + R
+    L = np.linalg.cholesky(0.5 * (S + S.T))
+    # S⁻¹ = L⁻ᵀ L⁻¹ from the inverse of the (m × m, m ≤ a few) Cholesky factor: one small
+    # inversion serves the gain and the whitened innovation
+    Li = np.linalg.inv(L)
+    K = PHt @ (Li.T @ Li)
     I_KH = np.eye(len(x)) - K @ H
     P_new = I_KH @ P @ I_KH.T + K @ R @ K.T
-    w = np.linalg.solve(L, y)
+    w = Li @ y
     return Update(x=x + K @ y, P=0.5 * (P_new + P_new.T), innovation=y, S=S, K=K,
                   nis=float(w @ w), standardized=w)
 
 
 def solve_spd(P: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """``P⁻¹ B`` for a covariance P whose diagonal spans many decades (an INS error state
-    mixes rad² and m²): solved on the correlation matrix ``D⁻¹ P D⁻¹``, D = √diag P."""
+    """``P⁻¹ B`` for a covariance P (n, n) whose diagonal spans many decades (an INS error
+    state mixes rad² and m²): solved on the correlation matrix ``D⁻¹ P D⁻¹``, D = √diag P.
+    B is (n,) or (n, k)."""
     P, B = np.asarray(P, dtype=float), np.asarray(B, dtype=float)
     d = np.sqrt(np.diag(P))
     dd = d[:, None] if B.ndim == 2 else d
     return np.linalg.solve(P / np.outer(d, d), B / dd) / dd
 
 
-def nees(error: np.ndarray, P: np.ndarray) -> float:
-    """Normalised estimation error squared ``eᵀ P⁻¹ e`` (χ²_n for a consistent filter)."""
-    e = np.asarray(error, dtype=float)
-    return float(e @ solve_spd(P, e))
+def nees(error: np.ndarray, P: np.ndarray):
+    """Normalised estimation error squared ``eᵀ P⁻¹ e`` (χ²_n for a consistent filter):
+    a float for error (n,) and P (n, n), or (K,) for stacks (K, n) and (K, n, n) (one
+    batched solve on the correlation matrices)."""
+    e, P = np.asarray(error, dtype=float), np.asarray(P, dtype=float)
+    if e.ndim == 1:
+        return float(e @ solve_spd(P, e))
+    d = np.sqrt(np.diagonal(P, axis1=-2, axis2=-1))
+    r = e / d
+    return np.einsum("ki,ki->k", r, np.linalg.solve(P / (d[:, :, None] * d[:, None, :]),
+                                                    r[..., None])[..., 0])
 
 
 def rts(Phis: np.ndarray, P_prior: np.ndarray, x_prior: np.ndarray, P_post: np.ndarray,

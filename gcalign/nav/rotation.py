@@ -117,13 +117,29 @@ def dcm_to_quat(C):
 
 
 def euler_to_quat(att):
-    """q_nb from ``[pitch, roll, yaw]`` (rad), shape (..., 3) -> (..., 4)."""
-    return dcm_to_quat(euler_to_dcm(att))
+    """q_nb from ``[pitch, roll, yaw]`` (rad), shape (..., 3) -> (..., 4), scalar part ≥ 0:
+    the product of the axis quaternions qz(yaw) ⊗ qx(pitch) ⊗ qy(roll) (the order of C_nb)."""
+    att = np.asarray(att, dtype=float)
+    cp, sp = np.cos(0.5 * att[..., 0]), np.sin(0.5 * att[..., 0])
+    cr, sr = np.cos(0.5 * att[..., 1]), np.sin(0.5 * att[..., 1])
+    cy, sy = np.cos(0.5 * att[..., 2]), np.sin(0.5 * att[..., 2])
+    q = np.stack([cy * cp * cr - sy * sp * sr, cy * sp * cr - sy * cp * sr,
+                  cy * cp * sr + sy * sp * cr, sy * cp * cr + cy * sp * sr], -1)
+    return q * np.where(q[..., :1] < 0, -1.0, 1.0)
 
 
 def quat_to_euler(q):
-    """``[pitch, roll, yaw]`` (rad) from q_nb, shape (..., 4) -> (..., 3)."""
-    return dcm_to_euler(quat_to_dcm(q))
+    """``[pitch, roll, yaw]`` (rad) from q_nb, shape (..., 4) -> (..., 3); the five elements
+    of C_nb that :func:`dcm_to_euler` reads, straight from the quaternion."""
+    q = np.asarray(q, dtype=float)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    c21 = 2.0 * (y * z + w * x)
+    c20 = 2.0 * (x * z - w * y)
+    c22 = w * w - x * x - y * y + z * z
+    c01 = 2.0 * (x * y - w * z)
+    c11 = w * w - x * x + y * y - z * z
+    return np.stack([np.arcsin(np.clip(c21, -1.0, 1.0)), np.arctan2(-c20, c22),
+                     np.arctan2(-c01, c11)], -1)
 
 
 def rotvec_to_quat(r):
@@ -163,3 +179,8 @@ def misalignment(C_nb_est, C_nb_true):
     """Misalignment φ (rad, ENU) from ``C_nb_est C_nb_true^T = exp(-[φ×]) ≈ I - [φ×]``."""
     D = np.asarray(C_nb_est) @ np.swapaxes(np.asarray(C_nb_true), -1, -2)
     return -quat_to_rotvec(dcm_to_quat(D))
+
+
+def misalignment_q(q_nb_est, q_nb_true):
+    """:func:`misalignment` from quaternions: φ = −rotvec(q_est ⊗ q_true*)."""
+    return -quat_to_rotvec(quat_mult(q_nb_est, quat_conj(q_nb_true)))

@@ -70,6 +70,22 @@ def schedule_quat(t0, kind, coef, step, theta0, axis, before, cyc, q0, period, r
     return rw, rx, ry, rz
 
 
+@njit(cache=True, inline="always")
+def rest_end(t0, period, repeat, memo):
+    """The time the rest piece remembered in `memo` (by :func:`schedule_quat`) ends; −∞ if
+    the last time looked up was not in a rest piece."""
+    if memo[0] < 0.0:
+        return -math.inf
+    j = int(memo[0])
+    if j < t0.shape[0] - 1:
+        end = t0[j + 1]
+    elif repeat:
+        end = period
+    else:
+        return math.inf  # the schedule is over and rests for ever
+    return end + memo[1] * period if repeat else end
+
+
 @njit(cache=True)
 def fixed_site_block(k0, n, ts, m, omega_ie, q_en, f_n, q_nb0, body, has_body, mech, has_mech,
                      mech_nav, dtheta, dv, q_nb_out, q_bs_out):
@@ -88,8 +104,43 @@ def fixed_site_block(k0, n, ts, m, omega_ie, q_en, f_n, q_nb0, body, has_body, m
     m0, m1, m2, m3, m4, m5, m6, m7, m8, m9, m10 = mech
     pw = px = py = pz = 0.0  # q_is at the start of the sample
     gx = gy = gz = 0.0  # f_s at the start of the sample
+    lw = lx = ly = lz = 0.0  # q_ns at the end of the last sample computed
+    rest_dtheta = np.zeros(3)  # the increment at rest (sensor frame)
+    inside_before = False  # the previous sample lay inside one rest piece of every schedule
+    stale = False  # q_is at the start of the sample not yet known (copied samples before)
+    # the end of the rest piece each schedule is in at the last computed sample's end
+    body_rest_until = math.inf if not has_body else -math.inf
+    mech_rest_until = math.inf if not has_mech else -math.inf
     for i in range(n):
         k = k0 + i
+        # Inside one rest piece (of the body's and of the mechanism's schedule) from the
+        # sample's start to its end, the sensor attitude is constant and so are the
+        # increments: from the second such sample on, Δv and the attitudes are copied and
+        # Δθ is the earth rate over ts.
+        t_end = (k + 1) * ts
+        inside = i > 0 and t_end < body_rest_until and t_end < mech_rest_until
+        if inside and inside_before:
+            # Δθ = C_sn ω_ie^n ts in closed form: copying a difference of attitudes would
+            # repeat its round-off (~1e-16 rad) coherently instead of letting it telescope
+            for c in range(3):
+                dtheta[i, c] = rest_dtheta[c]
+                dv[i, c] = dv[i - 1, c]
+            for c in range(4):
+                q_nb_out[i, c] = q_nb_out[i - 1, c]
+                q_bs_out[i, c] = q_bs_out[i - 1, c]
+            stale = True
+            continue
+        if inside and not inside_before:  # the first sample of a rest: the earth rate
+            ux, uy, uz = qrot(q_en[0], -q_en[1], -q_en[2], -q_en[3], 0.0, 0.0, omega_ie * ts)
+            rest_dtheta[0], rest_dtheta[1], rest_dtheta[2] = qrot(lw, -lx, -ly, -lz,
+                                                                  ux, uy, uz)
+        inside_before = inside
+        if stale:  # q_is at the start: the earth turned under a constant sensor attitude
+            half = 0.5 * omega_ie * (k * ts - t_ref)
+            uw, ux, uy, uz = qmul(math.cos(half), 0.0, 0.0, math.sin(half),
+                                  q_en[0], q_en[1], q_en[2], q_en[3])
+            pw, px, py, pz = qmul(uw, ux, uy, uz, lw, lx, ly, lz)
+            stale = False
         j0 = 0 if i == 0 else 1  # a sample starts where the previous one ended
         ax, ay, az = gx, gy, gz
         for j in range(j0, m + 1):
@@ -133,6 +184,11 @@ def fixed_site_block(k0, n, ts, m, omega_ie, q_en, f_n, q_nb0, body, has_body, m
                     q_bs_out[i, 0], q_bs_out[i, 1] = qw, qx
                     q_bs_out[i, 2], q_bs_out[i, 3] = qy, qz
                     gx, gy, gz = fx, fy, fz
+                    lw, lx, ly, lz = sw, sx, sy, sz
+                    if has_body:
+                        body_rest_until = rest_end(b0, b9, b10, memo[0])
+                    if has_mech:
+                        mech_rest_until = rest_end(m0, m9, m10, memo[1])
                 pw, px, py, pz = cw, cx, cy, cz
         c = h / 3.0
         dv[i, 0], dv[i, 1], dv[i, 2] = ax * c, ay * c, az * c

@@ -80,16 +80,22 @@ def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
         raise ValueError(f"substeps must be even for Simpson's rule, got {substeps}")
     n_total = sample_count(motion.duration, ts)
     m = substeps
-    h = ts / m
-    weights = np.ones(m + 1)
-    weights[1:-1:2], weights[2:-1:2] = 4.0, 2.0
-    weights *= h / 3.0
     site = np.asarray(site, dtype=float)
     if isinstance(motion, Static | Turntable):
         yield from _fixed_site_blocks(motion, site, ts, earth, mechanism, block or BLOCK, m,
                                       n_total)
-        return
-    block = block or GENERIC_BLOCK
+    else:
+        yield from _numpy_blocks(motion, site, ts, earth, mechanism, block or GENERIC_BLOCK,
+                                 m, n_total)
+
+
+def _numpy_blocks(motion: MotionType, site, ts, earth, mechanism, block, m,
+                  n_total) -> Iterator[SimBlock]:
+    """The vectorised route: any motion, the kinematics on a grid of sub-points."""
+    h = ts / m
+    weights = np.ones(m + 1)
+    weights[1:-1:2], weights[2:-1:2] = 4.0, 2.0
+    weights *= h / 3.0
     for k0 in range(0, n_total, block):
         n = min(block, n_total - k0)
         # Sub-point times from integers, so a boundary is the same number in both rows.

@@ -13,8 +13,6 @@ GAIN_NAMES = "K_E1, K_E2, K_E3, K_N1, K_N2, K_N3, K_U1, K_U2, K_U3, K_U4"
 def write_alignment(f: h5py.File, run, stream=None) -> None:
     """/align/pass_NN (attitude and error per pass), /align/result, /align/gains, and the
     true attitude at the stored samples under /truth (t, att)."""
-    from gcalign.nav.rotation import quat_to_euler
-
     if run.pass_truth is not None:
         rows = {}
         for rec, tr in zip(run.passes, run.pass_truth, strict=True):
@@ -28,12 +26,13 @@ def write_alignment(f: h5py.File, run, stream=None) -> None:
     g.attrs["mode"] = run.cfg.mode
     g.attrs["azimuth_poles"] = run.azimuth_poles
     g.attrs["t1_s"], g.attrs["t2_s"], g.attrs["t3_s"] = run.t1, run.t2, run.t3
-    for rec, err, phi in zip(run.passes, run.pass_errors, run.pass_phi, strict=True):
+    for rec, att, err, phi in zip(run.passes, run.pass_att, run.pass_errors, run.pass_phi,
+                                  strict=True):
         p = g.create_group(f"pass_{rec.index:02d}")
         p.attrs["direction"], p.attrs["kind"], p.attrs["stage"] = rec.direction, rec.kind, rec.stage
         put(p, "t", rec.t, "s",
             description="data time, processing order (decreasing in a reverse pass)")
-        put(p, "att", quat_to_euler(rec.q_nb), "rad", ATT_FRAME)
+        put(p, "att", att, "rad", ATT_FRAME)
         put(p, "gains", rec.gains, "SI", names=GAIN_NAMES)
         if err is not None:
             put(p, "error", err, "rad", "Euler differences est - true, yaw wrapped")

@@ -28,6 +28,7 @@ from gcalign.nav.rotation import (
     euler_to_dcm,
     euler_to_quat,
     misalignment,
+    misalignment_q,
     quat_to_dcm,
     quat_to_euler,
 )
@@ -64,15 +65,18 @@ class AlignRun:
         return None if self.truth_t3 is None else attitude_error(self.att_t3, self.truth_t3)
 
     @cached_property
+    def pass_att(self) -> list[np.ndarray]:
+        """Euler angles (n, 3) rad along each pass (its stored rows)."""
+        return [quat_to_euler(r.q_nb) for r in self.passes]
+
+    @cached_property
     def pass_errors(self) -> list[np.ndarray | None]:
-        """Euler-angle error (n+1, 3) rad along each pass; computed when first asked for
+        """Euler-angle error (n, 3) rad along each pass; computed when first asked for
         (a batch needs only the end of each pass)."""
         if self.pass_truth is None:
             return [None] * len(self.passes)
-        return [
-            attitude_error(quat_to_euler(r.q_nb), tr)
-            for r, tr in zip(self.passes, self.pass_truth, strict=True)
-        ]
+        return [attitude_error(a, tr) for a, tr in zip(self.pass_att, self.pass_truth,
+                                                         strict=True)]
 
     @cached_property
     def pass_phi(self) -> list[np.ndarray | None]:
@@ -80,7 +84,7 @@ class AlignRun:
         if self.pass_truth is None:
             return [None] * len(self.passes)
         return [
-            misalignment(quat_to_dcm(r.q_nb), euler_to_dcm(tr))
+            misalignment_q(r.q_nb, euler_to_quat(tr))
             for r, tr in zip(self.passes, self.pass_truth, strict=True)
         ]
 

@@ -154,8 +154,9 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     if command is None:
         has = [c for c in COMMANDS if isinstance(base_data, dict) and c in base_data]
         if len(has) > 1:
-            raise ScenarioError(f"{source}: command: the base has both 'align' and 'northfind' "
-                                "sections; say which to run (command: align | northfind)")
+            raise ScenarioError(f"{source}: command: the base has sections for "
+                                f"{', '.join(has)}; say which to run (command: "
+                                f"{' | '.join(has)})")
         command = has[0] if has else "align"
     if command not in COMMANDS:
         raise ScenarioError(f"{source}: command: must be one of {', '.join(COMMANDS)}, "

@@ -166,6 +166,8 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
                          "error/pos": r[:, 15:18], "error/phi": r[:, 18:21]}
             series.append(**data)
         last = (states[-1], None if b.q_bs is None else b.q_bs[hi - 1])
+    if series is not None:
+        series.flush()
     assert last is not None
     s_end, qbs_end = last
     q_end = s_end[K.Q] if qbs_end is None else body_attitude(s_end[K.Q][None], qbs_end[None])[0]

@@ -61,33 +61,37 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     for b in stream.blocks():
         tr = b.truth
         if tr is not None:
-            v = np.vstack([v_prev[None], tr.v_n])
-            distance += float(np.linalg.norm(0.5 * (v[1:] + v[:-1]), axis=1).sum() * ts)
+            v_mid = 0.5 * (np.vstack([v_prev[None], tr.v_n[:-1]]) + tr.v_n)
+            distance += float(np.sqrt(np.einsum("ij,ij->i", v_mid, v_mid)).sum() * ts)
             v_prev = tr.v_n[-1]
             h_range = (min(h_range[0], float(tr.pos[:, 2].min())),
                        max(h_range[1], float(tr.pos[:, 2].max())))
-        k = b.k0 + np.arange(1, len(b.t) + 1)
-        keep = (k % stride) == 0
+        # rows kept: the samples k (1-based over the run) with k % stride == 0
+        keep = np.arange((-(b.k0 + 1)) % stride, len(b.t), stride)
         if truth is not None and tr is not None:
             truth.append(t=b.t[keep], att=tr.att[keep], v_n=tr.v_n[keep], pos=tr.pos[keep],
                          segment=tr.segment[keep])
         if imu is not None:
-            ends = np.flatnonzero(keep)
             if stride == 1:
                 rows = {"dtheta": b.dtheta, "dv": b.dv}
             else:  # sums over each output interval, the remainder carried to the next block
                 rows = {}
+                starts = np.r_[0, keep + 1]
                 for name, inc in (("dtheta", b.dtheta), ("dv", b.dv)):
-                    P = np.cumsum(inc, axis=0)
-                    if len(ends):
-                        rows[name] = P[ends] - np.vstack([-carry[name][None], P[ends[:-1]]])
-                        carry[name] = P[-1] - P[ends[-1]]
+                    sums = np.add.reduceat(inc, starts[starts < len(inc)], axis=0)
+                    sums[0] += carry[name]
+                    if starts[-1] < len(inc):  # samples after the last kept one
+                        carry[name] = sums[-1]
+                        sums = sums[:-1]
                     else:
-                        rows[name] = np.empty((0, 3))
-                        carry[name] = carry[name] + P[-1]
+                        carry[name] = np.zeros(3)
+                    rows[name] = sums
             extra = {} if b.q_bs is None else {"q_bs": b.q_bs[keep]}
             imu.append(t=b.t[keep], **rows, **extra)
         last = b
+    for series in (truth, imu):
+        if series is not None:
+            series.flush()
     summary: dict = {
         "scenario": sc.name,
         "seed": stream.seed,

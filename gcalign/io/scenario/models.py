@@ -11,6 +11,7 @@ from pydantic import BeforeValidator, Field, field_validator, model_validator
 from gcalign import units as u
 from gcalign.io.scenario.align import AlignConfig
 from gcalign.io.scenario.base import Model, NonNegVec3, Vec3
+from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
@@ -140,6 +141,8 @@ class Scenario(Model):
     output: OutputConfig = Field(default_factory=OutputConfig)
     align: AlignConfig | None = None
     northfind: NorthfindConfig | None = None
+    calibrate: CalibrateConfig | None = None
+    observability: ObservabilityConfig | None = None
     realtime: RealtimeConfig | None = None
 
     @property

@@ -118,12 +118,45 @@ class FlightSegmentModel(Model):
             None if self.angle_deg is None else self.angle_deg * d, self.name)
 
 
+def flight_extent(motion: M.Moving, step: float = 0.25) -> tuple[float, float]:
+    """Highest climb above the start and largest horizontal distance from it (m) of a
+    moving base: its ENU velocity integrated by Simpson's rule on pieces of at most `step`
+    s inside each segment (smooth there), on the local level (the earth's curvature over
+    15 km changes a distance by 1e-6 of itself)."""
+    starts = np.concatenate([[0.0], np.cumsum([s.duration for s in motion.segments])])
+    starts = np.minimum(starts, motion.duration)
+    starts[-1] = motion.duration
+    top = far = 0.0
+    p = np.zeros(3)
+    for j, (a, b) in enumerate(zip(starts[:-1], starts[1:], strict=True)):
+        if b <= a:
+            continue
+        n = max(1, int(np.ceil((b - a) / step - 1e-9)))
+        t = a + (b - a) * np.arange(2 * n + 1) / (2 * n)
+        v = motion.velocity(t, np.full(t.size, min(j, len(motion.segments) - 1)))[0]
+        h = (b - a) / (2 * n)
+        inc = (v[0:-2:2] + 4 * v[1:-1:2] + v[2::2]) * h / 3.0  # Simpson per piece
+        track = p + np.cumsum(inc, axis=0)
+        top = max(top, float(track[:, 2].max()))
+        far = max(far, float(np.hypot(track[:, 0], track[:, 1]).max()))
+        p = track[-1]
+    return top, far
+
+
+class Envelope(Model):
+    """Limits a flight must stay within (bad input otherwise)."""
+
+    max_height_m: float | None = Field(None, gt=0, description="climb above the start")
+    max_horizontal_m: float | None = Field(None, gt=0, description="distance from the start")
+
+
 class FlightModel(_Base):
     kind: Literal["flight"]
     duration_s: float | None = Field(None, gt=0, le=1e6,  # type: ignore[assignment]
                                      description="default: the sum of the segments")
     speed_mps: float = Field(0.0, ge=0)
     segments: list[FlightSegmentModel] = Field(min_length=1)
+    envelope: Envelope | None = None
 
     @model_validator(mode="after")
     def _resolve(self):
@@ -131,6 +164,15 @@ class FlightModel(_Base):
         if self.duration_s is not None and self.duration_s < motion.duration - 1e-9:
             raise ValueError(f"duration_s: {self.duration_s:g} s is shorter than the "
                              f"segments ({motion.duration:g} s); omit it to use their sum")
+        env = self.envelope
+        if env is not None and (env.max_height_m or env.max_horizontal_m):
+            top, far = flight_extent(self.to_motion())
+            if env.max_height_m is not None and top > env.max_height_m:
+                raise ValueError(f"envelope.max_height_m: the flight climbs {top:.0f} m above "
+                                 f"its start, above the envelope's {env.max_height_m:g} m")
+            if env.max_horizontal_m is not None and far > env.max_horizontal_m:
+                raise ValueError(f"envelope.max_horizontal_m: the flight goes {far:.0f} m from "
+                                 f"its start, beyond the envelope's {env.max_horizontal_m:g} m")
         return self
 
     def _flight(self) -> M.Moving:

@@ -1,0 +1,86 @@
+"""The /calibrate group of a results file: every filter run's estimates, σ, truth and
+innovations at the filter epochs (SI), and the flight's segments.
+
+Layout::
+
+    /calibrate                 attrs: aiding, navigation_rate_hz, filter_rate_hz, compare,
+                                      states (names), state_units, display_units,
+                                      display_scale (SI -> display factors)
+    /calibrate/segments        name (strings), t0, t1 (s)
+    /calibrate/runs/NN         attrs: label (designed | conventional | ""), measure
+        t (K+1,) s; estimate, sigma, truth (K+1, 21) SI in the state order; nees (K+1,);
+        innovation, standardized (K, m); nis (K,); att, v_n, pos (K+1, 3) the corrected
+        INS solution; smoothed/estimate, smoothed/sigma (K+1, 21) with the RTS smoother
+"""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+
+from gcalign.estimation import ins_error as ie
+from gcalign.io.results import ATT_FRAME, put
+
+STATE_SHAPE = "(epochs, 21) in the order of the 'states' attribute, SI units of 'state_units'"
+
+
+def write_segments(f: h5py.File, truth, segments) -> None:
+    """/truth/segment (index of each sample's manoeuvre) and /truth/segment_names."""
+    if "truth" not in f or truth is None:
+        return
+    g = f["truth"]
+    if "segment" not in g and truth.segment is not None:
+        put(g, "segment", truth.segment, "1", description="index into segment_names")
+    g.create_dataset("segment_names", data=np.array([s.name for s in segments],
+                                                     dtype=h5py.string_dtype()))
+
+
+def write_calibration(f: h5py.File, case, runs, compare: bool) -> None:
+    d = case.data
+    write_segments(f, case.truth(), d.segments)
+    g = f.create_group("calibrate")
+    g.attrs["aiding"] = case.aiding
+    g.attrs["navigation_rate_hz"] = case.navigation_rate
+    g.attrs["filter_rate_hz"] = case.settings.filter_rate
+    g.attrs["compare"] = compare
+    g.attrs["states"] = ",".join(ie.STATE_NAMES)
+    g.attrs["state_units"] = ",".join(ie.STATE_UNITS)
+    g.attrs["display_units"] = ",".join(ie.DISPLAY_UNITS)
+    g.attrs["display_scale"] = ie.display_scale(float(d.start.pos[0]), float(d.start.pos[2]),
+                                                d.earth)
+    seg = g.create_group("segments")
+    seg.create_dataset("name", data=np.array([s.name for s in d.segments],
+                                             dtype=h5py.string_dtype()))
+    put(seg, "t0", [s.start for s in d.segments], "s")
+    put(seg, "t1", [s.end for s in d.segments], "s")
+    rg = g.create_group("runs")
+    for i, run in enumerate(runs):
+        _write_run(rg.create_group(f"{i:02d}"), run)
+
+
+def _write_run(g: h5py.Group, run) -> None:
+    r = run.result
+    g.attrs["label"] = run.label
+    g.attrs["measure"] = r.settings.measure
+    g.attrs["measure_names"] = ",".join(r.measure_names)
+    put(g, "t", r.t, "s", description="filter epochs (t[0]: the start, no update)")
+    put(g, "estimate", r.estimate, "SI", shape=STATE_SHAPE,
+        description="sensor errors: the parameters in force after the update; navigation "
+        "errors: the estimated error of the INS before the correction")
+    put(g, "sigma", r.sigma, "SI", shape=STATE_SHAPE, description="posterior 1-sigma")
+    if r.truth is not None:
+        put(g, "truth", r.truth, "SI", shape=STATE_SHAPE)
+        put(g, "nees", r.nees, "1", description="chi-square, 21 degrees of freedom")
+    units = "m/s" if r.settings.measure == "velocity" else (
+        "m" if r.settings.measure == "position" else "m/s, m/s, m, m")
+    put(g, "innovation", r.innovation, units, names=",".join(r.measure_names),
+        description="z - H x-, z = INS - reference")
+    put(g, "standardized", r.standardized, "1", description="L^-1 innovation, S = L L^T")
+    put(g, "nis", r.nis, "1", description=f"chi-square, {r.standardized.shape[1]} dof")
+    put(g, "att", r.att, "rad", ATT_FRAME)
+    put(g, "v_n", r.v_n, "m/s", "ENU")
+    put(g, "pos", r.pos, "rad, rad, m", "[latitude, longitude, height]")
+    if r.smoothed is not None:
+        s = g.create_group("smoothed")
+        put(s, "estimate", r.smoothed.estimate, "SI", shape=STATE_SHAPE)
+        put(s, "sigma", r.smoothed.sigma, "SI", shape=STATE_SHAPE)

@@ -1,0 +1,312 @@
+"""Calibration figures (seed 002 Figs. 1–3 and the filter's own checks).
+
+* ``trajectory`` -- ground track and height of the flight, segments numbered (Fig. 1);
+* ``sensor_biases`` -- ε (°/h) and ∇ (µg) estimates against time with ±3σ envelopes and
+  the truth (Fig. 2; with ``--compare``: velocity, position and both on the designed
+  flight, in the paper's styles: red dashed v+p, cyan v, purple dash-dot p);
+* ``scale_factors`` -- δKg, δKa (ppm) likewise (Fig. 3);
+* ``sigma`` -- σ/σ0 of the twelve sensor errors, log scale (they span decades);
+* ``navigation_errors`` -- φ, δv of the corrected INS (estimate − truth) with ±3σ;
+* ``innovations`` -- standardized innovations with ±3, NEES with its χ²₂₁ band, NIS;
+* ``attitude`` -- recorded data (no truth): the INS attitude with ±3σ of φ.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from gcalign.app.calibrate import UNIT_TEXT
+from gcalign.app.plots import _s, new_figure
+
+STYLE = {"both": dict(color="tab:red", linestyle="--"),
+         "velocity": dict(color="tab:cyan", linestyle="-"),
+         "position": dict(color="tab:purple", linestyle="-.")}
+AXES = ("x", "y", "z")
+
+
+def read_runs(f) -> tuple[list[dict], dict]:
+    """The runs of a calibrate file (arrays SI) and the group's attributes."""
+    g = f["calibrate"]
+    attrs = {k: (_s(v) if isinstance(v, (bytes, str)) else v) for k, v in g.attrs.items()}
+    runs = []
+    for key in sorted(g["runs"]):
+        r = g["runs"][key]
+        run: dict = {"label": _s(r.attrs.get("label", "")), "measure": _s(r.attrs["measure"]),
+               "measure_names": _s(r.attrs.get("measure_names", "")).split(",")}
+        for name in ("t", "estimate", "sigma", "truth", "nees", "standardized", "nis", "att"):
+            run[name] = r[name][()] if name in r else None
+        runs.append(run)
+    seg = g["segments"]
+    attrs["segments"] = [(_s(n), float(a), float(b)) for n, a, b in
+                         zip(seg["name"][()], seg["t0"][()], seg["t1"][()], strict=True)]
+    return runs, attrs
+
+
+def _time_axis(t: np.ndarray) -> tuple[np.ndarray, str]:
+    return (t / 60.0, "time (min)") if t[-1] - t[0] > 1200 else (t, "time (s)")
+
+
+def _segment_lines(ax, segments, minutes: bool) -> None:
+    k = 60.0 if minutes else 1.0
+    for _, a, _b in segments[1:]:
+        ax.axvline(a / k, color="0.85", linewidth=0.6, zorder=0, label="_segment")
+
+
+def _ylim(est, sig, truth, t) -> float:
+    """Half-height that shows the second half of the run's estimate ± 3σ and the truth."""
+    half = t >= t[0] + 0.5 * (t[-1] - t[0])
+    lim = float(np.max(np.abs(est[half]) + 3 * sig[half]))
+    if truth is not None:
+        lim = max(lim, float(np.max(np.abs(truth))) * 1.2)
+    return 1.15 * lim if lim > 0 else 1.0
+
+
+def _panel(ax, name: str, unit: str, lim: float) -> None:
+    ax.set_ylim(-lim, lim)
+    ax.set_title(name, fontsize="medium")
+    ax.set_ylabel(UNIT_TEXT.get(unit, unit))
+    ax.grid(True, alpha=0.3)
+
+
+def _finish(fig, axes, xlabel: str, title: str) -> Figure:
+    """A 2 × 3 grid: time labels on the bottom row, the legend in the first panel."""
+    for ax in axes[3:]:
+        ax.set_xlabel(xlabel)
+    axes[0].legend(loc="upper right", fontsize="x-small")
+    fig.suptitle(title)
+    return fig
+
+
+def estimates_figure(runs, attrs, states: list[str], title: str) -> Figure:
+    """Estimates of `states` (2 rows × 3 axes) against time with ±3σ and the truth."""
+    names = attrs["states"].split(",")
+    units = attrs["display_units"].split(",")
+    scale = np.asarray(attrs["display_scale"])
+    fig, axes = new_figure(2, 3, width=12.0, height=6.0)
+    for ax, name in zip(axes, states, strict=True):
+        i = names.index(name)
+        k = scale[i]
+        lim = 0.0
+        for r in runs:
+            t, minutes = r["t"], False
+            tx, xlabel = _time_axis(t)
+            minutes = xlabel.endswith("(min)")
+            est, sig = r["estimate"][:, i] * k, r["sigma"][:, i] * k
+            style = STYLE[r["measure"]] if len(runs) > 1 else dict(color="tab:blue",
+                                                                   linestyle="-")
+            lab = r["measure"] if len(runs) > 1 else "estimate"
+            ax.plot(tx, est, linewidth=1.1, label=lab, **style)
+            if len(runs) == 1:
+                ax.fill_between(tx, est - 3 * sig, est + 3 * sig, color=style["color"],
+                                alpha=0.18, linewidth=0, label="±3σ")
+            else:  # envelopes as thin lines in the run's colour and style
+                for sign in (1, -1):
+                    ax.plot(tx, est + sign * 3 * sig, linewidth=0.7, alpha=0.7,
+                            label="_3s", **style)
+            truth = None if r["truth"] is None else r["truth"][:, i] * k
+            lim = max(lim, _ylim(est, sig, truth, t))
+        if runs[0]["truth"] is not None:
+            ax.axhline(runs[0]["truth"][0, i] * k, color="black", linewidth=0.9,
+                       linestyle=(0, (4, 2)), label="truth")
+        _segment_lines(ax, attrs["segments"], minutes)
+        _panel(ax, name, units[i], lim)
+    return _finish(fig, axes, xlabel, title)
+
+
+def sigma_figure(runs, attrs, title: str) -> Figure:
+    """σ/σ0 of the twelve sensor errors against time (log scale), one panel per group."""
+    names = attrs["states"].split(",")
+    fig, axes = new_figure(2, 2, width=11.0, height=6.5)
+    groups = (("gyro bias ε", "eb"), ("accelerometer bias ∇", "db"),
+              ("gyro scale factor δKg", "dKg"), ("accelerometer scale factor δKa", "dKa"))
+    colors = ("tab:blue", "tab:orange", "tab:green")
+    for ax, (label, stem) in zip(axes, groups, strict=True):
+        for r in runs:
+            tx, xlabel = _time_axis(r["t"])
+            ls = STYLE[r["measure"]]["linestyle"] if len(runs) > 1 else "-"
+            for c, axis in zip(colors, AXES, strict=True):
+                i = names.index(stem + axis)
+                ax.semilogy(tx, r["sigma"][:, i] / r["sigma"][0, i], color=c, linestyle=ls,
+                            linewidth=1.0, label=f"{axis}" + (f" {r['measure']}"
+                                                              if len(runs) > 1 else ""))
+        _segment_lines(ax, attrs["segments"], xlabel.endswith("(min)"))
+        ax.set_title(label, fontsize="medium")
+        ax.set_ylabel("σ / σ0")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(loc="lower left", fontsize="x-small", ncol=3 if len(runs) > 1 else 1)
+    for ax in axes[2:]:
+        ax.set_xlabel(xlabel)
+    fig.suptitle(title)
+    return fig
+
+
+def navigation_figure(run, attrs, title: str) -> Figure:
+    """φ and δv of the corrected INS solution (estimate − truth: what the closed loop
+    leaves; feed-forward: the error of the estimate) with the filter's ±3σ."""
+    names = attrs["states"].split(",")
+    units = attrs["display_units"].split(",")
+    scale = np.asarray(attrs["display_scale"])
+    fig, axes = new_figure(2, 3, width=12.0, height=6.0)
+    tx, xlabel = _time_axis(run["t"])
+    for ax, name in zip(axes, names[:6], strict=True):
+        i = names.index(name)
+        k = scale[i]
+        err = (run["estimate"][:, i] - run["truth"][:, i]) * k
+        sig = run["sigma"][:, i] * k
+        ax.fill_between(tx, -3 * sig, 3 * sig, color="tab:blue", alpha=0.18, linewidth=0,
+                        label="±3σ")
+        ax.plot(tx, err, color="black", linewidth=0.8, label="error")
+        _panel(ax, name, units[i], _ylim(err, sig, None, run["t"]))
+    return _finish(fig, axes, xlabel, title)
+
+
+def innovations_figure(run, title: str) -> Figure:
+    """Standardized innovations (each ~ N(0, 1)) with ±3, NEES with the χ²₂₁ 95 % band, NIS."""
+    from scipy.stats import chi2
+
+    has_nees = run["nees"] is not None
+    fig, axes = new_figure(3 if has_nees else 2, height=7.5 if has_nees else 5.5)
+    t = run["t"]
+    tx, xlabel = _time_axis(t)
+    z = run["standardized"]
+    for j, name in enumerate(run["measure_names"]):
+        axes[0].plot(tx[1:], z[:, j], ".", markersize=2, label=name)
+    for y in (-3, 3):
+        axes[0].axhline(y, color="black", linewidth=0.7, linestyle="--", label="_3")
+    axes[0].set_ylabel("standardized\ninnovation")
+    m = z.shape[1]
+    lo, hi = chi2.ppf([0.025, 0.975], m)
+    axes[1].semilogy(tx[1:], np.maximum(run["nis"], 1e-6), ".", markersize=2, label="NIS")
+    axes[1].axhspan(lo, hi, color="tab:green", alpha=0.15, label=f"χ²({m}) 95 %")
+    axes[1].set_ylabel("NIS")
+    if has_nees:
+        lo, hi = chi2.ppf([0.025, 0.975], 21)
+        axes[2].plot(tx, run["nees"], linewidth=0.9, label="NEES")
+        axes[2].axhspan(lo, hi, color="tab:green", alpha=0.15,
+                        label="χ²(21) 95 % (truth drawn from P0)")
+        axes[2].set_ylabel("NEES")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize="x-small", ncol=4)
+    axes[-1].set_xlabel(xlabel)
+    fig.suptitle(title)
+    return fig
+
+
+def attitude_figure(run, title: str) -> Figure:
+    """Recorded data: the corrected INS attitude (deg) with ±3σ of the misalignment."""
+    fig, axes = new_figure(3, height=7.0)
+    tx, xlabel = _time_axis(run["t"])
+    sig = run["sigma"][:, :3]
+    # ±3σ of φ as an attitude band: φE, φN for pitch and roll (small angles), φU for yaw
+    for ax, j, name, s in zip(axes, range(3), ("pitch", "roll", "yaw"),
+                              (sig[:, 0], sig[:, 1], sig[:, 2]), strict=True):
+        a = np.degrees(run["att"][:, j])
+        ax.plot(tx, a, color="tab:blue", linewidth=1.0, label=name)
+        ax.fill_between(tx, a - 3 * np.degrees(s), a + 3 * np.degrees(s), color="tab:blue",
+                        alpha=0.15, label="±3σ")
+        half = run["t"] >= run["t"][0] + 0.5 * (run["t"][-1] - run["t"][0])
+        span = float(np.max(3 * np.degrees(s[half]) + np.abs(a[half] - a[-1])))
+        ax.set_ylim(a[-1] - 1.5 * span, a[-1] + 1.5 * span)
+        ax.set_ylabel(f"{name} (deg)")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize="x-small")
+    axes[-1].set_xlabel(xlabel)
+    fig.suptitle(title)
+    return fig
+
+
+def enu_track(pos: np.ndarray) -> np.ndarray:
+    """East, north, up (m) from the first point: angles times the radii at the start
+    latitude and each point's own height (the horizontal distance flown at altitude, as
+    the flight's envelope measures it; WGS-84)."""
+    from gcalign.nav.earth import WGS84
+
+    r_m, r_n = WGS84.radii(pos[0, 0])
+    h = pos[:, 2]
+    return np.stack([(pos[:, 1] - pos[0, 1]) * (r_n + h) * np.cos(pos[0, 0]),
+                     (pos[:, 0] - pos[0, 0]) * (r_m + h), h - pos[0, 2]], -1)
+
+
+def trajectory_figure(t, pos, segment, names, title: str) -> Figure:
+    """Seed 002 Fig. 1: ground track (km) and height (km) against time, segments numbered
+    (the numbers refer to the list on the right)."""
+    enu = enu_track(pos) / 1000.0
+    fig = Figure(figsize=(13.0, 5.2), dpi=120, layout="constrained")
+    ax_track, ax_h = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.0, 1.3]})
+    seg = np.asarray(segment)
+    colors = [f"C{i % 10}" for i in range(len(names))]
+    for i in range(len(names)):
+        m = seg == i
+        idx = np.flatnonzero(m)
+        if idx.size == 0:
+            continue
+        lo, hi = idx[0], min(idx[-1] + 2, len(t))
+        ax_track.plot(enu[lo:hi, 0], enu[lo:hi, 1], color=colors[i], linewidth=1.5)
+        ax_h.plot(t[lo:hi], enu[lo:hi, 2], color=colors[i], linewidth=1.5)
+        ax_track.annotate(str(i + 1), enu[lo, :2], fontsize=7, color=colors[i],
+                          xytext=(3, 3), textcoords="offset points")
+        ax_h.annotate(str(i + 1), (t[lo], enu[lo, 2]), fontsize=7, color=colors[i],
+                      xytext=(2, 4), textcoords="offset points")
+    ax_track.plot(*enu[0, :2], "k^", label="start")
+    ax_track.set_aspect("equal", adjustable="datalim")
+    ax_track.set_xlabel("east (km)")
+    ax_track.set_ylabel("north (km)")
+    ax_track.legend(loc="best", fontsize="small")
+    ax_h.set_xlabel("time (s)")
+    ax_h.set_ylabel("height above the start (km)")
+    for ax in (ax_track, ax_h):
+        ax.grid(True, alpha=0.3)
+    far = float(np.hypot(enu[:, 0], enu[:, 1]).max())
+    ax_h.set_title(f"highest {enu[:, 2].max():.3f} km above the start, farthest {far:.2f} km "
+                   "from it",
+                   fontsize="medium")
+    listing = "\n".join(f"{i + 1:2d} {n}" for i, n in enumerate(names))
+    ax_h.text(1.02, 1.0, listing, transform=ax_h.transAxes, va="top", ha="left",
+              fontsize=7, family="monospace")
+    fig.suptitle(title)
+    return fig
+
+
+def truth_trajectory(f, name: str) -> dict[str, Figure]:
+    """The trajectory figure of any results file with /truth and a segment list."""
+    if "truth" not in f or "segment" not in f["truth"]:
+        return {}
+    g = f["truth"]
+    names = [_s(n) for n in g["segment_names"][()]] if "segment_names" in g else []
+    seg = g["segment"][()]
+    if not names:
+        names = [f"segment {i + 1}" for i in range(int(seg.max()) + 1)]
+    return {"trajectory": trajectory_figure(g["t"][()], g["pos"][()], seg, names,
+                                            f"{name}: trajectory")}
+
+
+def figures(f, name: str) -> dict[str, Figure]:
+    """The figures of a calibrate results file."""
+    figs = truth_trajectory(f, name)
+    if "calibrate" not in f:
+        return figs
+    runs, attrs = read_runs(f)
+    shown = [r for r in runs if r["label"] in ("", "designed")]
+    what = ("designed flight, velocity / position / both" if len(shown) > 1
+            else f"{shown[0]['measure']} matching")
+    figs["sensor_biases"] = estimates_figure(
+        shown, attrs, ["ebx", "eby", "ebz", "dbx", "dby", "dbz"],
+        f"{name}: gyro biases ε and accelerometer biases ∇, estimate ±3σ ({what})")
+    figs["scale_factors"] = estimates_figure(
+        shown, attrs, ["dKgx", "dKgy", "dKgz", "dKax", "dKay", "dKaz"],
+        f"{name}: gyro and accelerometer scale factors, estimate ±3σ ({what})")
+    figs["sigma"] = sigma_figure(shown, attrs, f"{name}: σ of the sensor errors relative to P0 "
+                                               f"({what})")
+    first = shown[0]
+    if first["truth"] is not None:
+        figs["navigation_errors"] = navigation_figure(
+            first, attrs, f"{name}: misalignment φ and velocity error of the corrected INS "
+            f"(estimate − truth) with ±3σ ({first['measure']})")
+    else:
+        figs["attitude"] = attitude_figure(first, f"{name}: INS attitude with ±3σ "
+                                                  "(zero-velocity updates)")
+    figs["innovations"] = innovations_figure(
+        first, f"{name}: standardized innovations, NIS and NEES ({first['measure']})")
+    return figs

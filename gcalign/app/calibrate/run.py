@@ -1,0 +1,322 @@
+"""In-flight calibration of a scenario: data, filter, summary (seed 002; spec 002 §2, §5).
+
+Simulated flights: the truth and ideal increments of the motion (computed once per batch
+variant), the injected errors (``calibrate.truth``: the scenario's own, or all 21 drawn
+from P0 with the run's seed), sensor noise from ``imu``, navigation increments combined
+from IMU ones, DGNSS velocity/position from the truth plus noise of σ. Recorded data: a
+coarse alignment at the start of the window, then zero-velocity updates at the site (the
+same filter as a zero-velocity fine alignment).
+
+Random streams: the sensor noise is ``default_rng(seed)`` (the same numbers as ``gcalign
+simulate`` of the scenario), the truth draw ``default_rng([seed, 2])``, the DGNSS noise
+``default_rng([seed, 3])`` (shared by the measurements and trajectories of ``--compare``:
+common random numbers).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from gcalign.app.registry import Outcome
+from gcalign.calibrate import (
+    CalibrationResult,
+    FlightData,
+    Settings,
+    calibrate,
+    combine_increments,
+    draw_truth,
+    flight_from_ideal,
+    motion_spans,
+    sampled_truth,
+    zero_velocity_data,
+)
+from gcalign.calibrate.filter import warm_up
+from gcalign.errors import ScenarioError
+from gcalign.estimation import ins_error as ie
+from gcalign.io.scenario import Scenario
+from gcalign.io.scenario.calibrate import CalibrateConfig
+from gcalign.nav.strapdown import NavState
+from gcalign.sim.motions import Truth
+
+MEASURES = ie.MEASUREMENTS
+
+
+@dataclass(frozen=True)
+class Case:
+    """A scenario's calibration input at the navigation rate and how it was made.
+
+    data : the filter's input. settings : the filter settings (SI). source : "simulated"
+    or the recorded file. aiding : "dgnss" | "zero-velocity". subsamples : IMU increments
+    per navigation step. imu_rate : Hz. seed : the run's seed (None for recorded data).
+    truth_source : "scenario" | "draw" | None. coarse_att : the coarse attitude (rad) of
+    recorded data. window : (start, coarse end, end) in data time, s.
+    """
+
+    data: FlightData
+    settings: Settings
+    source: str
+    aiding: str
+    subsamples: int
+    imu_rate: float
+    seed: int | None
+    truth_source: str | None
+    coarse_att: np.ndarray | None
+    window: tuple[float, float, float]
+
+    @property
+    def navigation_rate(self) -> float:
+        return self.imu_rate / self.subsamples
+
+    def truth(self) -> Truth | None:
+        """The truth at the navigation rate (for /truth), with the segment of each sample."""
+        tr = self.data.truth
+        return None if tr is None else sampled_truth(tr, self.data.segments)
+
+
+def config_of(sc: Scenario) -> CalibrateConfig:
+    return sc.calibrate or CalibrateConfig()
+
+
+def injected_truth(sc: Scenario, cfg: CalibrateConfig, settings: Settings, site, earth,
+                   seed: int) -> np.ndarray:
+    """The 21 injected errors (SI): the imu section's biases and scale factors and
+    ``calibrate.initial_error`` (truth: scenario), or a draw from the filter's P0."""
+    if cfg.truth == "draw":
+        P0 = settings.covariances(site, earth)[0]
+        return draw_truth(P0, np.random.default_rng([seed, 2]))
+    err = sc.imu.errors()
+    x = np.zeros(ie.N_STATES)
+    x[ie.NAV] = cfg.initial_error.to_si(float(site[0]), float(site[2]), earth)
+    x[ie.EB], x[ie.DB] = err.gyro.bias, err.accel.bias
+    x[ie.DKG], x[ie.DKA] = err.gyro.scale, err.accel.scale
+    return x
+
+
+def simulated_case(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+                   cfg: CalibrateConfig | None = None) -> Case:
+    """The flight of a simulated scenario with its injected errors (see the module doc)."""
+    from gcalign.app.data import cached_noise_free, noise_free
+
+    cfg = cfg or config_of(sc)
+    cfg.check(sc)
+    assert sc.motion is not None
+    raw = cached_noise_free(sc, cache_key) if cache_key is not None else noise_free(sc)
+    assert raw.truth is not None
+    seed = sc.imu.seed if seed is None else seed
+    earth, site = sc.earth_model, raw.site
+    n = cfg.subsamples(sc.imu.rate_hz)
+    settings = cfg.settings(site, earth)
+    x = injected_truth(sc, cfg, settings, site, earth, seed)
+    data = flight_from_ideal(raw.truth, raw.imu, x, sc.imu.errors(), np.random.default_rng(seed),
+                             motion_spans(sc.motion.to_motion(), float(raw.truth.t[-1])), n,
+                             earth)
+    window = cfg.window(sc.motion.duration(), 1.0 / sc.imu.rate_hz)
+    if window[0] > 0 or window[2] < data.t[-1] - 1e-9:
+        data = data.between(window[0], window[2])
+    if cfg.aiding_for(sc) == "zero-velocity":
+        data = zero_velocity_reference(data)
+    return Case(data, settings, "simulated", cfg.aiding_for(sc), n, sc.imu.rate_hz, seed,
+                cfg.truth, None, window)
+
+
+def zero_velocity_reference(data: FlightData) -> FlightData:
+    """The same data aided by zero velocity at the start position (a parked vehicle)."""
+    from dataclasses import replace
+
+    n = len(data.t)
+    return replace(data, ref_v_n=np.zeros((n, 3)),
+                   ref_pos=np.tile(np.asarray(data.start.pos, float), (n, 1)))
+
+
+def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
+    """Recorded data on a parked vehicle: coarse alignment over the start of the window,
+    then zero-velocity updates at the site to the end of the window."""
+    from gcalign.align import coarse as coarse_mod
+    from gcalign.app.data import scenario_data
+
+    cfg = cfg or config_of(sc)
+    cfg.check(sc)
+    run = scenario_data(sc)
+    imu, ts, site, earth = run.imu, run.imu.ts, run.site, run.earth
+    rate = 1.0 / ts
+    n = cfg.subsamples(rate)
+    cfg.steps_per_update(rate)
+    start, coarse_end, end = cfg.window(len(imu) * ts, ts)
+    i0, i1, i2 = (int(round(t / ts)) for t in (start, coarse_end, end))
+    dth, dv = imu.dtheta[i0:i1], imu.dv[i0:i1]
+    try:
+        if cfg.coarse.method == "analytic":
+            att = coarse_mod.analytic_coarse(dth, dv, ts, site[0], earth)
+        else:
+            att = coarse_mod.inertial_frame_coarse(dth, dv, ts, site[0], site[1], site[2],
+                                                   earth=earth)
+    except ValueError as err:
+        raise ScenarioError(f"calibrate.coarse.duration_s: {err}") from None
+    dth, dv = combine_increments(imu.dtheta[i1:i2], imu.dv[i1:i2], n)
+    t = coarse_end + np.arange(len(dth) + 1) * n * ts
+    data = zero_velocity_data(t, dth, dv, NavState.from_euler(att, np.zeros(3), site), earth)
+    return Case(data, cfg.settings(site, earth), imu.source, "zero-velocity", n, rate, None,
+                None, att, (start, coarse_end, end))
+
+
+def scenario_case(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Case:
+    if sc.imu_file is not None:
+        return recorded_case(sc)
+    return simulated_case(sc, seed, cache_key)
+
+
+@dataclass(frozen=True)
+class Run:
+    """One filter run on a case: its label, the result, and its compute time (s)."""
+
+    label: str
+    data: FlightData
+    result: CalibrationResult
+    compute_s: float
+
+
+def run_filter(case: Case, measure: str | None = None, data: FlightData | None = None,
+               label: str = "") -> Run:
+    """The calibration filter on the case's data (or `data`, a part of it)."""
+    from dataclasses import replace
+
+    s = case.settings if measure is None else replace(case.settings, measure=measure)
+    data = case.data if data is None else data
+    rng = np.random.default_rng([0 if case.seed is None else case.seed, 3])
+    warm_up()
+    t0 = time.perf_counter()
+    result = calibrate(data, s, rng)
+    return Run(label, data, result, time.perf_counter() - t0)
+
+
+def compare_runs(case: Case, segments: int) -> list[Run]:
+    """The seed's Table 3: velocity, position and both on the whole flight ("designed")
+    and on its first `segments` segments ("conventional"), on the same data and noise."""
+    spans = case.data.segments
+    if case.data.truth is None or len(spans) <= segments:
+        raise ScenarioError(f"calibrate.conventional_segments: --compare needs a simulated "
+                            f"flight with more than {segments} segments (the conventional "
+                            f"take-off is its first {segments}); this one has {len(spans)}")
+    short = case.data.between(float(case.data.t[0]), spans[segments - 1].end)
+    runs = []
+    for label, data in (("designed", case.data), ("conventional", short)):
+        for measure in MEASURES:
+            runs.append(run_filter(case, measure, data, label))
+    return runs
+
+
+# ---------------------------------------------------------------------- summary
+
+
+def _chi2_band(dof: int, level: float = 0.95) -> list[float]:
+    from scipy.stats import chi2
+
+    return [float(chi2.ppf((1 - level) / 2, dof)), float(chi2.ppf((1 + level) / 2, dof))]
+
+
+def run_summary(run: Run) -> dict:
+    """The per-state part of the summary (SI): the JSON contract of ``gcalign calibrate``."""
+    r, data = run.result, run.data
+    names = ie.STATE_NAMES
+    x0 = data.x_true
+    truth_end = None if r.truth is None else r.truth[-1]
+    states = {}
+    for i, name in enumerate(names):
+        est, sig = float(r.estimate[-1, i]), float(r.sigma[-1, i])
+        tru = None if truth_end is None else float(truth_end[i])
+        states[name] = {
+            "injected": None if x0 is None else float(x0[i]),
+            "truth": tru,
+            "estimate": est,
+            "error": None if tru is None else est - tru,
+            "sigma": sig,
+            "sigma0": float(r.sigma[0, i]),
+        }
+    m = r.standardized.shape[1]
+    out = {
+        "label": run.label,
+        "measure": r.settings.measure,
+        "duration_s": float(r.t[-1] - r.t[0]),
+        "epochs": len(r.t),
+        "segments": [{"name": s.name, "t0_s": s.start, "t1_s": s.end} for s in data.segments],
+        "states": states,
+        "normalized_error": None if r.error is None
+        else (r.error[-1] / r.sigma[-1]).tolist(),
+        "nees": None,
+        "nis": {"mean": float(r.nis.mean()), "dof": m, "band_95": _chi2_band(m)},
+        "innovation": {"names": list(r.measure_names),
+                       "standardized_mean": r.standardized.mean(0).tolist(),
+                       "standardized_std": r.standardized.std(0).tolist()},
+        "attitude_deg": np.degrees(r.att[-1]).tolist(),
+        "velocity_mps": r.v_n[-1].tolist(),
+        "position_deg_m": [*np.degrees(r.pos[-1, :2]).tolist(), float(r.pos[-1, 2])],
+        "compute_s": run.compute_s,
+    }
+    if r.nees is not None:
+        lo, hi = _chi2_band(ie.N_STATES)
+        out["nees"] = {"final": float(r.nees[-1]), "mean": float(r.nees.mean()),
+                       "dof": ie.N_STATES, "band_95": [lo, hi],
+                       "inside_95": float(np.mean((r.nees > lo) & (r.nees < hi)))}
+    if r.smoothed is not None:
+        sm = r.smoothed
+        out["smoothed_initial"] = {
+            name: {"estimate": float(sm.estimate[0, i]), "sigma": float(sm.sigma[0, i]),
+                   "filtered_sigma": float(r.sigma[0, i]),
+                   "truth": None if r.truth is None else float(r.truth[0, i])}
+            for i, name in enumerate(names[:9])}
+    return out
+
+
+def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
+    """The command's summary: the run's settings and data, then one run (or the six of
+    ``--compare`` under ``runs``)."""
+    d = case.data
+    s = case.settings
+    out = {
+        "scenario": sc.name,
+        "seed": case.seed,
+        "source": case.source,
+        "aiding": case.aiding,
+        "truth_source": case.truth_source,
+        "feedback": s.feedback,
+        "smoother": s.smoother,
+        "discretization": s.discretization,
+        "imu_rate_hz": case.imu_rate,
+        "navigation_rate_hz": case.navigation_rate,
+        "filter_rate_hz": s.filter_rate,
+        "p0_scale": s.p0_scale,
+        "sigma_v_mps": s.sigma_v,
+        "sigma_p_m": s.sigma_p,
+        "window_s": list(case.window),
+        "site_deg_m": [*np.degrees(d.start.pos[:2]).tolist(), float(d.start.pos[2])],
+        "earth": d.earth.name,
+        "units": dict(zip(ie.STATE_NAMES, ie.STATE_UNITS, strict=True)),
+        "display_scale": ie.display_scale(float(d.start.pos[0]), float(d.start.pos[2]),
+                                          d.earth).tolist(),
+        "display_units": dict(zip(ie.STATE_NAMES, ie.DISPLAY_UNITS, strict=True)),
+        "coarse_attitude_deg": None if case.coarse_att is None
+        else np.degrees(case.coarse_att).tolist(),
+        "compare": compare,
+    }
+    if compare:
+        out["runs"] = [run_summary(r) for r in runs]
+        out["compute_s"] = float(sum(r.compute_s for r in runs))
+    else:
+        out |= run_summary(runs[0])
+    return out
+
+
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+            compare: bool = False) -> Outcome:
+    """Build the case, run the filter (or the six runs of `compare`), summarise."""
+    from gcalign.app.calibrate.hdf5 import write_calibration
+
+    case = scenario_case(sc, seed, cache_key)
+    runs = (compare_runs(case, config_of(sc).conventional_segments) if compare
+            else [run_filter(case)])
+    out = summary(sc, case, runs, compare)
+    return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),
+                   case.seed)

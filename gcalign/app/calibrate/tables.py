@@ -1,0 +1,152 @@
+"""The `gcalign calibrate` tables: one run per state (injected, estimate, error, σ), or the
+six runs of ``--compare`` (the seed's Table 3 analogue). Display units are the seed's
+(″, ′, m/s, m, °/h, µg, ppm); the JSON holds SI."""
+
+from __future__ import annotations
+
+import math
+
+from rich import box
+from rich.table import Table
+from rich.text import Text
+
+from gcalign.app.calibrate import UNIT_TEXT
+from gcalign.app.report import fmt
+
+GROUP_ENDS = ("phiU", "dvU", "dh", "ebz", "dbz", "dKgz", "dKaz")
+SHORT = {"velocity": "v", "position": "p", "both": "v+p"}
+
+
+def _g(x, digits: int = 3) -> str:
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "—"
+    if x == 0:
+        return "0"
+    return f"{x:.{digits}g}"
+
+
+def _display(s: dict):
+    names = list(s["units"])
+    scale = dict(zip(names, s["display_scale"], strict=True))
+    return names, scale, s["display_units"]
+
+
+def _captioned(table: Table, notes: list[str]) -> Table:
+    table.caption = "\n".join(notes)
+    table.caption_justify = "left"
+    return table
+
+
+def _scaled(v, k):
+    return None if v is None else v * k
+
+
+def calibrate_table(s: dict) -> Table:
+    return compare_table(s) if s.get("compare") else run_table(s)
+
+
+def _title(s: dict, what: str) -> str:
+    loop = "closed loop" if s["feedback"] else "feed-forward"
+    return (f"gcalign calibrate: {s['scenario']} — {what}, navigation "
+            f"{s['navigation_rate_hz']:g} Hz, filter {s['filter_rate_hz']:g} Hz, {loop}")
+
+
+def run_table(s: dict) -> Table:
+    names, scale, units = _display(s)
+    aid = "zero-velocity updates" if s["aiding"] == "zero-velocity" else f"DGNSS {s['measure']}"
+    table = Table(title=_title(s, f"{aid} over {s['duration_s']:.0f} s"),
+                  title_justify="left", header_style="bold")
+    heads = ("state", "unit", "injected", "estimate", "error", "σ final", "σ0", "error/σ")
+    for h in heads:
+        table.add_column(h, justify="left" if h in ("state", "unit") else "right")
+    for name in names:
+        st, k = s["states"][name], scale[name]
+        err = st["error"]
+        table.add_row(Text(name), UNIT_TEXT.get(units[name], units[name]),
+                      _g(_scaled(st["injected"], k)), _g(st["estimate"] * k),
+                      _g(_scaled(err, k)), _g(st["sigma"] * k), _g(st["sigma0"] * k),
+                      "—" if err is None else f"{err / st['sigma']:+.2f}",
+                      end_section=name in GROUP_ENDS)
+    notes = []
+    nees = s.get("nees")
+    if nees is not None:
+        lo, hi = nees["band_95"]
+        notes.append(f"NEES final {nees['final']:.1f}, mean {nees['mean']:.1f} (χ²₂₁ 95 % band "
+                     f"{lo:.1f}…{hi:.1f} for a truth drawn from P0; {100 * nees['inside_95']:.0f}"
+                     " % of epochs inside)")
+    nis, inn = s["nis"], s["innovation"]
+    notes.append(f"NIS mean {nis['mean']:.2f} (χ²_{nis['dof']} mean {nis['dof']}); standardized "
+                 f"innovations {', '.join(inn['names'])}: mean "
+                 f"{fmt([round(x, 3) for x in inn['standardized_mean']], 3)}, std "
+                 f"{fmt([round(x, 3) for x in inn['standardized_std']], 3)}")
+    att = s["attitude_deg"]
+    notes.append(f"INS attitude at the end (pitch, roll, yaw) {att[0]:.4f}°, {att[1]:.4f}°, "
+                 f"{att[2]:.4f}°" + (f"; coarse {fmt(s['coarse_attitude_deg'], 4)}°"
+                                     if s.get("coarse_attitude_deg") else ""))
+    sm = s.get("smoothed_initial")
+    if sm:
+        k = scale["phiU"]
+        notes.append(f"RTS smoother: φU at the start σ {sm['phiU']['filtered_sigma'] * k:.3g}′ "
+                     f"filtered → {sm['phiU']['sigma'] * k:.3g}′ smoothed (the sensor errors, "
+                     "constants without process noise, gain nothing: their smoothed σ is the "
+                     "final filtered σ)")
+    notes.append("navigation states at the end: estimate = estimated error of the INS before "
+                 "the last correction; error = what the correction leaves; injected at t = 0")
+    seed = "—" if s["seed"] is None else s["seed"]
+    notes.append(f"truth {s['truth_source'] or 'unknown (recorded data)'}; seed {seed}; "
+                 f"compute {s['compute_s']:.2f} s; output {s.get('output') or '—'}")
+    return _captioned(table, notes)
+
+
+def _c(x) -> str:
+    """A compact number for the comparison cells (at most 8 characters)."""
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "—"
+    if x == 0 or abs(x) >= 100:
+        return f"{x:.0f}"
+    return f"{x:.3g}" if abs(x) >= 1 else f"{x:.2g}"
+
+
+def _tag(run: dict) -> str:
+    return f"{'des.' if run['label'] == 'designed' else 'conv.'} {SHORT[run['measure']]}"
+
+
+def compare_table(s: dict) -> Table:
+    """Final error and final σ of the heading and the sensor errors for each trajectory and
+    measurement, in two blocks that fit 80 columns."""
+    names, scale, units = _display(s)
+    runs = s["runs"]
+    shown = names[2:3] + names[9:]  # φU and the twelve sensor errors
+    blocks = []
+    for what in ("error", "sigma"):
+        t = Table(title="estimate − truth at the end" if what == "error" else "final σ",
+                  title_justify="left", header_style="bold", box=box.SIMPLE_HEAD,
+                  pad_edge=False, padding=(0, 0), collapse_padding=True)
+        t.add_column("state", min_width=5)
+        t.add_column("unit", min_width=4)
+        t.add_column("injected", justify="right", min_width=8)
+        for r in runs:
+            t.add_column(_tag(r), justify="right", min_width=8, no_wrap=True)
+        for name in shown:
+            k = scale[name]
+            cells = [_c(_scaled(r["states"][name][what], k)) for r in runs]
+            t.add_row(Text(name), UNIT_TEXT.get(units[name], units[name]),
+                      _c(_scaled(runs[0]["states"][name]["injected"], k)), *cells,
+                      end_section=name in GROUP_ENDS)
+        blocks.append(t)
+    outer = Table(title=_title(s, "designed vs conventional take-off (seed Table 3)"),
+                  title_justify="left", box=None, show_header=False, padding=(0, 0))
+    outer.add_column()
+    for b in blocks:
+        outer.add_row(b)
+    durations = {r["label"]: (r["duration_s"], len(r["segments"])) for r in runs}
+    notes = [f"{lab}: {n} segments, {d:.0f} s of filter steps" for lab, (d, n)
+             in durations.items()]
+    nees = [f"{_tag(r)} {r['nees']['final']:.1f}" for r in runs if r.get("nees")]
+    if nees:
+        notes.append("NEES final (χ²₂₁): " + ", ".join(nees))
+    notes.append("v: velocity, p: position, v+p: both; φU: the INS heading error the "
+                 "correction leaves; the same data and DGNSS noise in every column")
+    notes.append(f"seed {s['seed']}; compute {s['compute_s']:.2f} s; output "
+                 f"{s.get('output') or '—'}")
+    return _captioned(outer, notes)

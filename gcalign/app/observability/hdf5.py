@@ -1,0 +1,46 @@
+"""The /observability group of a results file (seed 002 §4): degrees per segment and
+cumulative, ranks, the null-space condition, the covariance degree.
+
+Layout::
+
+    /observability        attrs: measure, scaling, rank_rtol, piece_s, states (names)
+        segment_name (S,), t0, t1 (S,) s
+        eta, eta_cum, sigma_state (S, 21); rank, tom_rank, rank_cum, tom_rank_cum (S,)
+        null_residual (S,), condition (S,) bool
+        cov_degree, cov_degree_segment (S, 21) sigma(0)/sigma(t_end), sigma(t0)/sigma(t_end)
+"""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+
+from gcalign.app.calibrate.hdf5 import write_segments
+from gcalign.estimation import ins_error as ie
+from gcalign.io.results import put
+
+DEGREE = "(segments, 21) in the order of the 'states' attribute"
+
+
+def write_observability(f: h5py.File, tab, truth, spans) -> None:
+    write_segments(f, truth, spans)
+    g = f.create_group("observability")
+    g.attrs["measure"], g.attrs["scaling"] = tab.measure, tab.scaling
+    g.attrs["rank_rtol"], g.attrs["piece_s"] = tab.rtol, tab.piece_s
+    g.attrs["states"] = ",".join(ie.STATE_NAMES)
+    g.create_dataset("segment_name", data=np.array([s.name for s in spans],
+                                                   dtype=h5py.string_dtype()))
+    put(g, "t0", [s.start for s in spans], "s")
+    put(g, "t1", [s.end for s in spans], "s")
+    put(g, "eta", tab.eta, "1", shape=DEGREE, description="seed eq. 17 per segment")
+    put(g, "eta_cum", tab.eta_cum, "1", shape=DEGREE, description="from the start of the run")
+    put(g, "sigma_state", tab.sigma_state, "SOM units", shape=DEGREE)
+    for name in ("rank", "tom_rank", "rank_cum", "tom_rank_cum", "null_residual"):
+        put(g, name, getattr(tab, name), "1")
+    put(g, "condition", tab.condition.astype(np.int8), "1",
+        description="null(O_j) in null(F_j) for every piece (seed eq. 12)")
+    if tab.cov_degree is not None:
+        put(g, "cov_degree", tab.cov_degree, "1", shape=DEGREE,
+            description="sigma(0)/sigma(t_end), PSINS kfstat")
+        put(g, "cov_degree_segment", tab.cov_degree_segment, "1", shape=DEGREE,
+            description="sigma(t_start)/sigma(t_end)")

@@ -1,0 +1,276 @@
+"""The `calibrate` and `observability` sections of a scenario (seed 002; spec 002 §2, §4).
+
+::
+
+    calibrate:
+      measure: velocity          # velocity | position | both (seed eqs. 5-7)
+      sigma_v_mps: 0.2           # DGNSS velocity σ (R = σ², seed §5.2)
+      sigma_p_m: 1.0             # DGNSS position σ, metres north and east
+      p0_scale: 10               # P0 = (p0_scale · listed σ)², the seed's "×10"
+      # p0: {attitude_arcsec: [20, 20, 1800], velocity_enu_mps: 0.2, ...}  # the listed σ
+      q: {arw_dprh: 0.001, vrw_ugrhz: 10}   # the filter's white-noise densities (Q)
+      navigation_rate_hz: 25     # the IMU rate / a whole n (n increments per step)
+      filter_rate_hz: 1          # navigation rate / a whole number
+      feedback: true             # closed loop; false: feed-forward (linearised KF)
+      discretization: accumulated   # or van_loan (on the mean F of the filter step)
+      smoother: false            # also run the RTS smoother (post-flight)
+      truth: scenario            # scenario: imu biases/scale factors + initial_error;
+                                 # draw: all 21 errors drawn from P0 with the run's seed
+      initial_error: {attitude_arcsec: [20, -20, 1800]}  # φ ENU; velocity_enu_mps, position_enu_m
+      gnss_noise: true           # add DGNSS noise of σ to the simulated measurements
+      aiding: auto               # dgnss (simulated truth) | zero-velocity (a parked vehicle)
+      coarse: {method: none}     # none (start from truth + initial_error) | analytic | inertial
+      start_s: 0                 # data time at which the calibration (or coarse) window opens
+      # duration_s: 400          # default: to the end of the data
+      conventional_segments: 6   # --compare: the conventional take-off = the first n segments
+
+    observability:
+      measure: velocity          # the seed's Table 1 is velocity matching
+      scaling: none              # none (the paper) | p0 (columns × initial σ)
+      piece_s: 1                 # PWCS piece length
+      rank_rtol: 1.0e-12         # singular values ≤ rank_rtol · σ_max count as zero
+      null_tol: 1.0e-9           # the null-space condition of seed eq. (12) holds below this
+      covariance: true           # also the covariance degree σ(0)/σ(t) (PSINS kfstat)
+
+User units in the keys (″, m/s, m, °/h, µg, ppm, °/√h, µg/√Hz); :meth:`CalibrateConfig.settings`
+converts them once to the SI :class:`gcalign.calibrate.Settings`.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import BeforeValidator, Field
+
+from gcalign import units as u
+from gcalign.errors import ScenarioError
+from gcalign.io.scenario.base import Model, PosVec3, Vec3
+from gcalign.nav.earth import EarthModel
+
+
+def _three(x):
+    """One number stands for all three axes."""
+    if isinstance(x, (int, float)) and not isinstance(x, bool):
+        return [x, x, x]
+    return x
+
+
+Pos3 = Annotated[PosVec3, BeforeValidator(_three)]
+Any3 = Annotated[Vec3, BeforeValidator(_three)]
+
+
+def _enu_m_to_si(enu, lat: float, h: float, earth: EarthModel) -> np.ndarray:
+    """Metres [east, north, up] -> the states [δL, δλ, δh] (rad, rad, m) at lat, h."""
+    r_m, r_n = earth.radii(lat)
+    e, n, up = (float(v) for v in enu)
+    return np.array([n / (r_m + h), e / ((r_n + h) * np.cos(lat)), up])
+
+
+class P0Sigma(Model):
+    """The listed initial σ before ``p0_scale`` (default: the seed's §5.2 list)."""
+
+    attitude_arcsec: Pos3 = Field(default_factory=lambda: [20.0, 20.0, 1800.0],
+                                  description="φ [E, N, U]; the seed's 20″, 20″, 30′")
+    velocity_enu_mps: Pos3 = Field(default_factory=lambda: [0.2, 0.2, 0.2])
+    position_enu_m: Pos3 = Field(default_factory=lambda: [1.0, 1.0, 1.0])
+    gyro_bias_dph: Pos3 = Field(default_factory=lambda: [0.01, 0.01, 0.01])
+    accel_bias_ug: Pos3 = Field(default_factory=lambda: [50.0, 50.0, 50.0])
+    gyro_scale_ppm: Pos3 = Field(default_factory=lambda: [100.0, 100.0, 100.0])
+    accel_scale_ppm: Pos3 = Field(default_factory=lambda: [100.0, 100.0, 100.0])
+
+    def to_si(self, lat: float, h: float, earth: EarthModel) -> np.ndarray:
+        """(21,) SI σ in the state order."""
+        return np.concatenate([
+            np.asarray(self.attitude_arcsec) * u.ARCSEC, np.asarray(self.velocity_enu_mps),
+            _enu_m_to_si(self.position_enu_m, lat, h, earth),
+            np.asarray(self.gyro_bias_dph) * u.DPH, np.asarray(self.accel_bias_ug) * u.UG,
+            np.asarray(self.gyro_scale_ppm) * u.PPM, np.asarray(self.accel_scale_ppm) * u.PPM])
+
+
+class ProcessNoise(Model):
+    """White-noise densities of the filter's Q (spec 002 §2 [X]: the seed lost its Q)."""
+
+    arw_dprh: float = Field(0.001, ge=0, description="gyro angle random walk, °/√h")
+    vrw_ugrhz: float = Field(10.0, ge=0, description="accelerometer velocity random walk, µg/√Hz")
+
+
+class InitialError(Model):
+    """The INS's initial errors in a simulation with ``truth: scenario`` (spec 002 §2 [X])."""
+
+    attitude_arcsec: Any3 = Field(default_factory=lambda: [20.0, -20.0, 1800.0],
+                                  description="misalignment φ [E, N, U]")
+    velocity_enu_mps: Any3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    position_enu_m: Any3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+    def to_si(self, lat: float, h: float, earth: EarthModel) -> np.ndarray:
+        """(9,) SI: [φ, δv, δL, δλ, δh]."""
+        return np.concatenate([np.asarray(self.attitude_arcsec) * u.ARCSEC,
+                               np.asarray(self.velocity_enu_mps, float),
+                               _enu_m_to_si(self.position_enu_m, lat, h, earth)])
+
+
+class Coarse(Model):
+    method: Literal["none", "analytic", "inertial"] = Field(
+        "none", description="none: start from the truth plus initial_error (simulation)")
+    duration_s: float = Field(60.0, gt=0, description="coarse window at the start")
+
+
+def _divides(rate: float, sub: float) -> int | None:
+    """The whole number `rate / sub`, or None."""
+    k = rate / sub
+    return int(round(k)) if round(k) >= 1 and abs(k - round(k)) <= 1e-9 * k else None
+
+
+class CalibrateConfig(Model):
+    measure: Literal["velocity", "position", "both"] = "velocity"
+    sigma_v_mps: float = Field(0.2, gt=0, description="DGNSS velocity σ; R = σ²")
+    sigma_p_m: float = Field(1.0, gt=0, description="DGNSS position σ (north, east); R = σ²")
+    p0_scale: float = Field(10.0, gt=0, description="P0 = (p0_scale · listed σ)²")
+    p0: P0Sigma = Field(default_factory=P0Sigma)
+    q: ProcessNoise = Field(default_factory=ProcessNoise)
+    navigation_rate_hz: float | None = Field(None, gt=0, description="default: the IMU rate")
+    filter_rate_hz: float = Field(1.0, gt=0)
+    feedback: bool = True
+    discretization: Literal["accumulated", "van_loan"] = "accumulated"
+    smoother: bool = False
+    truth: Literal["scenario", "draw"] = "scenario"
+    initial_error: InitialError = Field(default_factory=InitialError)
+    gnss_noise: bool = True
+    aiding: Literal["auto", "dgnss", "zero-velocity"] = "auto"
+    coarse: Coarse = Field(default_factory=Coarse)
+    start_s: float = Field(0.0, ge=0)
+    duration_s: float | None = Field(None, gt=0)
+    conventional_segments: int = Field(6, ge=1)
+
+    # ------------------------------------------------------------------ rates
+
+    def subsamples(self, imu_rate: float) -> int:
+        """IMU increments per navigation step; ScenarioError naming the field."""
+        nav = self.navigation_rate_hz or imu_rate
+        n = _divides(imu_rate, nav)
+        if n is None:
+            allowed = ", ".join(f"{imu_rate / k:g}" for k in range(1, 6))
+            raise ScenarioError(
+                f"calibrate.navigation_rate_hz: must be the IMU rate {imu_rate:g} Hz divided by "
+                f"a whole number (e.g. {allowed} Hz), got {nav:g}")
+        return n
+
+    def steps_per_update(self, imu_rate: float) -> int:
+        """Navigation steps per filter step; ScenarioError naming the field."""
+        nav = imu_rate / self.subsamples(imu_rate)
+        S = _divides(nav, self.filter_rate_hz)
+        if S is None:
+            ok = [nav / k for k in range(1, int(nav) + 1) if (nav / k).is_integer()]
+            raise ScenarioError(
+                f"calibrate.filter_rate_hz: must be the navigation rate {nav:g} Hz divided by a "
+                f"whole number (e.g. {', '.join(f'{r:g}' for r in ok[:6])} Hz), got "
+                f"{self.filter_rate_hz:g}")
+        return S
+
+    # ------------------------------------------------------------------ checks
+
+    def recorded(self, sc) -> bool:
+        return sc.imu_file is not None
+
+    def aiding_for(self, sc) -> str:
+        if self.aiding != "auto":
+            return self.aiding
+        return "zero-velocity" if self.recorded(sc) else "dgnss"
+
+    def check(self, sc) -> None:
+        """Checks that need the rest of the scenario; ScenarioError naming the field."""
+        if self.recorded(sc):
+            if self.aiding == "dgnss":
+                raise ScenarioError("calibrate.aiding: 'dgnss' compares with the simulated "
+                                    "truth; recorded data support 'zero-velocity' (or auto)")
+            if self.coarse.method == "none":
+                raise ScenarioError("calibrate.coarse.method: recorded data have no truth to "
+                                    "start from; use analytic or inertial, got 'none'")
+            if self.truth == "draw":
+                raise ScenarioError("calibrate.truth: 'draw' injects errors into simulated "
+                                    "data; recorded data carry their own (use scenario)")
+            return
+        if sc.motion is None:
+            raise ScenarioError("motion: missing; calibrate needs 'motion' or 'imu_file'")
+        rate = sc.imu.rate_hz
+        self.steps_per_update(rate)
+        duration = sc.motion.duration()
+        self.window(duration, 1.0 / rate)
+
+    def window(self, duration: float, ts: float) -> tuple[float, float, float]:
+        """``(start, coarse end, end)`` of the calibration window in data time (s);
+        ScenarioError when it does not fit the data (`duration` s)."""
+        start = self.start_s
+        coarse = self.coarse.duration_s if self.coarse.method != "none" else 0.0
+        end = duration if self.duration_s is None else start + self.duration_s
+        if end > duration + 1e-9:
+            raise ScenarioError(f"calibrate.duration_s: the window ends at {end:g} s, after the "
+                                f"end of the data ({duration:g} s)")
+        if start + coarse >= end - ts:
+            field = "coarse.duration_s" if coarse else "start_s"
+            raise ScenarioError(f"calibrate.{field}: nothing left to calibrate: the window is "
+                                f"[{start:g}, {end:g}] s and the coarse alignment takes "
+                                f"{coarse:g} s of it")
+        return start, start + coarse, end
+
+    # ------------------------------------------------------------------ SI
+
+    def settings(self, site_si, earth: EarthModel, measure: str | None = None):
+        """The SI :class:`gcalign.calibrate.Settings` at the site ``[lat, lon, h]``."""
+        from gcalign.calibrate import Settings
+
+        lat, h = float(site_si[0]), float(site_si[2])
+        return Settings(
+            measure=measure or self.measure, sigma_v=self.sigma_v_mps, sigma_p=self.sigma_p_m,
+            p0_scale=self.p0_scale, p0_sigma=tuple(self.p0.to_si(lat, h, earth)),
+            arw=self.q.arw_dprh * u.DPSH, vrw=self.q.vrw_ugrhz * u.UGPSHZ,
+            filter_rate=self.filter_rate_hz, discretization=self.discretization,
+            feedback=self.feedback, gnss_noise=self.gnss_noise, smoother=self.smoother)
+
+    def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
+        rows = [
+            ("calibrate.measure", self.measure,
+             f"R = diag({self.sigma_v_mps:g} m/s, {self.sigma_p_m:g} m)²"),
+            ("calibrate.p0_scale", f"{self.p0_scale:g}", "P0 = (p0_scale · listed σ)²"),
+            ("calibrate.q", f"ARW {self.q.arw_dprh:g} °/√h, VRW {self.q.vrw_ugrhz:g} µg/√Hz",
+             f"{self.q.arw_dprh * u.DPSH:.6g} rad/√s, {self.q.vrw_ugrhz * u.UGPSHZ:.6g} m/s/√s"),
+            ("calibrate.truth", self.truth, "imu biases, scale factors + initial_error"
+             if self.truth == "scenario" else "all 21 errors ~ N(0, P0), the run's seed"),
+            ("calibrate.aiding", self.aiding_for(sc), ""),
+            ("calibrate.feedback", str(self.feedback), "closed loop" if self.feedback
+             else "feed-forward"),
+            ("calibrate.discretization", self.discretization, ""),
+            ("calibrate.smoother", str(self.smoother), ""),
+        ]
+        if not self.recorded(sc):
+            rate = sc.imu.rate_hz
+            n = self.subsamples(rate)
+            rows += [("calibrate.navigation_rate_hz", f"{rate / n:g} Hz",
+                      f"{n} IMU increment(s) per step"),
+                     ("calibrate.filter_rate_hz", f"{self.filter_rate_hz:g} Hz",
+                      f"{self.steps_per_update(rate)} navigation steps per update")]
+        return rows
+
+
+class ObservabilityConfig(Model):
+    measure: Literal["velocity", "position", "both"] = "velocity"
+    scaling: Literal["none", "p0"] = "none"
+    piece_s: float = Field(1.0, gt=0)
+    rank_rtol: float = Field(1e-12, gt=0, lt=1)
+    null_tol: float = Field(1e-9, gt=0)
+    covariance: bool = True
+
+    def check(self, sc) -> None:
+        if sc.motion is None:
+            raise ScenarioError("motion: missing; the observability table needs a simulated "
+                                "motion (its truth)")
+        if sc.calibrate is not None:
+            sc.calibrate.check(sc)
+
+    def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
+        return [("observability.measure", self.measure, ""),
+                ("observability.scaling", self.scaling, "unscaled states (the paper)"
+                 if self.scaling == "none" else "columns × initial σ"),
+                ("observability.piece_s", f"{self.piece_s:g} s", ""),
+                ("observability.rank_rtol", f"{self.rank_rtol:g}", "")]
