@@ -89,9 +89,11 @@ def main() -> None:
         v = F.violations(case, out)
         total[case.cls] += 1
         bad[case.cls] += bool(v)
-        rows.append({"i": i, "id": case.id, "exit": out.exit_code, "violations": v,
-                     "elapsed_s": round(out.elapsed_s, 2),
-                     "stderr": out.stderr.strip()[-300:]})
+        rows.append({"i": i, "id": case.id, "cls": case.cls, "exit": out.exit_code,
+                     "violations": v, "elapsed_s": round(out.elapsed_s, 2),
+                     "stderr": out.stderr.strip()[-300:], "new_files": out.new_files,
+                     "validate_exit": out.validate_exit, "note": out.note,
+                     "non_finite": F._non_finite(out.summary)})
         print(f"{i:4d} {'FAIL' if v else 'ok  '} {out.elapsed_s:6.1f}s {case.id[:90]}"
               + (f"  <- {'; '.join(v)}" if v else ""), flush=True)
     print("\nclass  cases  broken")

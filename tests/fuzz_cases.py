@@ -169,6 +169,17 @@ REALTIME = {
                      {"name": "r5", "steps": [{"axis": "z", "profile": "rate", "rate_dps": 5,
                                                "duration_s": 2}]}]},
 }
+CALIBRATE = {  # a short flight: calibrate and observability (seed 002)
+    "name": "cal", "site": {"lat_deg": 38.0, "lon_deg": 121.0, "height_m": 0},
+    "imu": {"rate_hz": 50, "seed": 1, "gyro": {"bias_dph": [0.01, -0.01, 0.01],
+                                               "arw_dprh": 0.001},
+            "accel": {"bias_ug": [50, -50, 50], "vrw_ugrhz": 10}},
+    "motion": {"kind": "flight", "speed_mps": 100, "segments": [
+        {"kind": "hold", "duration_s": 10}, {"kind": "turn", "rate_dps": 9, "angle_deg": 90},
+        {"kind": "hold", "duration_s": 10}]},
+    "calibrate": {"measure": "velocity", "navigation_rate_hz": 25, "filter_rate_hz": 1},
+    "observability": {"measure": "velocity", "piece_s": 5},
+}
 SWEEP = {"name": "sw", "base": "S.yaml", "grid": {"align.stages.0.t_z_s": [20, 30]},
          "seeds": 2}
 
@@ -177,6 +188,7 @@ BASES: dict[str, tuple[dict, str]] = {
     "S": (S, "align"), "swing": (SWING, "align"), "flight": (FLIGHT, "navigate"),
     "turntable": (TURNTABLE, "simulate"), "mechanism": (MECHANISM, "navigate"),
     "northfind": (NORTHFIND, "northfind"), "realtime": (REALTIME, "realtime"),
+    "calibrate": (CALIBRATE, "calibrate"), "observability": (CALIBRATE, "observability"),
 }
 
 # Hostile scalars and structures (YAML text).
@@ -834,7 +846,7 @@ def input_file_cases() -> list[Case]:
     return out
 
 
-def all_cases(seed: int, n_scenarios: int = 220, n_sweeps: int = 24,
+def all_cases(seed: int, n_scenarios: int = 240, n_sweeps: int = 24,
               n_options: int = 30) -> list[Case]:
     """Every case of one fuzz run, in a fixed order (the same seed gives the same cases)."""
     rng = random.Random(seed)

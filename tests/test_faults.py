@@ -347,3 +347,21 @@ def test_plot_into_an_existing_file_or_under_one_is_one_line(tmp_path):
         assert res.returncode == 2, res.stderr
         assert "--output" in one_error_line(res.stderr)
     assert (tmp_path / "afile").read_text() == "x"
+
+
+def test_stale_temps_of_dead_processes_are_removed_and_live_ones_kept(tmp_path):
+    """Temporary files of processes that are gone (this version's names and the older
+    ``.NAME.PID.tmp`` of HDF5 files) are removed by the next run into the folder; those of
+    a live process, and files that only look like them, are kept."""
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    live = str(os.getpid())
+    hdf5 = b"\x89HDF\r\n\x1a\n" + b"\0" * 100
+    files = {f".a.h5.{dead}.x1y2{results.TMP_SUFFIX}": b"", f".b.h5.{dead}.tmp": hdf5,
+             f".c.h5.{live}.x1y2{results.TMP_SUFFIX}": b"", f".d.h5.{dead}.tmp": b"not hdf5",
+             f"e.h5.{dead}.tmp": hdf5}
+    for name, body in files.items():
+        (tmp_path / name).write_bytes(body)
+    removed = {p.name for p in results.clean_stale_temps(tmp_path)}
+    assert removed == {f".a.h5.{dead}.x1y2{results.TMP_SUFFIX}", f".b.h5.{dead}.tmp"}
+    assert {p.name for p in tmp_path.iterdir()} == set(files) - removed

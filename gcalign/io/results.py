@@ -37,6 +37,8 @@ ATT_FRAME = "[pitch, roll, yaw], C_nb = Rz(yaw) Rx(pitch) Ry(roll), ENU, yaw CCW
 
 TMP_SUFFIX = ".gcalign-tmp"  #: temporary files: .NAME.PID.RANDOM.gcalign-tmp
 _TMP_NAME = re.compile(r"^\..+\.(\d+)\.[^.]+" + re.escape(TMP_SUFFIX) + "$")
+_OLD_TMP_NAME = re.compile(r"^\..+\.h5\.(\d+)\.tmp$")  # before mkstemp: .NAME.PID.tmp
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _WRITE_ERRNOS = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT, errno.EIO}
 
 
@@ -101,15 +103,21 @@ def clean_stale_temps(folder: Path) -> list[Path]:
     except OSError:
         return removed
     for p in entries:
-        m = _TMP_NAME.match(p.name)
+        m = _TMP_NAME.match(p.name) or _OLD_TMP_NAME.match(p.name)
         if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
             try:
-                if p.is_file() and not p.is_symlink():
+                if p.is_file() and not p.is_symlink() and (
+                        p.name.endswith(TMP_SUFFIX) or _is_hdf5(p)):
                     p.unlink()
                     removed.append(p)
             except OSError:
                 pass
     return removed
+
+
+def _is_hdf5(p: Path) -> bool:
+    with open(p, "rb") as f:
+        return f.read(8) == _HDF5_SIGNATURE
 
 
 def make_temp(path: Path) -> tuple[int, Path]:
