@@ -137,7 +137,11 @@ def test_a_symlink_at_a_temporary_name_is_not_followed(tmp_path):
 def test_full_disk_is_exit_1_one_line_and_nothing_kept(tmp_path):
     """``ulimit -f`` (EFBIG; Python ignores SIGXFSZ) while a run writes: exit 1, one line
     naming the file, no file under the final name, no temp file."""
-    scenario(tmp_path, duration_s=600.0)
+    d = json.loads(json.dumps(F.S))
+    d["motion"]["duration_s"] = 600.0
+    d["output"] = {"rate_hz": "full"}  # noisy increments at every sample: about 3 MB
+    d["imu"].update(gyro={"arw_dprh": 0.01}, accel={"vrw_ugrhz": 50})
+    (tmp_path / "S.yaml").write_text(F.emit(d))
     res = cli(["simulate", "S.yaml", "-o", "s.h5"], tmp_path, limit_fsize=200_000)
     assert res.returncode == 1, res.stderr
     line = one_error_line(res.stderr)
@@ -365,3 +369,41 @@ def test_stale_temps_of_dead_processes_are_removed_and_live_ones_kept(tmp_path):
     removed = {p.name for p in results.clean_stale_temps(tmp_path)}
     assert removed == {f".a.h5.{dead}.x1y2{results.TMP_SUFFIX}", f".b.h5.{dead}.tmp"}
     assert {p.name for p in tmp_path.iterdir()} == set(files) - removed
+
+
+def test_a_terminated_pool_worker_dies_even_under_the_commands_sigterm_handler(tmp_path):
+    """The command's SIGTERM handler raises (so that it can remove its temporary files);
+    forked pool workers inherit it. ``close(cancel=True)`` terminates the workers: they must
+    die, not send the exception back through a queue no one reads (which hung the process
+    that ran the batch in-process, at its exit). In a fresh process: a pool is forked only
+    from a process with a single thread."""
+    code = """if True:
+        import signal, sys, time
+        from gcalign.app.batch.backends import LocalBackend
+        from gcalign.cli import _terminate
+        signal.signal(signal.SIGTERM, _terminate)
+        backend = LocalBackend(2, "simulate")
+        assert backend.start_method == "fork", backend.start_method
+        procs = list(backend._pool._processes.values())
+        assert len(procs) == 2 and all(p.is_alive() for p in procs)
+        backend.close(cancel=True)
+        deadline = time.monotonic() + 10
+        while any(p.is_alive() for p in procs) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        print([p.exitcode for p in procs])
+    """
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=60, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == f"[{-signal.SIGTERM}, {-signal.SIGTERM}]", res.stdout
+
+
+def test_results_files_have_ordinary_permissions(tmp_path):
+    """The temporary file is private (mkstemp); the file under the final name is not."""
+    mask = os.umask(0o022)
+    try:
+        with results.atomic_h5(tmp_path / "r.h5") as f:
+            f.attrs["x"] = 1
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "r.h5").stat().st_mode & 0o777 == 0o644

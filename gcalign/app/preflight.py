@@ -71,6 +71,8 @@ def preflight(sc: Scenario, command: str | None = None, read_recorded: bool = Tr
     commands = [command] if command else _commands_of(sc)
     check_seed(sc.imu.seed, "imu.seed")
     ext = extent(sc, read_recorded)
+    if ext is not None and not ext.recorded:
+        sensor_errors(sc)
     if ext is None and sc.imu_file is None:
         needs = [c for c in commands if c in DATA_COMMANDS]
         if needs or not any(c in SELF_CONTAINED for c in commands):
@@ -154,6 +156,37 @@ def _navigate(sc: Scenario, ext: Extent) -> None:
         raise ScenarioError(f"navigation.start_s: {cfg.start_s:g} s is past the end of the "
                             f"data ({ext.samples * ext.ts:g} s)")
     _stride(sc, ext)
+
+
+def sensor_errors(sc: Scenario) -> None:
+    """Refuse sensor errors that alone put a simulated increment past the bounds recorded
+    data are held to (:data:`gcalign.io.imu_files.MAX_DTHETA_RAD`, ``MAX_DV_MPS`` per
+    sample), so that validate refuses what the run would refuse in its first block
+    (:func:`gcalign.app.data.check_finite_block`, e.g. ``bias_ug: [1e308, 0, 0]``): the bias
+    over one sample, a tenth of the bound for one standard deviation of the noise (a
+    Gaussian tail would cross it within a run), and scale-factor and misalignment errors
+    beyond 100 % (1e6 ppm, 1 rad). Necessary, not sufficient: the motion adds its own
+    increments, which only the run sees."""
+    import numpy as np
+
+    from gcalign.io.imu_files import MAX_DTHETA_RAD, MAX_DV_MPS
+
+    ts = sc.imu.ts
+    errs = sc.imu.errors()
+    for name, e, bound, keys, unit in (
+            ("gyro", errs.gyro, MAX_DTHETA_RAD, ("bias_dph", "arw_dprh"), "rad"),
+            ("accel", errs.accel, MAX_DV_MPS, ("bias_ug", "vrw_ugrhz"), "m/s")):
+        for key, per_sample, cap in ((keys[0], np.abs(e.bias) * ts, bound),
+                                     (keys[1], e.noise * np.sqrt(ts), bound / 10)):
+            if not (per_sample <= cap).all():
+                raise ScenarioError(
+                    f"imu.{name}.{key}: {float(per_sample.max()):.3g} {unit} per sample at "
+                    f"{sc.imu.rate_hz:g} Hz, beyond {cap:g} {unit} (no instrument is this bad)")
+        for key, a, cap in (("scale_ppm", np.abs(e.scale) + np.abs(e.asym), 1.0),
+                            ("misalignment_arcsec", np.abs(e.misalignment), 1.0)):
+            if not (a <= cap).all():
+                raise ScenarioError(f"imu.{name}.{key}: beyond 100 % (1e6 ppm, 1 rad) of the "
+                                    "input; check the units")
 
 
 def cost(sc: Scenario, command: str, ext: Extent) -> tuple[float, float, float]:

@@ -65,7 +65,7 @@ class OneLineErrors(TyperGroup):
             where = f" (see '{err.ctx.command_path} --help')" if getattr(err, "ctx", None) \
                 else ""
             _fail(f"{err.format_message()}{where}", err.exit_code)
-        except click_errors.Abort:
+        except typer.Abort:  # typer ≥ 0.2x: its own Abort, not in its click copy
             _fail("aborted", 1)
         if not standalone_mode:
             return rv
@@ -126,7 +126,7 @@ def user_errors(fn):
         except Terminated:
             sys.stderr.write("error: terminated (SIGTERM)\n")
             raise typer.Exit(143) from None
-        except (typer.Exit, click_errors.ClickException, click_errors.Abort):
+        except (typer.Exit, typer.Abort, click_errors.ClickException):
             raise
         except MemoryError:
             sys.stderr.write("error: out of memory; a smaller run, or lower GCALIGN_MAX_MEMORY_MB "

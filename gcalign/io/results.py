@@ -120,6 +120,12 @@ def _is_hdf5(p: Path) -> bool:
         return f.read(8) == _HDF5_SIGNATURE
 
 
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def make_temp(path: Path) -> tuple[int, Path]:
     """A new, exclusively created temporary file beside `path` (mkstemp: a random name, so
     nothing placed there beforehand, a symlink say, is followed); stale ones of dead
@@ -129,6 +135,12 @@ def make_temp(path: Path) -> tuple[int, Path]:
         clean_stale_temps(path.parent)
         fd, name = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX,
                                     dir=path.parent)
+        try:  # mkstemp makes it private (0600); the renamed file is an ordinary one
+            os.fchmod(fd, 0o666 & ~_umask())
+        except OSError:
+            os.close(fd)
+            os.unlink(name)
+            raise
     except OSError as err:
         raise write_error(path, err) from None
     return fd, Path(name)

@@ -28,9 +28,13 @@ def _watch_parent(parent: int) -> None:  # pragma: no cover - runs in workers
 
 
 def _init_worker(command: str) -> None:  # pragma: no cover - runs in workers
-    """Process-pool initializer: Ctrl-C is the parent's business; exit with the parent;
-    load the JIT cache once."""
+    """Process-pool initializer: Ctrl-C is the parent's business, SIGTERM kills; exit with
+    the parent; load the JIT cache once."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # A forked worker inherits the command's SIGTERM handler (which raises, so that the
+    # command removes its temporary files): a worker that the pool terminates must die,
+    # not send the exception back through a queue nobody reads any more (a hang at exit).
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True).start()
     warm_up(command)
 

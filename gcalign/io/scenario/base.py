@@ -57,5 +57,7 @@ class Model(BaseModel):
 
 
 def _yaml_bool(value: Any) -> str:
-    v = value if isinstance(value, bool) else next(x for x in value if isinstance(x, bool))
-    return "true" if v else "false"
+    """The first boolean in `value` (a boolean or nested lists holding one), as YAML."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return next(_yaml_bool(v) for v in value[:10_000] if _has_bool(v))
