@@ -110,3 +110,26 @@ def test_an_unexpected_exception_is_one_line_and_exit_1(fuzz_env, monkeypatch):
     assert res.stderr.strip().splitlines() == [
         "error: internal error, RuntimeError: boom (a bug in gcalign; GCALIGN_TRACEBACK=1 "
         "shows where)"]
+
+
+BY_NAME = {c.name: c for c in CASES}
+
+
+@pytest.mark.parametrize("name, expected", [
+    ("CSV 90 s gap", r"d\.csv:1002: time jumps from 10(\.0)? to 100\.01 s"),
+    ("PSINS header latitude 90", r"d\.imu: header row 2 field 1 \(latitude, deg\)"),
+    ("navigate on results file: NaN rows", r"d\.h5: /imu: row 101: dtheta must be finite"),
+    ("navigate on results file: ts 0", r"d\.h5: /imu: sample interval must lie in"),
+    ("long bad value", r"align\.mode: .*got 'm{60,90}\.\.\.'$"),
+    ("--seed -5", r"--seed: must be a whole number within \[0, 2\^63\), got -5$"),
+])
+def test_messages_name_the_file_row_and_value(name, expected, fuzz_env):
+    """Recorded data are blamed by file and row (not the alignment window that used to be
+    blamed); bad values are echoed cut at about 80 characters (issue 14, classes 6, 11)."""
+    import re
+
+    out = run_case(BY_NAME[name], fuzz_env)
+    assert out.exit_code == 2, out.stderr
+    line = out.stderr.strip()
+    assert re.search(expected, line), line
+    assert "align.coarse" not in line
