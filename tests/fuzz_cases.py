@@ -522,6 +522,37 @@ def simulate_summary(rows: int) -> dict:
             "final_displacement_m": [0.0, 0.0, 0.0], "output": "d.h5"}
 
 
+_DELETE = object()
+#: mutations of one attribute: (root "/" or "/imu", attribute, new value or _DELETE)
+ATTR_MUTATIONS = {
+    "summary missing": ("/", "summary_json", _DELETE),
+    "summary invalid": ("/", "summary_json", "{not json"),
+    "summary a list": ("/", "summary_json", "[1, 2]"),
+    "summary empty": ("/", "summary_json", "{}"),
+    "summary NaN": ("/", "summary_json", '{"x": NaN}'),
+    "kind missing": ("/", "kind", _DELETE),
+    "kind unknown": ("/", "kind", "nosuch"),
+    "kind batch": ("/", "kind", "batch"),
+    "kind align": ("/", "kind", "align"),
+    "kind navigate": ("/", "kind", "navigate"),
+    "kind a number": ("/", "kind", 7),
+    "scenario missing": ("/", "scenario_yaml", _DELETE),
+    "scenario invalid": ("/", "scenario_yaml", "a: [1, 2"),
+    "scenario bomb": ("/", "scenario_yaml", "name: " + bomb(9, 9)),
+    "scenario a list": ("/", "scenario_yaml", "[1, 2]"),
+    "version missing": ("/", "gcalign_version", _DELETE),
+    "ts missing": ("/imu", "ts", _DELETE),
+    "ts 0": ("/imu", "ts", 0.0),
+    "ts negative": ("/imu", "ts", -0.01),
+    "ts NaN": ("/imu", "ts", float("nan")),
+    "ts a string": ("/imu", "ts", "fast"),
+    "ts 1e300": ("/imu", "ts", 1e300),
+    "site wrong shape": ("/imu", "site", np.zeros(2)),
+    "site latitude 2 rad": ("/imu", "site", np.array([2.0, 0.0, 0.0])),
+    "att0 NaN": ("/imu", "att0", np.array([np.nan, 0, 0])),
+}
+
+
 def results_file(mutation: str = "", rows: int = 2000) -> bytes:
     """A gcalign results file with /imu (as `gcalign simulate` writes it), crafted."""
 
@@ -540,50 +571,13 @@ def results_file(mutation: str = "", rows: int = 2000) -> bytes:
         g_attrs = {"ts": ts, "source": "crafted", "site": np.radians([40, 116, 0]) * [1, 1, 0],
                    "att0": np.zeros(3), "v0_n": np.zeros(3)}
         m = mutation
-        if m == "summary missing":
-            del attrs["summary_json"]
-        elif m == "summary invalid":
-            attrs["summary_json"] = "{not json"
-        elif m == "summary a list":
-            attrs["summary_json"] = "[1, 2]"
-        elif m == "summary empty":
-            attrs["summary_json"] = "{}"
-        elif m == "summary NaN":
-            attrs["summary_json"] = '{"x": NaN}'
-        elif m == "kind missing":
-            del attrs["kind"]
-        elif m == "kind unknown":
-            attrs["kind"] = "nosuch"
-        elif m == "kind batch":
-            attrs["kind"] = "batch"
-        elif m == "kind align":
-            attrs["kind"] = "align"
-        elif m == "kind navigate":
-            attrs["kind"] = "navigate"
-        elif m == "kind a number":
-            attrs["kind"] = 7
-        elif m == "scenario missing":
-            del attrs["scenario_yaml"]
-        elif m == "scenario invalid":
-            attrs["scenario_yaml"] = "a: [1, 2"
-        elif m == "scenario bomb":
-            attrs["scenario_yaml"] = "name: " + bomb(9, 9)
-        elif m == "scenario a list":
-            attrs["scenario_yaml"] = "[1, 2]"
-        elif m == "version missing":
-            del attrs["gcalign_version"]
-        elif m == "ts missing":
-            del g_attrs["ts"]
-        elif m == "ts 0":
-            g_attrs["ts"] = 0.0
-        elif m == "ts negative":
-            g_attrs["ts"] = -0.01
-        elif m == "ts NaN":
-            g_attrs["ts"] = float("nan")
-        elif m == "ts a string":
-            g_attrs["ts"] = "fast"
-        elif m == "ts 1e300":
-            g_attrs["ts"] = 1e300
+        where, key, value = ATTR_MUTATIONS.get(m, (None, None, None))
+        if where is not None:
+            target = attrs if where == "/" else g_attrs
+            if value is _DELETE:
+                del target[key]
+            else:
+                target[key] = value
         elif m == "dtheta (5, 2)":
             dth = np.zeros((5, 2))
         elif m == "dtheta 1-d":
@@ -607,12 +601,6 @@ def results_file(mutation: str = "", rows: int = 2000) -> bytes:
             dth = np.array([["a", "b", "c"]] * rows, dtype=object)
         elif m == "empty":
             t, dth, dv = t[:0], dth[:0], dv[:0]
-        elif m == "site wrong shape":
-            g_attrs["site"] = np.zeros(2)
-        elif m == "site latitude 2 rad":
-            g_attrs["site"] = np.array([2.0, 0.0, 0.0])
-        elif m == "att0 NaN":
-            g_attrs["att0"] = np.array([np.nan, 0, 0])
         for k, v in attrs.items():
             f.attrs[k] = v
         if m == "no imu":
