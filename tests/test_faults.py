@@ -84,6 +84,7 @@ def aggregate_of(path: Path) -> dict:
 # --------------------------------------------------------------------------- single runs
 
 
+@pytest.mark.slow  # several seconds of child processes
 def test_kill_9_of_a_run_leaves_no_file_and_the_next_run_removes_its_temp(tmp_path):
     """kill -9 of simulate at random points (seeded): never a file under the final name; a
     temp file may remain (nothing can remove it at SIGKILL), and the next run into the folder
@@ -172,6 +173,7 @@ def uninterrupted(tmp_path_factory):
     return aggregate_of(d / "ref.h5")
 
 
+@pytest.mark.slow  # several seconds of child processes
 def test_kill_9_of_a_batch_and_resume_give_every_run_once(tmp_path, uninterrupted):
     """kill -9 at random points (seeded), then --resume until complete: every (variant,
     seed) exactly once and the uninterrupted aggregate, to the bit."""
@@ -190,6 +192,7 @@ def test_kill_9_of_a_batch_and_resume_give_every_run_once(tmp_path, uninterrupte
     assert temps(tmp_path) == [] and not (tmp_path / ".b.h5.lock").exists()
 
 
+@pytest.mark.slow  # several seconds of child processes
 def test_full_disk_during_a_batch_then_resume_completes(tmp_path, uninterrupted):
     """``ulimit -f`` small enough that the results file cannot be written: exit 1, one line;
     the journal keeps the finished runs; with the limit lifted, --resume completes with the
@@ -204,6 +207,7 @@ def test_full_disk_during_a_batch_then_resume_completes(tmp_path, uninterrupted)
     assert aggregate_of(tmp_path / "b.h5") == uninterrupted
 
 
+@pytest.mark.slow  # several seconds of child processes
 def test_a_second_batch_on_the_same_output_is_refused(tmp_path):
     sweep(tmp_path, seeds=40)
     first = spawn(["batch", "SW.yaml", "-o", "b.h5", "-w", "1"], tmp_path)
@@ -286,6 +290,7 @@ def _dask_fails_fast(tmp_path, address, expect: str, resume: bool = False):
     return res
 
 
+@pytest.mark.slow  # several seconds of child processes
 @pytest.mark.parametrize("http", [False, True], ids=["plain-tcp", "http"])
 def test_a_listener_that_is_not_dask_fails_within_the_bound(tmp_path, http):
     pytest.importorskip("distributed")
@@ -300,11 +305,13 @@ def test_a_bad_address_fails_within_the_bound_without_a_traceback(tmp_path):
     assert "Exception ignored" not in res.stderr
 
 
+@pytest.mark.slow  # several seconds of child processes
 def test_a_scheduler_without_workers_fails_within_the_bound(tmp_path, zero_worker_scheduler):
     _dask_fails_fast(tmp_path, zero_worker_scheduler, "has no workers")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["S.yaml", "SW.yaml"]
 
 
+@pytest.mark.slow  # several seconds of child processes
 def test_a_resumed_batch_keeps_its_journal_when_the_scheduler_fails(tmp_path,
                                                                      zero_worker_scheduler):
     sweep(tmp_path)
@@ -321,6 +328,7 @@ def test_a_resumed_batch_keeps_its_journal_when_the_scheduler_fails(tmp_path,
     assert journal.read_bytes() == before
 
 
+@pytest.mark.slow  # several seconds of child processes
 def test_resume_rejects_damaged_records_and_reruns_them(tmp_path, uninterrupted):
     """A journal with garbage, records without metrics, NaN or short-list metrics: those
     lines are skipped (a note says how many) and their runs run again; the aggregate is the
