@@ -10,6 +10,7 @@ errors (and variants that differ only in errors or algorithm settings share it).
 from __future__ import annotations
 
 import copy
+import difflib
 import os
 import sys
 import time
@@ -72,6 +73,9 @@ def metric_value(summary: dict, path: str):
         if isinstance(node, dict):
             if part not in node:
                 names = [str(k) for k in node]
+                # the closest names first: the list is cut, and a typo's fix should show
+                close = difflib.get_close_matches(part, names, n=3, cutoff=0.6)
+                names = close + [n for n in names if n not in close]
                 more = f", … ({len(names) - 12} more)" if len(names) > 12 else ""
                 raise MetricError(f"metric {path[:60]!r}: {here} has no {part[:40]!r}; it has: "
                                   f"{', '.join(names[:12])}{more}")
