@@ -88,7 +88,15 @@ def test_reproduction(case, fuzz_env):
     check(case, fuzz_env, case.name)
 
 
-@pytest.mark.parametrize("i", range(len(GENERATED)), ids=lambda i: f"{i}-c{GENERATED[i].cls}")
+def _case_id(i: int) -> str:
+    """Index, class and the start of the name: the crafted files, journals and options
+    (recorded_cases, journal_cases, ...) include reproductions of the issue by name."""
+    c = GENERATED[i]
+    name = "".join(ch if ch.isprintable() and ch not in "[]:" else "_" for ch in c.name[:60])
+    return f"{i}-c{c.cls}-{name}"
+
+
+@pytest.mark.parametrize("i", range(len(GENERATED)), ids=_case_id)
 def test_contract(i, fuzz_env):
     """Generated case i of seed SEED keeps the contract."""
     check(GENERATED[i], fuzz_env, i)
