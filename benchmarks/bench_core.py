@@ -131,7 +131,7 @@ def gyrocompass_on_seed_data() -> tuple[float, int]:
     from gcalign.align import kernel as AK
 
     state0 = AK.new_state(euler_to_quat(data.att_at(i1)), [0.0, 0.0], data.pos_t1)
-    stages = [s.to_stage() for s in cfg.stages]
+    stages = cfg.stage_list()
 
     def passes():
         run_passes(state0, block, cfg.mode, cfg.pass_count, stages, "double-oscillator",

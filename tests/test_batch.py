@@ -309,20 +309,23 @@ def test_numba_cache_is_loaded_not_compiled_in_fresh_processes():
 
 
 def test_failing_runs_are_recorded_and_exit_1(tmp_path):
-    # T3 past the end of the data passes validation but fails in the run.
-    sweep = write_sweep(tmp_path, grid={"align.t3_s": [70, 500]}, seeds=2, metrics=["error_t3_deg"])
+    # Loops of nanosecond periods pass validation but diverge: a result that is not finite
+    # is a failed run (issue 14 class 6), recorded, the others go on.
+    stages = [[{"t_xy_s": 20, "t_z_s": 60}], [{"t_xy_s": 1e-9, "t_z_s": 1e-9}]]
+    sweep = write_sweep(tmp_path, grid={"align.stages": stages}, seeds=2,
+                        metrics=["error_t3_deg"])
     out = tmp_path / "f.h5"
     res = batch_cli(sweep, "--workers", 1, "-o", out, "--json")
     assert res.exit_code == 1, res.output
     s = json.loads(res.stdout)
     assert (s["ok"], s["failed"]) == (2, 2)
     assert s["variants"][0]["ok"] == 2 and s["variants"][1]["failed"] == 2
-    assert "past the end of the data" in s["failures"][0]["error"]
+    assert "not finite" in s["failures"][0]["error"]
     with h5py.File(out, "r") as f:
         status = [x.decode() for x in f["batch/runs/status"][()]]
         assert status == ["ok", "ok", "failed", "failed"]
         assert np.isnan(f["batch/runs/metrics/error_t3_deg"][2]).all()
-        assert "t3_s" in f["batch/runs/error"][2].decode()
+        assert "diverged" in f["batch/runs/error"][2].decode()
 
 
 class _FlakyBackend:

@@ -101,6 +101,20 @@ class Stream:
 
 #: Compressed recordings (``x.imu.xz``), opened by the standard library.
 COMPRESSED = {".gz": "gzip", ".xz": "lzma"}
+def check_finite_block(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray) -> None:
+    """ScenarioError naming the sensor and the time if simulated increments are not finite
+    or beyond what recorded data may hold (:data:`gcalign.io.imu_files.MAX_DTHETA_RAD`,
+    ``MAX_DV_MPS`` per sample): sensor errors far beyond any instrument, e.g.
+    ``bias_dph: [1e308, 0, 0]``."""
+    from gcalign.io.imu_files import MAX_DTHETA_RAD, MAX_DV_MPS
+
+    for name, a, bound in (("gyro", dtheta, MAX_DTHETA_RAD), ("accel", dv, MAX_DV_MPS)):
+        ok = (np.abs(a) <= bound).all(1)  # False for NaN too
+        if not ok.all():
+            k = int(np.argmin(ok))
+            raise ScenarioError(f"imu.{name}: the sensor errors make the simulated increments "
+                                f"{a[k].tolist()} at t = {float(t[k]):g} s, beyond {bound:g} "
+                                "per sample; check the biases, scale factors and noise")
 
 
 def read_data_file(path: Path) -> tuple[ImuData, Truth | None]:
@@ -188,6 +202,7 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
         stream = ErrorStream(errors, ts, np.random.default_rng(seed), n)
         for b in ideal_blocks(motion, site, ts, earth, mech, block=block):
             dtheta, dv = stream.apply(b.dtheta, b.dv)
+            check_finite_block(b.t, dtheta, dv)
             yield DataBlock(b.k0, b.t, dtheta, dv,
                             BlockTruth(b.att, b.q_nb, b.v_n, b.pos, b.segment), b.q_bs)
 
@@ -313,6 +328,7 @@ def with_errors(scenario: Scenario, ideal: RunData, seed: int | None = None) -> 
     stream = ErrorStream(scenario.imu.errors(), ideal.imu.ts, np.random.default_rng(seed),
                          len(ideal.imu))
     dtheta, dv = stream.apply(ideal.imu.dtheta, ideal.imu.dv)
+    check_finite_block(ideal.imu.t, dtheta, dv)
     return RunData(imu=replace(ideal.imu, dtheta=dtheta, dv=dv), truth=ideal.truth,
                    site=ideal.site.copy(), seed=seed, earth=ideal.earth)
 

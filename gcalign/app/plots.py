@@ -19,7 +19,6 @@ l.get_label().startswith("_")]`` are the data series.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Literal
@@ -173,22 +172,21 @@ def _s(x) -> str:
     return x.decode() if isinstance(x, bytes) else str(x)
 
 
-def imu_figure_of(g, title: str) -> Figure:
-    """The IMU figure of an ``/imu`` group (its increments are sums over each stored
-    interval when decimated: rates over that interval)."""
-    ts = float(g.attrs["ts"])
-    frame = _s(g["dtheta"].attrs.get("frame", "body")).split(":")[0]
-    return imu_figure(g["t"][()], g["dtheta"][()], g["dv"][()], ts, frame, title)
-
-
 def truth_and_imu(f, name: str) -> dict[str, Figure]:
-    """The truth (``/truth`` with velocities) and IMU output (``/imu``) figures of a file."""
+    """The truth (``/truth`` with velocities) and IMU output (``/imu``; its increments are
+    sums over each stored interval when decimated: rates over that interval) figures of
+    the open file `f`, read through the checked readers (a damaged file: one line)."""
+    from gcalign.io.results import imu_series, read_truth
+
+    path = Path(f.filename)
     figs: dict[str, Figure] = {}
     if "truth" in f and "v_n" in f["truth"]:
-        figs["truth"] = truth_figure(f["truth/t"][()], f["truth/att"][()], f["truth/v_n"][()],
-                                     title=f"{name}: truth")
+        truth = read_truth(path)
+        assert truth is not None
+        figs["truth"] = truth_figure(truth.t, truth.att, truth.v_n, title=f"{name}: truth")
     if "imu" in f and "dtheta" in f["imu"]:
-        figs["imu"] = imu_figure_of(f["imu"], f"{name}: IMU output")
+        t, dtheta, dv, ts, frame = imu_series(path)
+        figs["imu"] = imu_figure(t, dtheta, dv, ts, frame, f"{name}: IMU output")
     return figs
 
 
@@ -203,10 +201,11 @@ def figures_for(path: Path) -> dict[str, Figure]:
     path = Path(path)
     if not _is_hdf5(path):
         return {"imu": _recorded_imu_figure(path)}
+    kind, summary, _ = results.read_summary(path)  # ScenarioError if kind/summary are bad
+    name = summary.get("scenario") or summary.get("sweep") or path.stem
+    if not isinstance(name, str):
+        name = path.stem
     with results.open_results(path) as f:
-        kind = _s(f.attrs.get("kind", ""))
-        summary = json.loads(_s(f.attrs.get("summary_json", "{}")))
-        name = summary.get("scenario") or summary.get("sweep") or path.stem
         figs: dict[str, Figure] = COMMANDS[kind].load().figures(f, name) if kind in COMMANDS else {}
         if not figs:
             figs = truth_and_imu(f, name)
@@ -236,16 +235,21 @@ def default_plot_dir(path: Path) -> Path:
     return path.with_name(path.name.split(".")[0] + "_plots")
 
 
-def plot_file(path: Path, out_dir: Path | None = None, progress=None) -> list[Path]:
+def plot_file(path: Path, out_dir: Path | str | None = None, progress=None) -> list[Path]:
     """Write every figure of a results file as PNG; the paths written. `progress(done,
     total, what)` hears of each figure written."""
     figs = figures_for(path)
-    out_dir = Path(out_dir) if out_dir is not None else default_plot_dir(path)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    from gcalign.io.results import check_output_dir, write_error
+
+    out_dir = check_output_dir(out_dir if out_dir is not None else default_plot_dir(path))
     written = []
     for i, (stem, fig) in enumerate(figs.items()):
         p = out_dir / f"{stem}.png"
-        fig.savefig(p, dpi=DPI)
+        try:
+            fig.savefig(p, dpi=DPI)
+        except OSError as err:  # a full disk: one line, not a traceback
+            p.unlink(missing_ok=True)
+            raise write_error(p, err) from None
         written.append(p)
         if progress is not None:
             progress(i + 1, len(figs), "figures")

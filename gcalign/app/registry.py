@@ -64,6 +64,19 @@ class Command:
             raise KeyError(f"{self.name!r} has no built-in scenario")
         return builtin_text(self.builtin)
 
+    def execute(self, sc, seed: int | None = None, *args, **options) -> Outcome:
+        """The room's ``execute`` after the checks and the cost estimate of
+        :func:`gcalign.app.preflight.preflight` (the same ones ``gcalign validate`` runs),
+        with the seed checked to lie in [0, 2^63); the summary is checked to be finite."""
+        from gcalign.app.preflight import check_seed, preflight
+        from gcalign.io.results import finite_summary
+
+        check_seed(seed)
+        preflight(sc, self.name, read_recorded=False)
+        outcome = self.load().execute(sc, seed, *args, **options)
+        finite_summary(outcome.summary, self.name)
+        return outcome
+
 
 def builtin_text(name: str) -> str:
     """YAML text of a built-in scenario file (package data in gcalign/scenarios)."""

@@ -172,8 +172,15 @@ def summary_table(kind: str, summary: dict) -> RenderableType:
     """The table a command prints, from its summary (also for `gcalign show`), with the
     run's warnings."""
     from gcalign.app.registry import COMMANDS
+    from gcalign.errors import ScenarioError
 
     if kind not in COMMANDS:
-        return kv_table(f"gcalign {kind}", ((k, str(v)) for k, v in summary.items()))
-    table = COMMANDS[kind].load().table(summary)
+        raise ScenarioError(f"kind: {kind!r} is not a gcalign command ({', '.join(COMMANDS)}); "
+                            "a results file from another version, or a damaged one")
+    try:
+        table = COMMANDS[kind].load().table(summary)
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError) as err:
+        raise ScenarioError(f"summary_json: not the summary of a {kind!r} run "
+                            f"({type(err).__name__}: {str(err)[:60]}); a damaged results "
+                            "file, or one from another version") from None
     return with_warnings(table, summary.get("warnings") or [])

@@ -42,10 +42,11 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
     t0 = time.perf_counter()
     try:
         with results.atomic_h5(out) as f:
+            # the registry's execute: preflight checks, the seed's range, a finite summary
             if cmd.streams:
-                outcome = room.execute(sc, seed, sink=f, **kwargs)
+                outcome = cmd.execute(sc, seed, sink=f, **kwargs)
             else:
-                outcome = room.execute(sc, seed, **kwargs)
+                outcome = cmd.execute(sc, seed, **kwargs)
             if before_write is not None:
                 before_write()
             summary = outcome.summary

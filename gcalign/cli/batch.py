@@ -148,5 +148,7 @@ def batch(
     consoles(as_json).print(engine.table(summary))
     if as_json:
         emit_json(summary)
-    if summary["failed"]:
+    if summary["failed"]:  # the file records them: a result, but not a success
+        sys.stderr.write(f"error: {summary['failed']} of {summary['runs']} run(s) failed "
+                         f"(each recorded with its message in {out})\n")
         raise typer.Exit(1)

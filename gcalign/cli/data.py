@@ -9,6 +9,7 @@ from pathlib import Path
 import typer
 import yaml
 
+from gcalign.app.preflight import preflight
 from gcalign.app.registry import COMMANDS
 from gcalign.app.report import kv_table, summary_table, with_warnings
 from gcalign.cli import app, consoles, emit_json, user_errors
@@ -118,6 +119,7 @@ def validate(
     """Check a scenario and print its resolved values in user units and SI, and the keys
     that cannot matter (as warnings)."""
     sc, _, _ = load_with_overrides(scenario, "", "", {})
+    preflight(sc)  # the checks every command runs first, for every section
     rows = resolved_rows(sc)
     sections = [c.section for c in COMMANDS.values() if c.section]
     warnings = list(dict.fromkeys(w for sec in sections for w in sc.unused(sec)))

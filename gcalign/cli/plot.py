@@ -16,7 +16,7 @@ from gcalign.cli.data import JSON_HELP
 def plot(
     file: Path = typer.Argument(..., help="A gcalign results file (.h5), or recorded IMU "
                                 "data (PSINS .imu, CSV; .gz/.xz): its IMU output."),
-    out_dir: Path | None = typer.Option(
+    out_dir: str | None = typer.Option(  # a str: a Path would turn '' into '.'
         None,
         "-o",
         "--output",

@@ -166,6 +166,80 @@ def _data_lineno(lines, start, comment, row) -> int:
     return len(lines)
 
 
+# --------------------------------------------------------------------------- checks
+
+TS_RANGE_S = (1e-7, 10.0)  #: sample intervals accepted (10 MHz .. 0.1 Hz)
+REGULAR_TOL = 0.05  #: each time step within ±5 % of the interval (jitter, not gaps)
+MAX_DTHETA_RAD = math.pi  #: more than half a turn in one sample is aliasing, not data
+MAX_DV_MPS = 1000.0  #: 1000 m/s in one sample is 100 000 g at 100 Hz
+
+
+def check_increments(name: str, t, dtheta, dv, ts, where=None) -> None:
+    """Recorded increments validated like a scenario: shapes, finite values, a positive
+    interval in :data:`TS_RANGE_S`, time strictly increasing and regular within
+    :data:`REGULAR_TOL`, increments within physical bounds.
+
+    `where(k)` names data row k after the file name in messages (``:LINE`` for text files;
+    default ``: row K``). Raises :class:`ImuFileError` naming the file and the row.
+    """
+    where = where or (lambda k: f": row {k + 1}")
+    lo, hi = TS_RANGE_S
+    if not (isinstance(ts, (int, float, np.floating)) and math.isfinite(ts) and lo <= ts <= hi):
+        raise ImuFileError(f"{name}: sample interval must lie in [{lo:g}, {hi:g}] s, got "
+                           f"{ts!r}")
+    t, dtheta, dv = np.asarray(t), np.asarray(dtheta), np.asarray(dv)
+    for label, a, shape in (("t", t, "(N,)"), ("dtheta", dtheta, "(N, 3)"),
+                            ("dv", dv, "(N, 3)")):
+        if a.dtype.kind not in "fiu":
+            raise ImuFileError(f"{name}: {label} must hold numbers, got {a.dtype}")
+        ok = a.ndim == 1 if shape == "(N,)" else (a.ndim == 2 and a.shape[1] == 3)
+        if not ok or len(a) != len(t):
+            raise ImuFileError(f"{name}: {label} must have shape {shape} with N = {len(t)} "
+                               f"(the time stamps), got {a.shape}")
+    if len(t) < 2:
+        raise ImuFileError(f"{name}: {len(t)} sample(s); need at least 2")
+    for label, a, bound, unit in (("t", t[:, None], None, "s"),
+                                  ("dtheta", dtheta, MAX_DTHETA_RAD, "rad"),
+                                  ("dv", dv, MAX_DV_MPS, "m/s")):
+        bad = ~np.isfinite(a).all(1)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise ImuFileError(f"{name}{where(k)}: {label} must be finite, got "
+                               f"{a[k].tolist()}")
+        if bound is not None:
+            big = (np.abs(a) > bound).any(1)
+            if big.any():
+                k = int(np.argmax(big))
+                raise ImuFileError(f"{name}{where(k)}: {label} {a[k].tolist()} exceeds "
+                                   f"{bound:g} {unit} in one sample")
+    _increasing(name, t, where)
+    dt = np.diff(t.astype(float))
+    off = np.abs(dt - ts) > REGULAR_TOL * ts
+    if off.any():
+        k = int(np.argmax(off)) + 1
+        raise ImuFileError(
+            f"{name}{where(k)}: time jumps from {float(t[k - 1])!r} to {float(t[k])!r} s, a step "
+            f"of {float(dt[k - 1]):.6g} s where the interval is {ts:.6g} s (gaps and jitter "
+            f"over {REGULAR_TOL:.0%} are not supported: split the file at the gap)")
+
+
+def _increasing(name: str, t: np.ndarray, where) -> None:
+    dt = np.diff(t)
+    if (dt <= 0).any():
+        k = int(np.argmax(dt <= 0)) + 1
+        raise ImuFileError(f"{name}{where(k)}: time must increase strictly, got t = "
+                           f"{float(t[k])!r} after {float(t[k - 1])!r}")
+
+
+def _check_range(name: str, row: int, col: int, what: str, v: float, lo: float, hi: float,
+                 open_ends: bool = False) -> None:
+    ok = (lo < v < hi) if open_ends else (lo <= v <= hi)
+    if not (math.isfinite(v) and ok):
+        span = f"({lo:g}, {hi:g})" if open_ends else f"[{lo:g}, {hi:g}]"
+        raise ImuFileError(f"{name}: header row {row} field {col} ({what}) must lie in "
+                           f"{span}, got {v!r}")
+
+
 # --------------------------------------------------------------------------- PSINS
 
 
@@ -214,12 +288,20 @@ def read_psins_imu(path) -> ImuData:
             "(initial state; site and timing; scale factors)"
         )
     (pitch, roll, yaw, ve, vn, vu), (lat, lon, h, t0, interval_ms, g), scales = header
-    if not interval_ms > 0:
-        raise ImuFileError(
-            f"{name}: header row 2 field 5 (sampling interval, ms) must be > 0, got {interval_ms!r}"
-        )
-    if not g > 0:
-        raise ImuFileError(f"{name}: header row 2 field 6 (g, m/s²) must be > 0, got {g!r}")
+    lo, hi = TS_RANGE_S
+    for row, col, what, v, a, b, open_ends in (
+            (1, 1, "pitch, deg", pitch, -90, 90, True), (1, 2, "roll, deg", roll, -180, 180,
+                                                         False),
+            (1, 3, "yaw, deg", yaw, -360, 360, False), (1, 4, "VE, m/s", ve, -1e4, 1e4, False),
+            (1, 5, "VN, m/s", vn, -1e4, 1e4, False), (1, 6, "VU, m/s", vu, -1e4, 1e4, False),
+            (2, 1, "latitude, deg", lat, -90, 90, True),
+            (2, 2, "longitude, deg", lon, -180, 360, False),
+            (2, 3, "height, m", h, -1000, 1e5, False), (2, 4, "t0, s", t0, -1e9, 1e9, False),
+            (2, 5, "sampling interval, ms", interval_ms, lo * 1e3, hi * 1e3, False),
+            (2, 6, "g, m/s²", g, 9.0, 10.5, False)):
+        _check_range(name, row, col, what, v, a, b, open_ends)
+    for col, v in enumerate(scales, start=1):
+        _check_range(name, 3, col, "scale factor", v, 0, 1e6, open_ends=True)
 
     labels = ("gyro x", "gyro y", "gyro z", "accel x", "accel y", "accel z")
     counts = _parse_block(name, lines, i, 6, "%", None, labels)
@@ -230,6 +312,7 @@ def read_psins_imu(path) -> ImuData:
     ts = interval_ms * 1e-3
     n = len(counts)
     t = t0 + ts * np.arange(1, n + 1)
+    check_increments(name, t, dtheta, dv, ts, lambda k: f":{_data_lineno(lines, i, '%', k)}")
     meta = {
         "format": "psins",
         "att0_deg": [pitch, roll, yaw],
@@ -309,13 +392,7 @@ def read_csv_imu(path, ts: float | None = None) -> ImuData:
     data = _parse_block(name, lines, i, 7, "#", delimiter, _CSV_COLUMNS)
     t = data[:, 0].copy()
     dt = np.diff(t)
-    if (dt <= 0).any():
-        k = int(np.argmax(dt <= 0)) + 1
-        lineno = _data_lineno(lines, i, "#", k)
-        raise ImuFileError(
-            f"{name}:{lineno}: time must increase strictly, got t = {float(t[k])!r} "
-            f"after {float(t[k - 1])!r}"
-        )
+    _increasing(name, t, lambda k: f":{_data_lineno(lines, i, '#', k)}")
     if ts is None:
         if len(t) < 2:
             raise ImuFileError(f"{name}: one sample only, cannot infer ts; pass ts explicitly")
@@ -325,6 +402,8 @@ def read_csv_imu(path, ts: float | None = None) -> ImuData:
     ts = float(ts)
     if not (math.isfinite(ts) and ts > 0):
         raise ImuFileError(f"{name}: sample interval ts must be > 0 s, got {ts!r}")
+    check_increments(name, t, data[:, 1:4], data[:, 4:7], ts,
+                     lambda k: f":{_data_lineno(lines, i, '#', k)}")
     meta = {
         "format": "csv",
         "columns": names,

@@ -9,9 +9,13 @@ where it applies, a ``frame`` attribute. Arrays are SI, time along axis 0.
 
 from __future__ import annotations
 
+import errno
 import json
+import math
 import os
+import re
 import sys
+import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from datetime import datetime, timezone
@@ -19,10 +23,10 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-import yaml
 
 from gcalign import __version__
-from gcalign.errors import ScenarioError
+from gcalign.errors import GcalignError, ScenarioError
+from gcalign.limits import SEED_MAX
 from gcalign.sim.imu import ImuData
 from gcalign.sim.motions import Truth
 
@@ -31,22 +35,242 @@ PHI_FRAME = "misalignment, ENU: C_nb,est C_nb,true^T = exp(-[phi x])"
 ATT_FRAME = "[pitch, roll, yaw], C_nb = Rz(yaw) Rx(pitch) Ry(roll), ENU, yaw CCW positive"
 
 
+TMP_SUFFIX = ".gcalign-tmp"  #: temporary files: .NAME.PID.RANDOM.gcalign-tmp
+_TMP_NAME = re.compile(r"^\..+\.(\d+)\.[^.]+" + re.escape(TMP_SUFFIX) + "$")
+_OLD_TMP_NAME = re.compile(r"^\..+\.h5\.(\d+)\.tmp$")  # before mkstemp: .NAME.PID.tmp
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+_WRITE_ERRNOS = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT, errno.EIO}
+
+
+def check_output(path, what: str = "--output") -> Path:
+    """`path` as the name of a new results file; ScenarioError (exit 2) before any work if it
+    names a directory (``-o ''`` and ``-o .`` included), a special file, or lies under a
+    file."""
+    p = Path(path)
+    if not str(path).strip() or p.name in ("", ".", ".."):
+        raise ScenarioError(f"{what}: {str(path)!r} is not a file name; give one such as "
+                            "runs/result.h5")
+    if p.is_dir():
+        raise ScenarioError(f"{what}: {p} is a directory; give a file name (e.g. "
+                            f"{p / 'result.h5'})")
+    if p.exists() and not p.is_file() and not p.is_symlink():
+        raise ScenarioError(f"{what}: {p} exists and is not a regular file")
+    parent = p.parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if parent.exists() and not parent.is_dir():
+        raise ScenarioError(f"{what}: {parent} is not a directory, so {p} cannot be written")
+    return p
+
+
+def check_output_dir(path, what: str = "--output") -> Path:
+    """`path` as a folder for figures (made if missing); ScenarioError (exit 2) if it, or a
+    folder above it, exists and is not a folder, or it cannot be made."""
+    p = Path(path)
+    if not str(path).strip():
+        raise ScenarioError(f"{what}: an empty path; give a folder for the figures")
+    if p.exists() and not p.is_dir():
+        raise ScenarioError(f"{what}: {p} exists and is not a folder; give a folder for the "
+                            "figures")
+    parent = p
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ScenarioError(f"{what}: {parent} is not a folder, so {p} cannot be made")
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise write_error(p, err) from None
+    return p
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def clean_stale_temps(folder: Path) -> list[Path]:
+    """Remove our temporary files in `folder` whose process is gone (SIGKILL, power loss);
+    files of live processes are kept. Returns what was removed."""
+    removed: list[Path] = []
+    try:
+        entries = list(Path(folder).iterdir())
+    except OSError:
+        return removed
+    for p in entries:
+        m = _TMP_NAME.match(p.name) or _OLD_TMP_NAME.match(p.name)
+        if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
+            try:
+                if p.is_file() and not p.is_symlink() and (
+                        p.name.endswith(TMP_SUFFIX) or _is_hdf5(p)):
+                    p.unlink()
+                    removed.append(p)
+            except OSError:
+                pass
+    return removed
+
+
+def _is_hdf5(p: Path) -> bool:
+    with open(p, "rb") as f:
+        return f.read(8) == _HDF5_SIGNATURE
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def make_temp(path: Path) -> tuple[int, Path]:
+    """A new, exclusively created temporary file beside `path` (mkstemp: a random name, so
+    nothing placed there beforehand, a symlink say, is followed); stale ones of dead
+    processes are removed first. OSError as GcalignError/ScenarioError (one line)."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        clean_stale_temps(path.parent)
+        fd, name = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX,
+                                    dir=path.parent)
+        try:  # mkstemp makes it private (0600); the renamed file is an ordinary one
+            os.fchmod(fd, 0o666 & ~_umask())
+        except OSError:
+            os.close(fd)
+            os.unlink(name)
+            raise
+    except OSError as err:
+        raise write_error(path, err) from None
+    return fd, Path(name)
+
+
+def write_error(path: Path, err: BaseException) -> GcalignError:
+    """One line for a failure to write `path`: exit 1 for a full disk, a file-size limit
+    or an I/O error (the run was fine; free space and rerun), exit 2 for a path that cannot
+    be written (permissions, read-only file system, name too long)."""
+    code = getattr(err, "errno", None)
+    if code is None:  # h5py wraps the C library's errno in the message
+        m = re.search(r"errno = (\d+)", str(err))
+        code = int(m.group(1)) if m else None
+    reason = os.strerror(code) if code else (str(err).splitlines() or ["write failed"])[0]
+    if code in _WRITE_ERRNOS or code is None:
+        return GcalignError(f"cannot write {path}: {reason}; nothing was kept under that name")
+    return ScenarioError(f"--output: cannot write {path}: {reason}")
+
+
+def _from_h5py(err: BaseException) -> bool:
+    """Whether `err` was raised inside h5py (a write that the file system refused)."""
+    tb = err.__traceback__
+    last = None
+    while tb is not None:
+        last = tb.tb_frame.f_code.co_filename
+        tb = tb.tb_next
+    return last is not None and f"{os.sep}h5py{os.sep}" in last
+
+
+class _GuardedFile:
+    """The temporary file as HDF5 sees it (h5py's ``fileobj`` driver): a refused write
+    (full disk, ``ulimit -f``) is recorded and reported as success, so HDF5 never meets an
+    error halfway, which it reports only while freeing objects, or by crashing when the file
+    is closed. :func:`atomic_h5` raises the recorded error once HDF5 is done. Writing through
+    the descriptor that mkstemp created also means no other file can be written instead."""
+
+    def __init__(self, raw):
+        self.raw = raw
+        self.error: OSError | None = None
+
+    def write(self, b) -> int:
+        if self.error is None:
+            try:
+                return self.raw.write(b)
+            except OSError as err:
+                self.error = err
+        return len(b)
+
+    def truncate(self, size=None):
+        try:
+            return self.raw.truncate(size)
+        except OSError as err:
+            self.error = self.error or err
+            return size
+
+    def flush(self) -> None:
+        try:
+            self.raw.flush()
+        except OSError as err:
+            self.error = self.error or err
+
+    def read(self, n=-1):
+        return self.raw.read(n)
+
+    def readinto(self, b):
+        return self.raw.readinto(b)
+
+    def seek(self, offset, whence=0):
+        return self.raw.seek(offset, whence)
+
+    def tell(self):
+        return self.raw.tell()
+
+
 @contextmanager
 def atomic_h5(path: Path) -> Iterator[h5py.File]:
     """Open `path` for writing under a temporary name; rename on success, delete on failure.
 
-    An interrupted or failed run therefore never leaves a truncated file under the final name.
+    An interrupted or failed run therefore never leaves a truncated file under the final
+    name, and never a temporary file either (a SIGKILL's is removed by the next run into
+    that folder). The temporary file is created exclusively (:func:`make_temp`) and written
+    through its own descriptor; a write refused by the file system (full disk, ``ulimit
+    -f``) becomes one line (:func:`write_error`).
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    path = check_output(path)
+    fd, tmp = make_temp(path)
+    raw = os.fdopen(fd, "w+b")
+    guard = _GuardedFile(raw)
+    f = None
     try:
-        with h5py.File(tmp, "w") as f:
-            yield f
+        f = h5py.File(guard, "w")
+        yield f
+        f.close()
+        f = None
+        guard.flush()
+        raw.close()
+        if guard.error is not None:
+            raise guard.error
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as err:
+        for closing in (f, raw):
+            try:
+                if closing is not None:
+                    closing.close()
+            except Exception:  # noqa: BLE001 - the file is deleted anyway
+                pass
         tmp.unlink(missing_ok=True)
+        refused = guard.error if guard.error is not None else err
+        if guard.error is not None or (isinstance(err, OSError) and (
+                _from_h5py(err) or err.errno in _WRITE_ERRNOS)):
+            if not isinstance(err, (KeyboardInterrupt, SystemExit)):
+                raise write_error(path, refused) from None
         raise
+
+
+def finite_summary(summary, where: str) -> None:
+    """GcalignError (exit 1) naming the first quantity of a run summary that is NaN or
+    infinite: a result that is not finite is a failure, never a silent exit 0."""
+    stack: list[tuple[str, object]] = [("", summary)]
+    while stack:
+        key, x = stack.pop()
+        if isinstance(x, float) and not math.isfinite(x):
+            raise GcalignError(f"{where}: the result {key or 'value'} is {x} (not finite); the "
+                               "computation diverged (check the loop settings and the sensor "
+                               "errors, or the data)")
+        if isinstance(x, dict):
+            stack.extend((f"{key}.{k}" if key else str(k), v) for k, v in reversed(x.items()))
+        elif isinstance(x, (list, tuple)):
+            stack.extend((f"{key}.{i}" if key else str(i), v) for i, v in
+                         reversed(list(enumerate(x))))
 
 
 def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None, **attrs):
@@ -121,6 +345,10 @@ class Series:
 
 
 def write_header(f: h5py.File, kind: str, scenario_yaml: str, seed: int | None, summary: dict):
+    """Root attributes; GcalignError if the summary holds a number that is not finite."""
+    finite_summary(summary, kind)
+    if seed is not None and not 0 <= int(seed) <= SEED_MAX:
+        raise ScenarioError(f"seed: must be within [0, 2^63), got {_short(seed)}")
     f.attrs["gcalign_version"] = __version__
     f.attrs["kind"] = kind
     f.attrs["command_line"] = " ".join(["gcalign", *sys.argv[1:]])
@@ -168,51 +396,183 @@ def open_results(path: Path) -> h5py.File:
     return f
 
 
+def _short(value, n: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= n else text[:n - 3] + "..."
+
+
+def text_attr(obj, name: str, path: Path) -> str:
+    """A text attribute of a results file (root or group); ScenarioError naming the file and
+    the attribute when it is missing or not text."""
+    where = "root" if obj.name == "/" else obj.name
+    if name not in obj.attrs:
+        raise ScenarioError(f"{path}: {where} attribute {name!r} missing (a damaged or "
+                            "incomplete gcalign results file)")
+    v = obj.attrs[name]
+    if isinstance(v, bytes):
+        try:
+            v = v.decode("utf-8")
+        except UnicodeDecodeError:
+            raise ScenarioError(f"{path}: {where} attribute {name!r} is not UTF-8 text") from None
+    if not isinstance(v, str):
+        raise ScenarioError(f"{path}: {where} attribute {name!r} must be text, got "
+                            f"{_short(v)}")
+    return v
+
+
 def read_summary(path: Path) -> tuple[str, dict, dict]:
-    """``(kind, summary, root attributes)`` of a results file."""
+    """``(kind, summary, root attributes)`` of a results file; ScenarioError naming the file
+    and the attribute if ``kind`` or ``summary_json`` is missing or invalid."""
     with open_results(path) as f:
-        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
-    return str(attrs["kind"]), json.loads(attrs["summary_json"]), attrs
+        kind = text_attr(f, "kind", path)
+        text = text_attr(f, "summary_json", path)
+        attrs = {k: (v.decode("utf-8", "replace") if isinstance(v, bytes) else v)
+                 for k, v in f.attrs.items()}
+    if not re.fullmatch(r"[a-z][a-z_0-9-]{0,40}", kind):
+        raise ScenarioError(f"{path}: root attribute 'kind' must name a command, got "
+                            f"{_short(kind)}")
+    try:
+        summary = json.loads(text)
+    except ValueError as err:
+        raise ScenarioError(f"{path}: root attribute 'summary_json' is not valid JSON "
+                            f"({getattr(err, 'msg', err)})") from None
+    if not isinstance(summary, dict):
+        raise ScenarioError(f"{path}: root attribute 'summary_json' must be a JSON object, got "
+                            f"{type(summary).__name__}")
+    return kind, summary, attrs
+
+
+def _dataset(g, name: str, path: Path) -> np.ndarray:
+    if name not in g or not isinstance(g[name], h5py.Dataset):
+        raise ScenarioError(f"{path}: dataset {g.name}/{name} missing")
+    ds = g[name]
+    if ds.dtype.kind not in "fiu":
+        raise ScenarioError(f"{path}: dataset {ds.name} must hold numbers, got {ds.dtype}")
+    return ds[()]
+
+
+def _vector_attr(g, name: str, path: Path, n: int = 3) -> np.ndarray | None:
+    if name not in g.attrs:
+        return None
+    try:
+        a = np.asarray(g.attrs[name], dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{path}: attribute {g.name} {name!r} must be {n} numbers") from None
+    if a.shape != (n,) or not np.isfinite(a).all():
+        raise ScenarioError(f"{path}: attribute {g.name} {name!r} must be {n} finite numbers, "
+                            f"got {_short(a.tolist())}")
+    return a
+
+
+def imu_series(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, str]:
+    """``(t, dtheta, dv, ts, frame)`` of the ``/imu`` group for a figure (decimated sums
+    allowed, unlike :func:`read_imu`); ScenarioError naming the dataset or attribute when
+    they are missing, not numbers or of mismatched shapes."""
+    with open_results(path) as f:
+        g = f["imu"] if "imu" in f and isinstance(f["imu"], h5py.Group) else None
+        if g is None:
+            raise ScenarioError(f"{path}: holds no /imu group")
+        try:
+            ts = float(np.asarray(g.attrs["ts"]).reshape(()))
+        except (KeyError, TypeError, ValueError):
+            raise ScenarioError(f"{path}: /imu attribute 'ts' (sample interval, s) must be a "
+                                f"number, got {_short(g.attrs.get('ts'))}") from None
+        if not (math.isfinite(ts) and ts > 0):
+            raise ScenarioError(f"{path}: /imu attribute 'ts' must be positive, got {ts!r}")
+        t, dtheta, dv = (_dataset(g, k, path) for k in ("t", "dtheta", "dv"))
+        n = len(t) if t.ndim == 1 else -1
+        for k, a, shape in (("t", t, (n,)), ("dtheta", dtheta, (n, 3)), ("dv", dv, (n, 3))):
+            if n < 1 or a.shape != shape:
+                raise ScenarioError(f"{path}: dataset /imu/{k} must have shape "
+                                    f"{(len(t),) + shape[1:]}, got {a.shape}")
+        frame = g["dtheta"].attrs.get("frame", "body")
+        frame = frame.decode() if isinstance(frame, bytes) else str(frame)
+    return t, dtheta, dv, ts, frame.split(":")[0]
 
 
 def read_truth(path: Path) -> Truth | None:
+    """The stored truth, or None; ScenarioError naming the dataset if it is damaged."""
     with open_results(path) as f:
         if "truth" not in f:
             return None
         g = f["truth"]
-        seg = g["segment"][()].astype(np.int64) if "segment" in g else None
-        return Truth(t=g["t"][()], att=g["att"][()], v_n=g["v_n"][()], pos=g["pos"][()],
-                     segment=seg)
+        t = _dataset(g, "t", path)
+        arrays = {k: _dataset(g, k, path) for k in ("att", "v_n", "pos")}
+        for k, a in arrays.items():
+            if a.shape != (len(t), 3) or not np.isfinite(a).all():
+                raise ScenarioError(f"{path}: dataset /truth/{k} must be finite, shape "
+                                    f"({len(t)}, 3), got shape {a.shape}")
+        seg = _dataset(g, "segment", path).astype(np.int64) if "segment" in g else None
+        return Truth(t=t, att=arrays["att"], v_n=arrays["v_n"], pos=arrays["pos"], segment=seg)
 
 
 def read_imu(path: Path) -> ImuData:
-    """The IMU block stored by ``gcalign simulate`` (so the same data feeds several runs)."""
+    """The IMU block stored by ``gcalign simulate`` (so the same data feeds several runs),
+    validated like recorded data (:func:`gcalign.io.imu_files.check_increments`)."""
+    from gcalign.io.imu_files import check_increments
+
+    scenario = read_scenario(path)
     with open_results(path) as f:
-        if "imu" not in f:
+        if "imu" not in f or not isinstance(f["imu"], h5py.Group):
             raise ScenarioError(f"{path}: holds no /imu group (write one with 'gcalign simulate')")
         g = f["imu"]
+        if "ts" not in g.attrs:
+            raise ScenarioError(f"{path}: /imu attribute 'ts' (sample interval, s) missing")
+        try:
+            ts = float(np.asarray(g.attrs["ts"]).reshape(()))
+        except (TypeError, ValueError):
+            raise ScenarioError(f"{path}: /imu attribute 'ts' must be a number, got "
+                                f"{_short(g.attrs['ts'])}") from None
         if "summed_from_ts" in g.attrs:
             raise ScenarioError(
-                f"{path}: /imu holds increments summed to {1 / float(g.attrs['ts']):g} Hz "
+                f"{path}: /imu holds increments summed to {1 / ts:g} Hz "
                 f"(output.rate_hz); navigation needs every sample (coning and sculling are "
                 f"lost in sums): simulate again with output: {{rate_hz: full}}")
-        extra: dict = {k: np.asarray(g.attrs[k]) for k in ("site", "att0", "v0_n") if k in g.attrs}
-        scenario = yaml.safe_load(str(f.attrs.get("scenario_yaml", ""))) or {}
+        t, dtheta, dv = (_dataset(g, k, path) for k in ("t", "dtheta", "dv"))
+        check_increments(f"{path}: /imu", t, dtheta, dv, ts)
+        extra: dict = {k: _vector_attr(g, k, path) for k in ("site", "att0", "v0_n")
+                       if k in g.attrs}
+        if "site" in extra and not abs(extra["site"][0]) < math.pi / 2:
+            raise ScenarioError(f"{path}: /imu attribute 'site': latitude must lie within "
+                                f"(-pi/2, pi/2) rad, got {extra['site'][0]!r}")
+        if "att0" in extra and not abs(extra["att0"][0]) < math.pi / 2:
+            raise ScenarioError(f"{path}: /imu attribute 'att0': pitch must lie within "
+                                f"(-pi/2, pi/2) rad, got {extra['att0'][0]!r}")
         motion = scenario.get("motion") if isinstance(scenario, dict) else None
         kind = motion.get("kind") if isinstance(motion, dict) else None
+        q_bs = None
+        if "q_bs" in g:
+            q_bs = _dataset(g, "q_bs", path)
+            if q_bs.shape != (len(t), 4) or not np.isfinite(q_bs).all():
+                raise ScenarioError(f"{path}: dataset /imu/q_bs must be finite, shape "
+                                    f"({len(t)}, 4), got {q_bs.shape}")
         return ImuData(
-            t=g["t"][()],
-            dtheta=g["dtheta"][()],
-            dv=g["dv"][()],
-            ts=float(g.attrs["ts"]),
-            source=str(path),
-            meta=({"motion_kind": kind} if kind else {})
-            | ({"q_bs0": np.asarray(g.attrs["q_bs0"])} if "q_bs0" in g.attrs else {}),
-            q_bs=g["q_bs"][()] if "q_bs" in g else None,
+            t=t, dtheta=dtheta, dv=dv, ts=ts, source=str(path),
+            meta=({"motion_kind": kind} if isinstance(kind, str) else {})
+            | ({"q_bs0": _vector_attr(g, "q_bs0", path, 4)} if "q_bs0" in g.attrs else {}),
+            q_bs=q_bs,
             **extra,
         )
 
 
+def read_scenario(path: Path):
+    """The scenario stored in a results file, parsed safely (a mapping, or None)."""
+    from gcalign.io.scenario.loader import loads
+
+    text = read_scenario_yaml(path)
+    data = loads(text, f"{path}: root attribute 'scenario_yaml'") if text.strip() else None
+    if data is not None and not isinstance(data, dict):
+        raise ScenarioError(f"{path}: root attribute 'scenario_yaml' must be a YAML mapping, "
+                            f"got {type(data).__name__}")
+    return data
+
+
 def read_scenario_yaml(path: Path) -> str:
+    """The scenario text stored in a results file; checked to parse safely (no alias bomb,
+    no duplicate key), so that callers may ``yaml.safe_load`` it."""
     with open_results(path) as f:
-        return str(f.attrs["scenario_yaml"])
+        text = text_attr(f, "scenario_yaml", path)
+    from gcalign.io.scenario.loader import loads
+
+    loads(text, f"{path}: root attribute 'scenario_yaml'")
+    return text

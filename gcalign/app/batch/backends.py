@@ -16,7 +16,8 @@ import time
 from gcalign.app.batch.runs import run_chunk, warm_up
 from gcalign.errors import GcalignError
 
-SCHEDULER_TIMEOUT_S = 5.0  # connecting to a Dask scheduler; the message comes within 10 s
+SCHEDULER_TIMEOUT_S = 4.0  # each step of connecting to a Dask scheduler (README: ≤ 15 s)
+WORKERS_TIMEOUT_S = 4.0  # waiting for a scheduler's first worker
 
 
 def _watch_parent(parent: int) -> None:  # pragma: no cover - runs in workers
@@ -27,9 +28,13 @@ def _watch_parent(parent: int) -> None:  # pragma: no cover - runs in workers
 
 
 def _init_worker(command: str) -> None:  # pragma: no cover - runs in workers
-    """Process-pool initializer: Ctrl-C is the parent's business; exit with the parent;
-    load the JIT cache once."""
+    """Process-pool initializer: Ctrl-C is the parent's business, SIGTERM kills; exit with
+    the parent; load the JIT cache once."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # A forked worker inherits the command's SIGTERM handler (which raises, so that the
+    # command removes its temporary files): a worker that the pool terminates must die,
+    # not send the exception back through a queue nobody reads any more (a hang at exit).
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True).start()
     warm_up(command)
 
@@ -112,20 +117,67 @@ class LocalBackend:
             self._pool.shutdown(wait=True)
 
 
-def dask_client(address: str, timeout: float = SCHEDULER_TIMEOUT_S):
-    """A ``distributed.Client`` connected to `address`; GcalignError if Dask is missing or
-    the scheduler does not answer within `timeout` seconds."""
+def _probe(address: str, timeout: float) -> None:
+    """Ask `address` for its identity, all of it within `timeout` s: a listener that is not a
+    Dask scheduler (a plain TCP or HTTP server) accepts the connection and never answers
+    what ``distributed.Client`` waits for, without a time limit."""
+    import asyncio
+
+    from distributed.comm import connect
+
+    async def ask() -> dict:
+        comm = await connect(address, timeout=timeout)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    reply = asyncio.run(asyncio.wait_for(ask(), timeout))
+    if not isinstance(reply, dict) or reply.get("type") != "Scheduler":
+        raise OSError(f"not a Dask scheduler (it answered {str(reply)[:60]!r})")
+
+
+def dask_client(address: str, timeout: float = SCHEDULER_TIMEOUT_S,
+                workers_timeout: float = WORKERS_TIMEOUT_S):
+    """A ``distributed.Client`` connected to `address` with at least one worker; GcalignError
+    (one line) if Dask is missing, `address` is not a scheduler that answers within
+    `timeout` seconds, or no worker joins within `workers_timeout` s. The whole attempt
+    takes at most ``2 * timeout + workers_timeout`` (15 s by default)."""
     try:
         import distributed
     except ImportError:
         raise GcalignError('--scheduler needs Dask distributed, which is not installed: '
                            'pip install -e ".[dask]"') from None
-    try:
-        return distributed.Client(address, timeout=timeout, set_as_default=False)
-    except Exception as err:  # OSError, TimeoutError, ValueError (bad address), ...
+
+    def fail(err: BaseException) -> GcalignError:
         msg = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise GcalignError(f"cannot reach the Dask scheduler at {address} "
-                           f"(waited {timeout:g} s): {msg}") from None
+        return GcalignError(f"cannot reach the Dask scheduler at {address} "
+                            f"(waited {timeout:g} s): {msg[:120]}")
+
+    try:
+        _probe(address, timeout)
+    except Exception as err:  # OSError, TimeoutError, ValueError (bad address), ...
+        raise fail(err) from None
+    try:
+        client = distributed.Client(address, timeout=timeout, set_as_default=False)
+    except Exception as err:
+        raise fail(err) from None
+    try:
+        client.wait_for_workers(1, timeout=workers_timeout)
+    except Exception:
+        _close(client)
+        raise GcalignError(f"the Dask scheduler at {address} has no workers (waited "
+                           f"{workers_timeout:g} s); start some with 'dask worker {address}'"
+                           ) from None
+    return client
+
+
+def _close(client) -> None:
+    try:
+        client.close(timeout=SCHEDULER_TIMEOUT_S)
+    except Exception:  # noqa: BLE001 - closing a broken connection
+        pass
 
 
 class DaskBackend:
@@ -179,10 +231,7 @@ class DaskBackend:
         return list(self.client.run(fn).values())
 
     def close(self, cancel: bool = False) -> None:
-        try:
-            self.client.close(timeout=SCHEDULER_TIMEOUT_S)
-        except Exception:  # noqa: BLE001 - closing a broken connection
-            pass
+        _close(self.client)
 
 
 def make_backend(command: str, workers: int | None = None, scheduler: str | None = None):

@@ -21,7 +21,7 @@ from gcalign.app.batch.aggregate import batch_summary
 from gcalign.app.batch.backends import LocalBackend, WorkerLost, make_backend
 from gcalign.app.batch.store import (
     Journal,
-    _clean_stale_tmp,
+    OutputLock,
     journal_path,
     previous_records,
     read_journal,
@@ -83,34 +83,86 @@ def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
     Returns the summary (also in the file) and the records. A failing run never raises;
     a worker process that dies takes its runs with it, and each is retried once alone.
     """
-    output = Path(output)
+    from gcalign.io.results import check_output, clean_stale_temps
+
+    output = check_output(output)
+    jpath = journal_path(output)
+    if jpath.exists() and not jpath.is_file():
+        raise ScenarioError(f"--output: the journal {jpath} exists and is not a regular file")
     log = log or (lambda msg: None)
     t_start = time.perf_counter()
-    _clean_stale_tmp(output)
     keys = sweep.run_keys()
-    records: dict[tuple[int, int], dict] = {}
-    reused = 0
-    if resume:
-        records, where = previous_records(sweep, output)
-        reused = len(records)
-        if where:
-            log(f"resuming from {where}: {reused} of {len(keys)} run(s) already finished")
-        else:
-            log(f"nothing to resume at {output}: starting afresh")
-    todo = [k for k in keys if k not in records]
+    n_workers = _workers(workers, scheduler, len(keys))
+    with OutputLock(output):
+        clean_stale_temps(output.parent)
+        records: dict[tuple[int, int], dict] = {}
+        reused = 0
+        notes: list[str] = []  # shown once the scheduler has answered: a failure is one line
+        if resume:
+            records, where = previous_records(sweep, output, notes.append)
+            reused = len(records)
+            if where:
+                notes.append(f"resuming from {where}: {reused} of {len(keys)} run(s) already "
+                             "finished")
+            else:
+                notes.append(f"nothing to resume at {output}: starting afresh")
+        todo = [k for k in keys if k not in records]
+        budget_check(sweep, n_workers if not scheduler else 1)
 
-    # Connect before touching the journal: an unreachable scheduler loses nothing.
-    if backend is None and todo:
-        backend = make_backend(sweep.command, min(workers or os.cpu_count() or 1, len(todo)),
-                               scheduler)
-    jpath = journal_path(output)
-    if not resume and jpath.is_file():
-        n_old = len(read_journal(jpath))
-        if n_old:
-            log(f"discarding {jpath} ({n_old} finished run(s)); use --resume to continue it")
+        # Connect before touching the journal: an unreachable scheduler loses nothing, and
+        # a new batch leaves no file behind.
+        if backend is None and todo:
+            backend = make_backend(sweep.command, min(n_workers, len(todo)), scheduler)
+        for note in notes:
+            log(note)
+        if not resume and jpath.is_file():
+            n_old = len(read_journal(jpath))
+            if n_old:
+                log(f"discarding {jpath} ({n_old} finished run(s)); use --resume to continue "
+                    "it")
+        return _run(sweep, output, jpath, records, reused, todo, backend, progress, keys,
+                    chunk_size, rebuild_every_s, t_start, resume)
+
+
+def _workers(workers: int | None, scheduler: str | None, runs: int) -> int:
+    from gcalign import limits
+
+    if scheduler:
+        return 1
+    n = workers or os.cpu_count() or 1
+    if workers is not None:
+        limits.MAX_WORKERS.check(workers, "--workers",
+                                 f"this machine has {os.cpu_count()} core(s)")
+    return max(1, min(n, runs))
+
+
+def budget_check(sweep: Sweep, workers: int) -> None:
+    """The memory of `workers` runs held at once (each worker keeps its variant's
+    noise-free simulation) against the limit, before anything runs."""
+    from gcalign.app.preflight import budget, extent
+    from gcalign.io.scenario import parse_scenario
+
+    v = max(sweep.variants, key=lambda v: _duration(v.scenario))
+    sc = parse_scenario(v.scenario, f"{sweep.source}: variant {v.label}")
+    ext = extent(sc, read_recorded=False)
+    if ext is not None:
+        budget(sc, "batch", ext, workers, where=f"{sweep.source}: variant {v.label}")
+
+
+def _duration(scenario: dict) -> float:
+    motion = scenario.get("motion") if isinstance(scenario, dict) else None
+    d = motion.get("duration_s") if isinstance(motion, dict) else None
+    rate = (scenario.get("imu") or {}).get("rate_hz", 100.0) if isinstance(
+        scenario.get("imu"), dict) else 100.0
+    return float(d or 0.0) * float(rate or 0.0)
+
+
+def _run(sweep, output, jpath, records, reused, todo, backend, progress, keys, chunk_size,
+         rebuild_every_s, t_start, resume) -> BatchResult:
     header = {"type": "header", "sweep": sweep.name, "source": sweep.source,
               "fingerprint": sweep.fingerprint, "runs": len(keys)}
     journal = Journal(jpath, header, [{"type": "run", **r} for r in records.values()])
+    existed = output.exists()
 
     extra = {"workers": None if backend is None else backend.workers,
              "executor": None if backend is None else backend.description}
@@ -128,16 +180,23 @@ def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
             _drive(backend, sweep, todo, records, journal, progress, len(keys),
                    chunk_size, rebuild, rebuild_every_s)
         summary = rebuild()
-    except BaseException:
-        # Ctrl-C, a bad metric, ...: keep what finished (journal + a consistent file).
+    except BaseException as err:
+        # Ctrl-C, a full disk, ...: keep what finished (journal + a consistent file). A bad
+        # metric is a bad sweep: a new batch then leaves nothing behind.
         if backend is not None:
             backend.close(cancel=True)
             backend = None
         journal.close()
-        try:
-            rebuild()
-        except Exception:  # noqa: BLE001 - the journal still holds every finished run
-            pass
+        if isinstance(err, ScenarioError) and not resume:
+            jpath.unlink(missing_ok=True)
+            if not existed:
+                output.unlink(missing_ok=True)
+            raise
+        if journal.exists:
+            try:
+                rebuild()
+            except Exception:  # noqa: BLE001 - the journal still holds every finished run
+                pass
         raise
     finally:
         if backend is not None:

@@ -10,6 +10,7 @@ errors (and variants that differ only in errors or algorithm settings share it).
 from __future__ import annotations
 
 import copy
+import difflib
 import os
 import sys
 import time
@@ -57,10 +58,10 @@ def run_summary(command: str, sc, seed: int, cache_key: str | None = None) -> di
     from gcalign.app.registry import command as lookup
 
     try:
-        room = lookup(command).load()
+        cmd = lookup(command)
     except KeyError as err:
         raise GcalignError(str(err.args[0])) from None
-    return room.execute(sc, seed, cache_key).summary
+    return cmd.execute(sc, seed, cache_key).summary
 
 
 def metric_value(summary: dict, path: str):
@@ -71,8 +72,13 @@ def metric_value(summary: dict, path: str):
         here = ".".join(parts[:depth]) or "the run summary"
         if isinstance(node, dict):
             if part not in node:
-                raise MetricError(f"metric {path!r}: {here} has no {part!r}; it has: "
-                                  f"{', '.join(map(str, node))}")
+                names = [str(k) for k in node]
+                # the closest names first: the list is cut, and a typo's fix should show
+                close = difflib.get_close_matches(part, names, n=3, cutoff=0.6)
+                names = close + [n for n in names if n not in close]
+                more = f", … ({len(names) - 12} more)" if len(names) > 12 else ""
+                raise MetricError(f"metric {path[:60]!r}: {here} has no {part[:40]!r}; it has: "
+                                  f"{', '.join(names[:12])}{more}")
             node = node[part]
         elif isinstance(node, list):
             if not part.isdigit() or int(part) >= len(node):

@@ -12,16 +12,19 @@ or more grid values reuses every run it already has.
 
 from __future__ import annotations
 
+import hashlib
 import json
+import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
+from typing import TextIO
 
 import numpy as np
 
 from gcalign.app.batch.aggregate import STATS, components, metric_units
 from gcalign.app.batch.sweep import Sweep
-from gcalign.errors import ScenarioError
+from gcalign.errors import GcalignError, ScenarioError
 
 JOURNAL_SUFFIX = ".journal.jsonl"
 
@@ -31,49 +34,204 @@ def journal_path(output: Path) -> Path:
     return output.with_name(output.name + JOURNAL_SUFFIX)
 
 
+def _checksum(record: dict) -> str:
+    body = {k: v for k, v in record.items() if k != "check"}
+    text = json.dumps(body, sort_keys=True, separators=(",", ":"), allow_nan=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _journal_error(path: Path, err: OSError) -> GcalignError:
+    return GcalignError(f"cannot write the journal {path}: {err.strerror or err}; the runs "
+                        "journaled so far are kept: free space and rerun with --resume")
+
+
 class Journal:
-    """Append-only JSON lines; each batch of lines is flushed and fsync'd."""
+    """Append-only JSON lines, each record with a checksum; each batch of lines is flushed
+    and fsync'd.
+
+    The file is created at the first :meth:`append` (a batch that fails before any run
+    finished leaves none), from a clean start: header + the records kept from a resume,
+    written under a temporary name and renamed, so that a torn last line from a SIGKILL is
+    never appended to. A failing write (full disk) is one line, exit 1; the lines written
+    before it stay valid.
+    """
 
     def __init__(self, path: Path, header: dict, keep: Iterable[dict] = ()):
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        # Start from a clean file (a torn last line from a SIGKILL must not be appended to):
-        # header + the records kept, written under a temporary name and renamed.
-        tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
-        with open(tmp, "w", encoding="utf-8") as f:
-            for obj in (header, *keep):
-                f.write(json.dumps(obj) + "\n")
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, self.path)
-        self._f = open(self.path, "a", encoding="utf-8")  # noqa: SIM115
+        self.header = header
+        self.keep = [_signed(r) for r in keep]
+        self._f: TextIO | None = None
+        if self.keep:
+            self._open()
+
+    def _open(self) -> None:
+        from gcalign.io.results import make_temp
+
+        fd, tmp = make_temp(self.path)
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                for obj in (self.header, *self.keep):
+                    f.write(json.dumps(obj) + "\n")
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(tmp, self.path)
+            self._f = open(self.path, "a", encoding="utf-8")  # noqa: SIM115
+        except OSError as err:
+            tmp.unlink(missing_ok=True)
+            raise _journal_error(self.path, err) from None
+
+    @property
+    def exists(self) -> bool:
+        return self._f is not None
 
     def append(self, records: Iterable[dict]) -> None:
-        for r in records:
-            self._f.write(json.dumps({"type": "run", **r}) + "\n")
-        self._f.flush()
-        os.fsync(self._f.fileno())
+        records = list(records)
+        if not records:
+            return
+        if self._f is None:
+            self._open()
+        assert self._f is not None
+        try:
+            for r in records:
+                self._f.write(json.dumps(_signed({"type": "run", **r})) + "\n")
+            self._f.flush()
+            os.fsync(self._f.fileno())
+        except OSError as err:
+            raise _journal_error(self.path, err) from None
 
     def close(self) -> None:
-        self._f.close()
-
-
-def read_journal(path: Path) -> list[dict]:
-    """Run records of a journal; a torn line (the process was killed mid-write) is skipped."""
-    out = []
-    with open(path, encoding="utf-8") as f:
-        for line in f:
+        if self._f is not None:
             try:
-                obj = json.loads(line)
-            except json.JSONDecodeError:
-                continue
-            if isinstance(obj, dict) and obj.get("type") == "run":
-                out.append(obj)
+                self._f.close()
+            except OSError:
+                pass
+
+
+class OutputLock:
+    """An exclusive lock on a batch output while the batch runs: ``flock`` on
+    ``.NAME.lock`` beside it, which the kernel releases when the process dies (SIGKILL
+    included). A second batch into the same output is refused with one line (exit 1)
+    instead of discarding the first one's journal. The lock file is removed on release."""
+
+    def __init__(self, output: Path):
+        self.output = Path(output)
+        self.path = self.output.with_name(f".{self.output.name}.lock")
+        self.fd: int | None = None
+
+    def __enter__(self) -> OutputLock:
+        import fcntl
+
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            from gcalign.io.results import write_error
+
+            raise write_error(self.output, err) from None
+        for _ in range(100):
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
+            except OSError as err:
+                from gcalign.io.results import write_error
+
+                raise write_error(self.output, err) from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
+                os.close(fd)
+                raise GcalignError(f"{self.output}: another batch (pid {holder}) is writing it; "
+                                   "wait for it to finish, or give another -o") from None
+            try:  # the previous holder may have removed the file between open and flock
+                same = os.stat(self.path, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                os.ftruncate(fd, 0)
+                os.write(fd, f"{os.getpid()}\n".encode())
+                self.fd = fd
+                return self
+            os.close(fd)
+        raise GcalignError(f"{self.output}: cannot take the lock {self.path}")
+
+    def __exit__(self, *exc) -> None:
+        if self.fd is not None:
+            self.path.unlink(missing_ok=True)
+            os.close(self.fd)
+            self.fd = None
+
+
+def _signed(record: dict) -> dict:
+    r = {k: v for k, v in record.items() if k != "check"}
+    r["check"] = _checksum(r)
+    return r
+
+
+def valid_record(r, metrics: Iterable[str] | None = None) -> bool:
+    """Whether a journal line is a run record this version wrote: its fields and types,
+    its checksum (a torn, edited or foreign line fails it), finite metric values."""
+    if not isinstance(r, dict) or r.get("type") != "run" or r.get("check") != _checksum(r):
+        return False
+    if not (isinstance(r.get("variant"), int) and isinstance(r.get("seed"), int)
+            and isinstance(r.get("vkey"), str) and r.get("status") in ("ok", "failed")
+            and isinstance(r.get("metrics"), dict)):
+        return False
+    if r["status"] == "ok":
+        for m in (metrics if metrics is not None else r["metrics"]):
+            if not _finite_metric(r["metrics"].get(m)):
+                return False
+    return True
+
+
+def _finite_metric(v) -> bool:
+    if isinstance(v, bool):
+        return False
+    if isinstance(v, (int, float)):
+        return math.isfinite(v)
+    return isinstance(v, list) and bool(v) and all(_finite_metric(x) and not isinstance(x, list)
+                                                   for x in v)
+
+
+def read_journal(path: Path, metrics: Iterable[str] | None = None,
+                 log=None) -> list[dict]:
+    """Run records of a journal. Lines that are not valid records (torn by a SIGKILL,
+    garbage, edited, NaN or missing metrics) are skipped, and `log` is told how many."""
+    out = []
+    skipped = 0
+    metrics = list(metrics) if metrics is not None else None
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for line in f:
+                if not line.strip():
+                    continue
+                try:
+                    obj = json.loads(line)
+                except ValueError:
+                    skipped += 1
+                    continue
+                if isinstance(obj, dict) and obj.get("type") == "header":
+                    continue
+                if valid_record(obj, metrics):
+                    out.append(obj)
+                else:
+                    skipped += 1
+    except OSError as err:
+        raise ScenarioError(f"{path}: cannot read the journal ({err.strerror or err})") from None
+    if skipped and log is not None:
+        log(f"{path}: skipped {skipped} line(s) that are not valid run records (torn, damaged "
+            "or edited); those runs run again")
     return out
 
 
 def read_runs_h5(path: Path) -> list[dict]:
     """Run records from a batch results file (``/batch/runs``)."""
+    try:
+        return _runs_h5(path)
+    except (KeyError, TypeError, ValueError, IndexError, OSError) as err:
+        raise ScenarioError(f"{path}: /batch/runs is damaged ({type(err).__name__}: "
+                            f"{str(err)[:60]})") from None
+
+
+def _runs_h5(path: Path) -> list[dict]:
     from gcalign.io import results
 
     with results.open_results(path) as f:
@@ -186,35 +344,19 @@ def _attr(value):
     return json.dumps(value, default=str)
 
 
-def _clean_stale_tmp(output: Path) -> None:
-    """Remove temporary files of our output left by a killed batch (dead pid only)."""
-    for p in output.parent.glob(f".{output.name}.*.tmp"):
-        try:
-            pid = int(p.name.rsplit(".", 2)[-2])
-        except ValueError:
-            continue
-        if pid != os.getpid() and not _alive(pid):
-            p.unlink(missing_ok=True)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
-def previous_records(sweep: Sweep, output: Path) -> tuple[dict, str]:
+def previous_records(sweep: Sweep, output: Path, log=None) -> tuple[dict, str]:
     """Finished runs of an earlier batch into `output` that this sweep still contains:
-    from the journal, else from the HDF5 file. Failed runs are not kept (they run again)."""
+    from the journal, else from the HDF5 file. Failed runs are not kept (they run again),
+    nor records that are damaged or hold metrics that are not finite."""
     jpath = journal_path(output)
+    if jpath.exists() and not jpath.is_file():
+        raise ScenarioError(f"{jpath}: not a regular file (the journal of {output})")
     if jpath.is_file():
-        recs, where = read_journal(jpath), str(jpath)
+        recs, where = read_journal(jpath, sweep.metrics, log), str(jpath)
     elif Path(output).is_file():
         recs, where = read_runs_h5(output), str(output)
+        recs = [r for r in recs if r["status"] != "ok"
+                or all(_finite_metric(r["metrics"].get(m)) for m in sweep.metrics)]
     else:
         return {}, ""
     index = {v.key: v.index for v in sweep.variants}

@@ -18,12 +18,16 @@ import copy
 import hashlib
 import itertools
 import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
 from gcalign.app.batch.overrides import apply_override
+from gcalign.app.preflight import total_runs
 from gcalign.app.registry import batchable
 from gcalign.errors import ScenarioError
+from gcalign.io.scenario.loader import _cut
+from gcalign.limits import SEED_MAX
 
 COMMANDS = tuple(batchable())
 DEFAULT_METRICS = {name: c.batch_metrics for name, c in batchable().items()}
@@ -121,7 +125,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     name = data.get("name", default_name)
     if not isinstance(name, str) or not name or any(c in name for c in "/\\ \t"):
         raise ScenarioError(f"{source}: name: must be a non-empty word (used in file names), "
-                            f"got {name!r}")
+                            f"got {_cut(name)}")
 
     # Base scenario: a file relative to the sweep, or an inline mapping.
     if "base" not in data:
@@ -131,7 +135,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     if isinstance(base, str):
         base_path = (base_dir / base) if not Path(base).is_absolute() else Path(base)
         if not base_path.is_file():
-            raise ScenarioError(f"{source}: base: {base!r}: file not found ({base_path})")
+            raise ScenarioError(f"{source}: base: {_cut(base)}: file not found ({base_path})")
         base_data = read_yaml(base_path)
         base_source, base_text = str(base_path), base_path.read_text(encoding="utf-8")
         imu_dir = base_path.parent
@@ -140,7 +144,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
         base_text, imu_dir = yaml.safe_dump(base, sort_keys=False), base_dir
     else:
         raise ScenarioError(f"{source}: base: must be a scenario file name or a mapping, "
-                            f"got {type(base).__name__} {base!r}")
+                            f"got {type(base).__name__} {_cut(base)}")
     if isinstance(base_data, dict) and isinstance(base_data.get("imu_file"), str):
         p = Path(base_data["imu_file"])  # workers may run elsewhere: make it absolute
         base_data["imu_file"] = str(p if p.is_absolute() else (imu_dir / p).resolve())
@@ -156,28 +160,32 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
         command = has[0] if has else "align"
     if command not in COMMANDS:
         raise ScenarioError(f"{source}: command: must be one of {', '.join(COMMANDS)}, "
-                            f"got {command!r}")
+                            f"got {_cut(command)}")
 
     seeds = data.get("seeds", 1)
     if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
         raise ScenarioError(f"{source}: seeds: must be a whole number ≥ 1 (the seed count), "
-                            f"got {seeds!r}")
+                            f"got {_cut(seeds)}")
     seed_start = data.get("seed_start", 1)
     if isinstance(seed_start, bool) or not isinstance(seed_start, int) or seed_start < 0:
-        raise ScenarioError(f"{source}: seed_start: must be a whole number ≥ 0, got {seed_start!r}")
+        raise ScenarioError(f"{source}: seed_start: must be a whole number ≥ 0, got "
+                            f"{_cut(seed_start)}")
+    if seed_start + seeds - 1 > SEED_MAX:
+        raise ScenarioError(f"{source}: seed_start: the seeds {seed_start} .. "
+                            f"{seed_start + seeds - 1} pass 2^63 - 1 (seeds are signed 64-bit)")
 
     metrics = data.get("metrics", list(DEFAULT_METRICS[command]))
     if isinstance(metrics, str):
         metrics = [metrics]
     if not isinstance(metrics, list) or not metrics:
         raise ScenarioError(f"{source}: metrics: must be a non-empty list of dotted paths into "
-                            f"the run summary (e.g. [error_t3_deg]), got {metrics!r}")
+                            f"the run summary (e.g. [error_t3_deg]), got {_cut(metrics)}")
     for m in metrics:
         if not isinstance(m, str) or not m or "/" in m or any(p == "" for p in m.split(".")):
-            raise ScenarioError(f"{source}: metrics: {m!r} is not a dotted path "
+            raise ScenarioError(f"{source}: metrics: {_cut(m)} is not a dotted path "
                                 "(e.g. error_t3_deg, passes.2.error_deg)")
     if len(set(metrics)) != len(metrics):
-        raise ScenarioError(f"{source}: metrics: {metrics!r} names a metric twice")
+        raise ScenarioError(f"{source}: metrics: {_cut(metrics)} names a metric twice")
 
     grid = data.get("grid") or {}
     if not isinstance(grid, dict):
@@ -187,7 +195,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     axes: dict[str, list] = {}
     for key, values in grid.items():
         if not isinstance(key, str) or not key:
-            raise ScenarioError(f"{source}: grid: {key!r}: keys must be dotted paths "
+            raise ScenarioError(f"{source}: grid: {_cut(key)}: keys must be dotted paths "
                                 "(e.g. align.mode)")
         if key == CASE_KEY:
             raise ScenarioError(f"{source}: grid: {CASE_KEY}: reserved for the names of the "
@@ -200,8 +208,11 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
         seen = [json.dumps(v, sort_keys=True, default=str) for v in values]
         for i, s in enumerate(seen):
             if s in seen[:i]:
-                raise ScenarioError(f"{source}: grid: {key}: value {values[i]!r} appears twice")
+                raise ScenarioError(f"{source}: grid: {key}: value {_cut(values[i])} appears twice")
         axes[key] = values
+
+    n_variants = math.prod(len(v) for v in axes.values()) * max(1, len(cases))
+    total_runs(n_variants, seeds, source)
 
     # Each case alone, then each grid key and value alone against the base: a message that
     # names exactly that case or pair.
@@ -212,7 +223,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
             try:
                 apply_override(trial, key, value, base_model)
             except ScenarioError as err:
-                raise ScenarioError(f"{where}: {key} = {value!r}: {err}") from None
+                raise ScenarioError(f"{where}: {key} = {_cut(value)}: {err}") from None
         _check_section(parse_scenario(trial, where), command, where)
     for key, values in axes.items():
         for value in values:
@@ -220,8 +231,8 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
             try:
                 apply_override(trial, key, value, base_model)
             except ScenarioError as err:
-                raise ScenarioError(f"{source}: grid: {key} = {value!r}: {err}") from None
-            where = f"{source}: grid: {key} = {value!r}"
+                raise ScenarioError(f"{source}: grid: {key} = {_cut(value)}: {err}") from None
+            where = f"{source}: grid: {key} = {_cut(value)}"
             _check_section(parse_scenario(trial, where), command, where)
 
     # Then every combination (a value may be valid alone but not with another one). A case's
@@ -233,7 +244,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     for i, combo in enumerate(itertools.product(*(axes[k] for k in keys))):
         overrides = dict(zip(keys, combo, strict=True))
         scenario = copy.deepcopy(base_data)
-        label = ", ".join(f"{k} = {v!r}" for k, v in overrides.items())
+        label = ", ".join(f"{k} = {_cut(v)}" for k, v in overrides.items())
         applied = [*cases.get(str(overrides.get(CASE_KEY)), {}).items(),
                    *((k, v) for k, v in overrides.items() if k != CASE_KEY)]
         try:
@@ -257,36 +268,37 @@ def _cases(cases, source: str) -> dict[str, dict]:
         return {}
     if not isinstance(cases, dict) or not cases:
         raise ScenarioError(f"{source}: cases: must be a non-empty mapping of case name -> "
-                            f"overrides (dotted key -> value), got {cases!r}")
+                            f"overrides (dotted key -> value), got {_cut(cases)}")
     out: dict[str, dict] = {}
     for name, over in cases.items():
         if not isinstance(name, str) or not name.strip():
-            raise ScenarioError(f"{source}: cases: {name!r}: a case name must be a non-empty "
+            raise ScenarioError(f"{source}: cases: {_cut(name)}: a case name must be a non-empty "
                                 "string")
         over = {} if over is None else over
         if not isinstance(over, dict):
             raise ScenarioError(f"{source}: cases: {name}: must be a mapping of dotted key -> "
-                                f"value (or empty), got {over!r}")
+                                f"value (or empty), got {_cut(over)}")
         for key in over:
             if not isinstance(key, str) or not key:
-                raise ScenarioError(f"{source}: cases: {name}: {key!r}: keys must be dotted "
+                raise ScenarioError(f"{source}: cases: {name}: {_cut(key)}: keys must be dotted "
                                     "paths (e.g. imu.gyro.arw_dprh)")
         out[name] = dict(over)
     return out
 
 
 def _check_section(sc, command: str, where: str) -> None:
-    """The command's own checks that need the whole scenario (e.g. ``northfind.check``)."""
+    """The checks a run of the command makes first (:func:`gcalign.app.preflight.preflight`:
+    the section's own ``check``, times against the data, the cost of one run)."""
+    from gcalign.app.preflight import preflight
+
     section = getattr(sc, command, None)
     if section is None and command != "align":
-        raise ScenarioError(f"{where}: {command}: missing; command {command!r} needs a "
+        raise ScenarioError(f"{where}: {command}: missing; command {_cut(command)} needs a "
                             f"'{command}' section in the base scenario")
-    check = getattr(section, "check", None)
-    if callable(check):
-        try:
-            check(sc)
-        except ScenarioError as err:
-            raise ScenarioError(f"{where}: {err}") from None
+    try:
+        preflight(sc, command, read_recorded=False)
+    except ScenarioError as err:
+        raise ScenarioError(f"{where}: {err}") from None
 
 
 #: The pseudo grid key of a batch over a list of scenario files: each file is a variant.

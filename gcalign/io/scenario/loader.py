@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import re
+import reprlib
 from pathlib import Path
 
 import yaml
 from pydantic import ValidationError
 
+from gcalign import limits
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.models import Scenario
 from gcalign.io.scenario.motion import MOTION_KINDS
@@ -21,6 +23,22 @@ _FIELD_PREFIX = re.compile(r"^([a-z_0-9]+(?:\.[a-z_0-9]+)*): ")
 # tags of the discriminated motion union).
 _UNION_TAG = re.compile(r"^(float|int|str|bool|constrained-\w+|\w+\[.*\]|"
                         + "|".join(MOTION_KINDS) + r")$")
+
+
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxlist, _REPR.maxdict = 3, 6, 4
+_REPR.maxstring = _REPR.maxother = 60
+_REPR.maxlong = 40
+CUT = 80  #: characters of a bad value echoed in a message
+
+
+def _cut(value) -> str:
+    """A value as a message shows it: repr, at most about CUT characters (a bad value
+    can be megabytes long, or an alias bomb)."""
+    text = value if isinstance(value, str) else _REPR.repr(value)
+    if isinstance(value, str):
+        text = repr(value if len(value) <= CUT else value[:CUT - 3] + "...")
+    return text if len(text) <= CUT + 2 else text[:CUT - 3] + "..."
 
 
 def scenario_errors(err: ValidationError, source: str = "") -> str:
@@ -48,14 +66,14 @@ def scenario_errors(err: ValidationError, source: str = "") -> str:
             where = ".".join([*loc, key])
             allowed = str(ctx.get("expected_tags", "")).replace("'", "") or ", ".join(
                 MOTION_KINDS)
-            msg = (f"allowed: {allowed}, got {ctx['tag']!r}" if "tag" in ctx
+            msg = (f"allowed: {allowed}, got {_cut(ctx['tag'])}" if "tag" in ctx
                    else f"missing; allowed: {allowed}")
             by_field.setdefault(where, [])
             if msg not in by_field[where]:
                 by_field[where].append(msg)
             continue
         elif e["type"] not in {"missing", "model_type", "value_error"}:
-            got_of[where] = f", got {e.get('input')!r}"
+            got_of[where] = f", got {_cut(e.get('input'))}"
         by_field.setdefault(where, [])
         if msg not in by_field[where]:
             by_field[where].append(msg)
@@ -77,21 +95,118 @@ def parse_scenario(data: dict, source: str = "scenario") -> Scenario:
         raise ScenarioError(scenario_errors(err, source)) from None
 
 
-def read_yaml(path: Path) -> dict:
-    """YAML text of a file as a mapping; ScenarioError names the file and the line."""
-    path = Path(path)
-    if not path.is_file():
-        raise ScenarioError(f"{path}: file not found")
+def _mark(node) -> str:
+    m = getattr(node, "start_mark", None)
+    return f"line {m.line + 1}" if m is not None else "?"
+
+
+def check_nodes(root, source: str) -> None:
+    """Refuse what safe_load would accept but no scenario is: a key given twice in one
+    mapping, and aliases that expand past the limit (a "billion laughs" of a few hundred
+    bytes expands to 10^9 values in every later walk). Sizes are counted once per node
+    (anchors share nodes), so the check costs the size of the text, not of the expansion."""
+    limit = limits.MAX_YAML_NODES.value()
+    size: dict[int, int] = {}
+    stack = [(root, False)]
+    while stack:
+        node, done = stack.pop()
+        key = id(node)
+        if done:
+            children = _children(node)
+            total = 1 + sum(size[id(c)] for c in children)
+            size[key] = total
+            if total > limit:
+                raise ScenarioError(
+                    f"{source}: {_mark(node)}: expands to more than {limits._num(limit)} "
+                    f"values (YAML aliases); refused (raise the limit with "
+                    f"{limits.MAX_YAML_NODES.env}=N if intended)")
+            continue
+        if key in size:
+            continue
+        size[key] = -1  # in progress
+        if isinstance(node, yaml.MappingNode):
+            seen: dict[tuple, yaml.Node] = {}
+            for k, _ in node.value:
+                if isinstance(k, yaml.ScalarNode) and k.tag != "tag:yaml.org,2002:merge":
+                    ident = (k.tag, k.value)
+                    if ident in seen:
+                        raise ScenarioError(
+                            f"{source}: {_mark(k)}: key {_cut(k.value)} given twice in one "
+                            f"mapping (first at {_mark(seen[ident])}); remove one")
+                    seen[ident] = k
+        stack.append((node, True))
+        for c in _children(node):
+            if size.get(id(c)) == -1:  # an ancestor: the alias is inside its own anchor
+                raise ScenarioError(f"{source}: {_mark(c)}: an alias refers to the value "
+                                    "that contains it (recursive YAML anchor)")
+            if id(c) not in size:
+                stack.append((c, False))
+
+
+def _children(node) -> list:
+    if isinstance(node, yaml.MappingNode):
+        return [x for pair in node.value for x in pair]
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    return []
+
+
+MAX_DEPTH = 200  #: nesting of flow collections ([ {) refused beyond this
+
+
+def _flow_depth(text: str) -> int:
+    """Deepest nesting of flow brackets outside quoted strings (PyYAML's scanner is
+    quadratic in it: 20000 levels take seconds before its own recursion error)."""
+    bare = re.sub(r'"(?:[^"\\]|\\.)*"|\'[^\']*\'|#[^\n]*', "", text)
+    depth = deepest = 0
+    for c in re.sub(r"[^\[\]{}]", "", bare):
+        depth = depth + 1 if c in "[{" else max(0, depth - 1)
+        deepest = max(deepest, depth)
+    return deepest
+
+
+def loads(text: str, source: str):
+    """Parse YAML text safely (safe tags only, checked by :func:`check_nodes`);
+    ScenarioError names the source and the line."""
+    if _flow_depth(text) > MAX_DEPTH:
+        raise ScenarioError(f"{source}: YAML nested more than {MAX_DEPTH} levels deep")
+    loader = yaml.SafeLoader(text)
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        check_nodes(node, source)
+        return loader.construct_document(node)
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-        raise ScenarioError(f"{path}: YAML syntax error{where}: {problem}") from None
+        raise ScenarioError(f"{source}: YAML syntax error{where}: {problem[:CUT]}") from None
+    except RecursionError:
+        raise ScenarioError(f"{source}: YAML nested too deeply") from None
+    finally:
+        loader.dispose()
+
+
+def read_yaml(path: Path) -> dict:
+    """YAML text of a file as a mapping; ScenarioError names the file and the line."""
+    path = Path(path)
+    if path.is_dir():
+        raise ScenarioError(f"{path}: is a directory, expected a YAML file")
+    if not path.is_file():
+        raise ScenarioError(f"{path}: file not found")
+    try:
+        size = path.stat().st_size
+        limits.MAX_YAML_MB.check(size / 2**20, str(path))
+        text = path.read_bytes().decode("utf-8")
     except UnicodeDecodeError:
         raise ScenarioError(f"{path}: not a text file (expected YAML)") from None
-    return data if data is not None else {}
+    except OSError as err:
+        raise ScenarioError(f"{path}: cannot read ({err.strerror or err})") from None
+    data = loads(text, str(path))
+    if data is None:
+        raise ScenarioError(f"{path}: empty; expected a YAML mapping of keys and values")
+    return data
 
 
 def load_scenario(path: Path) -> tuple[Scenario, str]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -169,6 +170,9 @@ class Scenario(Model):
             raise ValueError("site: missing; a simulated scenario needs a site")
         if self.motion is not None:
             n = self.motion.duration() * self.imu.rate_hz
+            if not math.isfinite(n):  # e.g. a turn of 1e308 degrees
+                raise ValueError(f"motion: a duration of {self.motion.duration():g} s at "
+                                 f"{self.imu.rate_hz:g} Hz is not a number of samples")
             if round(n) < 2:
                 raise ValueError(f"motion.duration_s: {self.motion.duration():g} s holds fewer "
                                  f"than 2 samples at {self.imu.rate_hz} Hz")

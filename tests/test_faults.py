@@ -1,0 +1,417 @@
+"""Faults (issue 14): kill -9 and SIGTERM at random points, a full disk, a second batch on
+the same output, symlinks at temporary names, and Dask schedulers that do not answer.
+
+Runs are child processes (``python -m``-style, the real command line) so that they can be
+killed; every Dask listener is started here on 127.0.0.1 and stops by itself.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import resource
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import fuzz_cases as F
+import h5py
+import numpy as np
+import pytest
+
+from gcalign.io import results
+
+GCALIGN = [sys.executable, "-c", "import sys; from gcalign.cli import main; "
+           "sys.argv[0] = 'gcalign'; main()"]
+DASK_BOUND_S = 15.0  #: README: a scheduler that does not answer fails within this
+
+
+def cli(args, cwd, env=None, limit_fsize=None, timeout=120, **kw):
+    e = {**os.environ, **(env or {})}
+
+    def pre():
+        if limit_fsize is not None:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit_fsize, limit_fsize))
+
+    return subprocess.run(GCALIGN + list(map(str, args)), cwd=cwd, env=e, capture_output=True,
+                          text=True, timeout=timeout, preexec_fn=pre, **kw)
+
+
+def spawn(args, cwd):
+    return subprocess.Popen(GCALIGN + list(map(str, args)), cwd=cwd, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def one_error_line(stderr: str) -> str:
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), stderr
+    assert "Traceback" not in stderr
+    return lines[0]
+
+
+def temps(folder: Path) -> list[str]:
+    return sorted(p.name for p in Path(folder).rglob("*") if p.name.endswith(results.TMP_SUFFIX))
+
+
+def scenario(folder: Path, duration_s: float = 60.0, name: str = "S.yaml") -> Path:
+    d = json.loads(json.dumps(F.S))
+    d["motion"]["duration_s"] = duration_s
+    p = folder / name
+    p.write_text(F.emit(d))
+    return p
+
+
+def sweep(folder: Path, seeds: int = 20) -> Path:
+    scenario(folder)
+    p = folder / "SW.yaml"
+    p.write_text(F.emit({**F.SWEEP, "seeds": seeds}))
+    return p
+
+
+def aggregate_of(path: Path) -> dict:
+    with h5py.File(path, "r") as f:
+        summary = json.loads(f.attrs["summary_json"])
+        runs = sorted(zip(f["batch/runs/variant"][()].tolist(), f["batch/runs/seed"][()].tolist(),
+                          strict=True))
+    return {"variants": summary["variants"], "runs": runs}
+
+
+# --------------------------------------------------------------------------- single runs
+
+
+@pytest.mark.slow  # several seconds of child processes
+def test_kill_9_of_a_run_leaves_no_file_and_the_next_run_removes_its_temp(tmp_path):
+    """kill -9 of simulate at random points (seeded): never a file under the final name; a
+    temp file may remain (nothing can remove it at SIGKILL), and the next run into the folder
+    removes it; then that run completes."""
+    rng = random.Random(14)
+    scenario(tmp_path, duration_s=3000.0, name="L.yaml")  # long enough to be killed in flight
+    for _ in range(3):
+        p = spawn(["simulate", "L.yaml", "-o", "out/l.h5"], tmp_path)
+        deadline = time.monotonic() + 60
+        while not temps(tmp_path / "out") and time.monotonic() < deadline:
+            time.sleep(0.02)  # the temp file exists once the run has started writing
+        time.sleep(rng.uniform(0.0, 1.0))
+        p.kill()
+        p.wait()
+        assert not (tmp_path / "out/l.h5").exists()
+    assert temps(tmp_path / "out")  # SIGKILL leaves them (at least the last one)
+    scenario(tmp_path)
+    res = cli(["simulate", "S.yaml", "-o", "out/s.h5"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert temps(tmp_path / "out") == []
+    assert (tmp_path / "out/s.h5").is_file() and not (tmp_path / "out/l.h5").exists()
+
+
+def test_sigterm_of_a_run_removes_its_temp_file(tmp_path):
+    scenario(tmp_path, duration_s=3000.0, name="L.yaml")
+    p = spawn(["simulate", "L.yaml", "-o", "l.h5"], tmp_path)
+    deadline = time.monotonic() + 60
+    while not temps(tmp_path) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 143
+    assert one_error_line(err) == "error: terminated (SIGTERM)"
+    assert temps(tmp_path) == [] and not (tmp_path / "l.h5").exists()
+
+
+def test_a_symlink_at_a_temporary_name_is_not_followed(tmp_path):
+    """The temp name is random (mkstemp): a symlink planted at the old predictable name, or
+    at any other name, is neither followed nor removed."""
+    target = tmp_path / "precious"
+    target.write_bytes(b"keep me")
+    scenario(tmp_path)
+    for pid in range(os.getpid() - 5, os.getpid() + 50):
+        (tmp_path / f".s.h5.{pid}.tmp").symlink_to(target)
+    res = cli(["align", "S.yaml", "-o", "s.h5"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert target.read_bytes() == b"keep me"
+    assert h5py.is_hdf5(tmp_path / "s.h5")
+
+
+def test_full_disk_is_exit_1_one_line_and_nothing_kept(tmp_path):
+    """``ulimit -f`` (EFBIG; Python ignores SIGXFSZ) while a run writes: exit 1, one line
+    naming the file, no file under the final name, no temp file."""
+    d = json.loads(json.dumps(F.S))
+    d["motion"]["duration_s"] = 600.0
+    d["output"] = {"rate_hz": "full"}  # noisy increments at every sample: about 3 MB
+    d["imu"].update(gyro={"arw_dprh": 0.01}, accel={"vrw_ugrhz": 50})
+    (tmp_path / "S.yaml").write_text(F.emit(d))
+    res = cli(["simulate", "S.yaml", "-o", "s.h5"], tmp_path, limit_fsize=200_000)
+    assert res.returncode == 1, res.stderr
+    line = one_error_line(res.stderr)
+    assert "cannot write s.h5: File too large" in line
+    assert not (tmp_path / "s.h5").exists() and temps(tmp_path) == []
+
+
+def test_output_that_names_a_directory_or_nothing_is_refused_before_the_run(tmp_path):
+    scenario(tmp_path)
+    (tmp_path / "adir").mkdir()
+    for out in ("", ".", "adir", "S.yaml/x.h5"):
+        res = cli(["align", "S.yaml", "-o", out], tmp_path)
+        assert res.returncode == 2, (out, res.stderr)
+        assert "--output" in one_error_line(res.stderr)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["S.yaml", "adir"]
+    assert list((tmp_path / "adir").iterdir()) == []
+
+
+# --------------------------------------------------------------------------- batches
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    d = tmp_path_factory.mktemp("ref")
+    sweep(d)
+    res = cli(["batch", "SW.yaml", "-o", "ref.h5", "-w", "2"], d)
+    assert res.returncode == 0, res.stderr
+    return aggregate_of(d / "ref.h5")
+
+
+@pytest.mark.slow  # several seconds of child processes
+def test_kill_9_of_a_batch_and_resume_give_every_run_once(tmp_path, uninterrupted):
+    """kill -9 at random points (seeded), then --resume until complete: every (variant,
+    seed) exactly once and the uninterrupted aggregate, to the bit."""
+    rng = random.Random(2026)
+    sweep(tmp_path)
+    for attempt in range(3):
+        p = spawn(["batch", "SW.yaml", "-o", "b.h5", "-w", "2"]
+                  + (["--resume"] if attempt else []), tmp_path)
+        time.sleep(rng.uniform(0.5, 4.0))
+        p.kill()
+        p.wait()
+    res = cli(["batch", "SW.yaml", "-o", "b.h5", "-w", "2", "--resume"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert aggregate_of(tmp_path / "b.h5") == uninterrupted
+    assert not (tmp_path / "b.h5.journal.jsonl").exists()
+    assert temps(tmp_path) == [] and not (tmp_path / ".b.h5.lock").exists()
+
+
+@pytest.mark.slow  # several seconds of child processes
+def test_full_disk_during_a_batch_then_resume_completes(tmp_path, uninterrupted):
+    """``ulimit -f`` small enough that the results file cannot be written: exit 1, one line;
+    the journal keeps the finished runs; with the limit lifted, --resume completes with the
+    uninterrupted aggregate."""
+    sweep(tmp_path)
+    res = cli(["batch", "SW.yaml", "-o", "b.h5", "-w", "1"], tmp_path, limit_fsize=6000)
+    assert res.returncode == 1, res.stderr
+    assert "cannot write" in one_error_line(res.stderr)
+    assert temps(tmp_path) == []
+    res = cli(["batch", "SW.yaml", "-o", "b.h5", "-w", "1", "--resume"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert aggregate_of(tmp_path / "b.h5") == uninterrupted
+
+
+@pytest.mark.slow  # several seconds of child processes
+def test_a_second_batch_on_the_same_output_is_refused(tmp_path):
+    sweep(tmp_path, seeds=40)
+    first = spawn(["batch", "SW.yaml", "-o", "b.h5", "-w", "1"], tmp_path)
+    try:
+        deadline = time.monotonic() + 60
+        while not (tmp_path / ".b.h5.lock").exists() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        res = cli(["batch", "SW.yaml", "-o", "b.h5", "-w", "1"], tmp_path)
+        assert res.returncode == 1
+        assert "another batch (pid" in one_error_line(res.stderr)
+    finally:
+        first.kill()
+        first.wait()
+    res = cli(["batch", "SW.yaml", "-o", "b.h5", "-w", "1", "--resume"], tmp_path)
+    assert res.returncode == 0, res.stderr  # the lock died with its holder
+
+
+# --------------------------------------------------------------------------- Dask
+
+
+class Listener:
+    """A TCP listener on 127.0.0.1 that accepts and then says nothing (or an HTTP reply);
+    it stops by itself after `life_s`."""
+
+    def __init__(self, http: bool = False, life_s: float = 40.0):
+        self.sock = socket.socket()
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.listen(8)
+        self.sock.settimeout(0.2)
+        self.port = self.sock.getsockname()[1]
+        self.http, self.life_s = http, life_s
+        self.conns: list[socket.socket] = []
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self):
+        end = time.monotonic() + self.life_s
+        while time.monotonic() < end:
+            try:
+                c, _ = self.sock.accept()
+            except OSError:
+                continue
+            self.conns.append(c)
+            if self.http:
+                c.sendall(b"HTTP/1.1 200 OK\r\nContent-Length: 2\r\n\r\nok")
+        for c in self.conns:
+            c.close()
+        self.sock.close()
+
+
+@pytest.fixture
+def zero_worker_scheduler():
+    """A real Dask scheduler on 127.0.0.1 with no workers (a child process, stopped after)."""
+    pytest.importorskip("distributed")
+    code = ("import asyncio, sys\nfrom distributed import Scheduler\n"
+            "async def main():\n"
+            "    async with Scheduler(host='127.0.0.1', port=0, dashboard_address=None) as s:\n"
+            "        print(s.address, flush=True)\n"
+            "        await asyncio.sleep(60)\n"
+            "asyncio.run(main())\n")
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
+                         stderr=subprocess.DEVNULL)
+    try:
+        address = p.stdout.readline().strip()
+        assert address.startswith("tcp://127.0.0.1:"), address
+        yield address
+    finally:
+        p.kill()
+        p.wait()
+
+
+def _dask_fails_fast(tmp_path, address, expect: str, resume: bool = False):
+    sweep(tmp_path)
+    t0 = time.monotonic()
+    res = cli(["batch", "SW.yaml", "-o", "b.h5", "--scheduler", address]
+              + (["--resume"] if resume else []), tmp_path, timeout=60)
+    elapsed = time.monotonic() - t0
+    assert res.returncode == 1, res.stderr
+    assert expect in one_error_line(res.stderr)
+    assert elapsed < DASK_BOUND_S, elapsed
+    return res
+
+
+@pytest.mark.slow  # several seconds of child processes
+@pytest.mark.parametrize("http", [False, True], ids=["plain-tcp", "http"])
+def test_a_listener_that_is_not_dask_fails_within_the_bound(tmp_path, http):
+    pytest.importorskip("distributed")
+    srv = Listener(http=http)
+    _dask_fails_fast(tmp_path, f"tcp://127.0.0.1:{srv.port}", "cannot reach the Dask scheduler")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["S.yaml", "SW.yaml"]
+
+
+def test_a_bad_address_fails_within_the_bound_without_a_traceback(tmp_path):
+    pytest.importorskip("distributed")
+    res = _dask_fails_fast(tmp_path, "notaurl", "cannot reach the Dask scheduler at notaurl")
+    assert "Exception ignored" not in res.stderr
+
+
+@pytest.mark.slow  # several seconds of child processes
+def test_a_scheduler_without_workers_fails_within_the_bound(tmp_path, zero_worker_scheduler):
+    _dask_fails_fast(tmp_path, zero_worker_scheduler, "has no workers")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["S.yaml", "SW.yaml"]
+
+
+@pytest.mark.slow  # several seconds of child processes
+def test_a_resumed_batch_keeps_its_journal_when_the_scheduler_fails(tmp_path,
+                                                                     zero_worker_scheduler):
+    sweep(tmp_path)
+    p = spawn(["batch", "SW.yaml", "-o", "b.h5", "-w", "1"], tmp_path)
+    deadline = time.monotonic() + 60
+    journal = tmp_path / "b.h5.journal.jsonl"
+    while time.monotonic() < deadline and (not journal.exists()
+                                           or len(journal.read_text().splitlines()) < 3):
+        time.sleep(0.02)
+    p.kill()
+    p.wait()
+    before = journal.read_bytes()
+    _dask_fails_fast(tmp_path, zero_worker_scheduler, "has no workers", resume=True)
+    assert journal.read_bytes() == before
+
+
+@pytest.mark.slow  # several seconds of child processes
+def test_resume_rejects_damaged_records_and_reruns_them(tmp_path, uninterrupted):
+    """A journal with garbage, records without metrics, NaN or short-list metrics: those
+    lines are skipped (a note says how many) and their runs run again; the aggregate is the
+    uninterrupted one."""
+    sweep(tmp_path)
+    good = cli(["batch", "SW.yaml", "-o", "ref.h5", "-w", "1"], tmp_path)
+    assert good.returncode == 0
+    header = json.dumps({"type": "header"})
+    bad = [b"\x00\xff garbage", b'{"type": "run", "variant": 0, "seed": 1}',
+           json.dumps({"type": "run", "variant": 0, "vkey": "x", "seed": 1, "status": "ok",
+                       "metrics": {"error_t3_deg": [float("nan"), 0, 0]}}).encode(),
+           json.dumps({"type": "run", "variant": 0, "vkey": "x", "seed": 2, "status": "ok",
+                       "metrics": {"error_t3_deg": [0.1]}}).encode()]
+    (tmp_path / "b.h5.journal.jsonl").write_bytes(header.encode() + b"\n" + b"\n".join(bad))
+    res = cli(["batch", "SW.yaml", "-o", "b.h5", "-w", "1", "--resume"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "skipped 4 line(s)" in res.stderr
+    assert aggregate_of(tmp_path / "b.h5") == uninterrupted
+    assert np.isfinite(np.asarray(aggregate_of(tmp_path / "b.h5")["runs"])).all()
+
+
+def test_plot_into_an_existing_file_or_under_one_is_one_line(tmp_path):
+    scenario(tmp_path)
+    assert cli(["align", "S.yaml", "-o", "s.h5"], tmp_path).returncode == 0
+    (tmp_path / "afile").write_text("x")
+    for out in ("afile", "afile/figs"):
+        res = cli(["plot", "s.h5", "-o", out], tmp_path)
+        assert res.returncode == 2, res.stderr
+        assert "--output" in one_error_line(res.stderr)
+    assert (tmp_path / "afile").read_text() == "x"
+
+
+def test_stale_temps_of_dead_processes_are_removed_and_live_ones_kept(tmp_path):
+    """Temporary files of processes that are gone (this version's names and the older
+    ``.NAME.PID.tmp`` of HDF5 files) are removed by the next run into the folder; those of
+    a live process, and files that only look like them, are kept."""
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    live = str(os.getpid())
+    hdf5 = b"\x89HDF\r\n\x1a\n" + b"\0" * 100
+    files = {f".a.h5.{dead}.x1y2{results.TMP_SUFFIX}": b"", f".b.h5.{dead}.tmp": hdf5,
+             f".c.h5.{live}.x1y2{results.TMP_SUFFIX}": b"", f".d.h5.{dead}.tmp": b"not hdf5",
+             f"e.h5.{dead}.tmp": hdf5}
+    for name, body in files.items():
+        (tmp_path / name).write_bytes(body)
+    removed = {p.name for p in results.clean_stale_temps(tmp_path)}
+    assert removed == {f".a.h5.{dead}.x1y2{results.TMP_SUFFIX}", f".b.h5.{dead}.tmp"}
+    assert {p.name for p in tmp_path.iterdir()} == set(files) - removed
+
+
+def test_a_terminated_pool_worker_dies_even_under_the_commands_sigterm_handler(tmp_path):
+    """The command's SIGTERM handler raises (so that it can remove its temporary files);
+    forked pool workers inherit it. ``close(cancel=True)`` terminates the workers: they must
+    die, not send the exception back through a queue no one reads (which hung the process
+    that ran the batch in-process, at its exit). In a fresh process: a pool is forked only
+    from a process with a single thread."""
+    code = """if True:
+        import signal, sys, time
+        from gcalign.app.batch.backends import LocalBackend
+        from gcalign.cli import _terminate
+        signal.signal(signal.SIGTERM, _terminate)
+        backend = LocalBackend(2, "simulate")
+        assert backend.start_method == "fork", backend.start_method
+        procs = list(backend._pool._processes.values())
+        assert len(procs) == 2 and all(p.is_alive() for p in procs)
+        backend.close(cancel=True)
+        deadline = time.monotonic() + 10
+        while any(p.is_alive() for p in procs) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        print([p.exitcode for p in procs])
+    """
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=60, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == f"[{-signal.SIGTERM}, {-signal.SIGTERM}]", res.stdout
+
+
+def test_results_files_have_ordinary_permissions(tmp_path):
+    """The temporary file is private (mkstemp); the file under the final name is not."""
+    mask = os.umask(0o022)
+    try:
+        with results.atomic_h5(tmp_path / "r.h5") as f:
+            f.attrs["x"] = 1
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "r.h5").stat().st_mode & 0o777 == 0o644

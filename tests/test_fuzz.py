@@ -1,0 +1,153 @@
+"""The fuzz suite of issue 14: hundreds of hostile inputs, every command, one contract.
+
+The cases come from :mod:`fuzz_cases` (seeded: ``GCALIGN_FUZZ_SEED``, default 14, gives
+the same cases in the same order, so a failure reproduces from its id). Each runs in-process
+(``typer.testing.CliRunner``) in an empty folder with tight resource limits
+(:data:`fuzz_cases.FUZZ_ENV`) and must keep the contract of :func:`fuzz_cases.violations`:
+exit 2 or 1 with one line on stderr and no traceback, no file left behind, validate agreeing
+with the run, a finite summary when it succeeds, within 10 s; the process stays under
+:data:`MAX_RSS_MB` throughout.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import time
+from collections import Counter
+
+import fuzz_cases as F
+import pytest
+from typer.testing import CliRunner
+
+from gcalign.cli import app
+
+SEED = int(os.environ.get("GCALIGN_FUZZ_SEED", "14"))
+CASES = F.all_cases(SEED)
+FIXED = F.fixed_cases()  # the reproductions of the issue, by name
+GENERATED = CASES[len(FIXED):]
+MAX_RSS_MB = 3000.0  # peak resident memory of the whole test process
+runner = CliRunner()
+
+
+def run_case(case: F.Case, folder) -> F.Outcome:
+    argv = F.materialize(case, folder)
+    before = F.snapshot(folder)
+    t0 = time.perf_counter()
+    res = runner.invoke(app, argv, catch_exceptions=True)
+    elapsed = time.perf_counter() - t0
+    note = ""
+    if res.exception is not None and not isinstance(res.exception, SystemExit):
+        note = f"exception {type(res.exception).__name__}: {res.exception}"
+    out = F.Outcome(res.exit_code, res.stderr, sorted(F.snapshot(folder) - before), elapsed,
+                    note=note)
+    if res.exit_code in (0, 1):  # 1: a batch with failed runs keeps its file
+        out.summary = F.read_summary(folder, case)
+    if case.validate is not None:
+        out.validate_exit = runner.invoke(app, ["validate", case.validate]).exit_code
+    return out
+
+
+@pytest.fixture
+def fuzz_env(monkeypatch, tmp_path):
+    for k in list(os.environ):
+        if k.startswith("GCALIGN_"):
+            monkeypatch.delenv(k)
+    for k, v in F.FUZZ_ENV.items():
+        monkeypatch.setenv(k, v)
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def test_enough_cases_of_every_class():
+    counts = Counter(c.cls for c in CASES)
+    assert len(GENERATED) >= 300  # generated, besides the named reproductions
+    assert set(counts) >= {0, 1, 3, 4, 5, 6, 7, 8, 11}, counts
+    assert len({c.id for c in CASES}) > 0.9 * len(CASES)  # names tell the cases apart
+
+
+def test_same_seed_same_cases():
+    assert [c.id for c in CASES[:len(FIXED)]] == [c.id for c in FIXED]
+    again = F.all_cases(SEED)
+    assert [(c.id, c.argv, c.files) for c in again] == [(c.id, c.argv, c.files) for c in CASES]
+
+
+def check(case: F.Case, folder, i: int | str) -> None:
+    out = run_case(case, folder)
+    v = F.violations(case, out)
+    rss_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    if rss_mb > MAX_RSS_MB:
+        v.append(f"peak memory {rss_mb:.0f} MB")
+    assert not v, (f"seed {SEED} case {i} {case.id} {list(case.argv)}: {'; '.join(v)}\n"
+                   f"stderr: {out.stderr[-600:]}{out.note}")
+
+
+@pytest.mark.parametrize("base", list(F.BASES))
+def test_every_base_is_valid_and_runs(base, fuzz_env):
+    """The scenarios the generator mutates run as given (exit 0): a base that a change of
+    the scenario schema made invalid would turn every mutation of it into a trivial exit 2."""
+    data, command = F.BASES[base]
+    case = F.Case(0, f"{base} as given", (command, "case.yaml", "-o", "out.h5"),
+                  (("case.yaml", F.emit(data).encode()),), frozenset({0}), validate="case.yaml")
+    check(case, fuzz_env, base)
+
+
+@pytest.mark.parametrize("case", FIXED, ids=lambda c: f"c{c.cls}-{c.name}")
+def test_reproduction(case, fuzz_env):
+    """Each reproduction of issue 14 (classes 1, 3, 4, 5, 6, 8, 11) keeps the contract."""
+    check(case, fuzz_env, case.name)
+
+
+def _case_id(i: int) -> str:
+    """Index, class and the start of the name: the crafted files, journals and options
+    (recorded_cases, journal_cases, ...) include reproductions of the issue by name."""
+    c = GENERATED[i]
+    name = "".join(ch if ch.isprintable() and ch not in "[]:" else "_" for ch in c.name[:60])
+    return f"{i}-c{c.cls}-{name}"
+
+
+@pytest.mark.parametrize("i", range(len(GENERATED)), ids=_case_id)
+def test_contract(i, fuzz_env):
+    """Generated case i of seed SEED keeps the contract."""
+    check(GENERATED[i], fuzz_env, i)
+
+
+def test_an_unexpected_exception_is_one_line_and_exit_1(fuzz_env, monkeypatch):
+    """A bug (any exception gcalign does not expect) is one line, exit 1, not a traceback:
+    the handler once named an exception class typer no longer has, so every unexpected
+    exception escaped as AttributeError."""
+    import gcalign.cli.data as cli_data
+
+    def boom(*args, **kwargs):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(cli_data, "preflight", boom)
+    (fuzz_env / "a.yaml").write_bytes(F.emit(F.S).encode())
+    res = runner.invoke(app, ["validate", "a.yaml"], catch_exceptions=True)
+    assert res.exit_code == 1 and isinstance(res.exception, SystemExit), res.exception
+    assert res.stderr.strip().splitlines() == [
+        "error: internal error, RuntimeError: boom (a bug in gcalign; GCALIGN_TRACEBACK=1 "
+        "shows where)"]
+
+
+BY_NAME = {c.name: c for c in CASES}
+
+
+@pytest.mark.parametrize("name, expected", [
+    ("CSV 90 s gap", r"d\.csv:1002: time jumps from 10(\.0)? to 100\.01 s"),
+    ("PSINS header latitude 90", r"d\.imu: header row 2 field 1 \(latitude, deg\)"),
+    ("navigate on results file: NaN rows", r"d\.h5: /imu: row 101: dtheta must be finite"),
+    ("navigate on results file: ts 0", r"d\.h5: /imu: sample interval must lie in"),
+    ("long bad value", r"align\.mode: .*got 'm{60,90}\.\.\.'$"),
+    ("--seed -5", r"--seed: must be a whole number within \[0, 2\^63\), got -5$"),
+])
+def test_messages_name_the_file_row_and_value(name, expected, fuzz_env):
+    """Recorded data are blamed by file and row (not the alignment window that used to be
+    blamed); bad values are echoed cut at about 80 characters (issue 14, classes 6, 11)."""
+    import re
+
+    out = run_case(BY_NAME[name], fuzz_env)
+    assert out.exit_code == 2, out.stderr
+    line = out.stderr.strip()
+    assert re.search(expected, line), line
+    assert "align.coarse" not in line
