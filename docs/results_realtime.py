@@ -344,9 +344,9 @@ python docs/results_realtime.py --seeds 10 # this section and its three figures
 python benchmarks/bench_realtime.py        # Table 1 end to end, median of 7 warm runs
 ```
 
-Benchmark (this machine, 2 cores shared with other work, load ≈ 2.5): the 12-case table,
+Benchmark (this machine, 2 cores, load ≈ 0.5, `bench_realtime.py`): the 12-case table,
 12 s per case at 5 kHz, three predictors, both metrics: median {bench_core} s warm in the
-chain (the core's ideal increments are 38 % of it), {bench_cmd} s for the command
+chain (the core's ideal increments are 31 % of it), {bench_cmd} s for the command
 in-process (13 cases, a 16 MB results file, the table); `gcalign realtime` as a new
 process {bench_cli} s (of which ≈ 2 s are the imports of numba and scipy and the first
 loads of the cached kernels). Target ≤ 5 s warm.
@@ -354,7 +354,7 @@ loads of the cached kernels). Target ≤ 5 s warm.
 
 
 # medians of benchmarks/bench_realtime.py (chain, command, CLI; s), quoted in the section
-BENCH = ("0.92", "1.43", "4.7")
+BENCH = ("0.80", "1.35", "3.5")
 
 
 def section(n_seeds: int = 10, figure_dir: Path | None = None, bench: tuple = BENCH) -> str:
