@@ -147,6 +147,8 @@ def _bad_table(tmp_path):
     (["--scheme", "seed-13"], "mechanism.scheme: unknown scheme 'seed-13'"),
     (["--compare", "fixed,seed-13"], "modulate.compare: unknown scheme 'seed-13'"),
     (["--dwell", -1], "mechanism.dwell_s"),
+    (["--dwell", 1e23],  # seed-12's cycle: 12 (Ts + Tz)
+     "mechanism.dwell_s: the mechanism's cycle is 1.2e+24 s; at most 1e+06 s"),
     (["--hours", 0], "modulate.hours"),
     (["--hours", -2], "modulate.hours"),
     ("turn", "mechanism.turn_s: the turn (6 s) is shorter than its acceleration plus "

@@ -82,11 +82,11 @@ def check(case: F.Case, folder, i: int | str) -> None:
                    f"stderr: {out.stderr[-600:]}{out.note}")
 
 
-@pytest.mark.parametrize("base", list(F.BASES))
+@pytest.mark.parametrize("base", [*F.BASES, *F.LATE_BASES])
 def test_every_base_is_valid_and_runs(base, fuzz_env):
     """The scenarios the generator mutates run as given (exit 0): a base that a change of
     the scenario schema made invalid would turn every mutation of it into a trivial exit 2."""
-    data, command = F.BASES[base]
+    data, command = (F.BASES | F.LATE_BASES)[base]
     case = F.Case(0, f"{base} as given", (command, "case.yaml", "-o", "out.h5"),
                   (("case.yaml", F.emit(data).encode()),), frozenset({0}), validate="case.yaml")
     check(case, fuzz_env, base)

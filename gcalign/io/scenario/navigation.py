@@ -45,6 +45,10 @@ class NavigationConfig(Model):
         return 30.0 if self.vertical_tau_s is None else self.vertical_tau_s
 
 
+#: Longest mechanism cycle (s): its invariants are integrated over one cycle.
+MAX_CYCLE_S = 1e6
+
+
 class MechanismConfig(Model):
     """The IMU on a mechanism: a built-in rotation scheme (``scheme``, with its timing
     overridable) or a table of rows (``steps``), referenced to the body or to the navigation
@@ -97,13 +101,18 @@ class MechanismConfig(Model):
             if timing:
                 raise ValueError(f"{timing[0]}: applies to a built-in scheme; a steps table "
                                  "gives its own timing in each row")
-            schedule_of(self.steps, self.repeat, self.start_deg)
+            period = schedule_of(self.steps, self.repeat, self.start_deg).period
+            where = "steps"
         else:
             if self.name is not None:
                 raise ValueError("name: names a steps table; a built-in scheme has its name")
             if not self.repeat:
                 raise ValueError("repeat: a built-in scheme is a cycle (repeat: true)")
-            self.scheme_of(self.scheme)  # type: ignore[arg-type]
+            period = self.scheme_of(self.scheme).schedule.period  # type: ignore[arg-type]
+            where = next((k for k in timing if k.endswith("_s")), "dwell_s")
+        if not period <= MAX_CYCLE_S:  # the invariants integrate over one cycle
+            raise ValueError(f"{where}: the mechanism's cycle is {period:.4g} s; at most "
+                             f"{MAX_CYCLE_S:g} s ({MAX_CYCLE_S / 86400:.3g} days) allowed")
         return self
 
     @property
