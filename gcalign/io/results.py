@@ -181,8 +181,12 @@ class _GuardedFile:
         self.raw = raw
         self.error: OSError | None = None
 
+    # Once a failed run has closed (and deleted) the file, HDF5 may still free objects
+    # that write or truncate through here (a SIGTERM landing inside h5py): nothing to do
+    # then, and an exception would only be printed as "Exception ignored".
+
     def write(self, b) -> int:
-        if self.error is None:
+        if self.error is None and not self.raw.closed:
             try:
                 return self.raw.write(b)
             except OSError as err:
@@ -190,6 +194,8 @@ class _GuardedFile:
         return len(b)
 
     def truncate(self, size=None):
+        if self.raw.closed:
+            return size
         try:
             return self.raw.truncate(size)
         except OSError as err:
@@ -197,22 +203,24 @@ class _GuardedFile:
             return size
 
     def flush(self) -> None:
+        if self.raw.closed:
+            return
         try:
             self.raw.flush()
         except OSError as err:
             self.error = self.error or err
 
     def read(self, n=-1):
-        return self.raw.read(n)
+        return b"" if self.raw.closed else self.raw.read(n)
 
     def readinto(self, b):
-        return self.raw.readinto(b)
+        return 0 if self.raw.closed else self.raw.readinto(b)
 
     def seek(self, offset, whence=0):
-        return self.raw.seek(offset, whence)
+        return 0 if self.raw.closed else self.raw.seek(offset, whence)
 
     def tell(self):
-        return self.raw.tell()
+        return 0 if self.raw.closed else self.raw.tell()
 
 
 @contextmanager
