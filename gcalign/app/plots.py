@@ -69,6 +69,19 @@ def legend_right(ax) -> None:
               borderaxespad=0.0)
 
 
+def finish(fig: Figure, axes, xlabel: str, title: str, ylabels=None) -> Figure:
+    """The common ending of a figure of stacked panels: each panel gridded with its legend
+    on the right (and its y label, if given), the x label under the last, the title."""
+    for i, ax in enumerate(axes):
+        if ylabels is not None:
+            ax.set_ylabel(ylabels[i])
+        ax.grid(True, alpha=0.3)
+        legend_right(ax)
+    axes[-1].set_xlabel(xlabel)
+    suptitle(fig, title)
+    return fig
+
+
 def time_axis(t: np.ndarray) -> tuple[np.ndarray, str]:
     """Time from the first sample in s, min or h, whichever reads best."""
     span = float(t[-1] - t[0]) if len(t) else 0.0

@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.app.calibrate import UNIT_TEXT
-from gcalign.app.plots import _s, legend_below, legend_right, new_figure, suptitle
+from gcalign.app.plots import _s, finish, legend_below, legend_right, new_figure, suptitle
 
 STYLE = {"both": dict(color="tab:red", linestyle="--"),
          "velocity": dict(color="tab:cyan", linestyle="-"),
@@ -189,12 +189,7 @@ def innovations_figure(run, title: str) -> Figure:
         axes[2].axhspan(lo, hi, color="tab:green", alpha=0.15,
                         label="χ²(21) 95 % (truth drawn from P0)")
         axes[2].set_ylabel("NEES")
-    for ax in axes:
-        ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    axes[-1].set_xlabel(xlabel)
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, xlabel, title)
 
 
 def attitude_figure(run, title: str) -> Figure:
@@ -213,11 +208,7 @@ def attitude_figure(run, title: str) -> Figure:
         span = float(np.max(3 * np.degrees(s[half]) + np.abs(a[half] - a[-1])))
         ax.set_ylim(a[-1] - 1.5 * span, a[-1] + 1.5 * span)
         ax.set_ylabel(f"{name} (deg)")
-        ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    axes[-1].set_xlabel(xlabel)
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, xlabel, title)
 
 
 def enu_track(pos: np.ndarray) -> np.ndarray:

@@ -11,10 +11,9 @@ from matplotlib.figure import Figure
 from gcalign.app.plots import (
     ENU,
     angle_scale,
-    legend_right,
+    finish,
     new_figure,
     plot_series,
-    suptitle,
     time_axis,
 )
 
@@ -31,14 +30,8 @@ def navigate_error_figure(t, phi, vel, pos, title: str = "navigation error") -> 
         plot_series(axes[2], x, pos[:, j], name)
     plot_series(axes[2], x, np.hypot(pos[:, 0], pos[:, 1]), "horizontal |·|", color="black",
                 linewidth=1.2)
-    for ax, lab in zip(axes, (f"misalignment ({unit})", "velocity error (m/s)",
-                              "position error (m)"), strict=True):
-        ax.set_ylabel(lab)
-        ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    axes[-1].set_xlabel(xlabel)
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, xlabel, title, (f"misalignment ({unit})", "velocity error (m/s)",
+                                             "position error (m)"))
 
 
 def navigate_state_figure(t, att, vel, displacement, title: str = "navigation") -> Figure:
@@ -55,15 +48,8 @@ def navigate_state_figure(t, att, vel, displacement, title: str = "navigation") 
     plot_series(axes[3], x, displacement[:, 1], "north")
     plot_series(axes[3], x, np.hypot(displacement[:, 0], displacement[:, 1]), "horizontal |·|",
                 color="black")
-    labels = ("pitch, roll (deg)", "yaw (deg)", "velocity (m/s)", "displacement from\nthe "
-              "start (m)")
-    for ax, lab in zip(axes, labels, strict=True):
-        ax.set_ylabel(lab)
-        ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    axes[-1].set_xlabel(xlabel)
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, xlabel, title, ("pitch, roll (deg)", "yaw (deg)",
+                                             "velocity (m/s)", "displacement from\nthe start (m)"))
 
 
 def figures(f, name: str) -> dict:

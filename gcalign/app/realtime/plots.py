@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.plots import ANGLES, _s, legend_right, new_figure, suptitle
+from gcalign.app.plots import ANGLES, _s, finish, legend_right, new_figure, suptitle
 
 ARCSEC = np.pi / 180.0 / 3600.0
 REFERENCE = {"seed": "against the INS's output T later (the seed's reference)",
@@ -55,11 +55,7 @@ def case_figure(t: np.ndarray, scored: np.ndarray, before: np.ndarray,
         ax.set_ylabel(f"{component} error (″)")
         if (~scored).any():
             ax.axvspan(t[0], t[~scored][-1], color="0.85", label="_not scored")
-        ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    axes[-1].set_xlabel("pulse time (s)")
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, "pulse time (s)", title)
 
 
 def filter_figure(freq: np.ndarray, magnitude: dict[str, np.ndarray], group_delay: np.ndarray,
