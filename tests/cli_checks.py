@@ -15,3 +15,13 @@ def assert_bad_input(res, out: Path, field: str, *more: str) -> None:
     for text in more:
         assert text in lines[0], res.output
     assert not out.exists()
+
+
+def assert_bad_run(run, folder: Path, args, field: str, *more: str) -> None:
+    """`run(*args, "-o", OUT)` is bad input (:func:`assert_bad_input`) and leaves no new file
+    in `folder`, no temporary file either."""
+    out = folder / "out.h5"
+    before = set(folder.iterdir())
+    res = run(*args, "-o", str(out))
+    assert_bad_input(res, out, field, *more)
+    assert set(folder.iterdir()) == before

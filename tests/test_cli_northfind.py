@@ -16,7 +16,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from cli_checks import assert_bad_input
+from cli_checks import assert_bad_run
 from typer.testing import CliRunner
 
 from gcalign.cli import app
@@ -173,11 +173,7 @@ def test_validate_configs(name):
 
 
 def _bad(tmp_path: Path, args, field: str, *more: str):
-    out = tmp_path / "out.h5"
-    before = set(tmp_path.iterdir())
-    res = _run(*args, "-o", str(out))
-    assert_bad_input(res, out, field, *more)
-    assert set(tmp_path.iterdir()) == before  # no temporary file left either
+    assert_bad_run(_run, tmp_path, args, field, *more)
 
 
 @pytest.mark.parametrize(

@@ -20,7 +20,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from cli_checks import assert_bad_input
+from cli_checks import assert_bad_run
 from scipy import signal
 from typer.testing import CliRunner
 
@@ -289,11 +289,7 @@ def test_validate_does_not_load_scipy_or_numba():
 # ---------------------------------------------------------------------------- bad input
 
 def _bad(tmp_path: Path, args, field: str, *more: str):
-    out = tmp_path / "out.h5"
-    before = set(tmp_path.iterdir())
-    res = _run(*args, "-o", str(out))
-    assert_bad_input(res, out, field, *more)
-    assert set(tmp_path.iterdir()) == before  # no temporary file left either
+    assert_bad_run(_run, tmp_path, args, field, *more)
 
 
 SWING_600 = [{"name": "fast", "steps": [{"axis": "z", "profile": "swing", "amplitude_deg": 1,
