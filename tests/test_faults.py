@@ -241,6 +241,61 @@ def test_a_second_batch_on_the_same_output_is_refused(tmp_path):
     assert res.returncode == 0, res.stderr  # the lock died with its holder
 
 
+HOLDER = """
+import os, sys, time
+from gcalign.app.batch.store import OutputLock
+with OutputLock(sys.argv[1]):
+    if os.fork() == 0:  # a pool worker's place: a forked child that outlives its parent
+        time.sleep(30)
+        os._exit(0)
+    print("locked", flush=True)
+    time.sleep(30)
+"""
+
+
+def test_the_batch_lock_dies_with_its_holder_not_with_its_forked_children(tmp_path):
+    """A forked child does not inherit the lock, nor keep the lock file open: the moment
+    the holder is killed with -9 the output is free, though its child still runs."""
+    from gcalign.app.batch.store import OutputLock
+
+    out = tmp_path / "b.h5"
+    children: list[int] = []
+    holder = subprocess.Popen([sys.executable, "-c", HOLDER, str(out)], stdout=subprocess.PIPE,
+                              text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        children += [int(p) for p in Path(f"/proc/{holder.pid}/task/{holder.pid}/children")
+                    .read_text().split()]
+        assert len(children) == 1
+        fds = Path(f"/proc/{children[0]}/fd")
+        assert not [p for p in fds.iterdir() if "lock" in os.path.realpath(p)]
+        with pytest.raises(Exception, match=rf"another batch \(pid {holder.pid}\)"):
+            OutputLock(out).__enter__()
+        holder.kill()
+        holder.wait()
+        assert Path(f"/proc/{children[0]}").exists()  # the child lives on
+        with OutputLock(out):
+            pass
+    finally:
+        holder.kill()
+        for pid in children:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+
+
+def test_a_second_lock_on_the_same_output_in_one_process_is_refused(tmp_path):
+    from gcalign.app.batch.store import OutputLock
+    from gcalign.errors import GcalignError
+
+    with OutputLock(tmp_path / "b.h5"):
+        with pytest.raises(GcalignError, match="this process"):
+            OutputLock(tmp_path / "b.h5").__enter__()
+    with OutputLock(tmp_path / "b.h5"):  # released: free again
+        pass
+
+
 # --------------------------------------------------------------------------- Dask
 
 

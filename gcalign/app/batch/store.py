@@ -12,6 +12,7 @@ or more grid values reuses every run it already has.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import math
@@ -107,11 +108,35 @@ class Journal:
                 pass
 
 
+_HELD_LOCKS: dict[int, Path] = {}  # descriptor -> lock file, of the locks this process holds
+
+
+def _forget_locks_in_child() -> None:  # pragma: no cover - runs in forked children
+    """A forked child (a pool worker) closes its copies of the lock descriptors: the lock
+    is the batch process's, and a child must not keep the file open after it dies."""
+    for fd in _HELD_LOCKS:
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+    _HELD_LOCKS.clear()
+
+
+os.register_at_fork(after_in_child=_forget_locks_in_child)
+
+
 class OutputLock:
-    """An exclusive lock on a batch output while the batch runs: ``flock`` on
-    ``.NAME.lock`` beside it, which the kernel releases when the process dies (SIGKILL
-    included). A second batch into the same output is refused with one line (exit 1)
-    instead of discarding the first one's journal. The lock file is removed on release."""
+    """An exclusive lock on a batch output while the batch runs: a POSIX record lock
+    (``lockf``) on ``.NAME.lock`` beside it, which the kernel releases when the process
+    that took it dies (SIGKILL included). A second batch into the same output is refused
+    with one line (exit 1) instead of discarding the first one's journal. The lock file is
+    removed on release.
+
+    Not ``flock``: an ``flock`` belongs to the open file, which forked pool workers share,
+    so a batch killed with -9 stayed locked until its last worker had exited. A record lock
+    belongs to the process and is not inherited by ``fork``; because a process does not
+    conflict with its own record locks, a second lock on the same file in this process is
+    refused from the table of held ones."""
 
     def __init__(self, output: Path):
         self.output = Path(output)
@@ -127,6 +152,10 @@ class OutputLock:
             from gcalign.io.results import write_error
 
             raise write_error(self.output, err) from None
+        if self.path.resolve() in _HELD_LOCKS.values():
+            raise GcalignError(f"{self.output}: another batch (pid {os.getpid()}, this "
+                               "process) is writing it; wait for it to finish, or give "
+                               "another -o")
         for _ in range(100):
             try:
                 fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
@@ -135,8 +164,13 @@ class OutputLock:
 
                 raise write_error(self.output, err) from None
             try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
+                fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as err:
+                if err.errno not in (errno.EACCES, errno.EAGAIN):
+                    os.close(fd)
+                    from gcalign.io.results import write_error
+
+                    raise write_error(self.output, err) from None
                 holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
                 os.close(fd)
                 raise GcalignError(f"{self.output}: another batch (pid {holder}) is writing it; "
@@ -149,6 +183,7 @@ class OutputLock:
                 os.ftruncate(fd, 0)
                 os.write(fd, f"{os.getpid()}\n".encode())
                 self.fd = fd
+                _HELD_LOCKS[fd] = self.path.resolve()
                 return self
             os.close(fd)
         raise GcalignError(f"{self.output}: cannot take the lock {self.path}")
@@ -156,6 +191,7 @@ class OutputLock:
     def __exit__(self, *exc) -> None:
         if self.fd is not None:
             self.path.unlink(missing_ok=True)
+            _HELD_LOCKS.pop(self.fd, None)
             os.close(self.fd)
             self.fd = None
 
