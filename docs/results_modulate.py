@@ -725,7 +725,7 @@ MUST_ROWS = (  # (item, checked by, measured: a format string of the values)
 
 
 def must_show(values: dict) -> str:
-    rows = ["### Issue 10's must-show items: where each is checked, what it measured", "",
+    rows = ["### The seed-004 checklist: where each item is checked, what it measured", "",
             "| # | item | checked by | measured |", "| --- " * 4 + "|"]
     for k, (item, tests, measured) in enumerate(MUST_ROWS, 1):
         rows.append(f"| {k} | {item} | {tests} | {measured.format(**values)} |")

@@ -1,4 +1,4 @@
-"""Hostile inputs for the fuzz suite of issue 14, and the contract every command keeps.
+"""Hostile inputs for the fuzz suite, and the contract every command keeps.
 
 A :class:`Case` is a command line and the files it reads (written into an empty folder).
 The generators below build them from a seeded :class:`random.Random` by mutating valid
@@ -16,7 +16,7 @@ a failure reproduces from its seed and index. :func:`violations` states the cont
 * ``gcalign validate`` agrees with the run about bad input (exit 2 for both or neither);
 * each case within ``TIME_LIMIT_S`` (the in-process suite also bounds memory).
 
-The class of each case (1 .. 11) is the numbered class of issue 14 it attacks; 0 is a
+The class of each case (1 .. 11) is the numbered class of docs/robustness.md ("Before and after") it attacks; 0 is a
 generic key-by-key mutation (contract only). ``benchmarks/fuzz_report.py`` runs the same
 cases in child processes (with a time and memory limit) and counts violations per class.
 """
@@ -46,7 +46,7 @@ FUZZ_ENV = {
 
 @dataclass(frozen=True)
 class Case:
-    cls: int  # issue 14 class attacked (0: generic mutation)
+    cls: int  # robustness class attacked (0: generic mutation)
     name: str
     argv: tuple[str, ...]
     files: tuple[tuple[str, bytes], ...] = ()
@@ -107,7 +107,7 @@ def bomb(depth: int, width: int) -> Raw:
 # --------------------------------------------------------------------------- valid bases
 
 SITE = {"lat_deg": 45.7796, "lon_deg": 126.6705, "height_m": 0}
-S = {  # the issue's S: 60 s static, align section
+S = {  # the base case: 60 s static, align section
     "name": "s", "site": SITE, "imu": {"rate_hz": 100, "seed": 1},
     "motion": {"kind": "static", "attitude_deg": [0, 0, 30], "duration_s": 60},
     "align": {"coarse": {"method": "given", "error_deg": [1, 1, 10]}, "mode": "conventional",
@@ -334,7 +334,7 @@ def _output_exits(out: str) -> frozenset[int]:
 
 
 def fixed_cases() -> list[Case]:
-    """The reproductions of issue 14 that are not Dask, kill or disk-full tests."""
+    """The named reproductions of the robustness classes that are not Dask, kill or disk-full tests."""
     s = emit(S).encode()
     sw = emit(SWEEP).encode()
 

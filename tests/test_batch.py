@@ -310,7 +310,7 @@ def test_numba_cache_is_loaded_not_compiled_in_fresh_processes():
 
 def test_failing_runs_are_recorded_and_exit_1(tmp_path):
     # Loops of nanosecond periods pass validation but diverge: a result that is not finite
-    # is a failed run (issue 14 class 6), recorded, the others go on.
+    # is a failed run (robustness class 6), recorded, the others go on.
     stages = [[{"t_xy_s": 20, "t_z_s": 60}], [{"t_xy_s": 1e-9, "t_z_s": 1e-9}]]
     sweep = write_sweep(tmp_path, grid={"align.stages": stages}, seeds=2,
                         metrics=["error_t3_deg"])

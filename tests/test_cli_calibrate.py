@@ -63,7 +63,7 @@ def test_builtin_equals_configs_copy():
 
 
 def test_builtin_json_contract(builtin):
-    """The issue's contract: measure, units (SI) and per state truth, estimate, sigma,
+    """The JSON contract: measure, units (SI) and per state truth, estimate, sigma,
     sigma0 in SI; the injected truth is the scenario's imu errors and φ0 = [20″, −20″, 30′]."""
     s, _ = builtin
     assert s["measure"] == "velocity" and s["aiding"] == "dgnss"

@@ -1,4 +1,4 @@
-"""What a user expects of any command line (issue 13), one behaviour per test: file names
+"""What a user expects of any command line, one behaviour per test: file names
 that say what was overridden, keys that cannot matter refused or shown, progress on long
 runs, --version, completion, `example`, `--set`, scalar biases, bare `gcalign`, recorded
 data with `--imu-file` and `--lat/--lon/--height`, batch over a list of files."""

@@ -1,4 +1,4 @@
-"""The fuzz suite of issue 14: hundreds of hostile inputs, every command, one contract.
+"""The fuzz suite: hundreds of hostile inputs, every command, one contract.
 
 The cases come from :mod:`fuzz_cases` (seeded: ``GCALIGN_FUZZ_SEED``, default 14, gives
 the same cases in the same order, so a failure reproduces from its id). Each runs in-process
@@ -94,7 +94,7 @@ def test_every_base_is_valid_and_runs(base, fuzz_env):
 
 @pytest.mark.parametrize("case", FIXED, ids=lambda c: f"c{c.cls}-{c.name}")
 def test_reproduction(case, fuzz_env):
-    """Each reproduction of issue 14 (classes 1, 3, 4, 5, 6, 8, 11) keeps the contract."""
+    """Each named reproduction (robustness classes 1, 3, 4, 5, 6, 8, 11) keeps the contract."""
     check(case, fuzz_env, case.name)
 
 
@@ -143,7 +143,7 @@ BY_NAME = {c.name: c for c in CASES}
 ])
 def test_messages_name_the_file_row_and_value(name, expected, fuzz_env):
     """Recorded data are blamed by file and row (not the alignment window that used to be
-    blamed); bad values are echoed cut at about 80 characters (issue 14, classes 6, 11)."""
+    blamed); bad values are echoed cut at about 80 characters (robustness classes 6, 11)."""
     import re
 
     out = run_case(BY_NAME[name], fuzz_env)

@@ -185,7 +185,7 @@ def test_asymmetric_scale_factor_closed_form_per_step(name):
 def test_scale_factor_returns_to_zero_with_the_implied_peaks(name, peaks):
     """Per unit δk (different on each axis, so that axes cannot hide one another): the
     net term over a cycle is < 1e-9 rad and the in-cycle peaks are as the schedule implies
-    (spec issue 10, must-show 4)."""
+    (spec 004's scale-factor invariant)."""
     dk = np.array([1.0, 1.3, 0.7])
     r = invariant_report(builtin_scheme(name), ErrorTerms(gyro_scale=dk))
     assert np.abs(r.scale_factor_net).max() < 1e-9

@@ -22,7 +22,7 @@ runner = CliRunner()
 
 
 def test_one_format_per_group():
-    # the column: fixed and scientific mixed (0.0043 │ -5.291e-04)
+    # a column of fixed and scientific values: fixed and scientific mixed (0.0043 │ -5.291e-04)
     assert R.numbers([0.0043, -5.291e-4]) == ["0.004300", "-0.000529"]
     assert R.numbers([12.5, 0.25, -3.0]) == ["12.50", "0.25", "-3.00"]
     assert R.numbers([2.5e7, 1.0]) == ["2.500e+07", "1.000e+00"]  # the group needs it
