@@ -16,9 +16,10 @@ a failure reproduces from its seed and index. :func:`violations` states the cont
 * ``gcalign validate`` agrees with the run about bad input (exit 2 for both or neither);
 * each case within ``TIME_LIMIT_S`` (the in-process suite also bounds memory).
 
-The class of each case (1 .. 11) is the numbered class of docs/robustness.md ("Before and after") it attacks; 0 is a
-generic key-by-key mutation (contract only). ``benchmarks/fuzz_report.py`` runs the same
-cases in child processes (with a time and memory limit) and counts violations per class.
+The class of each case (1 .. 11) is the numbered class of docs/robustness.md ("Before and
+after") it attacks; 0 is a generic key-by-key mutation (contract only).
+``benchmarks/fuzz_report.py`` runs the same cases in child processes (with a time and memory
+limit) and counts violations per class.
 """
 
 from __future__ import annotations
@@ -334,7 +335,8 @@ def _output_exits(out: str) -> frozenset[int]:
 
 
 def fixed_cases() -> list[Case]:
-    """The named reproductions of the robustness classes that are not Dask, kill or disk-full tests."""
+    """The named reproductions of the robustness classes that are not Dask, kill or disk-full
+    tests."""
     s = emit(S).encode()
     sw = emit(SWEEP).encode()
 

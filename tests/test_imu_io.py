@@ -221,8 +221,8 @@ def test_csv_bad_inputs(tmp_path, text, kwargs, expected):
 
 
 def test_csv_with_a_gap_is_refused_naming_the_line(tmp_path):
-    """Silent garbage in recorded data (robustness class 6): a gap in the time stamps is refused (the interval comes from the
-    median step; the line after the gap is named)."""
+    """Silent garbage in recorded data (robustness class 6): a gap in the time stamps is
+    refused (the interval comes from the median step; the line after the gap is named)."""
     t = np.r_[0.01 * np.arange(1, 11), 0.5]  # one dropped stretch at the end
     data = np.column_stack([t, np.zeros((11, 6))])
     p = tmp_path / "gap.csv"
