@@ -40,6 +40,7 @@ from gcalign.align.compensate import METHODS, compensate
 from gcalign.align.cycles import MODES, Block, PassRecord, run_passes
 from gcalign.align.gains import AZIMUTH_METHODS
 from gcalign.align.stages import Stage
+from gcalign.errors import InputError
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import (
     attitude_error,
@@ -51,7 +52,7 @@ from gcalign.nav.rotation import (
     quat_to_euler,
 )
 
-__all__ = ["AlignInputError", "AlignSettings", "Alignment", "Spread", "Timeline", "align",
+__all__ = ["AlignSettings", "Alignment", "Spread", "Timeline", "align",
            "timeline"]
 
 Array = NDArray[np.float64]
@@ -60,15 +61,6 @@ COARSE_METHODS = ("analytic", "inertial", "given")
 MAX_LAT_DEG = 85.0  #: gyrocompassing needs the horizontal earth rate ω_ie cos L
 MEASURED_MAX_S = 600.0  #: data kept after T2 for a 'measured' T3 (the computing latency)
 DEFAULT_PASSES = {"conventional": 1, "full-cycle": 5, "half-cycle": 5}
-
-
-class AlignInputError(ValueError):
-    """An input :func:`align` cannot use; `field` names the argument or the setting."""
-
-    def __init__(self, field: str, message: str):
-        super().__init__(f"{field}: {message}")
-        self.field = field
-        self.message = message
 
 
 @dataclass(frozen=True)
@@ -115,32 +107,32 @@ class AlignSettings:
                                      ("coarse", self.coarse, COARSE_METHODS),
                                      ("azimuth_poles", self.azimuth_poles, AZIMUTH_METHODS)):
             if value not in allowed:
-                raise AlignInputError(name, f"got {value!r}, allowed: {', '.join(allowed)}")
+                raise InputError(name, f"got {value!r}, allowed: {', '.join(allowed)}")
         times = [("start_s", self.start_s), ("t1_s", self.t1_s), ("t2_s", self.t2_s)]
         if self.t3_s != "measured":
             times.append(("t3_s", self.t3_s))
         for name, t in times:
             if not (isinstance(t, (int, float)) and math.isfinite(t) and t >= 0):
-                raise AlignInputError(name, f"must be a finite time ≥ 0 s, got {t!r}")
+                raise InputError(name, f"must be a finite time ≥ 0 s, got {t!r}")
         if self.t2_s <= self.t1_s:
-            raise AlignInputError("t2_s", f"must be greater than t1_s ({self.t1_s} s), got "
+            raise InputError("t2_s", f"must be greater than t1_s ({self.t1_s} s), got "
                                   f"{self.t2_s}")
         if self.t3_s != "measured" and self.t3_s < self.t2_s:
-            raise AlignInputError("t3_s", f"must be at least t2_s ({self.t2_s} s) or "
+            raise InputError("t3_s", f"must be at least t2_s ({self.t2_s} s) or "
                                   f"'measured', got {self.t3_s}")
         if self.coarse != "given" and self.t1_s <= 0:
-            raise AlignInputError("t1_s", f"coarse method {self.coarse!r} needs data before "
+            raise InputError("t1_s", f"coarse method {self.coarse!r} needs data before "
                                   "T1, got 0")
         if not self.stages:
-            raise AlignInputError("stages", "give at least one stage")
+            raise InputError("stages", "give at least one stage")
         n = self.pass_count
         if self.mode == "conventional" and n != 1:
-            raise AlignInputError("passes", f"conventional mode runs one pass, got {n}")
+            raise InputError("passes", f"conventional mode runs one pass, got {n}")
         if self.mode != "conventional" and (n < 3 or n % 2 == 0):
-            raise AlignInputError("passes", f"mode {self.mode!r} needs an odd number of "
+            raise InputError("passes", f"mode {self.mode!r} needs an odd number of "
                                   f"passes ≥ 3 (forward, reverse, …, forward), got {n}")
         if not 0 <= self.level_phase_s < self.t2_s - self.t1_s:
-            raise AlignInputError("level_s", f"the level phase ({self.level_phase_s} s) must "
+            raise InputError("level_s", f"the level phase ({self.level_phase_s} s) must "
                                   f"be shorter than t2_s - t1_s ({self.t2_s - self.t1_s} s)")
 
     @property
@@ -172,12 +164,12 @@ class Timeline:
 
 def timeline(settings: AlignSettings, ts: float, samples: int) -> Timeline:
     """The samples of the alignment times in a record of `samples` increments at interval
-    `ts` (s); AlignInputError naming the time that lies past the end of the data."""
+    `ts` (s); InputError naming the time that lies past the end of the data."""
 
     def index(t: float, name: str) -> int:
         k = int(round((settings.start_s + t) / ts))
         if k > samples:
-            raise AlignInputError(name, f"{t} s (+ start_s {settings.start_s} s) is past the "
+            raise InputError(name, f"{t} s (+ start_s {settings.start_s} s) is past the "
                                   f"end of the data ({samples * ts:.2f} s)")
         return k
 
@@ -326,9 +318,9 @@ def _array(name: str, value: ArrayLike, shape: tuple[int, ...]) -> Array:
     if a.ndim != len(shape) or any(s not in (-1, n) for s, n in zip(shape, a.shape,
                                                                      strict=True)):
         want = "(" + ", ".join("N" if s == -1 else str(s) for s in shape) + ")"
-        raise AlignInputError(name, f"must have shape {want}, got {a.shape}")
+        raise InputError(name, f"must have shape {want}, got {a.shape}")
     if not np.isfinite(a).all():
-        raise AlignInputError(name, "must be finite (NaN or infinity found)")
+        raise InputError(name, "must be finite (NaN or infinity found)")
     return a
 
 
@@ -346,7 +338,7 @@ def _coarse_attitude(settings: AlignSettings, dtheta: Array, dv: Array, ts: floa
         return coarse_mod.inertial_frame_coarse(dtheta, dv, ts, site[0], site[1], site[2],
                                                 earth=earth) + offset
     except ValueError as err:  # too short a window
-        raise AlignInputError("t1_s", f"the coarse window [0, {len(dtheta) * ts:g}] s does "
+        raise InputError("t1_s", f"the coarse window [0, {len(dtheta) * ts:g}] s does "
                               f"not fit method {settings.coarse!r}: {err}") from None
 
 
@@ -379,31 +371,31 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
 
     Returns
     -------
-    Alignment. AlignInputError (a ValueError) names the argument or setting it refuses.
+    Alignment. InputError (a ValueError) names the argument or setting it refuses.
     """
     ts = float(ts)
     if not (math.isfinite(ts) and ts > 0):
-        raise AlignInputError("ts", f"must be a finite interval > 0 s, got {ts}")
+        raise InputError("ts", f"must be a finite interval > 0 s, got {ts}")
     dth = _array("dtheta", dtheta, (-1, 3))
     dvb = _array("dv", dv, (len(dth), 3))
     n = len(dth)
     pos0 = _array("site", site, (3,))
     if abs(pos0[0]) > math.radians(MAX_LAT_DEG):
-        raise AlignInputError("site", f"gyrocompassing needs |latitude| < {MAX_LAT_DEG:g}°, "
+        raise InputError("site", f"gyrocompassing needs |latitude| < {MAX_LAT_DEG:g}°, "
                               f"got {math.degrees(pos0[0]):.4f}° (the horizontal earth rate "
                               "vanishes)")
     ref = np.zeros((n + 1, 3)) if vref is None else _array("vref", vref, (n + 1, 3))
     truth = None if truth_att is None else _array("truth_att", truth_att, (n + 1, 3))
     if not (isinstance(stride, (int, np.integer)) and stride >= 1):
-        raise AlignInputError("stride", f"must be a whole number ≥ 1, got {stride!r}")
+        raise InputError("stride", f"must be a whole number ≥ 1, got {stride!r}")
     total = first_sample + n if samples is None else samples
     if not 0 <= first_sample <= total - n:
-        raise AlignInputError("first_sample", f"{first_sample} with {n} increments does not "
+        raise InputError("first_sample", f"{first_sample} with {n} increments does not "
                               f"fit a record of {total}")
     tl = timeline(settings, ts, total)
     lo = first_sample
     if tl.lo < lo or tl.hi > lo + n:
-        raise AlignInputError("dtheta", f"covers samples {lo} .. {lo + n}; the alignment "
+        raise InputError("dtheta", f"covers samples {lo} .. {lo + n}; the alignment "
                               f"reads {tl.lo} .. {tl.hi}")
     given = None
     if settings.coarse == "given":
@@ -412,7 +404,7 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
         elif truth is not None:
             given = truth[tl.i1 - lo]
         else:
-            raise AlignInputError("coarse", "'given' needs att_t1 or truth_att; use "
+            raise InputError("coarse", "'given' needs att_t1 or truth_att; use "
                                   "'analytic' or 'inertial' for recorded data")
     pos1 = pos0.copy() if position_t1 is None else _array("position_t1", position_t1, (3,))
 
@@ -449,7 +441,7 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
     else:
         i3 = i2 + math.ceil(compute / ts) if tl.i3 is None else tl.i3
         if i3 > tl.hi:
-            raise AlignInputError("t3_s", "'measured' latency runs past the end of the data")
+            raise InputError("t3_s", "'measured' latency runs past the end of the data")
         q2 = state_end[K.ATT].copy()
         q3 = compensate(settings.compensation, state_end, block(i2, i3), earth)
         equivalent = (i1 - i0) * ts + settings.pass_count * (i2 - i1) * ts

@@ -15,7 +15,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from gcalign.align.gyrocompass import (
-    AlignInputError,
     Alignment,
     AlignSettings,
     Timeline,
@@ -24,7 +23,7 @@ from gcalign.align.gyrocompass import (
 )
 from gcalign.app.data import RunData, Stream, scenario_data, scenario_stream, stream_of
 from gcalign.app.registry import Outcome
-from gcalign.errors import ScenarioError
+from gcalign.errors import InputError, ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import Aiding, AlignConfig
 from gcalign.nav.earth import EarthModel
@@ -174,7 +173,7 @@ def still_base_warnings(dtheta: np.ndarray, dv: np.ndarray, ts: float, lat: floa
 
 
 
-def _scenario_error(err: AlignInputError) -> ScenarioError:
+def _scenario_error(err: InputError) -> ScenarioError:
     """The core's refusal, naming the scenario field it comes from."""
     names = {"site": "site.lat_deg", "coarse": "align.coarse.method", "passes": "align.stages"}
     return ScenarioError(f"{names.get(err.field, 'align.' + err.field)}: {err.message}")
@@ -212,7 +211,7 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
                     position_t1=data.pos_t1, vref=data.vref,
                     vref_body=cfg.aiding.source == "odometer", truth_att=data.truth_att,
                     t0=stream.t0, stride=stride, first_sample=tl.lo, samples=stream.samples)
-    except AlignInputError as err:
+    except InputError as err:
         raise _scenario_error(err) from None
     return replace(run, warnings=tuple(warnings))
 
