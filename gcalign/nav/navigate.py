@@ -335,7 +335,7 @@ def navigate(dtheta: ArrayLike, dv: ArrayLike, ts: float, start: NavState, *,
             tr = None if truth is None else NavTruth(
                 truth.att[sl], truth.v_n[sl], truth.pos[sl],
                 None if truth.q_nb is None else truth.q_nb[sl])
-            t = t0 + np.arange(k0 + 1, k0 + 1 + len(dth[sl])) * ts
+            t = np.asarray(t0 + np.arange(k0 + 1, k0 + 1 + len(dth[sl])) * ts, float)
             yield Increments(k0, t, dth[sl], dvb[sl], tr, None if qbs is None else qbs[sl])
 
     return navigate_blocks(blocks(), ts, start, k_end=n, earth=earth, vertical=vertical,
