@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Literal
@@ -342,6 +343,70 @@ def _coarse_attitude(settings: AlignSettings, dtheta: Array, dv: Array, ts: floa
                               f"not fit method {settings.coarse!r}: {err}") from None
 
 
+def _site(site: ArrayLike) -> Array:
+    pos = _array("site", site, (3,))
+    if abs(pos[0]) > math.radians(MAX_LAT_DEG):
+        raise InputError("site", f"gyrocompassing needs |latitude| < {MAX_LAT_DEG:g}°, got "
+                         f"{math.degrees(pos[0]):.4f}° (the horizontal earth rate vanishes)")
+    return pos
+
+
+def _window(settings: AlignSettings, ts: float, n: int, first: int,
+            samples: int | None) -> Timeline:
+    """The timeline of a record of `samples` increments, of which the arrays hold `n` from
+    sample `first`; they must cover what the alignment reads."""
+    total = first + n if samples is None else samples
+    if not 0 <= first <= total - n:
+        raise InputError("first_sample", f"{first} with {n} increments does not fit a record "
+                         f"of {total}")
+    tl = timeline(settings, ts, total)
+    if tl.lo < first or tl.hi > first + n:
+        raise InputError("dtheta", f"covers samples {first} .. {first + n}; the alignment "
+                         f"reads {tl.lo} .. {tl.hi}")
+    return tl
+
+
+def _given(settings: AlignSettings, att_t1: ArrayLike | None, truth: Array | None,
+           k1: int) -> Array | None:
+    """The attitude at T1 of coarse method 'given' (`att_t1`, else the truth's row k1)."""
+    if settings.coarse != "given":
+        return None
+    if att_t1 is not None:
+        return _array("att_t1", att_t1, (3,))
+    if truth is None:
+        raise InputError("coarse", "'given' needs att_t1 or truth_att; use 'analytic' or "
+                         "'inertial' for recorded data")
+    return truth[k1]
+
+
+def _passes(settings: AlignSettings, state0: Array, tl: Timeline,
+            block: Callable[[int, int], Block], t0: float, ts: float, earth: EarthModel,
+            stride: int) -> tuple[list[PassRecord], Array, Array, int, float]:
+    """The passes and the attitude at T2 and T3: (records, q2, q3, i3, compute_s).
+
+    Real-time conventional: one forward pass over live data to T3, no latency to
+    compensate ('measured' then means T3 = T2). Otherwise the passes run over the stored
+    block [T1, T2] and the compensation carries the attitude on to T3.
+    """
+    realtime = settings.realtime_conventional
+    end = tl.i3 if realtime and tl.i3 is not None else tl.i2
+    _warm_up()
+    t_start = time.perf_counter()
+    state_end, records = run_passes(
+        state0, block(tl.i1, end), settings.mode, settings.pass_count, list(settings.stages),
+        settings.azimuth_poles, settings.level_phase_s, earth, stride)
+    compute = time.perf_counter() - t_start
+    if realtime:
+        rec = records[0]
+        q2 = rec.q_nb[np.searchsorted(rec.t, t0 + tl.i2 * ts - 1e-9 * ts)]
+        return records, q2, state_end[K.ATT].copy(), end, compute
+    i3 = tl.i2 + math.ceil(compute / ts) if tl.i3 is None else tl.i3
+    if i3 > tl.hi:
+        raise InputError("t3_s", "'measured' latency runs past the end of the data")
+    q3 = compensate(settings.compensation, state_end, block(tl.i2, i3), earth)
+    return records, state_end[K.ATT].copy(), q3, i3, compute
+
+
 def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
           settings: AlignSettings = AlignSettings(), *, earth: EarthModel = WGS84,
           att_t1: ArrayLike | None = None, position_t1: ArrayLike | None = None,
@@ -376,44 +441,23 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
     ts = float(ts)
     if not (math.isfinite(ts) and ts > 0):
         raise InputError("ts", f"must be a finite interval > 0 s, got {ts}")
-    dth = _array("dtheta", dtheta, (-1, 3))
-    dvb = _array("dv", dv, (len(dth), 3))
-    n = len(dth)
-    pos0 = _array("site", site, (3,))
-    if abs(pos0[0]) > math.radians(MAX_LAT_DEG):
-        raise InputError("site", f"gyrocompassing needs |latitude| < {MAX_LAT_DEG:g}°, "
-                              f"got {math.degrees(pos0[0]):.4f}° (the horizontal earth rate "
-                              "vanishes)")
-    ref = np.zeros((n + 1, 3)) if vref is None else _array("vref", vref, (n + 1, 3))
-    truth = None if truth_att is None else _array("truth_att", truth_att, (n + 1, 3))
     if not (isinstance(stride, (int, np.integer)) and stride >= 1):
         raise InputError("stride", f"must be a whole number ≥ 1, got {stride!r}")
-    total = first_sample + n if samples is None else samples
-    if not 0 <= first_sample <= total - n:
-        raise InputError("first_sample", f"{first_sample} with {n} increments does not "
-                              f"fit a record of {total}")
-    tl = timeline(settings, ts, total)
+    dth = _array("dtheta", dtheta, (-1, 3))
+    n = len(dth)
+    dvb = _array("dv", dv, (n, 3))
+    pos0 = _site(site)
+    ref = np.zeros((n + 1, 3)) if vref is None else _array("vref", vref, (n + 1, 3))
+    truth = None if truth_att is None else _array("truth_att", truth_att, (n + 1, 3))
     lo = first_sample
-    if tl.lo < lo or tl.hi > lo + n:
-        raise InputError("dtheta", f"covers samples {lo} .. {lo + n}; the alignment "
-                              f"reads {tl.lo} .. {tl.hi}")
-    given = None
-    if settings.coarse == "given":
-        if att_t1 is not None:
-            given = _array("att_t1", att_t1, (3,))
-        elif truth is not None:
-            given = truth[tl.i1 - lo]
-        else:
-            raise InputError("coarse", "'given' needs att_t1 or truth_att; use "
-                                  "'analytic' or 'inertial' for recorded data")
-    pos1 = pos0.copy() if position_t1 is None else _array("position_t1", position_t1, (3,))
-
+    tl = _window(settings, ts, n, lo, samples)
     i0, i1, i2 = tl.i0, tl.i1, tl.i2
+    given = _given(settings, att_t1, truth, i1 - lo)
+    pos1 = pos0.copy() if position_t1 is None else _array("position_t1", position_t1, (3,))
     att1 = _coarse_attitude(settings, dth[i0 - lo:i1 - lo], dvb[i0 - lo:i1 - lo], ts, pos0,
                             earth, given)
     q1 = euler_to_quat(att1)
     v1 = quat_to_dcm(q1) @ ref[i1 - lo] if vref_body else ref[i1 - lo]
-    state0 = K.new_state(q1, v1, pos1)
 
     def block(a: int, b: int) -> Block:
         """Increments a .. b-1 and the reference at samples a .. b, as the passes take them."""
@@ -421,31 +465,12 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
         return Block(t=t0 + np.arange(a, b + 1) * ts, dtheta=dth[i:j], dv=dvb[i:j],
                      vref=ref[i:j + 1], vref_body=vref_body, ts=ts)
 
-    # Real-time conventional: one forward pass over live data to T3, no latency to
-    # compensate ('measured' then means T3 = T2). Otherwise the passes run over the stored
-    # block [T1, T2] and the compensation carries the attitude on to T3.
-    realtime = settings.realtime_conventional
-    end = tl.i3 if realtime and tl.i3 is not None else i2
-    _warm_up()
-    t_start = time.perf_counter()
-    state_end, records = run_passes(
-        state0, block(i1, end), settings.mode, settings.pass_count, list(settings.stages),
-        settings.azimuth_poles, settings.level_phase_s, earth, stride)
-    compute = time.perf_counter() - t_start
-    if realtime:
-        i3 = end
-        rec = records[0]
-        q2 = rec.q_nb[np.searchsorted(rec.t, t0 + i2 * ts - 1e-9 * ts)]
-        q3 = state_end[K.ATT].copy()
+    records, q2, q3, i3, compute = _passes(settings, K.new_state(q1, v1, pos1), tl, block,
+                                           t0, ts, earth, stride)
+    if settings.realtime_conventional:
         equivalent = (i3 - i0) * ts
     else:
-        i3 = i2 + math.ceil(compute / ts) if tl.i3 is None else tl.i3
-        if i3 > tl.hi:
-            raise InputError("t3_s", "'measured' latency runs past the end of the data")
-        q2 = state_end[K.ATT].copy()
-        q3 = compensate(settings.compensation, state_end, block(i2, i3), earth)
         equivalent = (i1 - i0) * ts + settings.pass_count * (i2 - i1) * ts
-
     pass_truth = None
     if truth is not None:
         pass_truth = [truth[np.rint((r.t - t0) / ts).astype(int) - lo] for r in records]

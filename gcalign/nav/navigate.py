@@ -170,6 +170,22 @@ class Navigation:
     wall_s: float
 
 
+_NONE, _Q_NONE = np.zeros((1, 3)), np.zeros((1, 4))  # error_block's "no truth" rows
+
+
+def _block_truth(tr: BlockTruth | None, lo: int, hi: int, h_prev: float
+                 ) -> tuple[tuple[Array, Array, Array, Array], Array | None, float]:
+    """error_block's truth rows lo .. hi-1 (att, q_nb, v_n, pos; placeholders without
+    truth), the true height at the start of each step (None without truth) and the height
+    the next block starts from."""
+    if tr is None:
+        return (_NONE, _Q_NONE, _NONE, _NONE), None, h_prev
+    h_ref = np.concatenate([[tr.pos[lo - 1, 2] if lo > 0 else h_prev], tr.pos[lo:hi - 1, 2]])
+    q = euler_to_quat(tr.att[lo:hi]) if tr.q_nb is None else tr.q_nb[lo:hi]
+    c = np.ascontiguousarray
+    return (c(tr.att[lo:hi]), c(q), c(tr.v_n[lo:hi]), c(tr.pos[lo:hi])), h_ref, tr.pos[hi - 1, 2]
+
+
 def _errors(a: Array) -> NavErrors:
     return NavErrors(a[0].copy(), a[1].copy(), a[2].copy(), a[3].copy())
 
@@ -204,7 +220,6 @@ def navigate_blocks(blocks: Iterable[ImuBlock], ts: float, start: NavState, *, k
                                                        np.asarray(q_bs0, float))
     nav = Navigator(NavState(q_ns0, start.v_n, pos0), ts, earth, vertical)
     acc = np.zeros((9, 3))
-    none, q_none = np.zeros((1, 3)), np.zeros((1, 4))
     last = None
     has_truth = False
     kept: list[NavRows] = []
@@ -216,33 +231,20 @@ def navigate_blocks(blocks: Iterable[ImuBlock], ts: float, start: NavState, *, k
             if b.k0 >= k_end:
                 break
             continue
-        tr = b.truth
-        has_truth = tr is not None
-        h_ref = None
-        if tr is not None:  # the true height at the start of each step
-            prev = tr.pos[lo - 1, 2] if lo > 0 else h_last
-            h_ref = np.concatenate([[prev], tr.pos[lo:hi - 1, 2]])
-            h_last = tr.pos[hi - 1, 2]
+        has_truth = b.truth is not None
+        truth_rows, h_ref, h_last = _block_truth(b.truth, lo, hi, h_last)
         c0 = time.perf_counter()
         states = nav.run(b.dtheta[lo:hi], b.dv[lo:hi], h_ref)
         compute += time.perf_counter() - c0
         q_bs = np.zeros((1, 4)) if b.q_bs is None else np.ascontiguousarray(b.q_bs[lo:hi])
         out = np.empty((len(states) // stride + 1, 21))
-        q_t = q_none
-        if tr is not None:
-            q_t = np.ascontiguousarray(euler_to_quat(tr.att[lo:hi]) if tr.q_nb is None
-                                       else tr.q_nb[lo:hi])
-        rows = K.error_block(states, q_bs, b.q_bs is not None,
-                             none if tr is None else np.ascontiguousarray(tr.att[lo:hi]),
-                             q_t,
-                             none if tr is None else np.ascontiguousarray(tr.v_n[lo:hi]),
-                             none if tr is None else np.ascontiguousarray(tr.pos[lo:hi]),
-                             tr is not None, E, pos0, b.k0 + lo - k_start, stride, acc, out)
+        rows = K.error_block(states, q_bs, b.q_bs is not None, *truth_rows, has_truth, E, pos0,
+                             b.k0 + lo - k_start, stride, acc, out)
         if rows:
             keep = np.flatnonzero((b.k0 + np.arange(lo, hi) + 1 - k_start) % stride == 0)
             r = out[:rows]
-            err = None if tr is None else NavErrors(r[:, 9:12], r[:, 12:15], r[:, 15:18],
-                                                    r[:, 18:21])
+            err = NavErrors(r[:, 9:12], r[:, 12:15], r[:, 15:18], r[:, 18:21]) if has_truth \
+                else None
             chunk = NavRows(b.t[lo:hi][keep], r[:, 0:3], r[:, 3:6], r[:, 6:9], err)
             if on_rows is not None:
                 on_rows(chunk)
