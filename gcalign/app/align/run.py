@@ -172,7 +172,6 @@ def still_base_warnings(dtheta: np.ndarray, dv: np.ndarray, ts: float, lat: floa
     return []
 
 
-
 def _scenario_error(err: InputError) -> ScenarioError:
     """The core's refusal, naming the scenario field it comes from."""
     names = {"site": "site.lat_deg", "coarse": "align.coarse.method", "passes": "align.stages"}
