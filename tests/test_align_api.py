@@ -17,7 +17,7 @@ from gcalign import units as u
 from gcalign.align.gains import azimuth_gains
 from gcalign.align.gyrocompass import AlignSettings, align, timeline
 from gcalign.align.stages import Stage
-from gcalign.errors import InputError
+from gcalign.errors import InputError, ScenarioError
 from gcalign.nav import earth
 from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import euler_to_dcm, misalignment
@@ -257,3 +257,19 @@ def test_window_of_a_longer_record_gives_the_same_result():
         align(dth[tl.lo + 1:tl.hi], dv[tl.lo + 1:tl.hi], ts, [LAT, 0.0, 0.0], s,
               first_sample=tl.lo + 1, samples=len(dth))
     assert copy.copy(s) == s
+
+
+@pytest.mark.parametrize("overrides, message", [
+    ({"align.t2_s": 5000, "align.t3_s": 5000}, "align.t2_s: 5000.0 s (+ start_s 0.0 s) is past "
+     "the end of the data"),
+    ({"site": {"lat_deg": 86.0, "lon_deg": 116.0, "height_m": 0.0}},
+     "site.lat_deg: gyrocompassing needs |latitude| < 85°, got 86.0000°"),
+])
+def test_the_cores_refusals_name_the_scenario_field(tmp_path, overrides, message):
+    """A recorded file's length and site are known only when it is read: the core refuses,
+    the command names the scenario's field (exit 2), and no file is left."""
+    sc = gcalign.load(ROOT / "configs/lasergyro_align.yaml", overrides)
+    with pytest.raises(ScenarioError) as err:
+        gcalign.run("align", sc, output=tmp_path / "x.h5")
+    assert str(err.value).startswith(message) and err.value.exit_code == 2
+    assert not list(tmp_path.iterdir())
