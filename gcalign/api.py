@@ -22,8 +22,9 @@ import atexit
 import copy
 import shutil
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -37,13 +38,20 @@ DATA_SUFFIXES = (".imu", ".csv", ".txt", ".h5", ".hdf5", ".hdf")
 class Result:
     """What a run produced: the command (``kind``), its summary (plain numbers, degrees and
     seconds: the JSON of ``--json``), the random seed (None for recorded data), the
-    warnings and the results file (``path``). ``res["error_t3_deg"]`` reads the summary."""
+    warnings and the results file (``path``). ``res["error_t3_deg"]`` reads the summary.
+
+    ``value`` is the capability's typed result in SI, as its function on arrays returns it
+    (``align``: :class:`gcalign.align.gyrocompass.Alignment`, ``navigate``:
+    :class:`gcalign.nav.navigate.Navigation`; None for a command without one), from
+    :func:`run` only: a Result read back from its file has None there. It takes no part in
+    ``==`` (the file holds the same numbers)."""
 
     kind: str
     summary: dict
     seed: int | None
     path: Path
     warnings: tuple[str, ...] = field(default=())
+    value: Any = field(default=None, compare=False, repr=False)
 
     def __getitem__(self, key: str):
         return self.summary[key]
@@ -162,7 +170,8 @@ def run(command: str, scenario, seed: int | None = None, output: str | Path | No
         progress=None, **options) -> Result:
     """Run `command` (a registry name) on `scenario` (a scenario model, or anything
     :func:`load` takes) as the command line does, write the results file (`output`, or a
-    temporary file kept while Python runs) and return its :class:`Result`. `options` are the
+    temporary file kept while Python runs) and return its :class:`Result`, with the typed
+    result in ``value``. `options` are the
     command's own (``navigate``: ``init="align.h5"``); `progress(done, total, what)`
     hears of long runs."""
     from gcalign.app.registry import COMMANDS
@@ -178,8 +187,10 @@ def run(command: str, scenario, seed: int | None = None, output: str | Path | No
         suffix=".h5", prefix=f"{sc.name}-{command}-", dir=_scratch())[1])
     if options.get("init") is not None:
         options["init"] = str(options["init"])
-    run_command(command, sc, scenario_text(sc), seed, out, progress=progress, **options)
-    return read(out)
+    outcomes: list = []
+    run_command(command, sc, scenario_text(sc), seed, out, progress=progress,
+                on_outcome=outcomes.append, **options)
+    return replace(read(out), value=outcomes[0].result)
 
 
 def read(path: str | Path) -> Result:

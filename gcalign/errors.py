@@ -14,3 +14,15 @@ class ScenarioError(GcalignError, ValueError):
     """
 
     exit_code = 2
+
+
+class InputError(ValueError):
+    """An input a numerical function cannot use (arrays of the wrong shape, a time past
+    the end of the data, ...); `field` names the argument or setting, `message` says what
+    was received and what is allowed. Not a :class:`GcalignError`: the app turns it into
+    a :class:`ScenarioError` naming the scenario's field."""
+
+    def __init__(self, field: str, message: str):
+        super().__init__(f"{field}: {message}")
+        self.field = field
+        self.message = message

@@ -2,6 +2,8 @@
 
 Modules:
 
+- :mod:`gcalign.align.gyrocompass` -- the public function ``align`` on arrays of
+  increments, with ``AlignSettings``, returning an ``Alignment`` (the seed-000 timeline).
 - :mod:`gcalign.align.coarse` -- analytic double-vector and inertial-frame coarse alignment.
 - :mod:`gcalign.align.gains` -- loop gains by pole placement (seed 000 §2, eqs. 5-9).
 - :mod:`gcalign.align.kernel` -- numba kernel of the strapdown gyrocompass loops.

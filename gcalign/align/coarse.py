@@ -35,15 +35,19 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from gcalign.nav import rotation
 from gcalign.nav.earth import WGS84, EarthModel
+
+Array = NDArray[np.float64]
 
 COARSE_EPOCHS = ("end", "start")
 """Allowed values of ``at`` in :func:`inertial_frame_coarse`."""
 
 
-def _check_inputs(dtheta, dv, ts, lat, min_samples):
+def _check_inputs(dtheta: ArrayLike, dv: ArrayLike, ts: float, lat: float,
+                  min_samples: int) -> tuple[Array, Array, float, float]:
     """Validate and convert the common inputs; errors name the field, value and range."""
     dtheta = np.asarray(dtheta, dtype=float)
     dv = np.asarray(dv, dtype=float)
@@ -78,7 +82,7 @@ def _check_inputs(dtheta, dv, ts, lat, min_samples):
     return dtheta, dv, ts_f, lat_f
 
 
-def _double_vector(a1, a2, b1, b2):
+def _double_vector(a1: Array, a2: Array, b1: Array, b2: Array) -> Array:
     """C_ab from a primary pair (a1 = C_ab b1, kept exactly) and a secondary pair (a2, b2)."""
     a = np.stack([a1 / np.linalg.norm(a1), a2 / np.linalg.norm(a2)])
     b = np.stack([b1 / np.linalg.norm(b1), b2 / np.linalg.norm(b2)])
@@ -88,7 +92,8 @@ def _double_vector(a1, a2, b1, b2):
     return rot.as_matrix()
 
 
-def analytic_coarse(dtheta, dv, ts, lat, earth: EarthModel = WGS84):
+def analytic_coarse(dtheta: ArrayLike, dv: ArrayLike, ts: float, lat: float,
+                    earth: EarthModel = WGS84) -> Array:
     """Static-base analytic (double-vector) coarse alignment.
 
     Parameters
@@ -123,7 +128,7 @@ def analytic_coarse(dtheta, dv, ts, lat, earth: EarthModel = WGS84):
     return rotation.dcm_to_euler(C_nb)
 
 
-def _cumulative_quat(dq):
+def _cumulative_quat(dq: ArrayLike) -> Array:
     """Prefix products ``dq_1 ⊗ dq_2 ⊗ … ⊗ dq_k`` for k = 1..N, shape (N, 4).
 
     A Hillis-Steele scan: log2(N) vectorised passes instead of a Python loop per sample;
@@ -139,7 +144,7 @@ def _cumulative_quat(dq):
     return q
 
 
-def _gravity_velocity_in0(t, lat, g, w):
+def _gravity_velocity_in0(t: NDArray[np.floating], lat: float, g: float, w: float) -> Array:
     """Velocity ∫_0^t C_n^in0(τ) [0, 0, g] dτ (m/s) of a point at rest, in in0, shape (N, 3).
 
     ``C_n^in0(τ)`` is the rotation by ``ω_ie τ`` about the earth axis ``e = [0, cos L, sin L]``
@@ -161,8 +166,9 @@ def _gravity_velocity_in0(t, lat, g, w):
     return g * v
 
 
-def inertial_frame_coarse(dtheta, dv, ts, lat, lon=0.0, h=0.0, at="end",
-                          earth: EarthModel = WGS84):
+def inertial_frame_coarse(dtheta: ArrayLike, dv: ArrayLike, ts: float, lat: float,
+                          lon: float = 0.0, h: float = 0.0, at: str = "end",
+                          earth: EarthModel = WGS84) -> Array:
     """Inertial-frame coarse alignment on a static, swinging or disturbed base.
 
     Parameters

@@ -14,6 +14,7 @@ T3. The IMU data stored after T2 carries the attitude forward:
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from gcalign.align import kernel as K
 from gcalign.align.cycles import Block, run_block
@@ -22,9 +23,10 @@ from gcalign.nav.rotation import dcm_to_quat, quat_to_dcm
 from gcalign.nav.strapdown import integrate_attitude
 
 METHODS = ("none", "one-off", "continued")
+Array = NDArray[np.float64]
 
 
-def _C_in(pos, tau, earth: EarthModel):
+def _C_in(pos: Array, tau: ArrayLike, earth: EarthModel) -> Array:
     """C_n^i at elapsed times tau (s) since T2 and positions [lat, lon, h]: Rz(ω τ) C_n^e."""
     a = earth.omega_ie * np.asarray(tau, float)
     c, s = np.cos(a), np.sin(a)
@@ -33,7 +35,7 @@ def _C_in(pos, tau, earth: EarthModel):
     return R @ C_en(pos[..., 0], pos[..., 1])
 
 
-def _track(pos0, t, v_n, earth: EarthModel):
+def _track(pos0: Array, t: Array, v_n: Array, earth: EarthModel) -> Array:
     """Latitude/longitude/height along ENU velocity samples (trapezoid rule)."""
     dt = np.diff(t)[:, None]
     r_m, r_n = earth.radii(pos0[0])
@@ -46,7 +48,7 @@ def _track(pos0, t, v_n, earth: EarthModel):
     )
 
 
-def one_off(state_t2: np.ndarray, after: Block, earth: EarthModel = WGS84) -> np.ndarray:
+def one_off(state_t2: Array, after: Block, earth: EarthModel = WGS84) -> Array:
     """q_nb at the end of `after` by seed eqs. 14-18 (see module docstring)."""
     # eq. 18: pure gyro quaternion integration from the body inertial frame frozen at T2
     q_ib0_b = integrate_attitude(np.array([1.0, 0.0, 0.0, 0.0]), after.dtheta, after.ts)

@@ -42,9 +42,11 @@ True
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 AZIMUTH_METHODS = ("double-oscillator", "oscillator-overdamped")
 """Allowed values of ``method`` in :func:`azimuth_gains` (aliases: ``"a"``, ``"b"``)."""
@@ -86,10 +88,11 @@ class AzimuthGains:
     k4: float
 
 
-def _check_number(name, value, allowed, ok):
+def _check_number(name: str, value: object, allowed: str,
+                  ok: Callable[[float], bool]) -> float:
     """Return float(value) or raise ValueError naming the field, the value and the range."""
     try:
-        x = float(value)
+        x = float(value)  # type: ignore[arg-type]  # anything float() takes
     except (TypeError, ValueError):
         x = math.nan
     if not (math.isfinite(x) and ok(x)):
@@ -97,19 +100,19 @@ def _check_number(name, value, allowed, ok):
     return x
 
 
-def _check_period_damping(t_d, xi):
+def _check_period_damping(t_d: float, xi: float) -> tuple[float, float]:
     t_d = _check_number("t_d (damped period, s)", t_d, "a finite number > 0", lambda x: x > 0)
     xi = _check_number("xi (damping ratio)", xi, "a number with 0 < xi < 1", lambda x: 0 < x < 1)
     return t_d, xi
 
 
-def _check_earth(g, r):
+def _check_earth(g: float, r: float) -> tuple[float, float]:
     g = _check_number("g (gravity, m/s²)", g, "a finite number > 0", lambda x: x > 0)
     r = _check_number("r (earth radius, m)", r, "a finite number > 0", lambda x: x > 0)
     return g, r
 
 
-def _check_method(method):
+def _check_method(method: str) -> str:
     if isinstance(method, str):
         m = _METHOD_ALIASES.get(method, method)
         if m in AZIMUTH_METHODS:
@@ -118,7 +121,7 @@ def _check_method(method):
     raise ValueError(f"method must be one of {allowed}, got {method!r}")
 
 
-def loop_frequencies(t_d, xi):
+def loop_frequencies(t_d: float, xi: float) -> tuple[float, float, float]:
     """Natural frequency, decay rate and damped frequency of a loop.
 
     Parameters
@@ -142,13 +145,13 @@ def loop_frequencies(t_d, xi):
     return omega_n, xi * omega_n, omega_n * root
 
 
-def schuler_rate_sq(g, r):
+def schuler_rate_sq(g: float, r: float) -> float:
     """Squared Schuler frequency ``ω_s² = g/R`` (rad²/s²) from gravity g (m/s²) and radius R (m)."""
     g, r = _check_earth(g, r)
     return g / r
 
 
-def level_gains(t_d, xi, g, r):
+def level_gains(t_d: float, xi: float, g: float, r: float) -> LevelGains:
     """Level-loop gains placing the poles at ``{−σ, −σ ± jω_d}`` (seed eqs. 5-6).
 
     Parameters
@@ -180,7 +183,7 @@ def level_gains(t_d, xi, g, r):
     )
 
 
-def _overdamped_k4_ratio(xi):
+def _overdamped_k4_ratio(xi: float) -> float:
     """Unique real root x = K_U4/ω_n of x³ − 2(1+ξ)x² + (2+4ξ)x − 2(1+ξ) = 0 (method b)."""
     a = 2.0 * (1.0 + xi)
     b = 2.0 + 4.0 * xi
@@ -198,7 +201,7 @@ def _overdamped_k4_ratio(xi):
     return x
 
 
-def azimuth_gains(t_d, xi, g, r, method):
+def azimuth_gains(t_d: float, xi: float, g: float, r: float, method: str) -> AzimuthGains:
     """Compass-loop gains ``K_U1 … K_U4`` by pole placement (seed eqs. 7-9).
 
     Parameters
@@ -269,7 +272,7 @@ def azimuth_gains(t_d, xi, g, r, method):
     return AzimuthGains(k1=k1, k2=p / ws2 - 1.0, k3=omega_n**4 / g, k4=k4)
 
 
-def closed_loop_level(gains, g, r):
+def closed_loop_level(gains: LevelGains, g: float, r: float) -> NDArray[np.float64]:
     """Closed-loop characteristic polynomial of the level loop (seed eq. 6).
 
     Parameters
@@ -287,7 +290,7 @@ def closed_loop_level(gains, g, r):
     return np.array([1.0, gains.k1, (1.0 + gains.k2) * ws2, float(g) * gains.k3])
 
 
-def closed_loop_azimuth(gains, g, r):
+def closed_loop_azimuth(gains: AzimuthGains, g: float, r: float) -> NDArray[np.float64]:
     """Closed-loop characteristic polynomial of the compass loop (seed eq. 7).
 
     Parameters
@@ -309,13 +312,13 @@ def closed_loop_azimuth(gains, g, r):
     )
 
 
-def designed_poles_level(t_d, xi):
+def designed_poles_level(t_d: float, xi: float) -> NDArray[np.complex128]:
     """Designed level-loop poles ``[−σ, −σ + jω_d, −σ − jω_d]`` (1/s), shape (3,) complex."""
     _, sigma, omega_d = loop_frequencies(t_d, xi)
     return np.array([-sigma, complex(-sigma, omega_d), complex(-sigma, -omega_d)])
 
 
-def designed_poles_azimuth(t_d, xi, method):
+def designed_poles_azimuth(t_d: float, xi: float, method: str) -> NDArray[np.complex128]:
     """Designed compass-loop poles (1/s), shape (4,) complex, double poles listed twice.
 
     ``"double-oscillator"``: ``−σ ± jω_d`` twice; ``"oscillator-overdamped"``:
@@ -329,7 +332,8 @@ def designed_poles_azimuth(t_d, xi, method):
     return np.array([complex(-omega_n, 0.0)] * 2 + pair)
 
 
-def heading_transient(t, gains, g, r):
+def heading_transient(t: ArrayLike, gains: AzimuthGains, g: float,
+                      r: float) -> NDArray[np.float64] | float:
     """Heading error of the linear compass loop after an initial heading error, as a
     fraction of it (seed §6.1: "at the first T_z the heading error falls to 4-6 %").
 

@@ -33,6 +33,8 @@ class Outcome:
     truth : the simulated truth to store under ``/truth``, if any.
     seed : the random seed the run used (None for recorded data).
     warnings : one line each, shown on stderr and kept in the summary.
+    result : the capability's typed result in SI (e.g.
+        :class:`gcalign.align.gyrocompass.Alignment`), or None.
     """
 
     summary: dict
@@ -40,6 +42,7 @@ class Outcome:
     truth: Any = None
     seed: int | None = None
     warnings: tuple[str, ...] = ()
+    result: Any = None
 
 
 @dataclass(frozen=True)

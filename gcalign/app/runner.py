@@ -11,7 +11,7 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from gcalign.app.registry import command
+from gcalign.app.registry import Outcome, command
 from gcalign.errors import ScenarioError
 from gcalign.io import results
 from gcalign.io.scenario import Scenario
@@ -25,14 +25,16 @@ def accepts(fn: Callable, name: str) -> bool:
 
 def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path, *,
                 progress: Callable | None = None, notes: Sequence[str] = (),
-                before_write: Callable[[], None] | None = None, **options) -> dict:
+                before_write: Callable[[], None] | None = None,
+                on_outcome: Callable[[Outcome], None] | None = None, **options) -> dict:
     """Run command `name` through its room, write the results file `out` (atomically: an
     interrupted run leaves no file) and return the summary it stored.
 
     The summary gets ``warnings`` (`notes`, the scenario's keys that cannot matter, and the
     run's own), ``wall_s`` (the whole call) and ``output``. `progress(done, total, what)`
     goes to a room whose ``execute`` takes it; `before_write` is called when the run is
-    done, before the file is finished (the command line closes its progress bar there).
+    done, before the file is finished (the command line closes its progress bar there);
+    `on_outcome` hears of the room's :class:`Outcome` (the Python API keeps its typed result).
     """
     cmd = command(name)
     room = cmd.load()
@@ -47,6 +49,8 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
                 outcome = cmd.execute(sc, seed, sink=f, **kwargs)
             else:
                 outcome = cmd.execute(sc, seed, **kwargs)
+            if on_outcome is not None:
+                on_outcome(outcome)
             if before_write is not None:
                 before_write()
             summary = outcome.summary

@@ -23,7 +23,7 @@ def write_alignment(f: h5py.File, run, stream=None) -> None:
         put(tg, "t", t, "s", description="the samples the passes stored (output rate)")
         put(tg, "att", np.array([rows[x] for x in t]), "rad", ATT_FRAME)
     g = f.create_group("align")
-    g.attrs["mode"] = run.cfg.mode
+    g.attrs["mode"] = run.settings.mode
     g.attrs["azimuth_poles"] = run.azimuth_poles
     g.attrs["t1_s"], g.attrs["t2_s"], g.attrs["t3_s"] = run.t1, run.t2, run.t3
     for rec, att, err, phi in zip(run.passes, run.pass_att, run.pass_errors, run.pass_phi,

@@ -1,190 +1,71 @@
-"""Gyrocompass alignment of a scenario: coarse on [0, T1], passes on [T1, T2], T2 → T3.
+"""Gyrocompass alignment of a scenario: its data as arrays, :func:`gcalign.align.gyrocompass.align`.
 
-Seed 000; DESIGN.md "Gyrocompass fine alignment". Returns an :class:`AlignRun` of plain
-arrays; the CLI writes and prints it.
+Seed 000. The scenario gives the settings (:func:`settings_of`) and the data (a
+:class:`gcalign.app.data.Stream`, simulated on the fly or recorded); :func:`collect` reads
+only the samples the alignment needs, the core aligns them, and the result
+(:class:`gcalign.align.gyrocompass.Alignment`) becomes the summary and the /align group.
 """
 
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass
-from functools import cached_property
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gcalign.align import coarse as coarse_mod
-from gcalign.align import kernel as K
-from gcalign.align.compensate import compensate
-from gcalign.align.cycles import Block, PassRecord, run_passes
+from gcalign.align.gyrocompass import (
+    Alignment,
+    AlignSettings,
+    Timeline,
+    align,
+    timeline,
+)
 from gcalign.app.data import RunData, Stream, scenario_data, scenario_stream, stream_of
 from gcalign.app.registry import Outcome
-from gcalign.errors import ScenarioError
+from gcalign.errors import InputError, ScenarioError
 from gcalign.io.scenario import Scenario
-from gcalign.io.scenario.align import AlignConfig
-from gcalign.nav.earth import WGS84, EarthModel
-from gcalign.nav.rotation import (
-    attitude_error,
-    euler_to_dcm,
-    euler_to_quat,
-    misalignment,
-    misalignment_q,
-    quat_to_dcm,
-    quat_to_euler,
-)
+from gcalign.io.scenario.align import Aiding, AlignConfig
+from gcalign.nav.earth import EarthModel
+from gcalign.nav.rotation import euler_to_dcm, quat_to_euler
+
+Progress = Callable[[float, float, str], None]
+
+
+def settings_of(cfg: AlignConfig, motion_kind: str | None) -> AlignSettings:
+    """The core's settings (SI) of a scenario's align section; the motion kind picks the
+    default pole set (data simulated earlier carry it along)."""
+    c = cfg.coarse
+    off = np.radians(c.error_deg if c.method == "given" else c.offset_deg)
+    return AlignSettings(
+        mode=cfg.mode, start_s=cfg.start_s, t1_s=cfg.t1_s, t2_s=cfg.t2_s, t3_s=cfg.t3_s,
+        realtime=cfg.realtime, compensation=cfg.compensation, coarse=c.method,
+        coarse_offset=(float(off[0]), float(off[1]), float(off[2])),
+        azimuth_poles=cfg.poles_for(motion_kind),  # type: ignore[arg-type]
+        level_s=cfg.level_phase_s, stages=tuple(cfg.stage_list()), passes=cfg.pass_count)
 
 
 @dataclass(frozen=True)
-class AlignRun:
-    """Everything an alignment produced (SI). Truth-dependent fields are None without truth."""
+class Window:
+    """Samples lo .. hi of a run as the core takes them (SI): increments lo .. hi-1, the
+    reference velocity and the true attitude at samples lo .. hi (truth None for recorded
+    data), the true position at T1 (the site without truth)."""
 
-    cfg: AlignConfig
-    azimuth_poles: str
-    t1: float
-    t2: float
-    t3: float
-    coarse_att: np.ndarray
-    passes: list[PassRecord]
-    pass_truth: list[np.ndarray] | None  # true attitude along each pass (rad), if known
-    att_t2: np.ndarray
-    att_t3: np.ndarray
-    truth_t2: np.ndarray | None
-    truth_t3: np.ndarray | None
-    compute_s: float
-    equivalent_s: float
-    index_offset: int  # data sample index of alignment time 0
-    t3_source: str  # "configured" or "measured"
-    warnings: tuple[str, ...] = ()
-
-    @property
-    def error_t2(self):
-        return None if self.truth_t2 is None else attitude_error(self.att_t2, self.truth_t2)
-
-    @property
-    def error_t3(self):
-        return None if self.truth_t3 is None else attitude_error(self.att_t3, self.truth_t3)
-
-    @cached_property
-    def pass_att(self) -> list[np.ndarray]:
-        """Euler angles (n, 3) rad along each pass (its stored rows)."""
-        return [quat_to_euler(r.q_nb) for r in self.passes]
-
-    @cached_property
-    def pass_errors(self) -> list[np.ndarray | None]:
-        """Euler-angle error (n, 3) rad along each pass; computed when first asked for
-        (a batch needs only the end of each pass)."""
-        if self.pass_truth is None:
-            return [None] * len(self.passes)
-        return [attitude_error(a, tr) for a, tr in zip(self.pass_att, self.pass_truth,
-                                                         strict=True)]
-
-    @cached_property
-    def pass_phi(self) -> list[np.ndarray | None]:
-        """Misalignment φ (n+1, 3) rad, ENU, along each pass."""
-        if self.pass_truth is None:
-            return [None] * len(self.passes)
-        return [
-            misalignment_q(r.q_nb, euler_to_quat(tr))
-            for r, tr in zip(self.passes, self.pass_truth, strict=True)
-        ]
-
-    def pass_end_error(self, i: int) -> np.ndarray | None:
-        """Euler-angle error at the end of pass i (rad)."""
-        if self.pass_truth is None:
-            return None
-        return attitude_error(quat_to_euler(self.passes[i].q_nb[-1]), self.pass_truth[i][-1])
-
-    def last_pass_spread(self) -> dict | None:
-        """The error's spread over the second half of the last pass (where a pass has
-        settled; the first half of a conventional run's only pass holds the coarse
-        transient): mean, std (ddof 0) and max |·| per angle (rad) of the stored rows, and
-        the window's first and last data times (s). None without truth."""
-        if self.pass_truth is None:
-            return None
-        r, tr = self.passes[-1], self.pass_truth[-1]
-        h = len(r.t) // 2
-        err = attitude_error(quat_to_euler(r.q_nb[h:]), tr[h:])
-        return {"mean": err.mean(0), "std": err.std(0), "max": np.abs(err).max(0),
-                "t_from": float(min(r.t[h], r.t[-1])), "t_to": float(max(r.t[h], r.t[-1])),
-                "rows": len(err)}
-
-    @property
-    def phi_t2(self):
-        """Misalignment φ at T2 (rad, ENU): C_nb,est C_nb,true^T = exp(−[φ×])."""
-        return None if self.truth_t2 is None else _phi(self.att_t2, self.truth_t2)
-
-    @property
-    def phi_t3(self):
-        return None if self.truth_t3 is None else _phi(self.att_t3, self.truth_t3)
-
-
-def _phi(att_est, att_true):
-    return misalignment(euler_to_dcm(att_est), euler_to_dcm(att_true))
-
-
-MEASURED_MAX_S = 600.0  #: data kept after T2 for a 'measured' T3 (the computing latency)
-
-
-@dataclass(frozen=True)
-class AlignInputs:
-    """The part of a run's data an alignment needs, collected from a stream in one go (SI).
-
-    Samples lo .. hi-1 of the increments, the reference velocity at samples lo .. hi, the
-    true attitude at the samples in `truth_idx` (every stored pass row, T1, T2, T3) and the
-    true position at T1; the rest of the run is never held in memory.
-    """
-
-    ts: float
-    t0: float  # data time of sample 0
-    samples: int
-    lo: int
     dtheta: np.ndarray
     dv: np.ndarray
     vref: np.ndarray
-    vref_body: bool
-    truth_idx: np.ndarray | None
     truth_att: np.ndarray | None
     pos_t1: np.ndarray
-    site: np.ndarray
-    earth: EarthModel
-    seed: int | None
-    source: str
-    motion_kind: str | None
-
-    def att_at(self, k) -> np.ndarray:
-        """True attitude at sample indices k (they must be among `truth_idx`)."""
-        assert self.truth_idx is not None and self.truth_att is not None
-        j = np.searchsorted(self.truth_idx, k)
-        return self.truth_att[j]
-
-    def block(self, a: int, b: int) -> Block:
-        """Increments a .. b-1 and the reference at samples a .. b, as the passes take them."""
-        i, j = a - self.lo, b - self.lo
-        return Block(t=self.t0 + np.arange(a, b + 1) * self.ts, dtheta=self.dtheta[i:j],
-                     dv=self.dv[i:j], vref=self.vref[i:j + 1], vref_body=self.vref_body,
-                     ts=self.ts)
 
 
-def _index(stream: Stream, cfg: AlignConfig, t: float, field: str) -> int:
-    """Data sample index of alignment time t (s); ScenarioError if outside the data."""
-    k = int(round((cfg.start_s + t) / stream.ts))
-    if k > stream.samples:
-        raise ScenarioError(
-            f"align.{field}: {t} s (+ start_s {cfg.start_s} s) is past the end of the data "
-            f"({stream.samples * stream.ts:.2f} s); lengthen motion.duration_s or choose an "
-            f"earlier time"
-        )
-    return k
-
-
-def _reference(cfg: AlignConfig, att, v_n, rng: np.random.Generator, body: bool):
+def _reference(aiding: Aiding, att, v_n, rng: np.random.Generator, body: bool):
     """Reference velocity of samples with true attitude att and velocity v_n (n, 3).
 
     nav: the true ENU velocity plus white noise. odometer: the body-frame forward speed
     plus white noise (seed §1: converted to the navigation frame with the computed attitude
     inside the loop). The noise of successive blocks continues one stream.
     """
-    noise = cfg.aiding.noise_mps
+    noise = aiding.noise_mps
     if not body:
         return v_n + noise * rng.standard_normal(v_n.shape)
     speed = np.einsum("kji,kj->ki", euler_to_dcm(att), v_n)[:, 1]
@@ -193,45 +74,41 @@ def _reference(cfg: AlignConfig, att, v_n, rng: np.random.Generator, body: bool)
     return np.stack([z, speed, z], -1)
 
 
-def collect(stream: Stream, cfg: AlignConfig, lo: int, hi: int, truth_rows,
-            progress=None) -> AlignInputs:
-    """One pass over the stream: increments lo .. hi-1, reference velocity at lo .. hi,
-    true attitude where `truth_rows(k)` (sample indices, bool array) says, position at T1.
-    `progress(done_s, total_s, what)` hears of every block (the simulation, if it is one,
-    is most of an alignment's time)."""
-    source = cfg.aiding.source
+def collect(stream: Stream, tl: Timeline, aiding: Aiding,
+            progress: Progress | None = None) -> Window:
+    """One pass over the stream for the samples tl.lo .. tl.hi; the rest of the run is
+    never held (nor, simulated, generated). `progress(done_s, total_s, what)` hears of
+    every block (the simulation, if it is one, is most of an alignment's time)."""
+    source = aiding.source
     has_truth = stream.truth0 is not None
-    if source != "none" and not has_truth:
+    if source != "none" and not has_truth:  # the reference is simulated from the truth
         raise ScenarioError(
             f"align.aiding.source: {source!r} needs a simulated motion (truth); "
             "recorded data supports 'none'"
         )
     body = source == "odometer"
     rng = np.random.default_rng([0 if stream.seed is None else stream.seed, 1])
+    lo, hi, i1 = tl.lo, tl.hi, tl.i1
     m = hi - lo
     dtheta, dv = np.empty((m, 3)), np.empty((m, 3))
     vref = np.zeros((m + 1, 3))
-    idx_parts, att_parts = [], []
-    i1 = _index(stream, cfg, cfg.t1_s, "t1_s")
+    truth_att = np.empty((m + 1, 3)) if has_truth else None
     pos_t1 = stream.site.copy()
 
-    def take(k0: int, att, v_n, pos):
-        """Truth rows of samples k0 .. k0+len-1: reference velocity, stored attitudes."""
+    def take(k0: int, att, v_n, pos) -> None:
+        """Truth rows of samples k0 .. k0+len-1: reference velocity, attitude, pos at T1."""
         nonlocal pos_t1
         k = k0 + np.arange(len(att))
+        sel = (k >= lo) & (k <= hi)
         if source != "none":
-            ref = _reference(cfg, att, v_n, rng, body)
-            sel = (k >= lo) & (k <= hi)
-            vref[k[sel] - lo] = ref[sel]
-        keep = truth_rows(k)
-        idx_parts.append(k[keep])
-        att_parts.append(att[keep])
+            vref[k[sel] - lo] = _reference(aiding, att, v_n, rng, body)[sel]
+        assert truth_att is not None
+        truth_att[k[sel] - lo] = att[sel]
         if k[0] <= i1 <= k[-1]:
             pos_t1 = pos[i1 - k[0]].copy()
 
-    if has_truth:
+    if stream.truth0 is not None:
         tr0 = stream.truth0
-        assert tr0 is not None
         take(0, tr0.att, tr0.v_n, tr0.pos)
     for b in stream.blocks():
         n = len(b.t)
@@ -244,43 +121,9 @@ def collect(stream: Stream, cfg: AlignConfig, lo: int, hi: int, truth_rows,
         if progress is not None:
             what = "simulating (data s)" if has_truth else "reading (data s)"
             progress(min(b.k0 + n, hi) * stream.ts, hi * stream.ts, what)
-        if b.k0 + n >= hi and (source == "none" or b.k0 + 1 + n > hi):
+        if b.k0 + n >= hi:
             break  # everything needed is in; the rest of the run is never generated
-    kind = stream.header.meta.get("motion_kind") if stream.header is not None else None
-    return AlignInputs(
-        ts=stream.ts, t0=stream.t0, samples=stream.samples, lo=lo, dtheta=dtheta, dv=dv,
-        vref=vref, vref_body=body,
-        truth_idx=np.concatenate(idx_parts) if has_truth else None,
-        truth_att=np.concatenate(att_parts) if has_truth else None,
-        pos_t1=pos_t1, site=stream.site, earth=stream.earth, seed=stream.seed,
-        source=stream.source, motion_kind=kind)
-
-
-def coarse_attitude(data: AlignInputs, cfg: AlignConfig, i0: int, i1: int):
-    """Attitude at T1 from the coarse method (rad): the truth plus ``error_deg`` (given), or
-    the analytic / inertial result over [0, T1] plus ``offset_deg``; and the warnings."""
-    c = cfg.coarse
-    if c.method == "given":
-        if data.truth_idx is None:
-            raise ScenarioError(
-                "align.coarse.method: 'given' needs truth; use 'analytic' or "
-                "'inertial' for recorded data"
-            )
-        return data.att_at(i1) + np.radians(c.error_deg), []
-    offset = np.radians(c.offset_deg)
-    dth, dv = data.dtheta[i0 - data.lo:i1 - data.lo], data.dv[i0 - data.lo:i1 - data.lo]
-    ts, site = data.ts, data.site
-    try:
-        if c.method == "analytic":
-            att = coarse_mod.analytic_coarse(dth, dv, ts, site[0], data.earth) + offset
-            return att, still_base_warnings(dth, dv, ts, site[0], data.earth)
-        return coarse_mod.inertial_frame_coarse(dth, dv, ts, site[0], site[1], site[2],
-                                                earth=data.earth) + offset, []
-    except ValueError as err:  # too short a window
-        raise ScenarioError(
-            f"align.t1_s: the coarse window [0, {(i1 - i0) * ts:g}] s does not fit method "
-            f"{c.method!r}: {err}"
-        ) from None
+    return Window(dtheta, dv, vref, truth_att, pos_t1)
 
 
 #: The share of the signal an excursion of the base may reach before the analytic coarse
@@ -329,30 +172,21 @@ def still_base_warnings(dtheta: np.ndarray, dv: np.ndarray, ts: float, lat: floa
     return []
 
 
-def warm_up() -> None:
-    """Load the compiled kernel (numba cache) before the computation is timed."""
-    state = K.new_state(np.array([1.0, 0.0, 0.0, 0.0]), np.zeros(3), np.array([0.7, 0.0, 0.0]))
-    K.gyrocompass_block(state, np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((2, 3)), False,
-                        0.01, 1.0, WGS84.params(), np.zeros(K.GAINS_SIZE), K.ATTITUDE,
-                        np.empty((2, 4)))
+def _scenario_error(err: InputError) -> ScenarioError:
+    """The core's refusal, naming the scenario field it comes from."""
+    names = {"site": "site.lat_deg", "coarse": "align.coarse.method", "passes": "align.stages"}
+    return ScenarioError(f"{names.get(err.field, 'align.' + err.field)}: {err.message}")
 
 
-def run_alignment(sc: Scenario, stream: Stream | RunData, progress=None) -> AlignRun:
-    """Coarse alignment, the passes of the mode, and the T2 → T3 compensation, on a stream
-    of the run's data (or the whole run in memory)."""
+def run_alignment(sc: Scenario, stream: Stream | RunData,
+                  progress: Progress | None = None) -> Alignment:
+    """Align a scenario's data (a stream, or the whole run in memory): the core's result
+    with the scenario's warnings."""
     if isinstance(stream, RunData):
         stream = stream_of(stream)
     cfg = sc.align or AlignConfig()
-    warm_up()
-    if abs(stream.site[0]) > math.radians(85.0):
-        raise ScenarioError(
-            f"site.lat_deg: gyrocompassing needs |latitude| < 85°, got "
-            f"{math.degrees(stream.site[0]):.4f}° (the horizontal earth rate vanishes)"
-        )
-    # The motion kind picks the default pole set; data simulated earlier carry it along.
     kind = sc.motion.kind if sc.motion else (
         stream.header.meta.get("motion_kind") if stream.header is not None else None)
-    poles = cfg.poles_for(kind)
     warnings = []
     if kind == "moving" and cfg.aiding.source == "none":
         warnings.append(
@@ -360,101 +194,37 @@ def run_alignment(sc: Scenario, stream: Stream | RunData, progress=None) -> Alig
             "vehicle's accelerations for tilt; expect degrees of error"
         )
     ts = stream.ts
-    i0 = _index(stream, cfg, 0.0, "start_s")
-    i1 = _index(stream, cfg, cfg.t1_s, "t1_s")
-    i2 = _index(stream, cfg, cfg.t2_s, "t2_s")
-    realtime = cfg.realtime_conventional
-    if cfg.t3_s == "measured":
-        i3 = i2 if realtime else None
-        hi = i2 if realtime else min(stream.samples, i2 + int(round(MEASURED_MAX_S / ts)))
-    else:
-        i3 = _index(stream, cfg, cfg.t3_s, "t3_s")
-        hi = i3
-    try:
+    try:  # preflight refuses a bad rate for simulated data; a recorded file's is known here
         stride = sc.output.stride(1.0 / ts, stream.samples * ts)
     except ValueError as err:
         raise ScenarioError(str(err)) from None
-    lo = i0 if cfg.coarse.method != "given" else i1
-    ends = {i1, i2, hi} | ({i3} if i3 is not None else set())
-
-    def truth_rows(k):
-        """Samples whose true attitude is kept: the stored pass rows and the ends."""
-        return ((k >= i1) & (k <= hi) & ((k - i1) % stride == 0)) | np.isin(k, list(ends))
-
-    data = collect(stream, cfg, lo, hi, truth_rows, progress)
-    att1, coarse_warnings = coarse_attitude(data, cfg, i0, i1)
-    warnings += coarse_warnings
-    q1 = euler_to_quat(att1)
-    v1 = quat_to_dcm(q1) @ data.vref[i1 - lo] if data.vref_body else data.vref[i1 - lo]
-    state0 = K.new_state(q1, v1, data.pos_t1)
-
-    # Real-time conventional: one forward pass over live data to T3, no latency to
-    # compensate ('measured' then means T3 = T2). Otherwise the passes run over the stored
-    # block [T1, T2] and the compensation carries the attitude on to T3.
-    t_start = time.perf_counter()
-    state_end, records = run_passes(
-        state0, data.block(i1, i3 if realtime else i2),  # type: ignore[arg-type]
-        cfg.mode, cfg.pass_count, cfg.stage_list(), poles,
-        cfg.level_phase_s, data.earth, stride,
-    )
-    compute = time.perf_counter() - t_start
-    if realtime:
-        assert i3 is not None
-        rec = records[0]
-        q2 = rec.q_nb[np.searchsorted(rec.t, data.t0 + i2 * ts - 1e-9 * ts)]
-        q3 = state_end[K.ATT].copy()
-        equivalent = (i3 - i0) * ts
-    else:
-        if i3 is None:
-            i3 = i2 + math.ceil(compute / ts)
-            if i3 > hi:
-                raise ScenarioError("align.t3_s: 'measured' latency runs past the end of the data")
-        q2 = state_end[K.ATT].copy()
-        q3 = compensate(cfg.compensation, state_end, data.block(i2, i3), data.earth)
-        equivalent = (i1 - i0) * ts + cfg.pass_count * (i2 - i1) * ts
-
-    has_truth = data.truth_idx is not None
-    pass_truth = None
-    if has_truth:
-        pass_truth = [data.att_at(np.rint((rec.t - data.t0) / ts).astype(int))
-                      for rec in records]
-    return AlignRun(
-        cfg=cfg,
-        azimuth_poles=poles,
-        t1=(i1 - i0) * ts,  # the sample times actually used
-        t2=(i2 - i0) * ts,
-        t3=(i3 - i0) * ts,
-        coarse_att=att1,
-        passes=records,
-        pass_truth=pass_truth,
-        att_t2=quat_to_euler(q2),
-        att_t3=quat_to_euler(q3),
-        truth_t2=data.att_at(i2) if has_truth else None,
-        truth_t3=data.att_at(i3) if has_truth and i3 in ends else (
-            _truth_at(stream, i3) if has_truth else None),
-        compute_s=compute,
-        equivalent_s=equivalent,
-        index_offset=i0,
-        t3_source="measured" if cfg.t3_s == "measured" else "configured",
-        warnings=tuple(warnings),
-    )
-
-
-def _truth_at(stream: Stream, k: int):
-    tr = stream.truth_at(k)
-    return None if tr is None else np.asarray(tr[0], float)
+    try:
+        settings = settings_of(cfg, kind)
+        tl = timeline(settings, ts, stream.samples)
+        data = collect(stream, tl, cfg.aiding, progress)
+        if settings.coarse == "analytic":
+            k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
+            warnings += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
+                                            stream.earth)
+        run = align(data.dtheta, data.dv, ts, stream.site, settings, earth=stream.earth,
+                    position_t1=data.pos_t1, vref=data.vref,
+                    vref_body=cfg.aiding.source == "odometer", truth_att=data.truth_att,
+                    t0=stream.t0, stride=stride, first_sample=tl.lo, samples=stream.samples)
+    except InputError as err:
+        raise _scenario_error(err) from None
+    return replace(run, warnings=tuple(warnings))
 
 
 def _deg(x):
     return None if x is None else np.degrees(x).tolist()
 
 
-def alignment_summary(run: AlignRun, stream: Stream | RunData, name: str) -> dict:
+def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> dict:
     """Plain-number summary (degrees, seconds): the JSON contract of `gcalign align --json`."""
     if isinstance(stream, RunData):
         stream = stream_of(stream)
-    cfg = run.cfg
-    realtime = cfg.realtime_conventional
+    s = run.settings
+    realtime = s.realtime_conventional
     start, ts = stream.t0, stream.ts  # data time of sample 0
 
     def aligned_time(t_data: float) -> float:
@@ -462,19 +232,18 @@ def alignment_summary(run: AlignRun, stream: Stream | RunData, name: str) -> dic
 
     spread = run.last_pass_spread()
     last = None if spread is None else {
-        "window_s": [aligned_time(spread["t_from"]), aligned_time(spread["t_to"])],
-        "rows": spread["rows"],
-        **{f"{k}_deg": _deg(spread[k]) for k in ("mean", "std", "max")}}
-    stages = cfg.stage_list()
+        "window_s": [aligned_time(spread.t_from), aligned_time(spread.t_to)],
+        "rows": spread.rows,
+        **{f"{k}_deg": _deg(getattr(spread, k)) for k in ("mean", "std", "max")}}
     return {
         "scenario": name,
         "seed": stream.seed,
         "source": stream.source,
-        "mode": cfg.mode,
-        "compensation": "real time" if realtime else cfg.compensation,
+        "mode": s.mode,
+        "compensation": "real time" if realtime else s.compensation,
         "azimuth_poles": run.azimuth_poles,
-        "stages": [{"stage": i + 1, "t_xy_s": s.t_xy, "t_z_s": s.t_z, "xi": s.xi,
-                    "passes": s.passes} for i, s in enumerate(stages)],
+        "stages": [{"stage": i + 1, "t_xy_s": st.t_xy, "t_z_s": st.t_z, "xi": st.xi,
+                    "passes": st.passes} for i, st in enumerate(s.stages)],
         "t1_s": run.t1,
         "t2_s": run.t2,
         "t3_s": run.t3,
@@ -509,7 +278,7 @@ def alignment_summary(run: AlignRun, stream: Stream | RunData, name: str) -> dic
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            progress=None) -> Outcome:
+            progress: Progress | None = None) -> Outcome:
     """Simulate (or read) the data, align, summarise; the registry's entry point."""
     from gcalign.app.align.hdf5 import write_alignment
 
@@ -519,4 +288,5 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
         stream = scenario_stream(sc, seed)
     run = run_alignment(sc, stream, progress)
     return Outcome(alignment_summary(run, stream, sc.name),
-                   lambda f: write_alignment(f, run, stream), None, stream.seed, run.warnings)
+                   lambda f: write_alignment(f, run, stream), None, stream.seed, run.warnings,
+                   result=run)

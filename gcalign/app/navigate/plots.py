@@ -66,7 +66,7 @@ def figures(f, name: str) -> dict:
         phi = e["phi"][()] if "phi" in e else e["att"][()]
         return {"navigate_error": navigate_error_figure(
             t, phi, e["v_n"][()], e["pos"][()], title=f"{head} — error against truth")}
-    from gcalign.app.navigate.run import position_error_enu
+    from gcalign.nav.navigate import position_error_enu
 
     pos = g["pos"][()]
     disp = position_error_enu(pos, np.broadcast_to(pos[0], pos.shape))

@@ -1,12 +1,9 @@
 """Strapdown navigation of a scenario's data, streamed block by block, with errors against truth.
 
 The data come as a :class:`gcalign.app.data.Stream` (simulated on the fly, or recorded);
-each block is integrated by :class:`gcalign.nav.strapdown.Navigator`, compared with the
-truth at every sample (final and largest errors use every sample), decimated to the output
-rate and appended to the results file, so memory does not grow with a run's duration.
-
-On a turning IMU (a mechanism) the navigation integrates the sensor frame and reports the
-body attitude through the mechanism angles the data carry, ``q_nb = q_ns ⊗ q_bs*``.
+:func:`gcalign.nav.navigate.navigate_blocks` navigates its blocks (errors against the truth
+at every sample, rows decimated to the output rate), and the rows are appended to the
+results file as they come, so memory does not grow with a run's duration.
 
 Where navigation starts (``--init``): the truth (simulated data), the file header (recorded
 data), or an alignment results file, whose attitude at T3 is taken at T3's data time.
@@ -15,7 +12,6 @@ data), or an alignment results file, whose attitude at T3 is taken at T3's data 
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,28 +19,12 @@ import numpy as np
 
 from gcalign.app.data import Stream, scenario_stream
 from gcalign.app.registry import Outcome
-from gcalign.errors import ScenarioError
+from gcalign.errors import InputError, ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.navigation import NavigationConfig
-from gcalign.nav import _kernels as K
-from gcalign.nav.earth import WGS84, EarthModel
-from gcalign.nav.rotation import quat_to_euler
-from gcalign.nav.strapdown import Navigator, NavState, Vertical
-from gcalign.sim.mechanism import body_attitude
-
-
-def position_error_enu(pos, pos_true, earth: EarthModel = WGS84):
-    """ENU metres between two ``[lat, lon, h]`` tracks, (N, 3), radii at the true latitude."""
-    r_m, r_n = earth.radii(pos_true[:, 0])
-    h = pos_true[:, 2]
-    return np.stack(
-        [
-            (pos[:, 1] - pos_true[:, 1]) * (r_n + h) * np.cos(pos_true[:, 0]),
-            (pos[:, 0] - pos_true[:, 0]) * (r_m + h),
-            pos[:, 2] - pos_true[:, 2],
-        ],
-        -1,
-    )
+from gcalign.nav.navigate import Navigation, NavRows, navigate_blocks
+from gcalign.nav.navigate import position_error_enu as position_error_enu  # its old home
+from gcalign.nav.strapdown import NavState, Vertical
 
 
 @dataclass(frozen=True)
@@ -89,24 +69,29 @@ def vertical_of(cfg: NavigationConfig, sc: Scenario, motion_kind: str | None = N
     return Vertical(mode, cfg.tau_s)
 
 
+def _as_dict(rows: NavRows) -> dict[str, np.ndarray]:
+    """Stored rows by the names of the results file's series."""
+    data = {"t": rows.t, "att": rows.att, "v_n": rows.v_n, "pos": rows.pos}
+    if rows.error is not None:
+        e = rows.error
+        data |= {"error/att": e.att, "error/v_n": e.v_n, "error/pos": e.pos, "error/phi": e.phi}
+    return data
+
+
 def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
                     duration_s: float | None = None, sink=None, on_rows=None,
                     progress=None) -> dict:
-    """Navigate from `start` to the end of the data (or for `duration_s`), compare with the
-    truth at every sample (:func:`gcalign.nav._kernels.error_block`), write every
-    `stride`-th row to `sink` (an h5py group) and hand it to `on_rows` (called with the
-    dict of arrays appended to the series, block by block), and return the plain-number
-    pieces of the summary (SI, radians). `progress(done_s, total_s, what)`, if given,
-    hears of every block (seconds of data navigated)."""
+    """Navigate from `start` to the end of the data (or for `duration_s`) by
+    :func:`gcalign.nav.navigate.navigate_blocks`, write every `stride`-th row to `sink` (an
+    h5py group) and hand it to `on_rows` (called with the dict of arrays appended to the
+    series, block by block), and return the plain-number pieces of the summary (SI,
+    radians) with the core's result under ``result``. `progress(done_s, total_s, what)`,
+    if given, hears of every block (seconds of data navigated)."""
     from gcalign.io.results import ATT_FRAME, PHI_FRAME, Series
 
-    ts, earth = stream.ts, stream.earth
-    E = earth.params()
+    ts = stream.ts
     k_end = stream.samples if duration_s is None else min(
         stream.samples, start.k + int(round(duration_s / ts)))
-    if k_end <= start.k:
-        raise ScenarioError(f"navigation: nothing to navigate: start at sample {start.k} of "
-                            f"{stream.samples} ({start.k * ts:g} s of {stream.samples * ts:g} s)")
     has_truth = stream.truth0 is not None
     series = None
     if sink is not None:
@@ -125,86 +110,50 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         if has_truth:
             row0 |= {f"error/{n}": np.zeros((1, 3)) for n in ("att", "v_n", "pos", "phi")}
         series.append(**row0)
-    state = start.state
-    pos0 = np.asarray(state.pos, dtype=float)
-    h_last = float(pos0[2])
-    q_bs0 = stream.q_bs_at(start.k)
-    q_ns0 = state.q_nb if q_bs0 is None else _qmul(state.q_nb, q_bs0)
-    nav = Navigator(NavState(q_ns0, state.v_n, pos0), ts, earth, vertical)
-    acc = np.zeros((9, 3))
-    none, q_none = np.zeros((1, 3)), np.zeros((1, 4))
-    last = None
-    compute = 0.0
-    t0 = time.perf_counter()
-    for b in stream.blocks():
-        lo, hi = max(start.k - b.k0, 0), min(k_end - b.k0, len(b.t))
-        if hi <= lo:
-            if b.k0 >= k_end:
-                break
-            continue
-        tr = b.truth
-        h_ref = None
-        if tr is not None:  # the true height at the start of each step
-            prev = tr.pos[lo - 1, 2] if lo > 0 else h_last
-            h_ref = np.concatenate([[prev], tr.pos[lo:hi - 1, 2]])
-            h_last = tr.pos[hi - 1, 2]
-        c0 = time.perf_counter()
-        states = nav.run(b.dtheta[lo:hi], b.dv[lo:hi], h_ref)
-        compute += time.perf_counter() - c0
-        q_bs = np.zeros((1, 4)) if b.q_bs is None else np.ascontiguousarray(b.q_bs[lo:hi])
-        out = np.empty((len(states) // stride + 1, 21))
-        rows = K.error_block(states, q_bs, b.q_bs is not None,
-                             none if tr is None else np.ascontiguousarray(tr.att[lo:hi]),
-                             q_none if tr is None else np.ascontiguousarray(tr.q_nb[lo:hi]),
-                             none if tr is None else np.ascontiguousarray(tr.v_n[lo:hi]),
-                             none if tr is None else np.ascontiguousarray(tr.pos[lo:hi]),
-                             tr is not None, E, pos0, b.k0 + lo - start.k, stride, acc, out)
-        if (series is not None or on_rows is not None) and rows:
-            keep = np.flatnonzero((b.k0 + np.arange(lo, hi) + 1 - start.k) % stride == 0)
-            r = out[:rows]
-            data = {"t": b.t[lo:hi][keep], "att": r[:, 0:3], "v_n": r[:, 3:6],
-                    "pos": r[:, 6:9]}
-            if has_truth:
-                data |= {"error/att": r[:, 9:12], "error/v_n": r[:, 12:15],
-                         "error/pos": r[:, 15:18], "error/phi": r[:, 18:21]}
-            if series is not None:
-                series.append(**data)
-            if on_rows is not None:
-                on_rows(data)
-        last = (states[-1], None if b.q_bs is None else b.q_bs[hi - 1])
-        if progress is not None:
-            progress((b.k0 + hi - start.k) * ts, (k_end - start.k) * ts, "navigating (data s)")
+
+    def rows_out(rows: NavRows) -> None:  # always given, so the rows are never all held
+        data = _as_dict(rows)
+        if series is not None:
+            series.append(**data)
+        if on_rows is not None:
+            on_rows(data)
+
+    try:
+        nav = navigate_blocks(stream.blocks(), ts, start.state, k_start=start.k, k_end=k_end,
+                              earth=stream.earth, vertical=vertical, stride=stride,
+                              q_bs0=stream.q_bs_at(start.k), t0=stream.t0, on_rows=rows_out,
+                              progress=progress)
+    except InputError as err:
+        raise ScenarioError(f"navigation: {err.message}") from None
     if series is not None:
         series.flush()
-    assert last is not None
-    s_end, qbs_end = last
-    q_end = s_end[K.Q] if qbs_end is None else body_attitude(s_end[K.Q][None], qbs_end[None])[0]
-    pos_end = s_end[K.P]
     return {
-        "samples": k_end - start.k,
-        "duration_s": (k_end - start.k) * ts,
-        "start_s": start.k * ts,
-        "final_state": (quat_to_euler(q_end), s_end[K.V].copy(), pos_end.copy()),
-        "displacement": position_error_enu(pos_end[None], pos0[None], earth)[0],
-        "max_horizontal_displacement": float(acc[3, 1]),
-        "peak": acc[[0, 1, 2, 4]] if has_truth else None,
-        "final_error": acc[5:9] if has_truth else None,
-        "max_horizontal_error": float(acc[3, 0]) if has_truth else None,
-        "compute_s": compute,
-        "wall_s": time.perf_counter() - t0,
+        "samples": nav.samples,
+        "duration_s": nav.duration_s,
+        "start_s": nav.start_s,
+        "final_state": (nav.final.att, nav.final.v_n, nav.final.pos),
+        "displacement": nav.displacement,
+        "max_horizontal_displacement": nav.max_horizontal_displacement,
+        "peak": None if nav.max_error is None else nav.max_error.stack(),
+        "final_error": None if nav.final_error is None else nav.final_error.stack(),
+        "max_horizontal_error": nav.max_horizontal_error,
+        "compute_s": nav.compute_s,
+        "wall_s": nav.wall_s,
+        "result": nav,
     }
-
-
-def _qmul(a, b):
-    from gcalign.nav.rotation import quat_mult
-
-    return quat_mult(np.asarray(a, float), np.asarray(b, float))
 
 
 def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | None = None,
                    sink=None, on_rows=None, progress=None) -> tuple[dict, Stream]:
     """Navigate a scenario's data; the summary (plain numbers, degrees/m) and the stream.
     `sink`, `on_rows` and `progress` as :func:`navigate_stream`."""
+    summary, stream, _ = _run(sc, seed, init, sink, on_rows, progress)
+    return summary, stream
+
+
+def _run(sc: Scenario, seed: int | None, init: str | Path | None, sink, on_rows,
+         progress) -> tuple[dict, Stream, Navigation]:
+    """:func:`run_navigation` with the core's result."""
     cfg = sc.navigation or NavigationConfig()
     stream = scenario_stream(sc, seed)
     kind = None if stream.header is None else stream.header.meta.get("motion_kind")
@@ -241,7 +190,7 @@ def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | Non
         start = Start(k, state, source)
     part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink, on_rows,
                            progress)
-    return _summary(sc, stream, start, vertical, stride, part), stream
+    return _summary(sc, stream, start, vertical, stride, part), stream, part["result"]
 
 
 def _stride(sc: Scenario, stream: Stream) -> int:
@@ -293,5 +242,5 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None, sink=None
     """Navigate (streamed); the registry's entry point. With `sink` (an open results file)
     the decimated series go into its /navigate group as they are computed."""
     group = None if sink is None else sink.create_group("navigate")
-    summary, stream = run_navigation(sc, seed, init, group, progress=progress)
-    return Outcome(summary, lambda f: None, None, stream.seed)
+    summary, stream, nav = _run(sc, seed, init, group, None, progress)
+    return Outcome(summary, lambda f: None, None, stream.seed, result=nav)
