@@ -73,7 +73,7 @@ class P0Sigma(Model):
 
     attitude_arcsec: Annotated[Pos3, B.P0_ATTITUDE_ARCSEC] = Field(
         default_factory=lambda: [20.0, 20.0, 1800.0],
-                                  description="φ [E, N, U]; the seed's 20″, 20″, 30′")
+        description="φ [E, N, U]; the seed's 20″, 20″, 30′")
     velocity_enu_mps: Annotated[Pos3, B.P0_VELOCITY_MPS] = Field(
         default_factory=lambda: [0.2, 0.2, 0.2])
     position_enu_m: Annotated[Pos3, B.P0_POSITION_M] = Field(

@@ -99,7 +99,8 @@ def _us(x: float | None) -> float | None:
 
 class FilterConfig(Model):
     fs_hz: Annotated[float, B.SENSOR_RATE_HZ] = Field(
-        5000.0, gt=0, description="sensor sampling and filter rate f1, ≤ 1e6 Hz")
+        5000.0, gt=0, description=f"sensor sampling and filter rate f1, "
+                                  f"{B.SENSOR_RATE_HZ.range()}")
     chain: Literal["navigation", "alignment"] = "navigation"
     nav_order: int = Field(40, description="FIR order (taps − 1) of the navigation chain")
     nav_cutoff_hz: float = 200.0
