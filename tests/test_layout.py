@@ -1,5 +1,7 @@
-"""The architecture as a test: imports go one way, the numerical core uses no I/O or UI
-library, and the commands that run no kernel do not load numba (DESIGN.md "Architecture")."""
+"""The architecture as a test: imports go one way through the layers (units/errors/limits →
+nav → sim, estimation → the capabilities → io → app → cli, api), the numerical core uses no
+I/O or UI library, and the commands that run no kernel do not load numba (DESIGN.md
+"Architecture")."""
 
 from __future__ import annotations
 
@@ -12,74 +14,118 @@ from pathlib import Path
 import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "gcalign"
-CORE = ("nav", "sim", "estimation", "align", "northfind", "modulate", "realtime", "calibrate")
-# Each layer may import itself and what is listed (plus the leaf modules units, errors,
-# limits).
-ALLOWED = {
-    "core": set(CORE),
-    "io": set(CORE) | {"io"},
-    "app": set(CORE) | {"io", "app"},
-    "cli": set(CORE) | {"io", "app", "cli"},
-    "api": set(CORE) | {"io", "app", "api"},  # the Python API: never the command line
-}
+# The packages in layers, lowest first. A module may import its own layer and the layers
+# below it, never one above, at the top of a file or inside a function alike.
+LAYERS = (
+    ("units", "errors", "limits"),
+    ("nav",),
+    ("sim", "estimation"),
+    ("align", "northfind", "calibrate", "realtime", "modulate"),  # the capabilities
+    ("io",),
+    ("app",),
+    ("cli", "api", "__main__"),
+)
+RANK = {name: i for i, names in enumerate(LAYERS) for name in names}
+CORE = {name for names in LAYERS[1:4] for name in names}
 CORE_FORBIDDEN = {"typer", "rich", "yaml", "pydantic", "h5py", "matplotlib"}
+# Not layered: the package's own __init__ (version and the lazy Python API) and the
+# built-in scenario files (package data).
+UNLAYERED = {"__init__", "scenarios"}
 
 
-def layer(module: str) -> str:
-    top = module.split(".")[1] if module.count(".") else ""
-    return "core" if top in CORE else top
+def top(module: str) -> str:
+    """The package of ``gcalign.<top>...`` (``__init__`` for gcalign itself)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "__init__"
 
 
 def imports(path: Path):
-    """(module imported, line) of every import in a file, absolute names."""
+    """(module imported, line) of every import in a file, absolute names; ``from gcalign
+    import units`` counts as ``gcalign.units`` when it names a module."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
     pkg = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1])
-    for node in ast.walk(tree):
+    for node in ast.walk(tree):  # every node: imports inside functions count too
         if isinstance(node, ast.Import):
             for a in node.names:
                 yield a.name, node.lineno
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 base = pkg.rsplit(".", node.level - 1)[0] if node.level > 1 else pkg
-                yield f"{base}.{node.module}" if node.module else base, node.lineno
-            elif node.module:
-                yield node.module, node.lineno
+                module = f"{base}.{node.module}" if node.module else base
+            else:
+                module = node.module or ""
+            if module == "gcalign":
+                for a in node.names:
+                    sub = PKG / a.name
+                    named = sub.is_dir() or sub.with_suffix(".py").is_file()
+                    yield (f"gcalign.{a.name}" if named else "gcalign"), node.lineno
+            else:
+                yield module, node.lineno
+
+
+def violations() -> list[str]:
+    bad = []
+    for path in sorted(PKG.rglob("*.py")):
+        module = ".".join(path.relative_to(PKG.parent).with_suffix("").parts)
+        here = top(module)
+        if here in UNLAYERED:
+            continue
+        if here not in RANK:
+            bad.append(f"{module}: package {here!r} is in no layer (add it to LAYERS)")
+            continue
+        for name, line in imports(path):
+            root = name.split(".")[0]
+            if here in CORE and root in CORE_FORBIDDEN:
+                bad.append(f"{module}:{line} imports {name} (the core takes and returns arrays)")
+            if root != "gcalign" or name == "gcalign":
+                continue
+            target = top(name)
+            if target in UNLAYERED:
+                continue
+            if target not in RANK:
+                bad.append(f"{module}:{line} imports {name}: package {target!r} is in no layer")
+            elif RANK[target] > RANK[here]:
+                bad.append(f"{module}:{line} imports {name} (upward: {here} is in layer "
+                           f"{RANK[here]}, {target} in layer {RANK[target]})")
+    return bad
 
 
 def test_imports_go_one_way():
-    bad = []
-    for path in PKG.rglob("*.py"):
-        module = ".".join(path.relative_to(PKG.parent).with_suffix("").parts)
-        here = layer(module)
-        if here not in ALLOWED:
-            continue  # gcalign/__init__, units, errors, limits
-        for name, line in imports(path):
-            root = name.split(".")[0]
-            if here == "core" and root in CORE_FORBIDDEN:
-                bad.append(f"{module}:{line} imports {name} (the core takes and returns arrays)")
-            if root != "gcalign" or name.count(".") == 0:
-                continue
-            target = name.split(".")[1]
-            if target in ("units", "errors", "limits", "__init__"):
-                continue
-            target_layer = "core" if target in CORE else target
-            allowed = ALLOWED[here]
-            if target_layer == "core":
-                ok = target in allowed or "core" in allowed
-            else:
-                ok = target_layer in allowed
-            if not ok:
-                bad.append(f"{module}:{line} imports {name} ({here} must not reach {target})")
+    bad = violations()
     assert not bad, "\n".join(bad)
 
 
-def test_the_check_sees_a_violation(tmp_path):
-    """The scanner reports an upward import (so the test above can fail)."""
-    f = PKG / "nav" / "_probe_layout.py"
+@pytest.mark.parametrize(("where", "text", "expected"), [
+    ("nav", "from gcalign.app import registry\n",
+     "nav._probe_layout:1 imports gcalign.app (upward: nav is in layer 1, app in layer 5)"),
+    ("nav", "def f():\n    from gcalign.sim import motions\n    return motions\n",
+     "nav._probe_layout:2 imports gcalign.sim (upward: nav is in layer 1, sim in layer 2)"),
+    ("sim", "import gcalign.align.gains\n",
+     "sim._probe_layout:1 imports gcalign.align.gains (upward: sim is in layer 2, align in"),
+    ("estimation", "from gcalign import calibrate\n",
+     "estimation._probe_layout:1 imports gcalign.calibrate (upward: estimation is in layer 2"),
+    ("align", "from ..io import results\n",
+     "align._probe_layout:1 imports gcalign.io (upward: align is in layer 3, io in layer 4)"),
+    ("calibrate", "import h5py\n", "calibrate._probe_layout:1 imports h5py (the core"),
+])
+def test_the_check_sees_a_violation(where, text, expected):
+    """An upward import planted in a file of the package is reported (so the test above
+    can fail): top-level, inside a function, relative, and a forbidden library."""
+    f = PKG / where / "_probe_layout.py"
     try:
-        f.write_text("from gcalign.app import registry\nimport h5py\n")
-        with pytest.raises(AssertionError, match="nav._probe_layout:1 imports gcalign.app"):
-            test_imports_go_one_way()
+        f.write_text(text)
+        assert any(v.startswith("gcalign." + expected) for v in violations()), violations()
+    finally:
+        f.unlink()
+
+
+def test_the_layers_allow_a_downward_import():
+    assert not [v for v in violations() if "_probe" in v]
+    f = PKG / "calibrate" / "_probe_layout.py"
+    try:
+        f.write_text("def f():\n    from gcalign.sim import motions\n"
+                     "    from gcalign import units\n")
+        assert not [v for v in violations() if "_probe" in v]
     finally:
         f.unlink()
 

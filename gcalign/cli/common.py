@@ -41,7 +41,7 @@ from gcalign.cli import consoles, emit_json
 from gcalign.errors import ScenarioError
 from gcalign.io import results
 from gcalign.io.scenario import Scenario, parse_scenario
-from gcalign.io.scenario.loader import read_yaml
+from gcalign.io.scenario.loader import parse_override, read_yaml
 
 # --------------------------------------------------------------------------- options
 
@@ -132,18 +132,7 @@ def install(app: typer.Typer) -> None:
 
 def parse_set(item: str) -> tuple[str, object]:
     """``KEY=VALUE`` -> (key, YAML value); ScenarioError names the option."""
-    key, sep, text = item.partition("=")
-    key = key.strip()
-    if not sep or not key:
-        raise ScenarioError(f"--set: expected KEY=VALUE (e.g. align.mode=conventional), "
-                            f"got {item!r}")
-    try:
-        value = yaml.safe_load(text) if text.strip() else None
-    except yaml.YAMLError:
-        raise ScenarioError(f"--set {key}: the value {text!r} is not YAML") from None
-    if value is None:
-        raise ScenarioError(f"--set {key}: give a value (KEY=VALUE)")
-    return key, value
+    return parse_override(item)
 
 
 def _apply_sets(data: dict, sets: list[str], taken: set[str], source: str,

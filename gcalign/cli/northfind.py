@@ -25,12 +25,16 @@ def parse_sweep(text: str | None) -> dict | None:
     if text is None:
         return None
     parts = text.split(":")
-    if len(parts) != 3 or not all(p.strip() for p in parts):
+    try:
+        values = [float(p) for p in parts]  # an option's text read as numbers, as typer does
+    except ValueError:
+        values = []
+    if len(values) != 3:
         raise ScenarioError(
             f"northfind.sweep: --sweep expects START:STOP:STEP in degrees (e.g. 0:360:5), "
             f"got {text!r}"
         )
-    return dict(zip(("start_deg", "stop_deg", "step_deg"), (p.strip() for p in parts), strict=True))
+    return dict(zip(("start_deg", "stop_deg", "step_deg"), values, strict=True))
 
 
 def _one_azimuth_source(section: dict, given: dict) -> None:

@@ -12,10 +12,13 @@ import math
 
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
 
 
 @njit(cache=True)
-def _radii(params, lat):
+def _radii(params: Array, lat: float) -> tuple[float, float]:
     s2 = math.sin(lat) ** 2
     if params[0] == 1.0:  # first order (EarthModel FIRST_ORDER)
         a, f = params[1], params[2]
@@ -27,7 +30,8 @@ def _radii(params, lat):
 
 
 @njit(cache=True)
-def _nav_rows(C, f_b, w_b, v, pos, params, F):
+def _nav_rows(C: Array, f_b: Array, w_b: Array, v: Array, pos: Array, params: Array,
+              F: Array) -> None:
     """Rows 0–8 of F (9, 21) at one point (spec 002 §2; PSINS etm + diagonal kffk 34)."""
     lat, h = pos[0], pos[2]
     wie = params[3]
@@ -94,7 +98,7 @@ def _nav_rows(C, f_b, w_b, v, pos, params, F):
 
 
 @njit(cache=True, inline="always")
-def _dcm_mid(q, r):
+def _dcm_mid(q: Array, r: Array) -> Array:
     """DCM of q ⊗ q(r), r a small rotation vector (the attitude half-way through a step)."""
     t2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
     if t2 < 1e-8:
@@ -123,7 +127,9 @@ def _dcm_mid(q, r):
 
 
 @njit(cache=True)
-def transition_block(q_nb, v_n, pos, dtheta, dv, ts, qc, params, Phi, Qd, F_mean, G_mean):
+def transition_block(q_nb: Array, v_n: Array, pos: Array, dtheta: Array, dv: Array, ts: float,
+                     qc: Array, params: Array, Phi: Array, Qd: Array, F_mean: Array,
+                     G_mean: Array) -> None:
     """Φ, Q_d (21, 21) over the S navigation steps of one filter step, and the mean F, G.
 
     q_nb (S+1, 4), v_n, pos (S+1, 3): the navigation states; dtheta, dv (S, 3): the

@@ -32,6 +32,7 @@ positively (≈ +2g/R), so the free vertical channel diverges with time constant
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from gcalign.errors import ScenarioError
 from gcalign.nav.earth import WGS84, EarthModel
@@ -89,7 +90,7 @@ def display_scale(lat: float, h: float = 0.0, earth: EarthModel = WGS84) -> np.n
     return 1.0 / np.array(per_si, dtype=float)
 
 
-def listed_sigma(pos, earth: EarthModel = WGS84) -> np.ndarray:
+def listed_sigma(pos: np.ndarray, earth: EarthModel = WGS84) -> np.ndarray:
     """The seed's P0 list (spec 002 §2) in SI, (21,): the values *before* the ×10.
 
     ``[20″, 20″, 30′; 0.2 m/s ×3; 1 m ×3; 0.01°/h ×3; 50 µg ×3; 100 ppm ×3; 100 ppm ×3]``;
@@ -98,7 +99,8 @@ def listed_sigma(pos, earth: EarthModel = WGS84) -> np.ndarray:
     return _P0_LISTED_DISPLAY / display_scale(float(pos[0]), float(pos[2]), earth)
 
 
-def initial_covariance(pos, p0_scale: float = P0_SCALE_DEFAULT, sigma=None,
+def initial_covariance(pos: np.ndarray, p0_scale: float = P0_SCALE_DEFAULT,
+                       sigma: ArrayLike | None = None,
                        earth: EarthModel = WGS84) -> np.ndarray:
     """P0 = diag((p0_scale · σ_listed)²) (spec 002 §2, PSINS ``diag([...]*10)^2``), (21, 21).
 
@@ -134,7 +136,8 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return out
 
 
-def error_matrix(C_nb, f_b, omega_ib_b, v_n, pos, earth: EarthModel = WGS84) -> np.ndarray:
+def error_matrix(C_nb: ArrayLike, f_b: ArrayLike, omega_ib_b: ArrayLike, v_n: ArrayLike,
+                 pos: ArrayLike, earth: EarthModel = WGS84) -> np.ndarray:
     """System matrix F of the 21-state model (spec 002 §2), vectorised over leading axes.
 
     Parameters
@@ -175,7 +178,7 @@ def error_matrix(C_nb, f_b, omega_ib_b, v_n, pos, earth: EarthModel = WGS84) -> 
     w_en = np.stack([-vn / r_mh, ve / r_nh, ve * tl / r_nh], -1)
     f_n = np.einsum("...ij,...j->...i", C, f_b)
 
-    def mat(rows):
+    def mat(rows: list[list[np.ndarray]]) -> np.ndarray:
         return np.stack([np.stack(r, -1) for r in rows], -2)
 
     Mav = mat([[zero, -1.0 / r_mh, zero], [1.0 / r_nh, zero, zero], [tl / r_nh, zero, zero]])
@@ -210,7 +213,7 @@ def error_matrix(C_nb, f_b, omega_ib_b, v_n, pos, earth: EarthModel = WGS84) -> 
     return F
 
 
-def noise_matrix(C_nb) -> np.ndarray:
+def noise_matrix(C_nb: ArrayLike) -> np.ndarray:
     """G (..., 21, 6) for ``w = [w_g; w_a]``: rows φ get −C, rows δv get +C (spec 002 §2)."""
     C = np.asarray(C_nb, dtype=float)
     G = np.zeros(C.shape[:-2] + (N_STATES, 6))
@@ -224,7 +227,7 @@ def _check_measure(measure: str) -> None:
         raise ScenarioError(f"measure: got {measure!r}, allowed: {', '.join(MEASUREMENTS)}")
 
 
-def measurement_matrix(measure: str, pos, earth: EarthModel = WGS84) -> np.ndarray:
+def measurement_matrix(measure: str, pos: np.ndarray, earth: EarthModel = WGS84) -> np.ndarray:
     """H (m, 21) of seed eqs. (5)–(7): ``velocity`` [δvE, δvN]; ``position`` [north, east] in
     metres, ``R_Mh δL`` and ``R_Nh cos L δλ`` at `pos` ``[L, λ, h]``; ``both`` stacks them."""
     _check_measure(measure)
@@ -249,7 +252,8 @@ def measurement_noise(measure: str, sigma_v: float = 0.2, sigma_p: float = 1.0) 
     return np.diag(np.square(sig))
 
 
-def accumulate(F_steps: np.ndarray, G_steps: np.ndarray, Qc: np.ndarray, ts: float):
+def accumulate(F_steps: np.ndarray, G_steps: np.ndarray, Qc: np.ndarray,
+               ts: float) -> tuple[np.ndarray, np.ndarray]:
     """Φ and Q_d over K navigation steps from F, G at each step (the alternative to Van Loan).
 
     ``Φ = A_K ⋯ A_1`` with ``A_k = I + F_k ts + (F_k ts)²/2`` (second order per step: a

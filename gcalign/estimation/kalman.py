@@ -14,12 +14,14 @@ measurement z (m,), H (m, n), R (m, m). Nothing is modified in place.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.linalg import expm
 
 
-def van_loan(F: np.ndarray, G: np.ndarray, Qc: np.ndarray, dt: float):
+def van_loan(F: np.ndarray, G: np.ndarray, Qc: np.ndarray,
+             dt: float) -> tuple[np.ndarray, np.ndarray]:
     """Exact discretisation of ``ẋ = F x + G w``, ``E[w wᵀ] = Qc δ(t − s)`` over `dt` (Van Loan).
 
     ``expm([[−F, G Qc Gᵀ], [0, Fᵀ]] dt) = [[·, Φ⁻¹ Q_d], [0, Φᵀ]]`` gives
@@ -38,7 +40,8 @@ def van_loan(F: np.ndarray, G: np.ndarray, Qc: np.ndarray, dt: float):
     return Phi, 0.5 * (Qd + Qd.T)
 
 
-def predict(x: np.ndarray, P: np.ndarray, Phi: np.ndarray, Qd: np.ndarray):
+def predict(x: np.ndarray, P: np.ndarray, Phi: np.ndarray,
+            Qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``x⁻ = Φ x``, ``P⁻ = Φ P Φᵀ + Q_d``."""
     P = Phi @ P @ Phi.T + Qd
     return Phi @ x, 0.5 * (P + P.T)
@@ -89,7 +92,7 @@ def solve_spd(P: np.ndarray, B: np.ndarray) -> np.ndarray:
     return np.linalg.solve(P / np.outer(d, d), B / dd) / dd
 
 
-def nees(error: np.ndarray, P: np.ndarray):
+def nees(error: np.ndarray, P: np.ndarray) -> Any:  # float or (K,): by the input shapes
     """Normalised estimation error squared ``eᵀ P⁻¹ e`` (χ²_n for a consistent filter):
     a float for error (n,) and P (n, n), or (K,) for stacks (K, n) and (K, n, n) (one
     batched solve on the correlation matrices)."""
@@ -103,7 +106,7 @@ def nees(error: np.ndarray, P: np.ndarray):
 
 
 def rts(Phis: np.ndarray, P_prior: np.ndarray, x_prior: np.ndarray, P_post: np.ndarray,
-        x_post: np.ndarray):
+        x_post: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Rauch–Tung–Striebel smoother over K filter steps.
 
     Phis (K, n, n): transition from epoch k to k+1; x_prior, P_prior (K, …): the prediction

@@ -31,9 +31,12 @@ The covariance-based degree σ_k(0)/σ_k(t) (PSINS ``kfstat``) is the cross-chec
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 RANK_RTOL_DEFAULT = 1e-12
 """Singular values below ``rtol · σ_max`` count as zero (rank and degree)."""
@@ -83,12 +86,13 @@ def r_factor(A: np.ndarray) -> np.ndarray:
     return np.asarray(np.linalg.qr(A, mode="r")) if A.shape[0] > n else A
 
 
-def som(O_pieces) -> np.ndarray:
+def som(O_pieces: Iterable[np.ndarray]) -> np.ndarray:
     """Stripped observability matrix ``[O_1; …; O_r]`` (seed eq. 11)."""
     return np.concatenate(list(O_pieces), axis=0)
 
 
-def tom(O_pieces, F_pieces, durations) -> np.ndarray:
+def tom(O_pieces: Sequence[np.ndarray], F_pieces: Sequence[np.ndarray] | np.ndarray,
+        durations: ArrayLike) -> np.ndarray:
     """Total observability matrix ``[O_1; O_2 e^{F_1Δ_1}; …]`` (seed eq. 10)."""
     n = F_pieces[0].shape[-1]
     Phi = expm_stack(np.asarray(F_pieces) * np.asarray(durations, dtype=float)[:, None, None])
@@ -100,7 +104,8 @@ def tom(O_pieces, F_pieces, durations) -> np.ndarray:
     return np.concatenate(out, axis=0)
 
 
-def null_space_residual(O: np.ndarray, F: np.ndarray, rtol: float = RANK_RTOL_DEFAULT):
+def null_space_residual(O: np.ndarray, F: np.ndarray,
+                        rtol: float = RANK_RTOL_DEFAULT) -> Any:  # float or (...,)
     """``‖F N‖_F / ‖F‖_F`` with N an orthonormal basis of null(O): zero exactly when
     null(O) ⊂ null(F) (the condition of seed eq. 12). Vectorised over leading axes of O
     (..., rows, n) and F (..., n, n); a float for a single piece."""
@@ -139,13 +144,9 @@ class Degree:
     rank: int
     rtol: float
 
-    @property
-    def relative(self) -> np.ndarray:
-        """``σ_state / σ_max`` (the scale-free companion of η)."""
-        return self.sigma_state / self.sigma[0] if self.sigma[0] > 0 else self.sigma_state
 
-
-def degree(Q: np.ndarray, measured, scale=None, rtol: float = RANK_RTOL_DEFAULT) -> Degree:
+def degree(Q: np.ndarray, measured: Iterable[int], scale: ArrayLike | None = None,
+           rtol: float = RANK_RTOL_DEFAULT) -> Degree:
     """Degree of observability of every state from the (stripped) observability matrix Q.
 
     Parameters

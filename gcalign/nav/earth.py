@@ -26,10 +26,15 @@ default to WGS-84. The same formulas run inside the numba kernels from
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 EXACT, FIRST_ORDER = 0, 1  # forms of the radii of curvature (EarthModel.radii_form)
+
+#: a latitude (rad) or an array of them; radii and gravity come back in the same form
+Lat = TypeVar("Lat", float, NDArray[np.float64])
 
 
 @dataclass(frozen=True)
@@ -57,14 +62,14 @@ class EarthModel:
         """First eccentricity squared, f (2 − f)."""
         return self.f * (2.0 - self.f)
 
-    def params(self) -> np.ndarray:
+    def params(self) -> NDArray[np.float64]:
         """The model as the float64 vector the numba kernels take:
         ``[form, a, e2 (exact) or f (first order), ω_ie, g0, g1, g2, g3]``."""
         shape = self.e2 if self.radii_form == EXACT else self.f
         return np.array([self.radii_form, self.a, shape, self.omega_ie,
                          self.g0, self.g1, self.g2, self.g3], dtype=float)
 
-    def radii(self, lat):
+    def radii(self, lat: Lat) -> tuple[Lat, Lat]:
         """Meridian and prime-vertical radii of curvature R_M, R_N (m) at latitude `lat` (rad)."""
         s2 = np.sin(lat) ** 2
         if self.radii_form == FIRST_ORDER:
@@ -75,24 +80,25 @@ class EarthModel:
         r_n = self.a / np.sqrt(w)
         return r_n * (1.0 - e2) / w, r_n
 
-    def gravity(self, lat, h=0.0):
+    def gravity(self, lat: Lat, h: float | NDArray[np.float64] = 0.0) -> Lat:
         """Normal gravity (m/s², pointing down) at latitude `lat` (rad) and height `h` (m)."""
         s2 = np.sin(lat) ** 2
         return self.g0 * (1.0 + self.g1 * s2 + self.g2 * s2 * s2) - self.g3 * h
 
-    def omega_ie_n(self, lat):
+    def omega_ie_n(self, lat: ArrayLike) -> NDArray[np.float64]:
         """Earth rate in ENU, shape (..., 3): ω_ie^n = ω_ie [0, cos L, sin L]."""
         lat = np.asarray(lat, dtype=float)
         return self.omega_ie * np.stack([np.zeros_like(lat), np.cos(lat), np.sin(lat)], axis=-1)
 
-    def omega_en_n(self, lat, h, v_n):
+    def omega_en_n(self, lat: Lat, h: float | NDArray[np.float64],
+                   v_n: ArrayLike) -> NDArray[np.float64]:
         """Transport rate in ENU, shape (..., 3), from ENU velocity `v_n` (m/s)."""
         v_n = np.asarray(v_n, dtype=float)
         r_m, r_n = self.radii(lat)
         ve, vn = v_n[..., 0], v_n[..., 1]
         return np.stack([-vn / (r_m + h), ve / (r_n + h), ve * np.tan(lat) / (r_n + h)], axis=-1)
 
-    def schuler_rate(self, lat, h=0.0) -> float:
+    def schuler_rate(self, lat: float, h: float = 0.0) -> float:
         """Schuler angular frequency ω_s = √(g / √(R_M R_N)) (rad/s) at the site."""
         r_m, r_n = self.radii(lat)
         return float(np.sqrt(self.gravity(lat, h) / np.sqrt((r_m + h) * (r_n + h))))
@@ -110,27 +116,29 @@ A, F, E2, OMEGA_IE = WGS84.a, WGS84.f, WGS84.e2, WGS84.omega_ie
 GE, G_C1, G_C2, G_C3 = WGS84.g0, WGS84.g1, WGS84.g2, WGS84.g3
 
 
-def radii(lat, earth: EarthModel = WGS84):
+def radii(lat: Lat, earth: EarthModel = WGS84) -> tuple[Lat, Lat]:
     """R_M, R_N (m) at latitude `lat` (rad); see :meth:`EarthModel.radii`."""
     return earth.radii(lat)
 
 
-def gravity(lat, h=0.0, earth: EarthModel = WGS84):
+def gravity(lat: Lat, h: float | NDArray[np.float64] = 0.0,
+            earth: EarthModel = WGS84) -> Lat:
     """Normal gravity (m/s², down) at `lat` (rad), `h` (m); see :meth:`EarthModel.gravity`."""
     return earth.gravity(lat, h)
 
 
-def omega_ie_n(lat, earth: EarthModel = WGS84):
+def omega_ie_n(lat: ArrayLike, earth: EarthModel = WGS84) -> NDArray[np.float64]:
     """Earth rate in ENU, shape (..., 3)."""
     return earth.omega_ie_n(lat)
 
 
-def omega_en_n(lat, h, v_n, earth: EarthModel = WGS84):
+def omega_en_n(lat: Lat, h: float | NDArray[np.float64], v_n: ArrayLike,
+               earth: EarthModel = WGS84) -> NDArray[np.float64]:
     """Transport rate in ENU, shape (..., 3)."""
     return earth.omega_en_n(lat, h, v_n)
 
 
-def C_en(lat, lon):
+def C_en(lat: ArrayLike, lon: ArrayLike) -> NDArray[np.float64]:
     """C_n^e: columns are the E, N, U axes resolved in the ECEF frame, shape (..., 3, 3)."""
     sl, cl = np.sin(lat), np.cos(lat)
     so, co = np.sin(lon), np.cos(lon)

@@ -14,9 +14,10 @@ body to navigation frame like ``C_nb``. All functions are vectorised over leadin
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 
-def skew(v):
+def skew(v: ArrayLike) -> NDArray[np.float64]:
     """Cross-product matrix [v×], shape (..., 3, 3)."""
     v = np.asarray(v, dtype=float)
     z = np.zeros_like(v[..., 0])
@@ -26,7 +27,7 @@ def skew(v):
     )
 
 
-def euler_to_dcm(att):
+def euler_to_dcm(att: ArrayLike) -> NDArray[np.float64]:
     """C_nb from ``att = [pitch, roll, yaw]`` (rad), shape (..., 3) -> (..., 3, 3)."""
     att = np.asarray(att, dtype=float)
     sp, sr, sy = np.sin(att[..., 0]), np.sin(att[..., 1]), np.sin(att[..., 2])
@@ -39,7 +40,7 @@ def euler_to_dcm(att):
     return np.stack([np.stack(r, -1) for r in rows], -2)
 
 
-def dcm_to_euler(C):
+def dcm_to_euler(C: ArrayLike) -> NDArray[np.float64]:
     """``[pitch, roll, yaw]`` (rad) from C_nb, (..., 3, 3) -> (..., 3); pitch in [-90°, 90°]."""
     C = np.asarray(C, dtype=float)
     pitch = np.arcsin(np.clip(C[..., 2, 1], -1.0, 1.0))
@@ -48,7 +49,7 @@ def dcm_to_euler(C):
     return np.stack([pitch, roll, yaw], -1)
 
 
-def quat_mult(p, q):
+def quat_mult(p: ArrayLike, q: ArrayLike) -> NDArray[np.float64]:
     """Hamilton product p ⊗ q, shape (..., 4)."""
     p, q = np.asarray(p, dtype=float), np.asarray(q, dtype=float)
     pw, px, py, pz = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
@@ -64,13 +65,13 @@ def quat_mult(p, q):
     )
 
 
-def quat_conj(q):
+def quat_conj(q: ArrayLike) -> NDArray[np.float64]:
     """Conjugate (inverse of a unit quaternion), shape (..., 4)."""
     q = np.asarray(q, dtype=float)
     return q * np.array([1.0, -1.0, -1.0, -1.0])
 
 
-def quat_to_dcm(q):
+def quat_to_dcm(q: ArrayLike) -> NDArray[np.float64]:
     """DCM of a unit quaternion, shape (..., 4) -> (..., 3, 3)."""
     q = np.asarray(q, dtype=float)
     w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
@@ -82,7 +83,7 @@ def quat_to_dcm(q):
     return np.stack([np.stack(r, -1) for r in rows], -2)
 
 
-def dcm_to_quat(C):
+def dcm_to_quat(C: ArrayLike) -> NDArray[np.float64]:
     """Unit quaternion (w >= 0) of a DCM, shape (..., 3, 3) -> (..., 4); robust for all angles."""
     C = np.asarray(C, dtype=float)
     tr = C[..., 0, 0] + C[..., 1, 1] + C[..., 2, 2]
@@ -116,7 +117,7 @@ def dcm_to_quat(C):
     return q * np.where(q[..., :1] < 0, -1.0, 1.0)
 
 
-def euler_to_quat(att):
+def euler_to_quat(att: ArrayLike) -> NDArray[np.float64]:
     """q_nb from ``[pitch, roll, yaw]`` (rad), shape (..., 3) -> (..., 4), scalar part ≥ 0:
     the product of the axis quaternions qz(yaw) ⊗ qx(pitch) ⊗ qy(roll) (the order of C_nb)."""
     att = np.asarray(att, dtype=float)
@@ -128,7 +129,7 @@ def euler_to_quat(att):
     return q * np.where(q[..., :1] < 0, -1.0, 1.0)
 
 
-def quat_to_euler(q):
+def quat_to_euler(q: ArrayLike) -> NDArray[np.float64]:
     """``[pitch, roll, yaw]`` (rad) from q_nb, shape (..., 4) -> (..., 3); the five elements
     of C_nb that :func:`dcm_to_euler` reads, straight from the quaternion."""
     q = np.asarray(q, dtype=float)
@@ -142,7 +143,7 @@ def quat_to_euler(q):
                      np.arctan2(-c01, c11)], -1)
 
 
-def rotvec_to_quat(r):
+def rotvec_to_quat(r: ArrayLike) -> NDArray[np.float64]:
     """Quaternion of the rotation vector `r` (rad), shape (..., 3) -> (..., 4)."""
     r = np.asarray(r, dtype=float)
     th = np.linalg.norm(r, axis=-1)
@@ -153,7 +154,7 @@ def rotvec_to_quat(r):
     return np.concatenate([np.cos(half)[..., None], r * ratio[..., None]], -1)
 
 
-def quat_to_rotvec(q):
+def quat_to_rotvec(q: ArrayLike) -> NDArray[np.float64]:
     """Rotation vector (rad, angle in [0, π]) of a unit quaternion, shape (..., 4) -> (..., 3)."""
     q = np.asarray(q, dtype=float)
     q = q * np.where(q[..., :1] < 0, -1.0, 1.0)
@@ -164,23 +165,23 @@ def quat_to_rotvec(q):
     return q[..., 1:] * ratio[..., None]
 
 
-def wrap_pi(a):
+def wrap_pi(a: ArrayLike) -> NDArray[np.float64]:
     """Wrap angles (rad) to [-π, π)."""
     return (np.asarray(a) + np.pi) % (2.0 * np.pi) - np.pi
 
 
-def attitude_error(att_est, att_true):
+def attitude_error(att_est: ArrayLike, att_true: ArrayLike) -> NDArray[np.float64]:
     """Euler-angle error ``est - true`` (rad), roll and yaw wrapped to ±π, shape (..., 3)."""
     d = np.asarray(att_est, dtype=float) - np.asarray(att_true, dtype=float)
     return np.concatenate([d[..., :1], wrap_pi(d[..., 1:])], -1)
 
 
-def misalignment(C_nb_est, C_nb_true):
+def misalignment(C_nb_est: ArrayLike, C_nb_true: ArrayLike) -> NDArray[np.float64]:
     """Misalignment φ (rad, ENU) from ``C_nb_est C_nb_true^T = exp(-[φ×]) ≈ I - [φ×]``."""
     D = np.asarray(C_nb_est) @ np.swapaxes(np.asarray(C_nb_true), -1, -2)
     return -quat_to_rotvec(dcm_to_quat(D))
 
 
-def misalignment_q(q_nb_est, q_nb_true):
+def misalignment_q(q_nb_est: ArrayLike, q_nb_true: ArrayLike) -> NDArray[np.float64]:
     """:func:`misalignment` from quaternions: φ = −rotvec(q_est ⊗ q_true*)."""
     return -quat_to_rotvec(quat_mult(q_nb_est, quat_conj(q_nb_true)))

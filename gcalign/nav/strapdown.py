@@ -23,6 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from gcalign.nav import _kernels as K
 from gcalign.nav.earth import WGS84, EarthModel
@@ -40,7 +41,7 @@ class NavState:
     pos: np.ndarray
 
     @classmethod
-    def from_euler(cls, att, v_n, pos) -> NavState:
+    def from_euler(cls, att: ArrayLike, v_n: ArrayLike, pos: ArrayLike) -> NavState:
         return cls(euler_to_quat(att), np.asarray(v_n, float), np.asarray(pos, float))
 
     @property
@@ -63,13 +64,13 @@ class Vertical:
     mode: str = "free"
     tau: float = 30.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.mode not in VERTICAL_MODES:
             raise ValueError(f"vertical: got {self.mode!r}, allowed: {', '.join(VERTICAL_MODES)}")
         if not self.tau > 0:
             raise ValueError(f"vertical tau: must be > 0 s, got {self.tau}")
 
-    def params(self, earth: EarthModel) -> np.ndarray:
+    def params(self, earth: EarthModel) -> NDArray[np.float64]:
         """``[mode, k1, k2, k3]`` for the kernels."""
         if self.mode == "damped":
             return K.vertical_gains(self.tau, earth.g3)
@@ -100,7 +101,8 @@ class NavSolution:
         return NavState(self.q_nb[k].copy(), self.v_n[k].copy(), self.pos[k].copy())
 
 
-def reverse_data(dtheta, dv):
+def reverse_data(dtheta: NDArray[np.float64],
+                 dv: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The data transform of a reverse pass: time reversed, gyro negated, Δv unchanged."""
     return np.ascontiguousarray(-dtheta[::-1]), np.ascontiguousarray(dv[::-1])
 
@@ -141,7 +143,8 @@ class Navigator:
         s = self._s
         return NavState(s[K.Q].copy(), self._sign * s[K.V], s[K.P].copy())
 
-    def run(self, dtheta, dv, h_ref=None, stride: int = 1) -> np.ndarray:
+    def run(self, dtheta: ArrayLike, dv: ArrayLike, h_ref: ArrayLike | None = None,
+            stride: int = 1) -> NDArray[np.float64]:
         """Integrate a block of increments (N, 3); the states after every `stride` steps,
         (N // stride, NAV_STATE) with the named slices of :mod:`gcalign.nav._kernels`
         (velocity in the forward-time sense). `h_ref` (N,) or a number: the reference
@@ -162,8 +165,9 @@ class Navigator:
         return out
 
 
-def navigate(t, dtheta, dv, ts: float, start: NavState, reverse: bool = False, *,
-             earth: EarthModel = WGS84, vertical: Vertical = FREE, h_ref=None) -> NavSolution:
+def navigate(t: NDArray[np.float64], dtheta: ArrayLike, dv: ArrayLike, ts: float,
+             start: NavState, reverse: bool = False, *, earth: EarthModel = WGS84,
+             vertical: Vertical = FREE, h_ref: ArrayLike | None = None) -> NavSolution:
     """Strapdown navigation over increments (N, 3) ending at times `t` (N,).
 
     Forward: `start` is the state at ``t[0] - ts``. Reverse: `start` is the state at
@@ -180,8 +184,9 @@ def navigate(t, dtheta, dv, ts: float, start: NavState, reverse: bool = False, *
     return NavSolution(t=times, q_nb=q, v_n=v, pos=p)
 
 
-def integrate_attitude(q0, dtheta, ts: float, w_in_n=None, subsamples: int = 1,
-                       stride: int = 1) -> np.ndarray:
+def integrate_attitude(q0: ArrayLike, dtheta: ArrayLike, ts: float,
+                       w_in_n: ArrayLike | None = None, subsamples: int = 1,
+                       stride: int = 1) -> NDArray[np.float64]:
     """Attitude-only strapdown: ``q ← q(−ω_in T) ⊗ q ⊗ q(φ)`` every `subsamples` increments
     (T = subsamples·ts), φ the coning-corrected rotation vector of the group (PSINS cone
     factors, exact to the order of a polynomial rate of degree subsamples − 1).

@@ -12,15 +12,23 @@ A schedule enters as the tuple :meth:`gcalign.sim.schedule.Schedule.kernel_table
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 
 from gcalign.nav._kernels import qmul, qrot, rv2q
 
+Array = NDArray[np.float64]
+Index = NDArray[np.int64]
+Quat = tuple[float, float, float, float]
+
 
 @njit(cache=True, inline="always")
-def schedule_quat(t0, kind, coef, step, theta0, axis, before, cyc, q0, period, repeat, t, memo):
+def schedule_quat(t0: Array, kind: Index, coef: Array, step: Index, theta0: Array, axis: Array,
+                  before: Array, cyc: Array, q0: Array, period: float, repeat: bool, t: float,
+                  memo: Array) -> Quat:
     """Quaternion of the schedule's rotation at time t (see :class:`Schedule`); the
     arguments before t are :meth:`Schedule.kernel_tables` (passed one by one: a tuple of
     arrays handed to an inlined function costs a reference count per array and call).
@@ -30,7 +38,7 @@ def schedule_quat(t0, kind, coef, step, theta0, axis, before, cyc, q0, period, r
     rotation; times that move forward find their piece from the last one.
     """
     if repeat:
-        k = math.floor(t / period)
+        k: float = math.floor(t / period)
         tau = t - k * period
     else:
         k = 0.0
@@ -71,7 +79,7 @@ def schedule_quat(t0, kind, coef, step, theta0, axis, before, cyc, q0, period, r
 
 
 @njit(cache=True, inline="always")
-def rest_end(t0, period, repeat, memo):
+def rest_end(t0: Array, period: float, repeat: bool, memo: Array) -> float:
     """The time the rest piece remembered in `memo` (by :func:`schedule_quat`) ends; −∞ if
     the last time looked up was not in a rest piece."""
     if memo[0] < 0.0:
@@ -87,8 +95,10 @@ def rest_end(t0, period, repeat, memo):
 
 
 @njit(cache=True)
-def fixed_site_block(k0, n, ts, m, omega_ie, q_en, f_n, q_nb0, body, has_body, mech, has_mech,
-                     mech_nav, dtheta, dv, q_nb_out, q_bs_out):
+def fixed_site_block(k0: int, n: int, ts: float, m: int, omega_ie: float, q_en: Array,
+                     f_n: Array, q_nb0: Array, body: tuple[Any, ...], has_body: bool,
+                     mech: tuple[Any, ...], has_mech: bool, mech_nav: bool, dtheta: Array,
+                     dv: Array, q_nb_out: Array, q_bs_out: Array) -> None:
     """Ideal increments k0 .. k0+n-1 of a base at a fixed site whose body attitude is q_nb0
     (times the schedule `body` if `has_body`), the IMU turned by `mech` (body- or, with
     `mech_nav`, navigation-referenced) if `has_mech`.
@@ -190,5 +200,5 @@ def fixed_site_block(k0, n, ts, m, omega_ie, q_en, f_n, q_nb0, body, has_body, m
                     if has_mech:
                         mech_rest_until = rest_end(m0, m9, m10, memo[1])
                 pw, px, py, pz = cw, cx, cy, cz
-        c = h / 3.0
-        dv[i, 0], dv[i, 1], dv[i, 2] = ax * c, ay * c, az * c
+        third = h / 3.0
+        dv[i, 0], dv[i, 1], dv[i, 2] = ax * third, ay * third, az * third

@@ -19,6 +19,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from gcalign.nav.earth import WGS84, C_en, EarthModel
 from gcalign.nav.rotation import (
@@ -32,6 +33,8 @@ from gcalign.nav.rotation import (
 from gcalign.sim.mechanism import Mechanism
 from gcalign.sim.motions import MotionType, Moving, Static, Truth, Turntable, sample_count
 from gcalign.sim.schedule import AngleProfile, Schedule, Step
+
+Array = NDArray[np.float64]  #: a float64 array (shapes in the docstrings)
 
 BLOCK = 1 << 16  #: samples per block of the numba route (fixed site)
 GENERIC_BLOCK = 1 << 14  #: of the NumPy route: ~1.4 KB of temporaries per sample
@@ -58,21 +61,21 @@ class SimBlock:
     q_bs: np.ndarray | None
 
 
-def _rotate(q, v):
+def _rotate(q: Array, v: Array) -> Array:
     """C(q) v for quaternions (..., 4) and vectors (..., 3)."""
     w, u = q[..., :1], q[..., 1:]
     t = 2.0 * np.cross(u, v)
     return v + w * t + np.cross(u, t)
 
 
-def initial_truth(motion: MotionType, site, earth: EarthModel = WGS84) -> Truth:
+def initial_truth(motion: MotionType, site: ArrayLike, earth: EarthModel = WGS84) -> Truth:
     """The truth at t = 0 as a one-row :class:`Truth`."""
     k = motion.kinematics(np.array([0.0]), site, earth)
     return Truth(t=np.zeros(1), att=np.array(k.att), v_n=np.array(k.v_n), pos=np.array(k.pos),
                  segment=np.zeros(1, dtype=np.int64))
 
 
-def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
+def ideal_blocks(motion: MotionType, site: ArrayLike, ts: float, earth: EarthModel = WGS84,
                  mechanism: Mechanism | None = None, block: int | None = None,
                  substeps: int = 2) -> Iterator[SimBlock]:
     """The ideal increments of `motion` at `site` ``[lat, lon, h]`` in blocks."""
@@ -89,8 +92,9 @@ def ideal_blocks(motion: MotionType, site, ts: float, earth: EarthModel = WGS84,
                                  m, n_total)
 
 
-def _numpy_blocks(motion: MotionType, site, ts, earth, mechanism, block, m,
-                  n_total) -> Iterator[SimBlock]:
+def _numpy_blocks(motion: MotionType, site: Array, ts: float, earth: EarthModel,
+                  mechanism: Mechanism | None, block: int, m: int,
+                  n_total: int) -> Iterator[SimBlock]:
     """The vectorised route: any motion, the kinematics on a grid of sub-points."""
     h = ts / m
     weights = np.ones(m + 1)
@@ -153,7 +157,8 @@ def _numpy_blocks(motion: MotionType, site, ts, earth, mechanism, block, m,
                        q_bs=q_bs)
 
 
-def _specific_force_s(motion, mechanism, site, earth, t, seg):
+def _specific_force_s(motion: Moving, mechanism: Mechanism | None, site: Array,
+                      earth: EarthModel, t: Array, seg: int) -> Array:
     """f_s at times t of one segment (the integrand of Δv)."""
     kin = motion.kinematics(t, site, earth, segment=np.full(t.shape, seg))
     q_nb = dcm_to_quat(kin.C_nb)
@@ -165,7 +170,8 @@ def _specific_force_s(motion, mechanism, site, earth, t, seg):
     return _rotate(quat_conj(q_ns), f_n)
 
 
-def _split_at_boundaries(dv, motion: Moving, mechanism, site, earth, k0, n, ts, m):
+def _split_at_boundaries(dv: Array, motion: Moving, mechanism: Mechanism | None, site: Array,
+                         earth: EarthModel, k0: int, n: int, ts: float, m: int) -> None:
     """Δv of the samples whose interior holds a segment boundary (the acceleration or a
     rate jumps there): Simpson on each side of the boundary, each with its own segment."""
     starts = np.cumsum([0.0] + [s.duration for s in motion.segments[:-1]])
@@ -186,8 +192,9 @@ def _split_at_boundaries(dv, motion: Moving, mechanism, site, earth, k0, n, ts, 
 _IDENTITY = Schedule((Step((0.0, 0.0, 1.0), AngleProfile.rest(1.0)),))
 
 
-def _fixed_site_blocks(motion: Static | Turntable, site, ts, earth, mechanism, block, m,
-                       n_total) -> Iterator[SimBlock]:
+def _fixed_site_blocks(motion: Static | Turntable, site: Array, ts: float, earth: EarthModel,
+                       mechanism: Mechanism | None, block: int, m: int,
+                       n_total: int) -> Iterator[SimBlock]:
     """The numba route for a base at a fixed site (:func:`fixed_site_block`)."""
     from gcalign.sim._kernels import fixed_site_block
 

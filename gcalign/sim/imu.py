@@ -8,8 +8,10 @@ frame unless a mechanism turns the IMU).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.sim.errors import ErrorStream, ImuErrors, SensorErrors
@@ -44,7 +46,7 @@ class ImuData:
     att0: np.ndarray | None = None
     v0_n: np.ndarray | None = None
     source: str = "simulated"
-    meta: dict = field(default_factory=dict)
+    meta: dict[str, Any] = field(default_factory=dict)
     q_bs: np.ndarray | None = None
 
     def __len__(self) -> int:
@@ -61,8 +63,9 @@ def apply_errors(ideal: ImuData, errors: ImuErrors, rng: np.random.Generator) ->
     return replace(ideal, dtheta=dtheta, dv=dv)
 
 
-def ideal_imu(motion: MotionType, site, ts: float, substeps: int = 2,
-              earth: EarthModel = WGS84, mechanism: Mechanism | None = None):
+def ideal_imu(motion: MotionType, site: ArrayLike, ts: float, substeps: int = 2,
+              earth: EarthModel = WGS84,
+              mechanism: Mechanism | None = None) -> tuple[Truth, ImuData]:
     """Truth and exact ideal increments of a whole run (see :mod:`gcalign.sim.ideal`).
 
     Returns ``(Truth, ImuData)``; truth has N+1 samples from t = 0, the IMU N increments.
@@ -71,9 +74,10 @@ def ideal_imu(motion: MotionType, site, ts: float, substeps: int = 2,
     from gcalign.sim.ideal import ideal_blocks, initial_truth
 
     first = initial_truth(motion, site, earth)
+    assert first.segment is not None  # the start of a run is in its first segment
     blocks = list(ideal_blocks(motion, site, ts, earth, mechanism, substeps=substeps))
 
-    def cat(name, head):
+    def cat(name: str, head: np.ndarray) -> np.ndarray:
         return np.concatenate([head] + [getattr(b, name) for b in blocks])
 
     truth = Truth(t=cat("t", first.t), att=cat("att", first.att), v_n=cat("v_n", first.v_n),

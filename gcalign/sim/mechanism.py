@@ -28,6 +28,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from gcalign.nav.rotation import quat_conj, quat_mult
 from gcalign.sim.schedule import Schedule
@@ -43,23 +44,23 @@ class Mechanism:
     reference: str = "body"
     lever: tuple[float, float, float] | None = None  # m, sensor frame (module docstring)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.reference not in REFERENCES:
             raise ValueError(f"mechanism reference: got {self.reference!r}, allowed: "
                              f"{', '.join(REFERENCES)}")
 
-    def q_ns(self, t, q_nb) -> np.ndarray:
+    def q_ns(self, t: ArrayLike, q_nb: ArrayLike) -> NDArray[np.float64]:
         """Sensor attitude quaternion q_ns (N, 4) at times t for body attitudes q_nb (N, 4)."""
         S = self.schedule.quat(t)
         return quat_mult(q_nb, S) if self.reference == "body" else S
 
-    def q_bs(self, t, q_nb) -> np.ndarray:
+    def q_bs(self, t: ArrayLike, q_nb: ArrayLike) -> NDArray[np.float64]:
         """Mechanism angles as the quaternion q_bs (C_s^b), (N, 4)."""
         S = self.schedule.quat(t)
         return S if self.reference == "body" else quat_mult(quat_conj(q_nb), S)
 
 
-    def lever_dv(self, k0: int, n: int, ts: float) -> np.ndarray:
+    def lever_dv(self, k0: int, n: int, ts: float) -> NDArray[np.float64]:
         """Velocity increments (n, 3) of the lever-arm term over samples k0 .. k0+n-1 (m/s,
         sensor frame): ``∫ ω̇ dt × r = (ω(b) − ω(a)) × r`` exactly (a rate that jumps at a
         sample time is given to the sample that ends there, so the sum telescopes), and
@@ -83,7 +84,7 @@ class Mechanism:
                     + 0.5 * ts * np.einsum("j,mjc->mc", w, centripetal))
         return out
 
-    def _at_rest(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    def _at_rest(self, a: np.ndarray, b: np.ndarray) -> NDArray[np.bool_]:
         """Whether [a, b] lies inside one rest piece of the schedule (no rate)."""
         tb = self.schedule.tables()
         T = float(tb["period"])
@@ -100,7 +101,7 @@ class Mechanism:
         return past | ((ka == kb) & (ja == jb) & rest[ja])
 
 
-def body_attitude(q_ns, q_bs) -> np.ndarray:
+def body_attitude(q_ns: ArrayLike, q_bs: ArrayLike) -> NDArray[np.float64]:
     """q_nb = q_ns ⊗ q_bs*: the body attitude from the sensor attitude and the mechanism
     angles (C_b^n = C_s^n (C_s^b)ᵀ), (N, 4)."""
     return quat_mult(q_ns, quat_conj(q_bs))

@@ -22,14 +22,18 @@ samples it. The earth model enters only through the radii.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm, quat_to_dcm
 from gcalign.sim.schedule import Schedule
+
+Array = NDArray[np.float64]  #: a float64 array (shapes in the docstrings)
 
 NODE_S = 0.25  #: largest spacing of the position nodes of a moving base (s)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(6)  # exact to degree 11 between nodes
@@ -64,7 +68,8 @@ class Truth:
     segment: np.ndarray | None = None
 
 
-def _fixed(t, att0, site, C=None, omega=None) -> Kinematics:
+def _fixed(t: ArrayLike, att0: ArrayLike, site: ArrayLike, C: Array | None = None,
+           omega: Array | None = None) -> Kinematics:
     t = np.atleast_1d(np.asarray(t, dtype=float))
     n = t.shape[0]
     att0 = np.asarray(att0, dtype=float)
@@ -75,7 +80,7 @@ def _fixed(t, att0, site, C=None, omega=None) -> Kinematics:
                       np.broadcast_to(np.asarray(site, float), (n, 3)), np.zeros(n, np.int64))
 
 
-def _euler_rate_to_body(att, att_dot):
+def _euler_rate_to_body(att: Array, att_dot: Array) -> Array:
     """ω_nb^b from Euler angles and their rates, C_nb = Rz(y) Rx(p) Ry(r):
     ω = Ry(r)ᵀ [ṗ, 0, 0] + Ry(r)ᵀ Rx(p)ᵀ [0, 0, ẏ] + [0, ṙ, 0]."""
     p, r = att[:, 0], att[:, 1]
@@ -92,7 +97,8 @@ class Static:
     duration: float
     kind: str = field(default="static", init=False)
 
-    def kinematics(self, t, site, earth: EarthModel = WGS84) -> Kinematics:
+    def kinematics(self, t: ArrayLike, site: ArrayLike,
+                   earth: EarthModel = WGS84) -> Kinematics:
         return _fixed(t, self.att0, site)
 
 
@@ -107,7 +113,7 @@ class Swing:
     phase: tuple[float, float, float] = (0.0, 0.0, 0.0)
     kind: str = field(default="swing", init=False)
 
-    def euler(self, t):
+    def euler(self, t: ArrayLike) -> tuple[Array, Array]:
         """Euler angles and their rates at times t."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         w = 2.0 * np.pi / np.asarray(self.period, dtype=float)
@@ -115,7 +121,8 @@ class Swing:
         amp = np.asarray(self.amplitude, dtype=float)
         return np.asarray(self.att0, float) + amp * np.sin(arg), amp * w * np.cos(arg)
 
-    def kinematics(self, t, site, earth: EarthModel = WGS84) -> Kinematics:
+    def kinematics(self, t: ArrayLike, site: ArrayLike,
+                   earth: EarthModel = WGS84) -> Kinematics:
         att, att_dot = self.euler(t)
         k = _fixed(t, self.att0, site, C=euler_to_dcm(att))
         return Kinematics(k.t, att, k.C_nb, _euler_rate_to_body(att, att_dot), k.v_n, k.a_n,
@@ -131,7 +138,8 @@ class Turntable:
     schedule: Schedule
     kind: str = field(default="turntable", init=False)
 
-    def kinematics(self, t, site, earth: EarthModel = WGS84) -> Kinematics:
+    def kinematics(self, t: ArrayLike, site: ArrayLike,
+                   earth: EarthModel = WGS84) -> Kinematics:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         C = euler_to_dcm(np.asarray(self.att0, float)) @ quat_to_dcm(self.schedule.quat(t))
         return _fixed(t, self.att0, site, C=C, omega=self.schedule.rate(t))
@@ -162,15 +170,16 @@ class Moving:
     segments: tuple[Segment, ...]
     speed0: float = 0.0
     kind: str = field(default="moving", init=False)
-    _nodes: dict = field(init=False, repr=False, compare=False, default_factory=dict)
+    _nodes: dict[tuple[Any, ...], tuple[Array, Array]] = field(
+        init=False, repr=False, compare=False, default_factory=dict)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not self.segments:
             raise ValueError("segments: a moving base needs at least one segment")
 
     # ------------------------------------------------------------------ segments
 
-    def _tables(self):
+    def _tables(self) -> tuple[Array, Array, Array, Array, Array]:
         d = np.array([s.duration for s in self.segments], dtype=float)
         accel = np.array([s.accel for s in self.segments], dtype=float)
         rate = np.array([s.rate for s in self.segments], dtype=float).reshape(-1, 3)
@@ -180,14 +189,16 @@ class Moving:
         speed_start = self.speed0 + np.concatenate([[0.0], np.cumsum(accel[:-1] * d[:-1])])
         return starts, accel, rate, att_start, speed_start
 
-    def segment_index(self, t, side: Literal["left", "right"] = "right") -> np.ndarray:
+    def segment_index(self, t: ArrayLike,
+                      side: Literal["left", "right"] = "right") -> NDArray[np.int64]:
         """Segment of each time; a time on a boundary belongs to the later segment
         (``side="right"``) or the earlier one (``"left"``); the last one is held."""
         starts = self._tables()[0]
         j = np.searchsorted(starts, np.atleast_1d(np.asarray(t, float)), side=side) - 1
         return np.clip(j, 0, len(starts) - 1)
 
-    def euler(self, t, segment=None):
+    def euler(self, t: ArrayLike, segment: NDArray[np.int64] | None = None,
+              ) -> tuple[Array, Array, Array, Array]:
         """Euler angles, their rates, forward speed and its rate at times t; `segment`
         (optional) picks the segment of each time (a sample's integral over a boundary
         takes the limits of its own side)."""
@@ -198,7 +209,8 @@ class Moving:
         return (att_start[j] + rate[j] * dt[:, None], rate[j], speed_start[j] + accel[j] * dt,
                 accel[j])
 
-    def velocity(self, t, segment=None):
+    def velocity(self, t: ArrayLike, segment: NDArray[np.int64] | None = None,
+                 ) -> tuple[Array, Array, Array, Array]:
         """ENU velocity and acceleration (m/s, m/s²), attitude and its rates at times t."""
         att, att_dot, s, s_dot = self.euler(t, segment)
         p, y = att[:, 0], att[:, 2]
@@ -221,13 +233,15 @@ class Moving:
         last = self.duration
         return np.unique(np.concatenate(grid + [np.array([last])]))
 
-    def _rate_of_position(self, t, seg, lat, h, earth):
+    def _rate_of_position(self, t: Array, seg: NDArray[np.int64], lat: Array, h: Array,
+                          earth: EarthModel) -> Array:
         v, *_ = self.velocity(t, seg)
         r_m, r_n = earth.radii(lat)
         return np.stack([v[:, 1] / (r_m + h), v[:, 0] / ((r_n + h) * np.cos(lat)), v[:, 2]],
                         -1)
 
-    def _gl(self, a, b, seg, pos_a, pos_b, earth, nodes=(_GL_X, _GL_W)):
+    def _gl(self, a: Array, b: Array, seg: NDArray[np.int64], pos_a: Array, pos_b: Array,
+            earth: EarthModel, nodes: tuple[Array, Array] = (_GL_X, _GL_W)) -> Array:
         """∫_a^b of the position rate (Gauss–Legendre, 6 points per interval). Latitude and
         height at the Gauss points come from the cubic Hermite through the interval's ends
         and their rates: a straight line between the ends would bend cos L enough in a
@@ -242,7 +256,7 @@ class Moving:
         h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
         h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
 
-        def hermite(c):
+        def hermite(c: int) -> Array:
             return (h00 * pos_a[:, None, c] + h10 * dt * ra[:, None, c]
                     + h01 * pos_b[:, None, c] + h11 * dt * rb[:, None, c])
 
@@ -252,7 +266,7 @@ class Moving:
                                       earth).reshape(-1, k, 3)
         return np.einsum("k,nkc->nc", w, rate) * half[:, None]
 
-    def nodes(self, site, earth: EarthModel = WGS84):
+    def nodes(self, site: ArrayLike, earth: EarthModel = WGS84) -> tuple[Array, Array]:
         """Node times and positions (cached per site and earth model)."""
         key = (tuple(np.asarray(site, float)), earth.name)
         hit = self._nodes.get(key)
@@ -269,7 +283,7 @@ class Moving:
         self._nodes[key] = (tn, pos)
         return tn, pos
 
-    def position(self, t, site, earth: EarthModel = WGS84) -> np.ndarray:
+    def position(self, t: ArrayLike, site: ArrayLike, earth: EarthModel = WGS84) -> Array:
         """``[lat, lon, h]`` at times t: the node before t plus the integral from it."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         tn, pn = self.nodes(site, earth)
@@ -284,14 +298,16 @@ class Moving:
         p_end = pn[i] + self._gl(tn[i], t, seg, pn[i], p_end, earth, _GL4)
         return pn[i] + self._gl(tn[i], t, seg, pn[i], p_end, earth, _GL4)
 
-    def kinematics(self, t, site, earth: EarthModel = WGS84, segment=None) -> Kinematics:
+    def kinematics(self, t: ArrayLike, site: ArrayLike, earth: EarthModel = WGS84,
+                   segment: NDArray[np.int64] | None = None) -> Kinematics:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         seg = self.segment_index(t) if segment is None else segment
         v, a, att, att_dot = self.velocity(t, seg)
         return Kinematics(t, att, euler_to_dcm(att), _euler_rate_to_body(att, att_dot), v, a,
                           self.position(t, site, earth), seg)
 
-    def grid_kinematics(self, grid, segment, site, earth: EarthModel = WGS84) -> Kinematics:
+    def grid_kinematics(self, grid: np.ndarray, segment: NDArray[np.int64], site: ArrayLike,
+                        earth: EarthModel = WGS84) -> Kinematics:
         """:meth:`kinematics` on a sample grid (n, m+1) of equal sub-intervals, rows sharing
         their ends (the ideal IMU's), with the positions integrated along the grid itself:
         from :meth:`position` at the grid's first time, Simpson's rule over each row's
@@ -336,7 +352,7 @@ class Moving:
                           pos, segment)
 
 
-def _cumulative_simpson(m: int) -> np.ndarray:
+def _cumulative_simpson(m: int) -> Array:
     """Weights (m+1, m+1): row j integrates from point 0 to point j of m+1 equally spaced
     points (unit spacing): Simpson pairs, the odd points by the quadratic through their pair
     (∫_0^1 of the parabola through 0, 1, 2 is (5 f0 + 8 f1 − f2)/12)."""
@@ -381,7 +397,8 @@ FLIGHT_KINDS = ("hold", "accelerate", "pitch", "roll", "yaw", "turn", "coordinat
 _AXIS = {"pitch": 0, "roll": 1, "yaw": 2}
 
 
-def flight(att0, segments, speed0: float = 0.0, g: float = 9.80665) -> Moving:
+def flight(att0: tuple[float, float, float], segments: Iterable[FlightSegment],
+           speed0: float = 0.0, g: float = 9.80665) -> Moving:
     """A :class:`Moving` motion from aircraft segments with targets (seed 002 §3), each
     resolved from the state its predecessor leaves: the duration a target needs, or a
     ValueError naming the segment when the target cannot be reached in the given time.
@@ -454,7 +471,7 @@ def flight(att0, segments, speed0: float = 0.0, g: float = 9.80665) -> Moving:
         if speed < -1e-9:
             raise ValueError(f"{where}: forward speed would become negative ({speed:g} m/s)")
     total = float(sum(s.duration for s in out))
-    return Moving(tuple(att0), total, tuple(out), speed0)
+    return Moving((float(att0[0]), float(att0[1]), float(att0[2])), total, tuple(out), speed0)
 
 
 # ---------------------------------------------------------------------- sampling

@@ -30,11 +30,16 @@ about its own fixed axis u).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from gcalign.nav.rotation import quat_mult, quat_to_dcm, quat_to_rotvec, rotvec_to_quat
+
+Array = NDArray[np.float64]  #: a float64 array (shapes in the docstrings)
 
 POLY, SINE = 0, 1  # piece kinds
 
@@ -57,7 +62,7 @@ class Piece:
     frequency: float = 0.0
     phase: float = 0.0
 
-    def angle_rate_accel(self, tau):
+    def angle_rate_accel(self, tau: ArrayLike) -> tuple[Array, Array, Array]:
         """θ − θ0, θ̇, θ̈ at local times `tau` (s) within the piece."""
         tau = np.asarray(tau, dtype=float)
         if self.kind == SINE:
@@ -94,7 +99,7 @@ class AngleProfile:
     # ------------------------------------------------------------------ constructors
 
     @classmethod
-    def of_pieces(cls, pieces) -> AngleProfile:
+    def of_pieces(cls, pieces: Iterable[Piece]) -> AngleProfile:
         pieces = tuple(pieces)
         total = 0.0
         for p in pieces:
@@ -188,7 +193,7 @@ class AngleProfile:
                                     phase=phase)])
 
 
-def _unit(axis) -> np.ndarray:
+def _unit(axis: ArrayLike) -> Array:
     u = np.asarray(axis, dtype=float)
     n = float(np.linalg.norm(u))
     if u.shape != (3,) or not abs(n - 1.0) < 1e-9:
@@ -206,7 +211,7 @@ class Step:
     profile: AngleProfile
     dwell: float = 0.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         _unit(self.axis)
         if self.dwell < 0:
             raise ValueError(f"dwell must be ≥ 0, got {self.dwell}")
@@ -230,9 +235,9 @@ class Schedule:
     steps: tuple[Step, ...]
     repeat: bool = False
     q0: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
-    _tables: dict = field(init=False, repr=False, compare=False, default_factory=dict)
+    _tables: dict[str, Any] = field(init=False, repr=False, compare=False, default_factory=dict)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not self.steps:
             raise ValueError("a schedule needs at least one step")
         if self.period <= 0:
@@ -245,7 +250,7 @@ class Schedule:
 
     # ------------------------------------------------------------------ tables
 
-    def tables(self) -> dict:
+    def tables(self) -> dict[str, Any]:
         """Arrays describing the schedule (cached): see the class docstring."""
         if self._tables:
             return self._tables
@@ -285,7 +290,7 @@ class Schedule:
         )
         return self._tables
 
-    def kernel_tables(self) -> tuple:
+    def kernel_tables(self) -> tuple[Any, ...]:
         """The tables as the tuple the numba kernels take (:mod:`gcalign.sim._kernels`)."""
         tb = self.tables()
         return (tb["t0"], tb["kind"], np.ascontiguousarray(tb["coef"]), tb["step"],
@@ -294,14 +299,15 @@ class Schedule:
                 tb["q0"], float(tb["period"]), bool(tb["repeat"]))
 
     @property
-    def cycle_rotation(self) -> np.ndarray:
+    def cycle_rotation(self) -> Array:
         """Quaternion of the rotation over one pass through the steps (identity for a
         schedule that returns the frame to its start)."""
         return self.tables()["cycle"]
 
     # ------------------------------------------------------------------ evaluation
 
-    def _locate(self, t):
+    def _locate(self, t: ArrayLike) -> tuple[dict[str, Any], Array, Array, NDArray[np.int64],
+                                              NDArray[np.bool_]]:
         """Tables, cycle count k, local time in the piece, piece index, and whether t is past
         the end of a schedule that does not repeat (its final state then holds)."""
         tb = self.tables()
@@ -317,7 +323,7 @@ class Schedule:
         j = np.clip(np.searchsorted(tb["t0"], tau, side="right") - 1, 0, len(tb["t0"]) - 1)
         return tb, k, tau - tb["t0"][j], j, past
 
-    def angle_rate_accel(self, t):
+    def angle_rate_accel(self, t: ArrayLike) -> tuple[Array, Array, Array, NDArray[np.int64]]:
         """Step angle θ (rad, from the step's start), θ̇, θ̈ (rad/s, rad/s²) and the step
         index at times t (s), shapes (N,)."""
         tb, _, tau, j, past = self._locate(t)
@@ -335,7 +341,7 @@ class Schedule:
         a = np.where(past, 0.0, np.where(sine, a_s, a_p))
         return theta, w, a, tb["step"][j]
 
-    def quat(self, t) -> np.ndarray:
+    def quat(self, t: ArrayLike) -> Array:
         """Quaternion of C(t) (rotating frame → reference frame), shape (N, 4)."""
         tb, k, _, _, _ = self._locate(t)
         theta, _, _, s = self.angle_rate_accel(t)
@@ -344,16 +350,16 @@ class Schedule:
             q = quat_mult(rotvec_to_quat(k[:, None] * tb["cycle_rotvec"]), q)
         return quat_mult(np.broadcast_to(tb["q0"], q.shape), q)
 
-    def dcm(self, t) -> np.ndarray:
+    def dcm(self, t: ArrayLike) -> Array:
         """C(t), shape (N, 3, 3)."""
         return quat_to_dcm(self.quat(t))
 
-    def rate(self, t) -> np.ndarray:
+    def rate(self, t: ArrayLike) -> Array:
         """Angular rate of the rotating frame (rad/s), resolved in it, shape (N, 3)."""
         _, w, _, s = self.angle_rate_accel(t)
         return self.tables()["axis"][s] * w[:, None]
 
-    def angular_accel(self, t) -> np.ndarray:
+    def angular_accel(self, t: ArrayLike) -> Array:
         """Angular acceleration (rad/s²), resolved in the rotating frame, shape (N, 3)."""
         _, _, a, s = self.angle_rate_accel(t)
         return self.tables()["axis"][s] * a[:, None]

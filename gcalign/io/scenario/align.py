@@ -15,12 +15,13 @@ count is the sum of the stages' ``passes``. Two kinds of keys that cannot matter
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
 
 from gcalign.align.stages import Stage, stage_of_passes
+from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, Vec3
 
 #: Passes in all when the last stage does not say: 3 forward + 2 reverse in the cycle
@@ -70,7 +71,8 @@ class Coarse(Model):
 
 class Aiding(Model):
     source: Literal["none", "odometer", "nav"] = "none"
-    noise_mps: float = Field(0.0, ge=0, description="white noise std of each reference sample")
+    noise_mps: Annotated[float, B.NOISE_MPS] = Field(
+        0.0, ge=0, description=f"white noise std of each reference sample, {B.NOISE_MPS.range()}")
 
 
 class StageModel(Model):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import types
 import typing
+from pathlib import PurePath
 from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -28,6 +29,30 @@ def _takes_bool(annotation: Any) -> bool:
     return False
 
 
+def _takes(annotation: Any, kinds: tuple[type, ...]) -> bool:
+    """Whether a field's type admits one of `kinds` anywhere (in a union, a list, a tuple,
+    a mapping's values); ``Any`` admits everything."""
+    if annotation is Any:
+        return True
+    if isinstance(annotation, type):
+        return issubclass(annotation, kinds) and annotation is not bool
+    return any(_takes(a, kinds) for a in typing.get_args(annotation)
+               if a is not Ellipsis and not isinstance(a, (str, int, float)))
+
+
+def _number_text(value: Any) -> str | None:
+    """The first text in `value` (nested lists and mappings) that reads as a number."""
+    if isinstance(value, str):
+        try:
+            float(value)
+        except ValueError:
+            return None
+        return value
+    items = value[:10_000] if isinstance(value, list) else (
+        list(value.values())[:10_000] if isinstance(value, dict) else [])
+    return next((t for t in map(_number_text, items) if t is not None), None)
+
+
 def _has_bool(value: Any) -> bool:
     if isinstance(value, bool):
         return True
@@ -39,7 +64,8 @@ def _has_bool(value: Any) -> bool:
 class Model(BaseModel):
     """Strict base: unknown keys and NaN/inf are errors; assignments are validated too;
     a boolean is not a number (YAML reads ``yes``/``on``/``true`` as booleans, and pydantic
-    would take them as 1)."""
+    would take them as 1), nor is text (``"0.2"`` or ``!!str 0.2``, which pydantic would
+    convert) where the field takes numbers and no text."""
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True, allow_inf_nan=False)
 
@@ -53,7 +79,18 @@ class Model(BaseModel):
                     raise ValueError(f"{name}: a boolean ({_yaml_bool(value)}) where a number "
                                      "or text is expected (YAML reads yes/no/on/off/true/false "
                                      "as booleans)")
+                if (field is not None and _takes(field.annotation, (int, float))
+                        and not _takes(field.annotation, (str, PurePath))):
+                    text = _number_text(value)
+                    if text is not None:
+                        raise ValueError(f"{name}: a number written as text ({_cut(text)}, "
+                                         "quoted or tagged !!str in the YAML); write the "
+                                         "number itself")
         return data
+
+
+def _cut(text: str, n: int = 40) -> str:
+    return repr(text if len(text) <= n else text[: n - 3] + "...")
 
 
 def _yaml_bool(value: Any) -> str:

@@ -45,6 +45,7 @@ from pydantic import BeforeValidator, Field
 
 from gcalign import units as u
 from gcalign.errors import ScenarioError
+from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, PosVec3, Vec3
 from gcalign.nav.earth import EarthModel
 
@@ -70,14 +71,21 @@ def _enu_m_to_si(enu, lat: float, h: float, earth: EarthModel) -> np.ndarray:
 class P0Sigma(Model):
     """The listed initial σ before ``p0_scale`` (default: the seed's §5.2 list)."""
 
-    attitude_arcsec: Pos3 = Field(default_factory=lambda: [20.0, 20.0, 1800.0],
-                                  description="φ [E, N, U]; the seed's 20″, 20″, 30′")
-    velocity_enu_mps: Pos3 = Field(default_factory=lambda: [0.2, 0.2, 0.2])
-    position_enu_m: Pos3 = Field(default_factory=lambda: [1.0, 1.0, 1.0])
-    gyro_bias_dph: Pos3 = Field(default_factory=lambda: [0.01, 0.01, 0.01])
-    accel_bias_ug: Pos3 = Field(default_factory=lambda: [50.0, 50.0, 50.0])
-    gyro_scale_ppm: Pos3 = Field(default_factory=lambda: [100.0, 100.0, 100.0])
-    accel_scale_ppm: Pos3 = Field(default_factory=lambda: [100.0, 100.0, 100.0])
+    attitude_arcsec: Annotated[Pos3, B.P0_ATTITUDE_ARCSEC] = Field(
+        default_factory=lambda: [20.0, 20.0, 1800.0],
+        description="φ [E, N, U]; the seed's 20″, 20″, 30′")
+    velocity_enu_mps: Annotated[Pos3, B.P0_VELOCITY_MPS] = Field(
+        default_factory=lambda: [0.2, 0.2, 0.2])
+    position_enu_m: Annotated[Pos3, B.P0_POSITION_M] = Field(
+        default_factory=lambda: [1.0, 1.0, 1.0])
+    gyro_bias_dph: Annotated[Pos3, B.P0_GYRO_BIAS_DPH] = Field(
+        default_factory=lambda: [0.01, 0.01, 0.01])
+    accel_bias_ug: Annotated[Pos3, B.P0_ACCEL_BIAS_UG] = Field(
+        default_factory=lambda: [50.0, 50.0, 50.0])
+    gyro_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = Field(
+        default_factory=lambda: [100.0, 100.0, 100.0])
+    accel_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = Field(
+        default_factory=lambda: [100.0, 100.0, 100.0])
 
     def to_si(self, lat: float, h: float, earth: EarthModel) -> np.ndarray:
         """(21,) SI σ in the state order."""
@@ -91,8 +99,10 @@ class P0Sigma(Model):
 class ProcessNoise(Model):
     """White-noise densities of the filter's Q (spec 002 §2 [X]: the seed lost its Q)."""
 
-    arw_dprh: float = Field(0.001, ge=0, description="gyro angle random walk, °/√h")
-    vrw_ugrhz: float = Field(10.0, ge=0, description="accelerometer velocity random walk, µg/√Hz")
+    arw_dprh: Annotated[float, B.ARW_DPRH] = Field(
+        0.001, ge=0, description=f"gyro angle random walk, {B.ARW_DPRH.range()}")
+    vrw_ugrhz: Annotated[float, B.VRW_UGRHZ] = Field(
+        10.0, ge=0, description=f"accelerometer velocity random walk, {B.VRW_UGRHZ.range()}")
 
 
 class InitialError(Model):
@@ -124,9 +134,12 @@ def _divides(rate: float, sub: float) -> int | None:
 
 class CalibrateConfig(Model):
     measure: Literal["velocity", "position", "both"] = "velocity"
-    sigma_v_mps: float = Field(0.2, gt=0, description="DGNSS velocity σ; R = σ²")
-    sigma_p_m: float = Field(1.0, gt=0, description="DGNSS position σ (north, east); R = σ²")
-    p0_scale: float = Field(10.0, gt=0, description="P0 = (p0_scale · listed σ)²")
+    sigma_v_mps: Annotated[float, B.SIGMA_V_MPS] = Field(
+        0.2, description=f"DGNSS velocity σ; R = σ²; {B.SIGMA_V_MPS.range()}")
+    sigma_p_m: Annotated[float, B.SIGMA_P_M] = Field(
+        1.0, description=f"DGNSS position σ (north, east); R = σ²; {B.SIGMA_P_M.range()}")
+    p0_scale: Annotated[float, B.P0_SCALE] = Field(
+        10.0, description=f"P0 = (p0_scale · listed σ)²; {B.P0_SCALE.range()}")
     p0: P0Sigma = Field(default_factory=P0Sigma)
     q: ProcessNoise = Field(default_factory=ProcessNoise)
     navigation_rate_hz: float | None = Field(None, gt=0, description="default: the IMU rate")

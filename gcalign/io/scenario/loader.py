@@ -1,7 +1,15 @@
-"""Reading scenario YAML and turning validation errors into one line per field."""
+"""Reading scenario YAML and turning validation errors into one line per field.
+
+Numbers follow the YAML 1.2 core schema, in files and ``--set`` values alike: ``1e-3``,
+``1E5``, ``.5``, ``-2e+3`` are floats (YAML 1.1, PyYAML's default, reads the first as the
+text '1e-3'), ``010`` is ten (not eight) and ``1:30`` is text (not ninety). Text is never
+turned into a number: ``"0.2"`` or ``!!str 0.2`` where a number belongs is refused by the
+models (:class:`gcalign.io.scenario.base.Model`).
+"""
 
 from __future__ import annotations
 
+import math
 import re
 import reprlib
 from pathlib import Path
@@ -151,6 +159,46 @@ def _children(node) -> list:
     return []
 
 
+class _Loader(yaml.SafeLoader):
+    """PyYAML's safe loader with the YAML 1.2 core schema's integers and floats."""
+
+
+_INT, _FLOAT = "tag:yaml.org,2002:int", "tag:yaml.org,2002:float"
+_Loader.yaml_implicit_resolvers = {
+    first: [(tag, rx) for tag, rx in resolvers if tag not in (_INT, _FLOAT)]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+# Integers first: the float pattern also matches "12".
+_Loader.add_implicit_resolver(_INT, re.compile(r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$"),
+                              list("-+0123456789"))
+_Loader.add_implicit_resolver(
+    _FLOAT, re.compile(r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+                       r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
+    list("-+.0123456789"))
+
+
+def _construct_int(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> int:
+    text = loader.construct_scalar(node)
+    try:
+        return int(text, 0) if text[:2] in ("0o", "0x") else int(text, 10)
+    except ValueError:
+        raise yaml.constructor.ConstructorError(
+            None, None, f"not an integer: {_cut(text)}", node.start_mark) from None
+
+
+def _construct_float(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
+    text = loader.construct_scalar(node)
+    special = {".inf": math.inf, "+.inf": math.inf, "-.inf": -math.inf, ".nan": math.nan}
+    try:
+        return special[text.lower()] if text.lower() in special else float(text)
+    except ValueError:
+        raise yaml.constructor.ConstructorError(
+            None, None, f"not a number: {_cut(text)}", node.start_mark) from None
+
+
+_Loader.add_constructor(_INT, _construct_int)
+_Loader.add_constructor(_FLOAT, _construct_float)
+
+
 MAX_DEPTH = 200  #: nesting of flow collections ([ {) refused beyond this
 
 
@@ -166,11 +214,11 @@ def _flow_depth(text: str) -> int:
 
 
 def loads(text: str, source: str):
-    """Parse YAML text safely (safe tags only, checked by :func:`check_nodes`);
-    ScenarioError names the source and the line."""
+    """Parse YAML text safely (safe tags only, YAML 1.2 numbers, checked by
+    :func:`check_nodes`); ScenarioError names the source and the line."""
     if _flow_depth(text) > MAX_DEPTH:
         raise ScenarioError(f"{source}: YAML nested more than {MAX_DEPTH} levels deep")
-    loader = yaml.SafeLoader(text)
+    loader = _Loader(text)
     try:
         node = loader.get_single_node()
         if node is None:
@@ -186,6 +234,20 @@ def loads(text: str, source: str):
         raise ScenarioError(f"{source}: YAML nested too deeply") from None
     finally:
         loader.dispose()
+
+
+def parse_override(item: str, option: str = "--set") -> tuple[str, object]:
+    """``KEY=VALUE`` -> (key, value), VALUE read as a scenario file is (:func:`loads`: YAML
+    1.2 numbers, no key twice, nesting limited); ScenarioError names the option and key."""
+    key, sep, text = item.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise ScenarioError(f"{option}: expected KEY=VALUE (e.g. align.mode=conventional), "
+                            f"got {_cut(item)}")
+    value = loads(text, f"{option} {key}") if text.strip() else None
+    if value is None:
+        raise ScenarioError(f"{option} {key}: give a value (KEY=VALUE)")
+    return key, value
 
 
 def read_yaml(path: Path) -> dict:

@@ -10,6 +10,7 @@ import numpy as np
 from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from gcalign import units as u
+from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.align import AlignConfig
 from gcalign.io.scenario.base import Model, NonNegVec3, Vec3
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
@@ -82,13 +83,17 @@ class Site(Model):
 
 
 class Gyro(Model):
-    bias_dph: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    arw_dprh: Noise = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    scale_ppm: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    bias_dph: Annotated[PerAxis, B.GYRO_BIAS_DPH] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0], description=B.GYRO_BIAS_DPH.range())
+    arw_dprh: Annotated[Noise, B.ARW_DPRH] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0], description=B.ARW_DPRH.range())
+    scale_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0], description=B.SCALE_PPM.range())
     misalignment_arcsec: list[list[float]] | None = None
     quantum_arcsec: float = Field(0.0, ge=0)
-    asym_ppm: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0],
-                           description="asymmetric scale factor: + for positive input, − negative")
+    asym_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description="asymmetric scale factor: + for positive input, − negative")
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
@@ -104,13 +109,17 @@ class Gyro(Model):
 
 
 class Accel(Model):
-    bias_ug: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    vrw_ugrhz: Noise = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    scale_ppm: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    bias_ug: Annotated[PerAxis, B.ACCEL_BIAS_UG] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0], description=B.ACCEL_BIAS_UG.range())
+    vrw_ugrhz: Annotated[Noise, B.VRW_UGRHZ] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0], description=B.VRW_UGRHZ.range())
+    scale_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0], description=B.SCALE_PPM.range())
     misalignment_arcsec: list[list[float]] | None = None
     quantum_ugs: float = Field(0.0, ge=0, description="velocity quantum, µg·s (PSINS header unit)")
-    asym_ppm: PerAxis = Field(default_factory=lambda: [0.0, 0.0, 0.0],
-                           description="asymmetric scale factor: + for positive input, − negative")
+    asym_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description="asymmetric scale factor: + for positive input, − negative")
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 

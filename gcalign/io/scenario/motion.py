@@ -13,6 +13,7 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from gcalign import units as u
+from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, NonNegVec3, PosVec3, Vec3
 from gcalign.io.scenario.schedule import RowModel, schedule_of
 from gcalign.sim import motions as M
@@ -68,8 +69,9 @@ class SwingModel(_Base):
 
 class SegmentModel(Model):
     duration_s: float = Field(gt=0)
-    accel_mps2: float = 0.0
-    rate_dps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    accel_mps2: Annotated[float, B.ACCEL_MPS2] = Field(0.0, description=B.ACCEL_MPS2.range())
+    rate_dps: Annotated[Vec3, B.RATE_DPS] = Field(default_factory=lambda: [0.0, 0.0, 0.0],
+                                                       description=B.RATE_DPS.range())
     name: str = ""
 
 
@@ -104,9 +106,11 @@ class TurntableModel(_Base):
 class FlightSegmentModel(Model):
     kind: Literal["hold", "accelerate", "pitch", "roll", "yaw", "turn", "coordinated_turn"]
     duration_s: float | None = Field(None, gt=0)
-    accel_mps2: float | None = None
+    accel_mps2: Annotated[float | None, B.ACCEL_MPS2] = Field(None,
+                                                          description=B.ACCEL_MPS2.range())
     speed_mps: float | None = Field(None, ge=0)
-    rate_dps: float | None = Field(None, gt=0)
+    rate_dps: Annotated[float | None, B.RATE_DPS] = Field(None, gt=0,
+                                                      description=B.RATE_DPS.range())
     angle_deg: float | None = None
     name: str = ""
 

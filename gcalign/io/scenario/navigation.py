@@ -8,11 +8,12 @@ what rate long series are stored.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
 
+from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, Vec3
 from gcalign.io.scenario.schedule import RowModel, schedule_of
 from gcalign.nav.rotation import euler_to_quat
@@ -84,7 +85,8 @@ class MechanismConfig(Model):
                                   "(default: accel_s)")
     turn_s: float | None = Field(None, gt=0, description="scheme: whole turn, s, instead of "
                                  "const_s (const = turn - accel - decel)")
-    rate_dps: float | None = Field(None, gt=0, description="continuous: rate, °/s (default 6)")
+    rate_dps: Annotated[float | None, B.RATE_DPS] = Field(
+        None, gt=0, description=f"continuous: rate, °/s (default 6), {B.RATE_DPS.range()}")
     axis: Literal["x", "y", "z", "-x", "-y", "-z"] | None = Field(
         None, description="continuous: the sensor axis it turns about (default z)")
     lever_arm_cm: Vec3 | None = Field(

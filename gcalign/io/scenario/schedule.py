@@ -14,12 +14,14 @@ or a unit vector) with one profile, then rests for ``dwell_s``::
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from gcalign import units as u
+from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model
 from gcalign.sim.schedule import AngleProfile, Schedule, Step
 
@@ -60,9 +62,11 @@ class RowModel(Model):
     accel_s: float | None = Field(None, gt=0)
     const_s: float | None = Field(None, ge=0)
     decel_s: float | None = Field(None, gt=0)
-    rate_dps: float | None = None
-    accel_dps2: float | None = None
-    jerk_dps3: float | None = Field(None, gt=0)
+    rate_dps: Annotated[float | None, B.RATE_DPS] = Field(None, description=B.RATE_DPS.range())
+    accel_dps2: Annotated[float | None, B.ANGULAR_ACCEL_DPS2] = Field(
+        None, description=B.ANGULAR_ACCEL_DPS2.range())
+    jerk_dps3: Annotated[float | None, B.ANGULAR_JERK_DPS3] = Field(
+        None, gt=0, description=B.ANGULAR_JERK_DPS3.range())
     amplitude_deg: float | None = None
     frequency_hz: float | None = Field(None, gt=0)
     phase_deg: float = 0.0
@@ -109,7 +113,24 @@ class RowModel(Model):
         if self.profile == "ramp" and (self.accel_dps2 or 0) * (self.rate_dps or 0) <= 0:
             raise ValueError(f"rate_dps: a ramp's accel_dps2 and rate_dps must be non-zero and "
                              f"of one sign, got {self.accel_dps2}, {self.rate_dps}")
+        self._implied_rate()
         return self
+
+    def _implied_rate(self) -> None:
+        """The peak rate of a trapezoid given by times and of a swing, held to the bound
+        of a rate given itself."""
+        if self.profile == "trapezoid" and self.accel_s is not None:
+            key = "angle_deg"
+            peak = abs(self.angle_deg or 0.0) / (0.5 * self.accel_s + (self.const_s or 0.0)
+                                                 + 0.5 * (self.decel_s or 0.0))
+        elif self.profile == "swing":
+            key = "amplitude_deg"
+            peak = 2.0 * math.pi * abs(self.amplitude_deg or 0.0) * (self.frequency_hz or 0.0)
+        else:
+            return
+        if not B.RATE_DPS.holds(peak):
+            raise ValueError(f"{key}: the turn's peak rate must be within {B.RATE_DPS.range()} "
+                             f"({B.RATE_DPS.why}), got {peak:g} °/s")
 
     def to_step(self) -> Step:
         d = u.DEG
