@@ -34,6 +34,8 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
     goes to a room whose ``execute`` takes it; `before_write` is called when the run is
     done, before the file is finished (the command line closes its progress bar there).
     """
+    from gcalign.app.data import recording_record
+
     cmd = command(name)
     room = cmd.load()
     kwargs = dict(options)
@@ -50,12 +52,15 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
             if before_write is not None:
                 before_write()
             summary = outcome.summary
+            record = recording_record(sc)  # what the reader of a recorded file assumed
             summary["warnings"] = list(dict.fromkeys(
                 [*notes, *sc.unused(cmd.section), *outcome.warnings,
-                 *summary.get("warnings", [])]))
+                 *summary.get("warnings", []), *(record or {}).get("warnings", [])]))
             summary["wall_s"] = time.perf_counter() - t0
             summary["output"] = str(out)
             results.write_header(f, name, text, outcome.seed, summary)
+            if record is not None:
+                results.write_recording(f, record)
             if outcome.truth is not None:
                 results.write_truth(f, outcome.truth)
             outcome.write(f)

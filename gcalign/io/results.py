@@ -387,6 +387,33 @@ def write_imu(f: h5py.File, imu: ImuData):
             g.attrs[name] = value
 
 
+def write_recording(f: h5py.File, record: dict) -> None:
+    """``/recording``: what the reader of a recorded file assumed (format, axes, units, time
+    origin, rate, gaps, gravity check; :func:`gcalign.io.recorded.read_recording`), one
+    attribute per entry (text, number, or JSON for lists and mappings) and the whole
+    record as ``record_json``."""
+    g = f.create_group("recording")
+    for key, value in record.items():
+        if isinstance(value, (str, int, float)) and not isinstance(value, bool):
+            g.attrs[key] = value
+        elif value is not None:
+            g.attrs[key] = json.dumps(value)
+    g.attrs["record_json"] = json.dumps(record)
+
+
+def read_recording_record(path: Path) -> dict | None:
+    """The ``/recording`` record of a results file, or None if it has none."""
+    with open_results(path) as f:
+        if "recording" not in f:
+            return None
+        text = text_attr(f["recording"], "record_json", path)
+    try:
+        record = json.loads(text)
+    except ValueError:
+        raise ScenarioError(f"{path}: /recording attribute 'record_json' is not JSON") from None
+    return record if isinstance(record, dict) else None
+
+
 def open_results(path: Path) -> h5py.File:
     """Open a gcalign results file for reading; ScenarioError if it is missing or not ours."""
     path = Path(path)

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BeforeValidator, Field, field_validator, model_validator
+from pydantic import BeforeValidator, Field, field_validator, model_serializer, model_validator
 
 from gcalign import units as u
 from gcalign.io.scenario.align import AlignConfig
@@ -18,6 +18,7 @@ from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
 from gcalign.io.scenario.realtime import RealtimeConfig
+from gcalign.io.scenario.recording import ImuLayout, split_imu_file
 from gcalign.nav.earth import MODELS, EarthModel
 from gcalign.sim.errors import ImuErrors, SensorErrors
 
@@ -149,6 +150,8 @@ class Scenario(Model):
     motion: MotionModel | None = None
     mechanism: MechanismConfig | None = None
     imu_file: Path | None = None
+    imu_layout: ImuLayout | None = Field(None, exclude=True, description=(
+        "written as imu_file: {path, format, axes, ...}; see gcalign.io.scenario.recording"))
     navigation: NavigationConfig | None = None
     output: OutputConfig = Field(default_factory=OutputConfig)
     align: AlignConfig | None = None
@@ -161,6 +164,28 @@ class Scenario(Model):
     @property
     def earth_model(self) -> EarthModel:
         return MODELS[self.earth]
+
+    @model_validator(mode="before")
+    @classmethod
+    def _imu_file_mapping(cls, data):
+        """``imu_file: {path, format, ...}``: the path and its layout (the plain path keeps
+        its meaning)."""
+        return split_imu_file(data)
+
+    @model_serializer(mode="wrap")
+    def _imu_file_as_written(self, handler):
+        """The layout goes back under ``imu_file`` as the scenario file writes it."""
+        out = handler(self)
+        if self.imu_layout is not None and isinstance(out, dict) and "imu_file" in out:
+            layout = self.imu_layout.model_dump(mode="json", exclude_unset=True)
+            out["imu_file"] = {"path": out["imu_file"], **layout}
+        return out
+
+    def recording_layout(self):
+        """How to read `imu_file` (:class:`gcalign.io.recorded.Layout`)."""
+        from gcalign.io.recorded import Layout
+
+        return Layout() if self.imu_layout is None else self.imu_layout.to_layout()
 
     @model_validator(mode="after")
     def _source(self):
@@ -176,6 +201,8 @@ class Scenario(Model):
             if round(n) < 2:
                 raise ValueError(f"motion.duration_s: {self.motion.duration():g} s holds fewer "
                                  f"than 2 samples at {self.imu.rate_hz} Hz")
+        if self.imu_layout is not None and self.imu_file is None:
+            raise ValueError("imu_file.path: missing; a layout needs the file it describes")
         if self.mechanism is not None and self.imu_file is not None:
             raise ValueError("mechanism: recorded data carry their own sensor frame; a "
                              "mechanism applies to simulated motion only (remove it)")
