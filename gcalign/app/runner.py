@@ -64,6 +64,7 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
             if outcome.truth is not None:
                 results.write_truth(f, outcome.truth)
             outcome.write(f)
+            results.add_dimension_scales(f)
     except OSError as err:
         raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
     return summary
