@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 import scipy.io
 import yaml
+from cli_checks import assert_bad_input
 from typer.testing import CliRunner
 
-from cli_checks import assert_bad_input
 from gcalign.cli import app
 from gcalign.io import results
 from gcalign.nav.rotation import euler_to_dcm
