@@ -18,7 +18,7 @@ from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
 from gcalign.io.scenario.realtime import RealtimeConfig
-from gcalign.io.scenario.recording import ImuLayout, split_imu_file
+from gcalign.io.scenario.recording import ImuLayout, Initial, ReferenceFile, split_imu_file
 from gcalign.nav.earth import MODELS, EarthModel
 from gcalign.sim.errors import ImuErrors, SensorErrors
 
@@ -152,6 +152,8 @@ class Scenario(Model):
     imu_file: Path | None = None
     imu_layout: ImuLayout | None = Field(None, exclude=True, description=(
         "written as imu_file: {path, format, axes, ...}; see gcalign.io.scenario.recording"))
+    reference: ReferenceFile | None = None
+    initial: Initial | None = None
     navigation: NavigationConfig | None = None
     output: OutputConfig = Field(default_factory=OutputConfig)
     align: AlignConfig | None = None
@@ -181,6 +183,14 @@ class Scenario(Model):
             out["imu_file"] = {"path": out["imu_file"], **layout}
         return out
 
+    def resolve_paths(self, folder) -> None:
+        """Relative file paths (imu_file, reference.path) taken from `folder` (the
+        scenario file's)."""
+        if self.imu_file is not None and not self.imu_file.is_absolute():
+            self.imu_file = (Path(folder) / self.imu_file).resolve()
+        if self.reference is not None and not self.reference.path.is_absolute():
+            self.reference.path = (Path(folder) / self.reference.path).resolve()
+
     def recording_layout(self):
         """How to read `imu_file` (:class:`gcalign.io.recorded.Layout`)."""
         from gcalign.io.recorded import Layout
@@ -201,6 +211,10 @@ class Scenario(Model):
             if round(n) < 2:
                 raise ValueError(f"motion.duration_s: {self.motion.duration():g} s holds fewer "
                                  f"than 2 samples at {self.imu.rate_hz} Hz")
+        if self.imu_file is None and (self.reference is not None or self.initial is not None):
+            key = "reference" if self.reference is not None else "initial"
+            raise ValueError(f"{key}: applies to recorded data (imu_file); a simulation has "
+                             "its truth and its motion's initial state")
         if self.imu_layout is not None and self.imu_file is None:
             raise ValueError("imu_file.path: missing; a layout needs the file it describes")
         if self.mechanism is not None and self.imu_file is not None:
@@ -218,6 +232,10 @@ class Scenario(Model):
             if keys:
                 out.append(f"{', '.join(keys)}: cannot matter with recorded data (imu_file): "
                            "the recording carries its own rate and sensor errors")
+        for key in ("reference", "initial"):
+            if getattr(self, key) is not None and section is not None:
+                out.append(f"{key}: read and checked (gcalign validate shows it), but "
+                           f"{section} does not use it yet")
         model = getattr(self, section, None) if section else None
         if model is not None and hasattr(model, "unused"):
             out += model.unused(self)

@@ -20,6 +20,7 @@ the rest in ``Scenario.imu_layout``; it writes them back as one ``imu_file`` map
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import Field, ValidationError, field_validator
@@ -27,7 +28,8 @@ from pydantic import Field, ValidationError, field_validator
 from gcalign.errors import ScenarioError
 from gcalign.io.recorded.axes import rotation_to_rfu
 from gcalign.io.recorded.imu import ACCEL_UNITS, FORMAT_NAMES, GYRO_UNITS, Layout
-from gcalign.io.scenario.base import Model
+from gcalign.io.recorded.reference import REFERENCE_FORMATS
+from gcalign.io.scenario.base import Model, Vec3
 
 
 class Units(Model):
@@ -76,6 +78,37 @@ class ImuLayout(Model):
             accel_units=None if self.units is None else self.units.accel,
             quantity=self.quantity, time=self.time, variable=self.variable,
             rate_hz=self.rate_hz, max_gap_s=self.max_gap_s, check_gravity=self.check_gravity)
+
+
+class ReferenceFile(Model):
+    """``reference: {path, format, variable, columns}``: a reference solution (a master
+    INS, a post-processed trajectory; :mod:`gcalign.io.recorded.reference`)."""
+
+    path: Path
+    format: str = "psins-mat"
+    variable: str | None = None
+    columns: list[str] | None = None
+
+    @field_validator("format")
+    @classmethod
+    def _known_format(cls, v):
+        if v not in REFERENCE_FORMATS:
+            raise ValueError(f"{v!r} is not a reference format; allowed: "
+                             f"{', '.join(REFERENCE_FORMATS)}")
+        return v
+
+    def read(self):
+        from gcalign.io.recorded.reference import read_reference
+
+        return read_reference(self.path, self.format, self.variable, self.columns)
+
+
+class Initial(Model):
+    """``initial: {att_deg, v_enu_mps}``: the state navigation starts from on recorded data
+    whose file gives none."""
+
+    att_deg: Vec3 = Field(description="[pitch, roll, yaw], deg (ENU, yaw CCW positive)")
+    v_enu_mps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 def split_imu_file(data: Any) -> Any:

@@ -28,6 +28,7 @@ def resolved_rows(sc: Scenario) -> list[tuple[str, str, str]]:
     if sc.imu_file is not None:
         rows.append(("imu_file", str(sc.imu_file), "(recorded data; imu errors not applied)"))
         rows += recording_rows(sc)
+        rows += reference_rows(sc)
     else:
         imu, err = sc.imu, sc.imu.errors()
         rows += [
@@ -128,3 +129,33 @@ def recording_rows(sc: Scenario) -> list[tuple[str, str, str]]:
          "" if isinstance(gravity, str) else
          f"f = {_v(gravity['specific_force_rfu_mps2'], 5)} m/s² (RFU)"),
     ]
+
+
+def reference_rows(sc: Scenario) -> list[tuple[str, str, str]]:
+    """The reference file and initial keys, read and checked: the reference must cover the
+    navigation window (``navigation.start_s``, ``duration_s``; the whole recording by
+    default) of the recorded data (ScenarioError naming both spans otherwise)."""
+    from gcalign.io.recorded import read_recording
+    from gcalign.io.recorded.reference import reference_at
+
+    rows: list[tuple[str, str, str]] = []
+    if sc.initial is not None:
+        rows.append(("initial.att_deg", _v(sc.initial.att_deg) + " °",
+                     _v(np.radians(sc.initial.att_deg)) + " rad"))
+        rows.append(("initial.v_enu_mps", _v(sc.initial.v_enu_mps) + " m/s", ""))
+    if sc.reference is None or sc.imu_file is None:
+        return rows
+    ref = sc.reference.read()
+    r = ref.record
+    imu = read_recording(sc.imu_file, sc.recording_layout())
+    nav = sc.navigation
+    start = float(imu.t[0] - imu.ts) + (nav.start_s if nav is not None else 0.0)
+    end = float(imu.t[-1]) if nav is None or nav.duration_s is None else min(
+        float(imu.t[-1]), start + nav.duration_s)
+    reference_at(ref, [start, end])  # refuses a reference that does not cover the run
+    rows.append(("reference", f"{r['path']} ({r['format']}"
+                 + (f", {r['variable']}" if "variable" in r else "") + ")",
+                 f"{r['epochs']} epochs at {r['rate_hz']:.4g} Hz, t {r['t_first_s']:.3f} .. "
+                 f"{r['t_last_s']:.3f} s ({r['time_origin']})"))
+    rows.append(("reference covers", f"{start:.3f} .. {end:.3f} s", "the navigation window"))
+    return rows
