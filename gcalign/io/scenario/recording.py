@@ -167,3 +167,17 @@ def recorded_scenario(section: str, imu_file) -> dict:
     if section in RECORDED_DEFAULTS:
         data[section] = dict(RECORDED_DEFAULTS[section])
     return data
+
+
+def absolute_paths(data: Any, folder) -> None:
+    """In a scenario mapping (before validation), the relative file paths -- ``imu_file``
+    (a path or its ``path``) and ``reference.path`` -- made absolute from `folder`, in place
+    (batch workers may run elsewhere)."""
+    if not isinstance(data, dict):
+        return
+    for key in ("imu_file", "reference"):
+        node = data.get(key)
+        holder, field = (data, key) if isinstance(node, str) else (node, "path")
+        if isinstance(holder, dict) and isinstance(holder.get(field), str):
+            p = Path(holder[field])
+            holder[field] = str(p if p.is_absolute() else (Path(folder) / p).resolve())
