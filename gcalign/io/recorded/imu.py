@@ -98,7 +98,6 @@ class FormatInfo:
     origin: str  # what the time column counts
     gyro: str
     accel: str
-    columns: tuple[str, ...] = COLUMN_NAMES
     declarable: frozenset[str] = frozenset()  # keys a user may declare for this format
 
 
@@ -107,7 +106,6 @@ FORMATS = {
     "psins": FormatInfo("RFU", "end", "header t0 + k·interval", "rad", "m/s",
                         declarable=frozenset({"axes"})),
     "psins-mat": FormatInfo("RFU", "end", "seconds, the array's last column", "rad", "m/s",
-                            ("gx", "gy", "gz", "ax", "ay", "az", "t"),
                             frozenset({"axes", "variable", "rate_hz"})),
     "i2nav": FormatInfo("FRD", "end", "GNSS seconds of week", "rad", "m/s",
                         declarable=frozenset({"axes", "rate_hz"})),
@@ -160,7 +158,7 @@ class _Raw:
     """A file's columns before conversion: time (N,), gyro and accel (N, 3) in the file's
     axes and units; where(k) names data row k in messages."""
 
-    t: np.ndarray | None
+    t: np.ndarray
     gyro: np.ndarray
     accel: np.ndarray
     where: object
@@ -233,7 +231,7 @@ def _number(s: str) -> bool:
     return True
 
 
-def _read_psins(name: str, path, layout: Layout) -> _Raw:
+def _read_psins(name: str, path) -> _Raw:
     imu = read_psins_imu(path)  # header, counts, implicit regular times (end of increments)
     header = replace(imu, source=name)
     return _Raw(imu.t, imu.dtheta, imu.dv, lambda k: f": sample {k + 1}", imu.ts, header,
@@ -582,11 +580,10 @@ def _read(name: str, layout: Layout) -> ImuData:
     declared_axes = layout.axes if layout.axes is not None else info.axes
     C = rotation_to_rfu(declared_axes)
     if fmt == "psins":
-        raw = _read_psins(name, name, layout)
+        raw = _read_psins(name, name)
     else:
         raw = _READERS[fmt](name, read_bytes(name)[1], layout)
     gyro_units, accel_units, quantity = _units(fmt, info, layout, raw.notes.get("header_units"))
-    assert raw.t is not None
     ts, ts_rule = _interval(name, raw.t, layout, raw.ts)
     t, weeks = (_unwrap_week(raw.t) if fmt == "i2nav" else (raw.t, 0))
     time = layout.time or info.time
