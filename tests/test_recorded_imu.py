@@ -233,10 +233,13 @@ def test_bad_recordings_exit_2_with_one_line(tmp_path, edit, options, field, mor
 
 
 def test_a_key_the_format_fixes_is_refused(tmp_path):
+    """Units of a PSINS file come from its header: declaring them is an error (and --set
+    cannot reach into imu_file, which the override checker knows as a path: --format,
+    --axes or the mapping in the scenario declare a layout; decision 010)."""
     out = tmp_path / "n.h5"
     res = runner.invoke(app, ["align", "--imu-file", str(LASERGYRO_XZ), "--set",
                               "imu_file.units={gyro: deg}", "-o", str(out)])
-    assert res.exit_code == 2, res.output
+    assert_bad_input(res, out, "--set imu_file.units", "no keys")
     sc = {"name": "x", "imu_file": {"path": str(LASERGYRO_XZ), "units": {"gyro": "deg"}}}
     from gcalign.io.scenario import parse_scenario
 
