@@ -618,12 +618,12 @@ def read_scenario_yaml(path: Path) -> str:
 
 def add_dimension_scales(f: h5py.File) -> None:
     """Make every group's time ``t`` an HDF5 dimension scale, attached to axis 0 of the
-    datasets of the same length in that group and in its subgroups without a ``t`` of their
-    own (``/navigate/error``), and give their other axes a scale of their size (``component``
-    = 0, 1, 2 for the width 3 of a vector), so that netCDF readers
+    time series of that group and of its subgroups without a ``t`` of their own
+    (``/navigate/error``), and give their other axes a scale of their size (``component`` =
+    0, 1, 2 for the width 3 of a vector, in the group of ``t``), so that netCDF readers
     (``xarray.open_dataset(path, group="navigate")``) see a time coordinate and named
-    dimensions instead of ``phony_dim``. Axis 0 of a dataset of another length gets a scale
-    named after its length (``n1000``)."""
+    dimensions instead of ``phony_dim``. Datasets that are not series of ``t`` are left
+    as they are."""
     groups: list[h5py.Group] = [f]
     f.visititems(lambda _, obj: groups.append(obj) if isinstance(obj, h5py.Group) else None)
     for g in groups:
@@ -636,15 +636,13 @@ def add_dimension_scales(f: h5py.File) -> None:
         if not t.is_scale:
             t.make_scale("t")
         for ds in list(g.values()):
-            if not isinstance(ds, h5py.Dataset) or ds.is_scale or ds.ndim == 0:
+            if (not isinstance(ds, h5py.Dataset) or ds.is_scale or ds.ndim == 0
+                    or ds.shape[0] != len(t) or ds.dims[0]):
                 continue
-            for axis, size in enumerate(ds.shape):
-                if ds.dims[axis]:  # already has a scale
-                    continue
-                scale = t if axis == 0 and size == len(t) else _index_scale(
-                    owner, f"n{size}" if axis == 0 else
-                    ("component" if size == 3 else f"component{size}"), size)
-                ds.dims[axis].attach_scale(scale)
+            ds.dims[0].attach_scale(t)
+            for axis, size in enumerate(ds.shape[1:], start=1):
+                name = "component" if size == 3 else f"component{size}"
+                ds.dims[axis].attach_scale(_index_scale(owner, name, size))
 
 
 def _is_time(t) -> bool:
