@@ -126,10 +126,13 @@ def test_reference_not_covering_the_run_exits_2(tmp_path):
         "100.000 s" in res.output
     print(res.output.strip())
     sc["navigation"] = {"start_s": 0.2, "duration_s": 60}
+    (tmp_path / "mems.mat").write_bytes(MAT.read_bytes())  # paths relative to the scenario
+    sc["imu_file"]["path"] = sc["reference"]["path"] = "mems.mat"
     p.write_text(yaml.safe_dump(sc))
     res = runner.invoke(app, ["validate", str(p)])
     assert res.exit_code == 0, res.output
     assert "reference covers" in res.stdout and "fogavp" in res.stdout
+    assert "0.190 .. 60.190 s" in res.stdout  # the window: -0.01 s + start_s, 60 s
     assert "imu_file.format" in res.stdout and "psins-mat" in res.stdout
 
 

@@ -246,8 +246,8 @@ def load_with_overrides(
         _apply_sets(data, inv.sets, {f"{section}.{k}" for k in given} | {
             k for k, _ in recorded}, source, recorded)
     sc = parse_scenario(data, source)
-    if sc.imu_file is not None and path is not None and not sc.imu_file.is_absolute():
-        sc.imu_file = (Path(path).parent / sc.imu_file).resolve()
+    if path is not None:
+        sc.resolve_paths(Path(path).parent)  # imu_file, reference.path
     inv.applied = [(f"{section}.{k}", v) for k, v in named.items()] + recorded
     if inv.applied:
         text += "\n# command-line overrides:\n" + yaml.safe_dump(

@@ -542,8 +542,8 @@ def read_recording(path, layout: Layout | None = None) -> ImuData:
         ``t`` (N,) end time of each increment in the file's own time (s; GNSS seconds of
         week for i2nav), ``dtheta`` (N, 3) rad, ``dv`` (N, 3) m/s in body RFU, ``ts`` s;
         ``site``, ``att0``, ``v0_n`` from a PSINS header; ``meta["recording"]`` the record
-        of what was assumed (JSON-able). The last file read is kept (one entry), so
-        reading it again for its record costs nothing.
+        of what was assumed (JSON-able). The last file read is kept (one entry, its
+        arrays read-only), so reading it again for its record costs nothing.
 
     Raises
     ------
@@ -561,6 +561,8 @@ def read_recording(path, layout: Layout | None = None) -> ImuData:
         return _CACHE[key]
     imu = _read(name, layout)
     if key is not None:
+        for a in (imu.t, imu.dtheta, imu.dv):  # shared by the next reader: read-only
+            a.flags.writeable = False
         _CACHE.clear()
         _CACHE[key] = imu
     return imu
