@@ -40,14 +40,11 @@ def default_output(path: Path, fmt: str) -> Path:
 
 
 def default_group(path: Path) -> str:
-    """The group of the command that wrote the file, if it holds a time series, else
-    ``navigate``."""
+    """The group of the command that wrote the file (``navigate``, ``simulate``'s
+    ``truth``, ...); :func:`gcalign.io.results.series` says which groups hold series when
+    it has none."""
     kind = results.read_summary(path)[0]
-    with results.open_results(path) as f:
-        g = f.get(kind)
-        if g is not None and "t" in g:
-            return kind
-    return "navigate"
+    return {"simulate": "truth"}.get(kind, kind)
 
 
 def export(path, fmt: str, out=None, group: str | None = None, week: int = 0) -> Path:

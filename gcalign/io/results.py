@@ -678,8 +678,12 @@ def series(path: Path, group: str = "navigate") -> dict[str, tuple[np.ndarray, s
                                 f"{', '.join(have) or 'none'}")
         t = g.get("t")
         if not (isinstance(t, h5py.Dataset) and t.ndim == 1 and t.dtype.kind == "f"):
+            timed: list[str] = []
+            f.visititems(lambda n, o: timed.append(n) if isinstance(o, h5py.Group)
+                         and _is_time(o.get("t")) else None)
             raise ScenarioError(f"--group: {path}: /{group.strip('/')} has no time series "
-                                "(no 1-D dataset 't')")
+                                f"(no 1-D dataset 't'); groups that have: "
+                                f"{', '.join(timed[:8]) or 'none'}")
         n = len(t)
         out = {"t": (t[()], _units_of(t))}
         for name, ds in _time_datasets(g, n):
