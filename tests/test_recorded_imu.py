@@ -290,3 +290,40 @@ def test_mat_file_variable_choice(tmp_path):
     with pytest.raises(ScenarioError, match="more than one array of 7 columns.*imu"):
         read_recording(two)
     assert len(read_recording(two, Layout(format="psins-mat", variable="imu"))) == 50
+
+
+def test_validate_shows_what_was_assumed(foreign, tmp_path):
+    import yaml
+
+    sc = {"name": "ride", "site": {"lat_deg": 34.246048, "lon_deg": 108.909664},
+          "imu_file": {"path": str(foreign["rates"]), "format": "csv", "axes": "FRD"}}
+    p = tmp_path / "s.yaml"
+    p.write_text(yaml.safe_dump(sc))
+    res = runner.invoke(app, ["validate", str(p), "--json"])
+    assert res.exit_code == 0, res.output
+    values = json.loads(res.stdout)["values"]
+    assert values["imu_file.format"]["value"] == "csv"
+    assert values["imu_file.axes"]["value"] == "FRD (declared)"
+    assert values["imu_file.axes"]["si"] == "v_rfu = C v_file, C = [[0, 1, 0], [1, 0, 0], " \
+        "[0, 0, -1]]"
+    assert values["imu_file.units"]["value"] == "gyro deg/s, accel m/s^2"
+    assert values["imu_file.units"]["si"].startswith("rates: rectangular")
+    assert values["imu_file.rate"]["value"] == "100 Hz (median time step)"
+    assert values["imu_file.gaps"]["value"] == "none"
+
+
+def test_the_imu_file_mapping_survives_a_dump():
+    """A scenario with a layout dumps (the API's scenario text) to the same mapping and
+    loads back to the same model; a plain path stays a plain path."""
+    from gcalign.io.scenario import parse_scenario
+
+    data = {"name": "x", "imu_file": {"path": "/d/ride.txt", "format": "csv", "axes": "FLU",
+                                      "units": {"gyro": "deg/s", "accel": "g"},
+                                      "max_gap_s": 0.05}}
+    sc = parse_scenario(json.loads(json.dumps(data)), "t")
+    dumped = sc.model_dump(mode="json", exclude_unset=True)
+    assert dumped == data
+    assert parse_scenario(dumped, "t") == sc
+    plain = parse_scenario({"name": "x", "imu_file": "/d/a.imu"}, "t")
+    assert plain.model_dump(mode="json", exclude_unset=True)["imu_file"] == "/d/a.imu"
+    assert plain.recording_layout() == Layout()
