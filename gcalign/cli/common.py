@@ -221,8 +221,9 @@ def load_with_overrides(
     elif path is None and (_INVOCATION.get() or Invocation()).imu_file is not None:
         from gcalign.io.scenario.recording import recorded_scenario  # a recording alone
 
-        data = recorded_scenario(section, (_INVOCATION.get() or Invocation()).imu_file)
-        text, source = yaml.safe_dump(data, sort_keys=False), "<recorded-data defaults>"
+        imu_file = (_INVOCATION.get() or Invocation()).imu_file
+        data = recorded_scenario(section, imu_file)
+        text, source = yaml.safe_dump(data, sort_keys=False), f"--imu-file {imu_file}"
     elif path is None:
         text, source = builtin_text(builtin), f"<built-in {builtin}>"
         data = yaml.safe_load(text)
