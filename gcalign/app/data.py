@@ -99,8 +99,6 @@ class Stream:
         return 0.0 if self.header is None else float(self.header.t[0] - self.ts)
 
 
-#: Compressed recordings (``x.imu.xz``), opened by the standard library.
-COMPRESSED = {".gz": "gzip", ".xz": "lzma"}
 def check_finite_block(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray) -> None:
     """ScenarioError naming the sensor and the time if simulated increments are not finite
     or beyond what recorded data may hold (:data:`gcalign.io.imu_files.MAX_DTHETA_RAD`,
@@ -117,49 +115,42 @@ def check_finite_block(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray) -> Non
                                 "per sample; check the biases, scale factors and noise")
 
 
-def read_data_file(path: Path) -> tuple[ImuData, Truth | None]:
-    """IMU (and truth, if the file has it) from our HDF5, a PSINS .imu or a CSV/text file;
-    a text file may be gzip- or xz-compressed (``lasergyro.imu.xz``)."""
+def read_data_file(path: Path, layout=None) -> tuple[ImuData, Truth | None]:
+    """IMU (and truth, if the file has it) from our HDF5, or a recording of any layout
+    (:func:`gcalign.io.recorded.read_recording`: PSINS .imu, PSINS MAT, KF-GINS text,
+    CSV/text with declared columns, units and axes; ``.gz``/``.xz`` compressed too)."""
     from gcalign.io import results
-    from gcalign.io.imu_files import read_imu_file
+    from gcalign.io.recorded import read_recording
 
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"imu_file: {path}: file not found")
     if path.suffix.lower() in HDF5_SUFFIXES:
+        if layout is not None and layout.declared() | ({layout.format} - {"auto"}):
+            raise ScenarioError(f"imu_file.format: {path} is a gcalign results file, which "
+                                "says its own layout; remove format, axes and the rest")
         return results.read_imu(path), results.read_truth(path)
     try:
-        if path.suffix.lower() in COMPRESSED:
-            return _read_compressed(path, read_imu_file), None
-        return read_imu_file(path), None
+        return read_recording(path, layout), None
     except ValueError as err:
-        raise ScenarioError(f"imu_file: {err}") from None
+        text = str(err)
+        raise ScenarioError(text if text.startswith("imu_file") else f"imu_file: {text}"
+                            ) from None
 
 
-def _read_compressed(path: Path, reader) -> ImuData:
-    """Decompress into a temporary file of the inner name (the readers take paths and
-    dispatch on the suffix), read it, and name the compressed file as the source."""
-    import importlib
-    import tempfile
-
-    module = importlib.import_module(COMPRESSED[path.suffix.lower()])
-    with tempfile.TemporaryDirectory(prefix="gcalign-") as tmp:
-        inner = Path(tmp) / path.with_suffix("").name
-        try:
-            with module.open(path, "rb") as src:
-                inner.write_bytes(src.read())
-        except (OSError, EOFError) as err:
-            raise ScenarioError(f"imu_file: {path}: cannot decompress ({err})") from None
-        try:
-            imu = reader(inner)
-        except ValueError as err:
-            raise ScenarioError(str(err).replace(str(inner), str(path))) from None
-    return replace(imu, source=str(path))
+def recording_record(sc: Scenario) -> dict | None:
+    """What the reader of the scenario's recorded file assumed (``meta["recording"]``), or
+    None for simulated data and our own HDF5 files (the reader keeps the last file it read,
+    so this costs nothing after the run)."""
+    if sc.imu_file is None or Path(sc.imu_file).suffix.lower() in HDF5_SUFFIXES:
+        return None
+    imu, _ = read_data_file(sc.imu_file, sc.recording_layout())
+    return imu.meta.get("recording")
 
 
 def _recorded(scenario: Scenario) -> RunData:
     assert scenario.imu_file is not None
-    imu, truth = read_data_file(scenario.imu_file)
+    imu, truth = read_data_file(scenario.imu_file, scenario.recording_layout())
     if scenario.site is not None:
         site = scenario.site.to_si()
     elif imu.site is not None:

@@ -53,7 +53,7 @@ def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
             if not sc.imu_file.is_file():
                 raise ScenarioError(f"imu_file: {sc.imu_file}: file not found")
             return None
-        imu, truth = read_data_file(sc.imu_file)
+        imu, truth = read_data_file(sc.imu_file, sc.recording_layout())
         if sc.site is None and imu.site is None:
             raise ScenarioError(f"site: missing; {sc.imu_file} does not give the site, so "
                                 "the scenario must (site: {lat_deg, lon_deg, height_m})")

@@ -36,6 +36,8 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
     done, before the file is finished (the command line closes its progress bar there);
     `on_outcome` hears of the room's :class:`Outcome` (the Python API keeps its typed result).
     """
+    from gcalign.app.data import recording_record
+
     cmd = command(name)
     room = cmd.load()
     kwargs = dict(options)
@@ -54,15 +56,19 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
             if before_write is not None:
                 before_write()
             summary = outcome.summary
+            record = recording_record(sc)  # what the reader of a recorded file assumed
             summary["warnings"] = list(dict.fromkeys(
                 [*notes, *sc.unused(cmd.section), *outcome.warnings,
-                 *summary.get("warnings", [])]))
+                 *summary.get("warnings", []), *(record or {}).get("warnings", [])]))
             summary["wall_s"] = time.perf_counter() - t0
             summary["output"] = str(out)
             results.write_header(f, name, text, outcome.seed, summary)
+            if record is not None:
+                results.write_recording(f, record)
             if outcome.truth is not None:
                 results.write_truth(f, outcome.truth)
             outcome.write(f)
+            results.add_dimension_scales(f)
     except OSError as err:
         raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
     return summary

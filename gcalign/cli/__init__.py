@@ -195,6 +195,7 @@ from gcalign.cli import batch as _batch  # noqa: E402,F401
 from gcalign.cli import calibrate as _calibrate  # noqa: E402,F401
 from gcalign.cli import data as _data  # noqa: E402,F401
 from gcalign.cli import example as _example  # noqa: E402,F401
+from gcalign.cli import export as _export  # noqa: E402,F401
 from gcalign.cli import modulate as _modulate  # noqa: E402,F401
 from gcalign.cli import northfind as _northfind  # noqa: E402,F401
 from gcalign.cli import plot as _plot  # noqa: E402,F401

@@ -51,6 +51,10 @@ IMU_FILE_HELP = ("Recorded IMU data (PSINS .imu, CSV/text, gcalign HDF5; .gz/.xz
                  "compressed) instead of the scenario's simulation: it replaces the motion, "
                  "mechanism, imu and site sections; the site then comes from the file's "
                  "header or --lat/--lon/--height.")
+FORMAT_HELP = ("Layout of the --imu-file (or the scenario's imu_file): psins | psins-mat | "
+               "i2nav | csv | auto (from the suffix); see README 'Your own recording'.")
+AXES_HELP = ("Body axes of the recording, the file's x, y, z: three of F/B, R/L, U/D, e.g. "
+             "RFU (ours), FRD (KF-GINS), FLU (ROS).")
 
 
 @dataclass
@@ -59,6 +63,7 @@ class Invocation:
 
     sets: list[str] = field(default_factory=list)
     imu_file: Path | None = None
+    imu_layout: dict = field(default_factory=dict)  # --format, --axes
     site: dict = field(default_factory=dict)  # lat_deg, lon_deg, height_m given as options
     applied: list[tuple[str, object]] = field(default_factory=list)  # (key, value), in order
     notes: list[str] = field(default_factory=list)  # warnings found while loading
@@ -78,6 +83,8 @@ def _common_parameters(recorded: bool) -> list[inspect.Parameter]:
     if recorded:
         params += [
             _option("imu_file", Path | None, "FILE", "--imu-file", help=IMU_FILE_HELP),
+            _option("imu_format", str | None, "FORMAT", "--format", help=FORMAT_HELP),
+            _option("imu_axes", str | None, "AXES", "--axes", help=AXES_HELP),
             _option("lat", float | None, "DEG", "--lat", help="Site latitude (deg); with "
                     "--lon (and --height) replaces the site of the scenario or of the data "
                     "file's header."),
@@ -99,7 +106,9 @@ def with_common_options(fn: Callable, recorded: bool) -> Callable:
         site = {k: given.get(o) for k, o in (("lat_deg", "lat"), ("lon_deg", "lon"),
                                              ("height_m", "height"))}
         inv = Invocation(sets=list(given.get("set_") or []), imu_file=given.get("imu_file"),
-                         site={k: v for k, v in site.items() if v is not None})
+                         site={k: v for k, v in site.items() if v is not None},
+                         imu_layout={k: given[o] for k, o in (("format", "imu_format"),
+                                     ("axes", "imu_axes")) if given.get(o) is not None})
         token = _INVOCATION.set(inv)
         try:
             return fn(*args, **kwargs)
@@ -166,6 +175,11 @@ def _apply_recorded(data: dict, inv: Invocation, applied: list) -> None:
             data.pop(key, None)
         data["imu_file"] = str(path.resolve())
         applied.append(("imu_file", path))
+    if inv.imu_layout:  # --format, --axes describe the recording
+        from gcalign.io.scenario.recording import with_layout
+
+        data["imu_file"] = with_layout(data.get("imu_file"), inv.imu_layout)
+        applied.extend((f"imu_file.{k}", v) for k, v in inv.imu_layout.items())
     if inv.site:
         site = dict(data.get("site") or {}) if isinstance(data.get("site"), dict) else {}
         site.update(inv.site)
@@ -193,6 +207,12 @@ def load_with_overrides(
     if data is not None:
         source = str(path) if path is not None else f"<built-in {builtin}>"
         text = text or yaml.safe_dump(data, sort_keys=False)
+    elif path is None and (_INVOCATION.get() or Invocation()).imu_file is not None:
+        from gcalign.io.scenario.recording import recorded_scenario  # a recording alone
+
+        imu_file = (_INVOCATION.get() or Invocation()).imu_file
+        data = recorded_scenario(section, imu_file)
+        text, source = yaml.safe_dump(data, sort_keys=False), f"--imu-file {imu_file}"
     elif path is None:
         text, source = builtin_text(builtin), f"<built-in {builtin}>"
         data = yaml.safe_load(text)
@@ -216,8 +236,8 @@ def load_with_overrides(
         _apply_sets(data, inv.sets, {f"{section}.{k}" for k in given} | {
             k for k, _ in recorded}, source, recorded)
     sc = parse_scenario(data, source)
-    if sc.imu_file is not None and path is not None and not sc.imu_file.is_absolute():
-        sc.imu_file = (Path(path).parent / sc.imu_file).resolve()
+    if path is not None:
+        sc.resolve_paths(Path(path).parent)  # imu_file, reference.path
     inv.applied = [(f"{section}.{k}", v) for k, v in named.items()] + recorded
     if inv.applied:
         text += "\n# command-line overrides:\n" + yaml.safe_dump(

@@ -17,7 +17,10 @@ Two text formats arrive from outside gcalign (DESIGN "Truth and IMU simulation")
 * Plain text/CSV of ``t, Δθx, Δθy, Δθz, Δvx, Δvy, Δvz`` (s, rad, m/s), comma or
   whitespace separated, ``#`` comments, an optional header line of column names.
 
-HDF5 files written by ``gcalign simulate`` are read by the results layer, not here.
+Both may be compressed (``.gz``, ``.xz``). Other layouts -- PSINS MAT arrays, KF-GINS text,
+rates, declared columns and body axes -- are read by :mod:`gcalign.io.recorded`, which
+builds on these two. HDF5 files written by ``gcalign simulate`` are read by the results
+layer, not here.
 Every reading problem raises :class:`ImuFileError` with one line that names the file,
 the line (and field) and what was expected.
 
@@ -52,7 +55,10 @@ from gcalign.sim.imu import ImuData
 from gcalign.units import ARCSEC, DEG
 
 __all__ = [
+    "COMPRESSED",
     "ImuFileError",
+    "data_suffix",
+    "read_bytes",
     "read_psins_imu",
     "read_csv_imu",
     "read_imu_file",
@@ -79,8 +85,23 @@ class ImuFileError(ScenarioError):
 # --------------------------------------------------------------------------- helpers
 
 
-def _read_lines(path) -> tuple[str, list[str]]:
-    """Text lines of `path` (without line ends); missing/unreadable files -> ImuFileError."""
+#: Compressed recordings (``x.imu.xz``), opened by the standard library.
+COMPRESSED = {".gz": "gzip", ".xz": "lzma"}
+
+
+def data_suffix(path) -> str:
+    """The suffix that says what a file holds, under a compression suffix (x.imu.xz: .imu)."""
+    suffixes = [x.lower() for x in Path(os.fspath(path)).suffixes]
+    if suffixes and suffixes[-1] in COMPRESSED:
+        suffixes = suffixes[:-1]
+    return suffixes[-1] if suffixes else ""
+
+
+def read_bytes(path) -> tuple[str, bytes]:
+    """``(name, content)`` of `path`, decompressed when it ends in ``.gz`` or ``.xz``;
+    missing, unreadable or damaged files -> ImuFileError naming the file."""
+    import importlib
+
     name = os.fspath(path)
     p = Path(name)
     if not p.exists():
@@ -88,10 +109,22 @@ def _read_lines(path) -> tuple[str, list[str]]:
     if p.is_dir():
         raise ImuFileError(f"{name}: is a directory, expected an IMU data file")
     try:
-        text = p.read_text(encoding="utf-8", errors="replace")
+        compression = COMPRESSED.get(p.suffix.lower())
+        if compression is None:
+            return name, p.read_bytes()
+        with importlib.import_module(compression).open(p, "rb") as fh:
+            return name, fh.read()
+    except (EOFError, ValueError) as exc:
+        raise ImuFileError(f"{name}: cannot decompress ({exc})") from None
     except OSError as exc:
         raise ImuFileError(f"{name}: cannot read file ({exc.strerror or exc})") from None
-    return name, text.splitlines()
+
+
+def _read_lines(path) -> tuple[str, list[str]]:
+    """Text lines of `path` (without line ends, decompressed if ``.gz``/``.xz``); missing
+    or unreadable files -> ImuFileError."""
+    name, data = read_bytes(path)
+    return name, data.decode("utf-8", errors="replace").splitlines()
 
 
 def _strip(line: str, comment: str) -> str:
@@ -441,16 +474,19 @@ def write_csv_imu(path, imu: ImuData) -> None:
 
 
 def read_imu_file(path, ts: float | None = None) -> ImuData:
-    """Read IMU increments from a PSINS ``.imu`` or a text/CSV file.
+    """Read IMU increments from a PSINS ``.imu`` or a text/CSV file, plain or compressed
+    (``.gz``, ``.xz``: ``lasergyro.imu.xz``).
 
-    Dispatch: ``.imu`` -> :func:`read_psins_imu`; ``.csv``/``.txt`` -> :func:`read_csv_imu`;
-    HDF5 (by extension or signature) -> :class:`ImuFileError` (read by the results layer);
-    any other name: PSINS if the first non-blank line is a ``%`` comment, else CSV.
-    `ts` is passed to the CSV reader only (PSINS files carry their own interval).
+    Dispatch on the suffix under any compression suffix: ``.imu`` -> :func:`read_psins_imu`;
+    ``.csv``/``.txt`` -> :func:`read_csv_imu`; HDF5 (by extension or signature) ->
+    :class:`ImuFileError` (read by the results layer); any other name: PSINS if the first
+    non-blank line is a ``%`` comment, else CSV. `ts` is passed to the CSV reader only
+    (PSINS files carry their own interval). Other layouts (MAT files, KF-GINS text, rates,
+    other body axes) are read by :func:`gcalign.io.recorded.read_recording`.
     """
     name = os.fspath(path)
     p = Path(name)
-    suffix = p.suffix.lower()
+    suffix = data_suffix(p)
     if suffix in (".h5", ".hdf5", ".hdf"):
         raise ImuFileError(
             f"{name}: HDF5 IMU files (from `gcalign simulate`) are read by the results "
@@ -461,8 +497,7 @@ def read_imu_file(path, ts: float | None = None) -> ImuData:
     if suffix in (".csv", ".txt"):
         return read_csv_imu(p, ts=ts)
     if p.is_file():
-        with open(p, "rb") as fh:
-            head = fh.read(4096)
+        head = read_bytes(p)[1][:4096]
         if head.startswith(_HDF5_MAGIC):
             raise ImuFileError(
                 f"{name}: is an HDF5 file; HDF5 IMU data is read by the results module, "

@@ -387,6 +387,33 @@ def write_imu(f: h5py.File, imu: ImuData):
             g.attrs[name] = value
 
 
+def write_recording(f: h5py.File, record: dict) -> None:
+    """``/recording``: what the reader of a recorded file assumed (format, axes, units, time
+    origin, rate, gaps, gravity check; :func:`gcalign.io.recorded.read_recording`), one
+    attribute per entry (text, number, or JSON for lists and mappings) and the whole
+    record as ``record_json``."""
+    g = f.create_group("recording")
+    for key, value in record.items():
+        if isinstance(value, (str, int, float)) and not isinstance(value, bool):
+            g.attrs[key] = value
+        elif value is not None:
+            g.attrs[key] = json.dumps(value)
+    g.attrs["record_json"] = json.dumps(record)
+
+
+def read_recording_record(path: Path) -> dict | None:
+    """The ``/recording`` record of a results file, or None if it has none."""
+    with open_results(path) as f:
+        if "recording" not in f:
+            return None
+        text = text_attr(f["recording"], "record_json", path)
+    try:
+        record = json.loads(text)
+    except ValueError:
+        raise ScenarioError(f"{path}: /recording attribute 'record_json' is not JSON") from None
+    return record if isinstance(record, dict) else None
+
+
 def open_results(path: Path) -> h5py.File:
     """Open a gcalign results file for reading; ScenarioError if it is missing or not ours."""
     path = Path(path)
@@ -584,3 +611,144 @@ def read_scenario_yaml(path: Path) -> str:
 
     loads(text, f"{path}: root attribute 'scenario_yaml'")
     return text
+
+
+# --------------------------------------------------------------------------- series out
+
+
+def add_dimension_scales(f: h5py.File) -> None:
+    """Make every group's time ``t`` an HDF5 dimension scale, attached to axis 0 of the
+    time series of that group and of its subgroups without a ``t`` of their own
+    (``/navigate/error``), and give their other axes a scale of their size (``component`` =
+    0, 1, 2 for the width 3 of a vector, in the group of ``t``), so that netCDF readers
+    (``xarray.open_dataset(path, group="navigate")``) see a time coordinate and named
+    dimensions instead of ``phony_dim``. Datasets that are not series of ``t`` are left
+    as they are."""
+    groups: list[h5py.Group] = [f]
+    f.visititems(lambda _, obj: groups.append(obj) if isinstance(obj, h5py.Group) else None)
+    for g in groups:
+        owner = g
+        while not _is_time(owner.get("t")) and owner.name != "/":
+            owner = owner.parent
+        t = owner.get("t")
+        if not _is_time(t):
+            continue
+        if not t.is_scale:
+            t.make_scale("t")
+        for ds in list(g.values()):
+            if (not isinstance(ds, h5py.Dataset) or ds.is_scale or ds.ndim == 0
+                    or ds.shape[0] != len(t) or ds.dims[0]):
+                continue
+            ds.dims[0].attach_scale(t)
+            for axis, size in enumerate(ds.shape[1:], start=1):
+                name = "component" if size == 3 else f"component{size}"
+                ds.dims[axis].attach_scale(_index_scale(owner, name, size))
+
+
+def _is_time(t) -> bool:
+    return isinstance(t, h5py.Dataset) and t.ndim == 1 and len(t) > 1 and t.dtype.kind == "f"
+
+
+def _index_scale(g: h5py.Group, name: str, size: int) -> h5py.Dataset:
+    """A dimension scale 0 .. size-1 named `name` in `g` (made once)."""
+    if name in g:
+        return g[name]
+    ds = g.create_dataset(name, data=np.arange(size, dtype=np.int64))
+    ds.attrs["units"] = "1"
+    ds.make_scale(name)
+    return ds
+
+
+#: Component names of a series by its frame attribute (first match).
+_COMPONENTS = (("[pitch, roll, yaw]", ("pitch", "roll", "yaw")),
+               ("[latitude, longitude, height]", ("lat", "lon", "h")),
+               ("ENU", ("e", "n", "u")), ("body", ("x", "y", "z")))
+
+
+def series(path: Path, group: str = "navigate") -> dict[str, tuple[np.ndarray, str]]:
+    """The time series of a group of a results file: ``{name: (array, units)}``, ``t``
+    first, then every dataset of the same length along axis 0 (attitude, velocity,
+    position, errors, ...), as stored (SI; time along axis 0). ScenarioError naming the
+    file and group when there is no such group or it has no time ``t``."""
+    with open_results(path) as f:
+        g = f.get(group.strip("/"))
+        if not isinstance(g, h5py.Group):
+            have = [k for k in f if isinstance(f[k], h5py.Group)]
+            raise ScenarioError(f"--group: {path} has no group {group!r}; it has "
+                                f"{', '.join(have) or 'none'}")
+        t = g.get("t")
+        if not (isinstance(t, h5py.Dataset) and t.ndim == 1 and t.dtype.kind == "f"):
+            timed: list[str] = []
+            f.visititems(lambda n, o: timed.append(n) if isinstance(o, h5py.Group)
+                         and _is_time(o.get("t")) else None)
+            raise ScenarioError(f"--group: {path}: /{group.strip('/')} has no time series "
+                                f"(no 1-D dataset 't'); groups that have: "
+                                f"{', '.join(timed[:8]) or 'none'}")
+        n = len(t)
+        out = {"t": (t[()], _units_of(t))}
+        for name, ds in _time_datasets(g, n):
+            out[name] = (ds[()], _units_of(ds))
+        return out
+
+
+def _time_datasets(g: h5py.Group, n: int, prefix: str = ""):
+    """``(name, dataset)`` of the numeric series of length `n` in `g` and in its subgroups
+    without a time of their own (``error/att`` as ``error_att``)."""
+    for name, obj in g.items():
+        if isinstance(obj, h5py.Group) and "t" not in obj:
+            yield from _time_datasets(obj, n, f"{prefix}{name}_")
+        elif (name != "t" and isinstance(obj, h5py.Dataset) and not obj.is_scale
+              and obj.ndim in (1, 2) and obj.shape[0] == n and obj.dtype.kind in "fiu"):
+            yield prefix + name, obj
+
+
+def series_components(path: Path, group: str = "navigate") -> dict[str, tuple[str, ...]]:
+    """Column labels of each (N, k) series: ``att -> (pitch, roll, yaw)``, ``v_n -> (e, n,
+    u)``, ``pos -> (lat, lon, h)``, otherwise ``0, 1, ...``."""
+    with open_results(path) as f:
+        g = f[group.strip("/")]
+        out = {}
+        for name, ds in _time_datasets(g, len(g["t"])):
+            if ds.ndim == 2:
+                frame = str(ds.attrs.get("frame", ""))
+                labels = next((c for key, c in _COMPONENTS if key in frame
+                               and len(c) == ds.shape[1]), None)
+                out[name] = labels or tuple(str(i) for i in range(ds.shape[1]))
+        return out
+
+
+def columns(path: Path, group: str = "navigate") -> list[tuple[str, np.ndarray, str]]:
+    """The group's series as flat columns ``(name, values (N,), units)``: ``t``, then each
+    vector series by component (``att_pitch``, ``v_n_e``, ``pos_lat``, ...)."""
+    labels = series_components(path, group)
+    out = []
+    for name, (a, units) in series(path, group).items():
+        if a.ndim == 1:
+            out.append((name, a, units))
+            continue
+        parts = [p.strip() for p in units.split(",")]
+        for j, label in enumerate(labels[name]):
+            out.append((f"{name}_{label}", a[:, j], parts[j] if len(parts) == a.shape[1]
+                        else units))
+    return out
+
+
+def dataframe(path: Path, group: str = "navigate"):
+    """The group's series as a pandas DataFrame indexed by ``t`` (s), one column per
+    component (:func:`columns`), units in ``df.attrs["units"]``; ImportError naming pandas
+    when it is not installed."""
+    try:
+        import pandas as pd
+    except ImportError:
+        raise ImportError("dataframe() needs pandas (pip install pandas); series() gives "
+                          "the same arrays without it") from None
+    cols = columns(path, group)
+    df = pd.DataFrame({name: a for name, a, _ in cols[1:]},
+                      index=pd.Index(cols[0][1], name="t"))
+    df.attrs["units"] = {name: units for name, _, units in cols}
+    return df
+
+
+def _units_of(ds: h5py.Dataset) -> str:
+    u = ds.attrs.get("units", "")
+    return u.decode() if isinstance(u, bytes) else str(u)

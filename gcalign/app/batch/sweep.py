@@ -27,6 +27,7 @@ from gcalign.app.preflight import total_runs
 from gcalign.app.registry import batchable
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.loader import _cut
+from gcalign.io.scenario.recording import absolute_paths
 from gcalign.limits import SEED_MAX
 
 COMMANDS = tuple(batchable())
@@ -145,9 +146,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     else:
         raise ScenarioError(f"{source}: base: must be a scenario file name or a mapping, "
                             f"got {type(base).__name__} {_cut(base)}")
-    if isinstance(base_data, dict) and isinstance(base_data.get("imu_file"), str):
-        p = Path(base_data["imu_file"])  # workers may run elsewhere: make it absolute
-        base_data["imu_file"] = str(p if p.is_absolute() else (imu_dir / p).resolve())
+    absolute_paths(base_data, imu_dir)  # workers may run elsewhere
     base_model = parse_scenario(base_data, base_source)
 
     command = data.get("command")
@@ -328,9 +327,7 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
         if isinstance(data, dict) and "base" in data:
             raise ScenarioError(f"{path}: a sweep file (it has 'base'); a batch takes one "
                                 "sweep file, or a list of scenario files")
-        if isinstance(data, dict) and isinstance(data.get("imu_file"), str):
-            p = Path(data["imu_file"])  # workers may run elsewhere: make it absolute
-            data["imu_file"] = str(p if p.is_absolute() else (path.parent / p).resolve())
+        absolute_paths(data, path.parent)  # workers may run elsewhere
         parse_scenario(copy.deepcopy(data), str(path))
         datas.append(data)
         texts.append(path.read_text(encoding="utf-8"))

@@ -274,11 +274,11 @@ def read_yaml(path: Path) -> dict:
 def load_scenario(path: Path) -> tuple[Scenario, str]:
     """Scenario model and its YAML text (stored verbatim in results files).
 
-    A relative `imu_file` is taken relative to the scenario file.
+    Relative file paths (`imu_file`, `reference.path`) are taken from the scenario file's
+    folder.
     """
     path = Path(path)
     data = read_yaml(path)
     scenario = parse_scenario(data, str(path))
-    if scenario.imu_file is not None and not scenario.imu_file.is_absolute():
-        scenario.imu_file = (path.parent / scenario.imu_file).resolve()
+    scenario.resolve_paths(path.parent)
     return scenario, path.read_text(encoding="utf-8")

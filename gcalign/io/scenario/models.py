@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BeforeValidator, Field, field_validator, model_validator
+from pydantic import BeforeValidator, Field, field_validator, model_serializer, model_validator
 
 from gcalign import units as u
 from gcalign.io.scenario import bounds as B
@@ -19,6 +19,7 @@ from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
 from gcalign.io.scenario.realtime import RealtimeConfig
+from gcalign.io.scenario.recording import ImuLayout, Initial, ReferenceFile, split_imu_file
 from gcalign.nav.earth import MODELS, EarthModel
 from gcalign.sim.errors import ImuErrors, SensorErrors
 
@@ -158,6 +159,10 @@ class Scenario(Model):
     motion: MotionModel | None = None
     mechanism: MechanismConfig | None = None
     imu_file: Path | None = None
+    imu_layout: ImuLayout | None = Field(None, exclude=True, description=(
+        "written as imu_file: {path, format, axes, ...}; see gcalign.io.scenario.recording"))
+    reference: ReferenceFile | None = None
+    initial: Initial | None = None
     navigation: NavigationConfig | None = None
     output: OutputConfig = Field(default_factory=OutputConfig)
     align: AlignConfig | None = None
@@ -170,6 +175,36 @@ class Scenario(Model):
     @property
     def earth_model(self) -> EarthModel:
         return MODELS[self.earth]
+
+    @model_validator(mode="before")
+    @classmethod
+    def _imu_file_mapping(cls, data):
+        """``imu_file: {path, format, ...}``: the path and its layout (the plain path keeps
+        its meaning)."""
+        return split_imu_file(data)
+
+    @model_serializer(mode="wrap")
+    def _imu_file_as_written(self, handler):
+        """The layout goes back under ``imu_file`` as the scenario file writes it."""
+        out = handler(self)
+        if self.imu_layout is not None and isinstance(out, dict) and "imu_file" in out:
+            layout = self.imu_layout.model_dump(mode="json", exclude_unset=True)
+            out["imu_file"] = {"path": out["imu_file"], **layout}
+        return out
+
+    def resolve_paths(self, folder) -> None:
+        """Relative file paths (imu_file, reference.path) taken from `folder` (the
+        scenario file's)."""
+        if self.imu_file is not None and not self.imu_file.is_absolute():
+            self.imu_file = (Path(folder) / self.imu_file).resolve()
+        if self.reference is not None and not self.reference.path.is_absolute():
+            self.reference.path = (Path(folder) / self.reference.path).resolve()
+
+    def recording_layout(self):
+        """How to read `imu_file` (:class:`gcalign.io.recorded.Layout`)."""
+        from gcalign.io.recorded import Layout
+
+        return Layout() if self.imu_layout is None else self.imu_layout.to_layout()
 
     @model_validator(mode="after")
     def _source(self):
@@ -185,6 +220,12 @@ class Scenario(Model):
             if round(n) < 2:
                 raise ValueError(f"motion.duration_s: {self.motion.duration():g} s holds fewer "
                                  f"than 2 samples at {self.imu.rate_hz} Hz")
+        if self.imu_file is None and (self.reference is not None or self.initial is not None):
+            key = "reference" if self.reference is not None else "initial"
+            raise ValueError(f"{key}: applies to recorded data (imu_file); a simulation has "
+                             "its truth and its motion's initial state")
+        if self.imu_layout is not None and self.imu_file is None:
+            raise ValueError("imu_file.path: missing; a layout needs the file it describes")
         if self.mechanism is not None and self.imu_file is not None:
             raise ValueError("mechanism: recorded data carry their own sensor frame; a "
                              "mechanism applies to simulated motion only (remove it)")
@@ -200,6 +241,10 @@ class Scenario(Model):
             if keys:
                 out.append(f"{', '.join(keys)}: cannot matter with recorded data (imu_file): "
                            "the recording carries its own rate and sensor errors")
+        for key in ("reference", "initial"):
+            if getattr(self, key) is not None and section is not None:
+                out.append(f"{key}: read and checked (gcalign validate shows it), but "
+                           f"{section} does not use it yet")
         model = getattr(self, section, None) if section else None
         if model is not None and hasattr(model, "unused"):
             out += model.unused(self)

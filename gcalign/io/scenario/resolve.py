@@ -27,6 +27,8 @@ def resolved_rows(sc: Scenario) -> list[tuple[str, str, str]]:
         ]
     if sc.imu_file is not None:
         rows.append(("imu_file", str(sc.imu_file), "(recorded data; imu errors not applied)"))
+        rows += recording_rows(sc)
+        rows += reference_rows(sc)
     else:
         imu, err = sc.imu, sc.imu.errors()
         rows += [
@@ -93,4 +95,67 @@ def motion_rows(sc: Scenario) -> list[tuple[str, str, str]]:
             rows.append((f"motion.steps.{i}", f"axis {_v(st.axis)}, "
                          f"{np.degrees(st.profile.angle):g}° in {st.profile.duration:g} s, "
                          f"dwell {st.dwell:g} s", f"{st.profile.angle:.9g} rad"))
+    return rows
+
+
+def recording_rows(sc: Scenario) -> list[tuple[str, str, str]]:
+    """What the reader assumes of the scenario's recorded file (format, axes, units, time,
+    rate, gaps, gravity), read from the file (a results file of ours says nothing here)."""
+    from gcalign.io.recorded import read_recording
+    from gcalign.io.results import HDF5_SUFFIXES
+
+    assert sc.imu_file is not None
+    if sc.imu_file.suffix.lower() in HDF5_SUFFIXES:
+        return []
+    r = read_recording(sc.imu_file, sc.recording_layout()).meta["recording"]
+    gravity = r["gravity_check"]
+    gaps = r["gaps"]
+    return [
+        ("imu_file.format", r["format"], r["time_origin"]),
+        ("imu_file.axes", f"{r['axes']} ({r['axes_source']})",
+         f"v_rfu = C v_file, C = {np.asarray(r['C_rfu_file']).astype(int).tolist()}"
+         if np.all(np.isin(r["C_rfu_file"], (-1, 0, 1))) else f"C = {r['C_rfu_file']}"),
+        ("imu_file.units", f"gyro {r['units']['gyro']}, accel {r['units']['accel']}",
+         f"{r['quantity']}: {r['rate_rule']}"),
+        ("imu_file.time", r["time_stamp"], f"t {r['t_first_s']:.6f} .. {r['t_last_s']:.6f} s, "
+         f"{r['samples']} samples"),
+        ("imu_file.rate", f"{r['rate_hz']:.6g} Hz ({r['ts_rule']})",
+         f"{r['ts_s']:.6g} s, jitter up to {r['jitter_max']:.2%}"),
+        ("imu_file.gaps", "none" if not gaps else f"{len(gaps)} filled",
+         "; ".join(f"{g['length_s']:.3g} s after {g['after_t_s']:.6f} s" for g in gaps)),
+        ("imu_file.gravity",
+         "not checked" if isinstance(gravity, str) else
+         f"tilt {gravity['tilt_deg']:.2f}° over the first {gravity['window_s']:g} s",
+         "" if isinstance(gravity, str) else
+         f"f = {_v(gravity['specific_force_rfu_mps2'], 5)} m/s² (RFU)"),
+    ]
+
+
+def reference_rows(sc: Scenario) -> list[tuple[str, str, str]]:
+    """The reference file and initial keys, read and checked: the reference must cover the
+    navigation window (``navigation.start_s``, ``duration_s``; the whole recording by
+    default) of the recorded data (ScenarioError naming both spans otherwise)."""
+    from gcalign.io.recorded import read_recording
+    from gcalign.io.recorded.reference import reference_at
+
+    rows: list[tuple[str, str, str]] = []
+    if sc.initial is not None:
+        rows.append(("initial.att_deg", _v(sc.initial.att_deg) + " °",
+                     _v(np.radians(sc.initial.att_deg)) + " rad"))
+        rows.append(("initial.v_enu_mps", _v(sc.initial.v_enu_mps) + " m/s", ""))
+    if sc.reference is None or sc.imu_file is None:
+        return rows
+    ref = sc.reference.read()
+    r = ref.record
+    imu = read_recording(sc.imu_file, sc.recording_layout())
+    nav = sc.navigation
+    start = float(imu.t[0] - imu.ts) + (nav.start_s if nav is not None else 0.0)
+    end = float(imu.t[-1]) if nav is None or nav.duration_s is None else min(
+        float(imu.t[-1]), start + nav.duration_s)
+    reference_at(ref, [start, end])  # refuses a reference that does not cover the run
+    rows.append(("reference", f"{r['path']} ({r['format']}"
+                 + (f", {r['variable']}" if "variable" in r else "") + ")",
+                 f"{r['epochs']} epochs at {r['rate_hz']:.4g} Hz, t {r['t_first_s']:.3f} .. "
+                 f"{r['t_last_s']:.3f} s ({r['time_origin']})"))
+    rows.append(("reference covers", f"{start:.3f} .. {end:.3f} s", "the navigation window"))
     return rows

@@ -1,0 +1,119 @@
+"""``gcalign export``: the time series of a results file in other tools' formats (spec 005).
+
+==============  ==========================================================================
+format          what is written
+==============  ==========================================================================
+``csv``         ``t`` and every series of the group by component, as stored (SI), the
+                unit of each column in its header name (``att_pitch (rad)``)
+``mat``         MATLAB file (``scipy.io.savemat``): one variable per series as stored,
+                ``units`` a struct of their units, ``source`` and ``group`` as text
+``i2nav-nav``   KF-GINS navigation result text: week, seconds of week, lat, lon (deg),
+                h (m), vN, vE, vD (m/s), roll, pitch, yaw (deg; NED, yaw = heading)
+``psins-avp``   MATLAB file with PSINS's ``avp = [att(3) v(3) lat lon h t]`` (rad, m/s
+                ENU, rad, m, s)
+==============  ==========================================================================
+
+gcalign's RFU/ENU attitude ``[pitch, roll, yaw]`` (``C_nb = Rz(yaw) Rx(pitch) Ry(roll)``)
+and KF-GINS's FRD/NED ``[roll, pitch, yaw]`` (z-y-x) are the same rotations about the same
+physical axes, down being minus up: roll and pitch are equal and the NED yaw is the
+heading, ``−yaw`` (tested against the matrices). The week of the i2nav-nav file is 0
+unless given: gcalign's time is the recording's own (GNSS seconds of week for i2nav input).
+Files are written under a temporary name and renamed: nothing half-written is left.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from gcalign.errors import ScenarioError
+from gcalign.io import results
+
+FORMATS = {"csv": ".csv", "mat": ".mat", "i2nav-nav": ".nav", "psins-avp": ".avp.mat"}
+
+
+def default_output(path: Path, fmt: str) -> Path:
+    """``runs/x-navigate.h5`` -> ``runs/x-navigate.csv`` (``.mat``, ``.nav``, ``.avp.mat``)."""
+    return path.with_name(path.name.split(".")[0] + FORMATS[fmt])
+
+
+def default_group(path: Path) -> str:
+    """The group of the command that wrote the file (``navigate``, ``simulate``'s
+    ``truth``, ...); :func:`gcalign.io.results.series` says which groups hold series when
+    it has none."""
+    kind = results.read_summary(path)[0]
+    return {"simulate": "truth"}.get(kind, kind)
+
+
+def export(path, fmt: str, out=None, group: str | None = None, week: int = 0) -> Path:
+    """Write the series of `group` of the results file `path` in format `fmt` to `out`
+    (default :func:`default_output`); ScenarioError (one line) on a bad format, file or
+    group. Returns the path written."""
+    path = Path(path)
+    if fmt not in FORMATS:
+        raise ScenarioError(f"--format: {fmt!r} is not an export format; allowed: "
+                            f"{', '.join(FORMATS)}")
+    group = group or default_group(path)
+    data = results.series(path, group)
+    out = results.check_output(default_output(path, fmt) if out is None else out)
+    if out.resolve() == path.resolve():
+        raise ScenarioError(f"--output: {out} is the results file itself; give another name")
+    writer = {"csv": _csv, "mat": _mat, "i2nav-nav": _i2nav_nav, "psins-avp": _psins_avp}[fmt]
+    fd, tmp = results.make_temp(out)
+    os.close(fd)
+    try:
+        writer(tmp, path, group, data, week)
+        os.replace(tmp, out)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return out
+
+
+def _csv(tmp: Path, path: Path, group: str, data, week: int) -> None:
+    cols = results.columns(path, group)
+    header = ",".join(f"{name} ({units})" for name, _, units in cols)
+    with open(tmp, "w", encoding="utf-8") as fh:
+        fh.write(f"# gcalign export of {path}, group /{group}; SI as stored, unit of each "
+                 "column in its name\n")
+        fh.write(header + "\n")
+        np.savetxt(fh, np.column_stack([a for _, a, _ in cols]), fmt="%.17g", delimiter=",")
+
+
+def _mat(tmp: Path, path: Path, group: str, data, week: int) -> None:
+    import scipy.io
+
+    arrays = {name: a for name, (a, _) in data.items()}
+    units = {name: u for name, (_, u) in data.items()}
+    with open(tmp, "wb") as fh:
+        scipy.io.savemat(fh, {**arrays, "units": units, "source": str(path), "group": group},
+                         do_compression=True)
+
+
+def _nav(data, group: str, path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    missing = [k for k in ("att", "v_n", "pos") if k not in data]
+    if missing:
+        raise ScenarioError(f"--format: {path}: /{group} has no {', '.join(missing)} series "
+                            "(a navigation solution needs att, v_n and pos); it has "
+                            f"{', '.join(data)}")
+    return data["t"][0], data["att"][0], data["v_n"][0], data["pos"][0]
+
+
+def _i2nav_nav(tmp: Path, path: Path, group: str, data, week: int) -> None:
+    t, att, v, pos = _nav(data, group, path)
+    heading = np.degrees(-att[:, 2])
+    heading = (heading + 180.0) % 360.0 - 180.0
+    rows = np.column_stack([np.full(len(t), week), t, np.degrees(pos[:, 0]),
+                            np.degrees(pos[:, 1]), pos[:, 2], v[:, 1], v[:, 0], 0.0 - v[:, 2],
+                            np.degrees(att[:, 1]), np.degrees(att[:, 0]), heading])
+    np.savetxt(tmp, rows, fmt=["%d"] + ["%.17g"] * 10)
+
+
+def _psins_avp(tmp: Path, path: Path, group: str, data, week: int) -> None:
+    import scipy.io
+
+    t, att, v, pos = _nav(data, group, path)
+    with open(tmp, "wb") as fh:
+        scipy.io.savemat(fh, {"avp": np.column_stack([att, v, pos, t])}, do_compression=True)

@@ -1,0 +1,179 @@
+"""Reference solutions (a master INS, a post-processed trajectory) and the initial state.
+
+==============  ===========================================================================
+format          layout
+==============  ===========================================================================
+``psins-mat``   MATLAB file, an ``avp`` array ``[att(3) v(3) lat lon h t]``: rad, m/s ENU,
+                rad, m, s (PSINS's ``avp``, ``fogavp``; ``variable`` names one of several)
+``i2nav-nav``   text (KF-GINS result): week, seconds of week, lat, lon (deg), h (m),
+                vN, vE, vD (m/s), roll, pitch, yaw (deg; NED, FRD: yaw is the heading)
+``csv``         declared ``columns`` (default ``t pitch roll yaw ve vn vu lat lon h``),
+                angles in deg, ENU, RFU conventions
+==============  ===========================================================================
+
+:func:`reference_at` interpolates a reference to the IMU's times: attitude on the rotation
+group (spherical linear interpolation of ``q_nb`` between neighbours: the geodesic, so a yaw
+from 179° to -179° passes 180°, not 0°), velocity and position linearly. A reference that
+does not cover the times asked for is refused, naming both spans. :func:`initial_state`
+takes the attitude and velocity to start from: keys, else the reference at the start time,
+else the recording's header; with none of them the refusal lists the three.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gcalign.errors import ScenarioError
+from gcalign.io.imu_files import ImuFileError, read_bytes
+from gcalign.io.recorded.aiding import _check_rows, _columns, _finite
+from gcalign.io.recorded.imu import _table, _text_lines
+from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
+from gcalign.units import DEG
+
+__all__ = ["Reference", "read_reference", "reference_at", "initial_state", "REFERENCE_FORMATS"]
+
+REFERENCE_FORMATS = ("psins-mat", "i2nav-nav", "csv")
+_CSV_COLUMNS = ("t", "pitch", "roll", "yaw", "ve", "vn", "vu", "lat", "lon", "h")
+_NAV_LABELS = ("week", "seconds of week", "lat", "lon", "h", "vN", "vE", "vD", "roll",
+               "pitch", "yaw")
+
+
+@dataclass(frozen=True)
+class Reference:
+    """t (N,) s; att (N, 3) [pitch, roll, yaw] rad (ENU, RFU); v_n (N, 3) ENU m/s;
+    pos (N, 3) [lat rad, lon rad, h m]; record: what was read."""
+
+    t: np.ndarray
+    att: np.ndarray
+    v_n: np.ndarray
+    pos: np.ndarray
+    record: dict = field(default_factory=dict)
+
+
+def read_reference(path, format: str = "psins-mat", variable: str | None = None,
+                   columns=None) -> Reference:
+    """A reference solution from `path` in `format` (module docstring); ScenarioError
+    naming the file, row and what is allowed."""
+    name = os.fspath(path)
+    if format not in REFERENCE_FORMATS:
+        raise ScenarioError(f"reference.format: {format!r} is not a reference format; "
+                            f"allowed: {', '.join(REFERENCE_FORMATS)}")
+    data = read_bytes(name)[1]
+    notes: dict = {}
+    if format == "psins-mat":
+        a, key, where = _avp(name, data, variable)
+        t, att, v, pos = a[:, 9], a[:, 0:3], a[:, 3:6], a[:, 6:9]
+        notes["variable"] = key
+        origin = "seconds, the avp array's last column"
+    elif format == "i2nav-nav":
+        rows, (_, where) = _table(name, _text_lines(name, data), 11, _NAV_LABELS)
+        _finite(name, rows, _NAV_LABELS, where)
+        t = rows[:, 1]
+        att = np.column_stack([rows[:, 9], rows[:, 8], -rows[:, 10]]) * DEG  # yaw = -heading
+        v = np.column_stack([rows[:, 6], rows[:, 5], -rows[:, 7]])
+        pos = np.column_stack([rows[:, 2] * DEG, rows[:, 3] * DEG, rows[:, 4]])
+        origin = "GNSS seconds of week"
+        notes["week"] = int(rows[0, 0])
+    else:
+        cols = _columns(columns, _CSV_COLUMNS)
+        rows, (_, where) = _table(name, _text_lines(name, data), len(cols), cols)
+        _finite(name, rows, cols, where)
+        c = {k: rows[:, cols.index(k)] for k in _CSV_COLUMNS}
+        t = c["t"]
+        att = np.column_stack([c["pitch"], c["roll"], c["yaw"]]) * DEG
+        v = np.column_stack([c["ve"], c["vn"], c["vu"]])
+        pos = np.column_stack([c["lat"] * DEG, c["lon"] * DEG, c["h"]])
+        origin = "the file's time column"
+    _check_rows(name, t, where)
+    if len(t) < 2:
+        raise ImuFileError(f"{name}: {len(t)} epoch(s); a reference needs at least 2")
+    record = {"format": format, "path": name, "epochs": int(len(t)), "t_first_s": float(t[0]),
+              "t_last_s": float(t[-1]), "time_origin": origin,
+              "rate_hz": float(1.0 / np.median(np.diff(t))), **notes}
+    return Reference(t.copy(), att.copy(), v.copy(), pos.copy(), record)
+
+
+def _avp(name: str, data: bytes, variable: str | None):
+    import scipy.io
+
+    try:
+        mat = scipy.io.loadmat(io.BytesIO(data))
+    except (NotImplementedError, ValueError, TypeError, OSError) as exc:
+        raise ImuFileError(f"{name}: not a MATLAB file that scipy.io.loadmat reads "
+                           f"({type(exc).__name__})") from None
+    arrays = {k: v for k, v in mat.items() if not k.startswith("__")
+              and isinstance(v, np.ndarray) and v.dtype.kind in "fiu" and v.ndim == 2}
+    if variable is None:
+        ten = sorted(k for k, v in arrays.items() if v.shape[1] == 10 and v.shape[0] >= 2)
+        if len(ten) != 1:
+            raise ImuFileError(f"{name}: variable: {'no' if not ten else 'more than one'} "
+                               "avp array [att(3) v(3) lat lon h t] of 10 columns "
+                               f"({', '.join(f'{k} {arrays[k].shape}' for k in sorted(arrays))}"
+                               "); name one with variable:")
+        variable = ten[0]
+    if variable not in arrays or arrays[variable].shape[1] != 10:
+        raise ImuFileError(f"{name}: variable {variable!r} is not an N x 10 avp array; the "
+                           f"file holds {', '.join(sorted(arrays)) or 'none'}")
+    a = np.asarray(arrays[variable], dtype=float)
+    labels = ("pitch", "roll", "yaw", "vE", "vN", "vU", "lat", "lon", "h", "t")
+    where = lambda k: f": {variable} row {k + 1}"  # noqa: E731
+    _finite(name, a, labels, where)
+    return a, variable, where
+
+
+def _covers(ref: Reference, t: np.ndarray, tol: float) -> None:
+    lo, hi = float(ref.t[0]), float(ref.t[-1])
+    if t[0] < lo - tol or t[-1] > hi + tol:
+        raise ScenarioError(
+            f"reference: {ref.record.get('path', 'the reference')} covers {lo:.3f} .. "
+            f"{hi:.3f} s, the run needs {float(t[0]):.3f} .. {float(t[-1]):.3f} s: a "
+            "reference must cover the whole run (start later, stop earlier, or give a "
+            "longer reference)")
+
+
+def reference_at(ref: Reference, t, tol: float = 1e-9) -> tuple[np.ndarray, np.ndarray,
+                                                                 np.ndarray]:
+    """``(att, v_n, pos)`` of `ref` at times `t` (M,): attitude by slerp of q_nb between
+    the neighbouring epochs, velocity and position linearly (longitude unwrapped).
+    ScenarioError if `t` leaves ``[t_first - tol, t_last + tol]``."""
+    from scipy.spatial.transform import Rotation, Slerp
+
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    _covers(ref, t, tol)
+    tq = np.clip(t, ref.t[0], ref.t[-1])
+    slerp = Slerp(ref.t, Rotation.from_matrix(euler_to_dcm(ref.att)))
+    att = dcm_to_euler(slerp(tq).as_matrix())
+    v = np.column_stack([np.interp(tq, ref.t, ref.v_n[:, i]) for i in range(3)])
+    lon = np.unwrap(ref.pos[:, 1])
+    pos = np.column_stack([np.interp(tq, ref.t, ref.pos[:, 0]), np.interp(tq, ref.t, lon),
+                           np.interp(tq, ref.t, ref.pos[:, 2])])
+    pos[:, 1] = (pos[:, 1] + np.pi) % (2 * np.pi) - np.pi
+    return att, v, pos
+
+
+def initial_state(name: str, t0: float, *, att_deg=None, v_enu_mps=None,
+                  reference: Reference | None = None, header_att=None, header_v=None
+                  ) -> tuple[np.ndarray, np.ndarray, str]:
+    """``(att rad, v_n m/s, source)`` to start navigating at data time `t0`: the keys
+    (``initial: {att_deg, v_enu_mps}``), else the reference at `t0`, else the recording's
+    header (PSINS); ScenarioError listing the three ways when none is given."""
+    if att_deg is not None:
+        att = np.radians(np.asarray(att_deg, dtype=float))
+        v = np.zeros(3) if v_enu_mps is None else np.asarray(v_enu_mps, dtype=float)
+        return att, v, "keys initial.att_deg, initial.v_enu_mps"
+    if reference is not None:
+        att, v, _ = reference_at(reference, [t0], tol=0.5 / reference.record.get(
+            "rate_hz", 1.0))
+        return att[0], v[0], f"reference {reference.record.get('path', '')} at {t0:g} s"
+    if header_att is not None:
+        v = np.zeros(3) if header_v is None else np.asarray(header_v, dtype=float)
+        return np.asarray(header_att, dtype=float), v, "the file's header"
+    raise ScenarioError(
+        f"initial: {name} gives no initial attitude and velocity; give one of: a file "
+        "whose header has them (PSINS .imu), a reference covering the start (reference: "
+        "{path, format}, --reference), or the keys initial: {att_deg: [pitch, roll, yaw], "
+        "v_enu_mps: [ve, vn, vu]}")

@@ -1,0 +1,183 @@
+"""The ``imu_file`` key: a recording's path, or its path with its layout (spec 005).
+
+``imu_file: data.imu`` keeps meaning what it always has (the format from the suffix, the
+format's own axes and units). The long form names what the file does not say itself::
+
+    imu_file:
+      path: ride.txt
+      format: csv                      # psins | psins-mat | i2nav | csv | auto
+      axes: FRD                        # the file's x, y, z (gcalign.io.recorded.axes)
+      columns: [t, gx, gy, gz, ax, ay, az]
+      units: {gyro: deg/s, accel: m/s^2}
+      time: end                        # each stamp marks the end (or begin) of its interval
+      rate_hz: 200                     # default: the median time step
+      max_gap_s: 0.05                  # gaps up to this long are filled, longer refused
+      variable: mimu                   # psins-mat: the array to read
+
+The scenario model keeps the path in ``Scenario.imu_file`` (a ``Path``, as before) and
+the rest in ``Scenario.imu_layout``; it writes them back as one ``imu_file`` mapping.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import Field, ValidationError, field_validator
+
+from gcalign.errors import ScenarioError
+from gcalign.io.recorded.axes import rotation_to_rfu
+from gcalign.io.recorded.imu import ACCEL_UNITS, FORMAT_NAMES, GYRO_UNITS, Layout
+from gcalign.io.recorded.reference import REFERENCE_FORMATS
+from gcalign.io.scenario.base import Model, Vec3
+
+
+class Units(Model):
+    gyro: str | None = Field(None, description=f"one of {', '.join(GYRO_UNITS)}")
+    accel: str | None = Field(None, description=f"one of {', '.join(ACCEL_UNITS)}")
+
+
+class ImuLayout(Model):
+    """Everything of ``imu_file`` but its path (see the module docstring)."""
+
+    format: str = "auto"
+    axes: str | list[list[float]] | None = None
+    columns: list[str] | None = None
+    units: Units | None = None
+    quantity: Literal["increments", "rates"] | None = None
+    time: Literal["end", "begin"] | None = None
+    variable: str | None = None
+    rate_hz: float | None = Field(None, gt=0, le=1e5)
+    max_gap_s: float = Field(0.0, ge=0, le=3600)
+    check_gravity: bool = True
+
+    @field_validator("format")
+    @classmethod
+    def _known_format(cls, v):
+        if v not in FORMAT_NAMES:
+            raise ValueError(f"{v!r} is not a format; allowed: {', '.join(FORMAT_NAMES)}")
+        return v
+
+    @field_validator("axes")
+    @classmethod
+    def _a_rotation(cls, v):
+        if v is not None:
+            try:
+                rotation_to_rfu(v)
+            except ScenarioError as err:
+                raise ValueError(str(err).removeprefix("axes: ")) from None
+        return v
+
+    def to_layout(self) -> Layout:
+        return Layout(
+            format=self.format,
+            axes=self.axes if isinstance(self.axes, str) or self.axes is None
+            else tuple(tuple(r) for r in self.axes),
+            columns=None if self.columns is None else tuple(self.columns),
+            gyro_units=None if self.units is None else self.units.gyro,
+            accel_units=None if self.units is None else self.units.accel,
+            quantity=self.quantity, time=self.time, variable=self.variable,
+            rate_hz=self.rate_hz, max_gap_s=self.max_gap_s, check_gravity=self.check_gravity)
+
+
+class ReferenceFile(Model):
+    """``reference: {path, format, variable, columns}``: a reference solution (a master
+    INS, a post-processed trajectory; :mod:`gcalign.io.recorded.reference`)."""
+
+    path: Path
+    format: str = "psins-mat"
+    variable: str | None = None
+    columns: list[str] | None = None
+
+    @field_validator("format")
+    @classmethod
+    def _known_format(cls, v):
+        if v not in REFERENCE_FORMATS:
+            raise ValueError(f"{v!r} is not a reference format; allowed: "
+                             f"{', '.join(REFERENCE_FORMATS)}")
+        return v
+
+    def read(self):
+        from gcalign.io.recorded.reference import read_reference
+
+        return read_reference(self.path, self.format, self.variable, self.columns)
+
+
+class Initial(Model):
+    """``initial: {att_deg, v_enu_mps}``: the state navigation starts from on recorded data
+    whose file gives none."""
+
+    att_deg: Vec3 = Field(description="[pitch, roll, yaw], deg (ENU, yaw CCW positive)")
+    v_enu_mps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+def split_imu_file(data: Any) -> Any:
+    """A scenario mapping whose ``imu_file`` is a mapping, as ``imu_file`` (its path) and
+    ``imu_layout`` (the rest, validated); ValueError ``imu_file.KEY: ...`` otherwise."""
+    if not isinstance(data, dict) or not isinstance(data.get("imu_file"), dict):
+        return data
+    spec = dict(data["imu_file"])
+    if "path" not in spec:
+        raise ValueError("imu_file.path: missing; imu_file takes a path, or a mapping "
+                         "{path, format, axes, ...}")
+    path = spec.pop("path")
+    try:
+        layout = ImuLayout.model_validate(spec)
+    except ValidationError as err:
+        e = err.errors()[0]
+        loc = ".".join(str(x) for x in e["loc"] if not str(x).startswith(("list[", "str")))
+        msg = e["msg"].removeprefix("Value error, ")
+        if e["type"] == "extra_forbidden":
+            msg = ("unknown key; imu_file takes path, " + ", ".join(ImuLayout.model_fields))
+        raise ValueError(f"imu_file.{loc}: {msg}") from None
+    return {**data, "imu_file": path, "imu_layout": layout}
+
+
+def with_layout(imu_file: Any, layout: dict) -> dict:
+    """A scenario's ``imu_file`` (a path or a mapping) with the keys of `layout` set
+    (``--format``, ``--axes``); ScenarioError when there is no recording to describe."""
+    if imu_file is None:
+        options = ", ".join(f"--{k}" for k in layout)
+        raise ScenarioError(f"{options}: describe a recording; give --imu-file FILE (or "
+                            "imu_file in the scenario)")
+    spec = dict(imu_file) if isinstance(imu_file, dict) else {"path": imu_file}
+    spec.update(layout)
+    return spec
+
+
+#: What ``--imu-file X`` alone (no scenario file) runs with: no simulated aiding, the
+#: inertial-frame coarse alignment over the file's first minute (it holds on a swaying or
+#: disturbed base, where the static one does not), then one gyrocompass pass to 300 s with
+#: the loop settings that align lasergyro.imu to -90.58° (DESIGN, "Gyrocompass").
+RECORDED_DEFAULTS: dict[str, dict] = {
+    "align": {"coarse": {"method": "inertial"}, "mode": "conventional", "t1_s": 60,
+              "t2_s": 300, "t3_s": 300, "stages": [{"t_xy_s": 20, "t_z_s": 100, "xi": 0.707}]},
+}
+
+
+def recorded_scenario(section: str, imu_file) -> dict:
+    """The scenario of a recording given alone: named after the file (``ride.txt.xz`` ->
+    ``ride``), with the recorded-data defaults of `section` (:data:`RECORDED_DEFAULTS`;
+    a command without them gets its section's own defaults)."""
+    import re
+    from pathlib import Path
+
+    stem = re.sub(r"[^A-Za-z0-9_.+-]", "_", Path(str(imu_file)).name.split(".")[0]) or "data"
+    data: dict = {"name": stem}
+    if section in RECORDED_DEFAULTS:
+        data[section] = dict(RECORDED_DEFAULTS[section])
+    return data
+
+
+def absolute_paths(data: Any, folder) -> None:
+    """In a scenario mapping (before validation), the relative file paths -- ``imu_file``
+    (a path or its ``path``) and ``reference.path`` -- made absolute from `folder`, in place
+    (batch workers may run elsewhere)."""
+    if not isinstance(data, dict):
+        return
+    for key in ("imu_file", "reference"):
+        node = data.get(key)
+        holder, field = (data, key) if isinstance(node, str) else (node, "path")
+        if isinstance(holder, dict) and isinstance(holder.get(field), str):
+            p = Path(holder[field])
+            holder[field] = str(p if p.is_absolute() else (Path(folder) / p).resolve())
