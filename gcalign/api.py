@@ -31,7 +31,7 @@ import yaml
 from gcalign.errors import ScenarioError
 
 #: Suffixes read as recorded IMU data rather than as a scenario (``load("x.imu.xz")``).
-DATA_SUFFIXES = (".imu", ".csv", ".txt", ".h5", ".hdf5", ".hdf")
+DATA_SUFFIXES = (".imu", ".csv", ".txt", ".mat", ".h5", ".hdf5", ".hdf")
 
 
 @dataclass(frozen=True)
@@ -86,6 +86,19 @@ class Result:
 
         return read_imu(self.path)
 
+    def series(self, group: str | None = None) -> dict:
+        """The time series of a group of the results file (default: the command's own),
+        ``{name: (array, units)}`` in SI, ``t`` first."""
+        from gcalign.io.results import series
+
+        return series(self.path, group or self.kind)
+
+    def dataframe(self, group: str | None = None):
+        """The same series as a pandas DataFrame indexed by ``t`` (needs pandas)."""
+        from gcalign.io.results import dataframe
+
+        return dataframe(self.path, group or self.kind)
+
     def save(self, path: str | Path) -> Result:
         """A copy of the results file at `path`; the Result read from there."""
         shutil.copyfile(self.path, path)
@@ -124,8 +137,8 @@ def load(source, overrides: dict | None = None):
             else:
                 apply_override(data, key, value, base)
     model = parse_scenario(data, name)
-    if model.imu_file is not None and folder is not None and not model.imu_file.is_absolute():
-        model.imu_file = (folder / model.imu_file).resolve()
+    if folder is not None:
+        model.resolve_paths(folder)
     return model
 
 
@@ -152,7 +165,9 @@ def example(command: str, overrides: dict | None = None):
     if c is None or not c.builtin:
         have = ", ".join(n for n, x in COMMANDS.items() if x.builtin)
         raise ScenarioError(f"example: {command!r} has no built-in scenario; built-in: {have}")
-    return load(yaml.safe_load(c.builtin_text()), overrides)
+    from gcalign.io.scenario.loader import loads
+
+    return load(loads(c.builtin_text(), f"example {command}"), overrides)
 
 
 _TEMP: list[str] = []

@@ -137,6 +137,16 @@ def test_series_and_dataframe(nav):
     assert df.attrs["units"]["pos_h"] == "m" and df.attrs["units"]["pos_lat"] == "rad"
 
 
+def test_the_python_result_gives_the_same_series(nav):
+    import gcalign
+
+    res = gcalign.read(nav)
+    s, direct = res.series(), results.series(nav, "navigate")
+    assert list(s) == list(direct)
+    np.testing.assert_array_equal(s["v_n"][0], direct["v_n"][0])
+    np.testing.assert_array_equal(res.dataframe()["pos_h"].to_numpy(), direct["pos"][0][:, 2])
+
+
 @pytest.mark.parametrize("args, field, more", [
     (["--format", "xls"], "--format", ("'xls' is not an export format", "csv, mat")),
     (["--format", "csv", "--group", "align"], "--group", ("no group 'align'",)),
