@@ -33,6 +33,7 @@ class Outcome:
     truth : the simulated truth to store under ``/truth``, if any.
     seed : the random seed the run used (None for recorded data).
     warnings : one line each, shown on stderr and kept in the summary.
+    result : the capability's typed result (SI arrays), as its core function returns it.
     """
 
     summary: dict
@@ -40,6 +41,7 @@ class Outcome:
     truth: Any = None
     seed: int | None = None
     warnings: tuple[str, ...] = ()
+    result: Any = None  # the capability's typed result object (SI), for the Python API
 
 
 @dataclass(frozen=True)

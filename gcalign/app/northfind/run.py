@@ -25,7 +25,7 @@ from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.northfind import NorthfindConfig, axis
 
-__all__ = ["NorthfindRun", "northfind_summary", "run_northfind", "run_northfind_scenario"]
+__all__ = ["NorthfindRun", "execute", "northfind_summary", "run_northfind"]
 
 
 @dataclass(frozen=True)
@@ -69,10 +69,6 @@ def run_northfind(sc: Scenario, seed: int | None = None) -> NorthfindRun:
     result = nf.run_northfind(setup, rng, methods=tuple(cfg.methods), samples=cfg.samples)
     return NorthfindRun(cfg=cfg, setup=setup, result=result, seed=seed,
                         compute_s=time.perf_counter() - t0)
-
-
-#: The name the brief and older callers use.
-run_northfind_scenario = run_northfind
 
 
 def _num(x) -> float | None:
@@ -177,4 +173,5 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None)
     from gcalign.app.northfind.hdf5 import write_northfind
 
     run = run_northfind(sc, seed)
-    return Outcome(northfind_summary(run, sc), lambda f: write_northfind(f, run), None, run.seed)
+    return Outcome(northfind_summary(run, sc), lambda f: write_northfind(f, run), None, run.seed,
+                   result=run.result)
