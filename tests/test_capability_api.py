@@ -98,3 +98,152 @@ def test_northfind_bad_setting_exits_2_with_one_line(args):
     assert res.returncode == 2, res.stderr
     lines = [ln for ln in (res.stdout + res.stderr).splitlines() if ln.strip()]
     assert len(lines) == 1 and "Traceback" not in lines[0], lines
+
+
+# ------------------------------------------------------------- calibration, observability
+
+_GYRO = {"bias_dph": [0.01, -0.01, 0.01], "arw_dprh": 0.001, "scale_ppm": [100, -100, 100]}
+_ACCEL = {"bias_ug": [50, -50, 50], "vrw_ugrhz": 10, "scale_ppm": [-100, 100, -100]}
+_SEGMENTS = [  # (kind, duration s, accel m/s², speed m/s, rate °/s, angle °, name)
+    ("hold", 20.0, None, None, None, None, "static"),
+    ("accelerate", None, 6.5, 60.0, None, None, "ground roll"),
+    ("pitch", None, None, None, 2.0, 10.0, "pitch-up"),
+    ("pitch", None, None, None, 2.0, 0.0, "level-off"),
+    ("turn", None, None, None, 9.0, -90.0, "turn right"),
+    ("hold", 10.0, None, None, None, None, "cruise"),
+]
+CALIBRATE = {
+    "name": "cal-small", "site": {"lat_deg": 38.0, "lon_deg": 121.0},
+    "imu": {"rate_hz": 25, "seed": 1, "gyro": _GYRO, "accel": _ACCEL},
+    "motion": {"kind": "flight", "segments": [
+        {k: v for k, v in zip(("kind", "duration_s", "accel_mps2", "speed_mps", "rate_dps",
+                                "angle_deg", "name"), s, strict=True) if v is not None}
+        for s in _SEGMENTS]},
+    "calibrate": {"q": {"arw_dprh": 0.001, "vrw_ugrhz": 10}},
+    "observability": {"covariance": False},
+}
+
+
+def _flight_arrays():
+    """Truth, ideal increments and manoeuvres of CALIBRATE's flight from the core alone."""
+    from gcalign.calibrate import motion_spans
+    from gcalign.sim.imu import ideal_imu
+    from gcalign.sim.motions import FlightSegment, flight
+
+    d = u.DEG
+    segments = [FlightSegment(k, dur, acc, spd, None if r is None else r * d,
+                              None if a is None else a * d, name)
+                for k, dur, acc, spd, r, a, name in _SEGMENTS]
+    motion = flight(np.zeros(3), segments)
+    site = np.array([38.0 * d, 121.0 * d, 0.0])
+    truth, ideal = ideal_imu(motion, site, 1.0 / 25.0)
+    return truth, ideal, motion_spans(motion, float(truth.t[-1])), site
+
+
+def _calibration_errors():
+    from gcalign.estimation import ins_error as ie
+    from gcalign.sim.errors import ImuErrors, SensorErrors
+
+    gyro = SensorErrors(bias=np.array(_GYRO["bias_dph"]) * u.DPH,
+                        noise=np.full(3, _GYRO["arw_dprh"]) * u.DPSH,
+                        scale=np.array(_GYRO["scale_ppm"], float) * u.PPM)
+    accel = SensorErrors(bias=np.array(_ACCEL["bias_ug"], float) * u.UG,
+                         noise=np.full(3, float(_ACCEL["vrw_ugrhz"])) * u.UGPSHZ,
+                         scale=np.array(_ACCEL["scale_ppm"], float) * u.PPM)
+    x = np.zeros(ie.N_STATES)
+    x[ie.PHI] = np.array([20.0, -20.0, 1800.0]) * u.ARCSEC  # the default initial error
+    x[ie.EB], x[ie.DB], x[ie.DKG], x[ie.DKA] = gyro.bias, accel.bias, gyro.scale, accel.scale
+    return x, ImuErrors(gyro=gyro, accel=accel)
+
+
+def _calibration_arrays(seed: int):
+    from gcalign.calibrate import Settings, calibrate, flight_from_ideal
+
+    truth, ideal, spans, site = _flight_arrays()
+    x, errors = _calibration_errors()
+    data = flight_from_ideal(truth, ideal, x, errors, np.random.default_rng(seed), spans)
+    r_m, r_n = earth.WGS84.radii(site[0])  # the seed's P0 list, 1 m of position in rad
+    p0 = np.concatenate([np.array([20.0, 20.0, 1800.0]) * u.ARCSEC, [0.2] * 3,
+                         [1.0 / r_m, 1.0 / (r_n * np.cos(site[0])), 1.0],
+                         np.full(3, 0.01) * u.DPH, np.full(3, 50.0) * u.UG,
+                         np.full(6, 100.0) * u.PPM])
+    settings = Settings(p0_sigma=tuple(p0), arw=0.001 * u.DPSH, vrw=10.0 * u.UGPSHZ)
+    return data, calibrate(data, settings, np.random.default_rng([seed, 3]))
+
+
+def test_calibrate_array_route_gives_the_cli_numbers_bit_for_bit():
+    from gcalign.app.registry import COMMANDS
+    from gcalign.estimation import ins_error as ie
+
+    sc = gcalign.load(CALIBRATE)
+    res = gcalign.run("calibrate", sc, seed=4)
+    _, r = _calibration_arrays(4)
+    assert r.error is not None and r.nees is not None
+    for i, name in enumerate(ie.STATE_NAMES):
+        st = res["states"][name]
+        assert (st["estimate"], st["sigma"], st["truth"]) == (
+            float(r.estimate[-1, i]), float(r.sigma[-1, i]), float(r.truth[-1, i])), name
+    assert res["nees"]["final"] == float(r.nees[-1])
+    assert res["normalized_error"] == (r.error[-1] / r.sigma[-1]).tolist()
+    # the typed result of the command's run is the core's, array for array
+    typed = COMMANDS["calibrate"].execute(sc, 4).result
+    for name in ("t", "estimate", "sigma", "truth", "nees", "innovation", "att", "v_n", "pos"):
+        assert np.array_equal(getattr(typed, name), getattr(r, name)), name
+
+
+def test_calibrate_heading_beats_the_static_floor_only_after_the_ground_roll():
+    """Spec 002 §3, §7 item 5: at rest the heading is tied to the east gyro bias,
+    φU = −εE/(Ω cos L), so no static run can know it better than σ(εE)/(Ω cos L) (0.48° for
+    the filter's 0.1°/h); the ground roll's acceleration separates them and σ(φU) falls far
+    below that floor, with the final error inside 3σ for every state."""
+    from gcalign.estimation import ins_error as ie
+
+    _, r = _calibration_arrays(4)
+    assert r.error is not None
+    phi_u, eps_e = ie.PHI.start + 2, ie.EB.start
+    floor = r.sigma[0, eps_e] / (earth.OMEGA_IE * np.cos(38.0 * u.DEG))
+    static_end = int(np.searchsorted(r.t, 20.0))
+    assert r.sigma[static_end, phi_u] > floor
+    assert r.sigma[-1, phi_u] < floor / 3.0
+    assert np.all(np.abs(r.error[-1] / r.sigma[-1]) < 3.0)
+
+
+def test_observability_array_route_gives_the_cli_numbers_bit_for_bit():
+    from gcalign.calibrate import ObservabilitySettings, observability, trajectory
+
+    res = gcalign.run("observability", gcalign.load(CALIBRATE))
+    truth, ideal, spans, _ = _flight_arrays()
+    traj = trajectory(truth.t, truth.att, truth.v_n, truth.pos, ideal.dtheta, ideal.dv)
+    tab = observability(traj, spans, ObservabilitySettings(covariance=False))
+    assert res["rank_final"] == int(tab.rank_cum[-1])
+    assert res["degree_final"] == tab.eta_cum[-1].tolist()
+    for i, seg in enumerate(res["segments"]):
+        assert seg["rank"] == int(tab.rank[i]) and seg["tom_rank"] == int(tab.tom_rank[i])
+        assert list(seg["degree"].values()) == tab.eta[i].tolist()
+        assert seg["null_residual"] == float(tab.null_residual[i])
+
+
+def test_observability_of_a_static_segment():
+    """Spec 002 §7 items 2-3 through the array route: at rest, level and at yaw 0, the
+    columns of δλ (velocity matching), δKgx, δKax and δKay are zero (η = 0); the closed-form
+    null space has at least 10 independent directions (three φ-bias pairs, δλ, and each
+    scale factor tied to its bias through the constant ω_ib^b and f^b), so the rank is at
+    most 11; the flight's ground roll then raises it."""
+    from gcalign.calibrate import ObservabilitySettings, Span, observability, trajectory
+    from gcalign.estimation import ins_error as ie
+    from gcalign.sim.imu import ideal_imu
+    from gcalign.sim.motions import Static
+
+    site = np.array([38.0 * u.DEG, 121.0 * u.DEG, 0.0])
+    truth, ideal = ideal_imu(Static((0.0, 0.0, 0.0), 20.0), site, 0.04)
+    traj = trajectory(truth.t, truth.att, truth.v_n, truth.pos, ideal.dtheta, ideal.dv)
+    tab = observability(traj, (Span("static", 0.0, 20.0),),
+                        ObservabilitySettings(covariance=False))
+    names = list(ie.STATE_NAMES)
+    for name in ("dlam", "dKgx", "dKax", "dKay"):
+        assert tab.eta[0, names.index(name)] == 0.0, name
+    assert 0 < tab.rank[0] <= 21 - 10
+    truth, ideal, spans, _ = _flight_arrays()
+    flight = observability(trajectory(truth.t, truth.att, truth.v_n, truth.pos, ideal.dtheta,
+                                      ideal.dv), spans, ObservabilitySettings(covariance=False))
+    assert flight.rank_cum[0] == tab.rank[0] and flight.rank_cum[1] > tab.rank[0]

@@ -13,7 +13,8 @@ Modules
   injected errors (navigation increments combined from IMU ones), zero-velocity data.
 - :mod:`gcalign.calibrate.filter` -- :func:`calibrate`, :func:`covariance_run` (the RTS
   smoother is :func:`gcalign.estimation.kalman.rts`).
-- :mod:`gcalign.calibrate.observability` -- :func:`observability_table`.
+- :mod:`gcalign.calibrate.observability` -- :func:`observability` (settings
+  :class:`ObservabilitySettings`), :func:`observability_table`.
 
 The error model is :mod:`gcalign.estimation.ins_error`, the Kalman steps
 :mod:`gcalign.estimation.kalman`, the PWCS/SVD algebra :mod:`gcalign.estimation.observability`.
@@ -33,6 +34,7 @@ from gcalign.calibrate.data import (
     sampled_truth,
     trajectory,
     white_noise,
+    zero_velocity_aiding,
     zero_velocity_data,
 )
 from gcalign.calibrate.filter import (
@@ -42,11 +44,17 @@ from gcalign.calibrate.filter import (
     calibrate,
     covariance_run,
 )
-from gcalign.calibrate.observability import ObservabilityTable, observability_table
+from gcalign.calibrate.observability import (
+    ObservabilitySettings,
+    ObservabilityTable,
+    observability,
+    observability_table,
+)
 
 __all__ = [
-    "CalibrationResult", "CovarianceRun", "FlightData", "ObservabilityTable", "Settings", "Span",
-    "Trajectory", "calibrate", "combine_increments", "covariance_run", "draw_truth",
-    "flight_from_ideal", "imu_errors", "motion_spans", "observability_table", "perturb",
-    "proposed_truth", "sampled_truth", "trajectory", "white_noise", "zero_velocity_data",
+    "CalibrationResult", "CovarianceRun", "FlightData", "ObservabilitySettings",
+    "ObservabilityTable", "Settings", "Span", "Trajectory", "calibrate", "combine_increments",
+    "covariance_run", "draw_truth", "flight_from_ideal", "imu_errors", "motion_spans",
+    "observability", "observability_table", "perturb", "proposed_truth", "sampled_truth",
+    "trajectory", "white_noise", "zero_velocity_aiding", "zero_velocity_data",
 ]

@@ -302,3 +302,11 @@ def zero_velocity_data(t, dtheta, dv, start: NavState, earth: EarthModel = WGS84
                       dv=np.asarray(dv, float), start=start, ref_v_n=np.zeros((n, 3)),
                       ref_pos=np.tile(np.asarray(start.pos, float), (n, 1)),
                       segments=(Span("static", float(t[0]), float(t[-1])),), earth=earth)
+
+
+def zero_velocity_aiding(data: FlightData) -> FlightData:
+    """The same data aided by zero velocity at the start position (a parked vehicle: the
+    aiding source measures v = 0 and the start position at every epoch)."""
+    n = len(data.t)
+    return replace(data, ref_v_n=np.zeros((n, 3)),
+                   ref_pos=np.tile(np.asarray(data.start.pos, float), (n, 1)))

@@ -92,6 +92,29 @@ def _stack_r(R: np.ndarray | None, rows: np.ndarray) -> np.ndarray:  # (≤ n, n
     return ob.r_factor(rows if R is None else np.vstack([R, rows]))
 
 
+@dataclass(frozen=True)
+class ObservabilitySettings:
+    """Settings of :func:`observability` (see :func:`observability_table` for each)."""
+
+    measure: str = "velocity"
+    scaling: str = "none"
+    rtol: float = ob.RANK_RTOL_DEFAULT
+    piece_s: float = 1.0
+    null_tol: float = 1e-9
+    covariance: bool = True
+
+
+def observability(truth: Trajectory, segments: tuple[Span, ...],
+                  settings: ObservabilitySettings | None = None,
+                  filter_settings: Settings | None = None) -> ObservabilityTable:
+    """The observability table of `truth` cut into `segments` (spec 002 §3–4): the array
+    route of ``gcalign observability``. `filter_settings` give P0 (scaling ``p0``) and the
+    covariance degree."""
+    s = settings or ObservabilitySettings()
+    return observability_table(truth, segments, s.measure, s.scaling, s.rtol, s.piece_s,
+                               s.null_tol, filter_settings, s.covariance)
+
+
 def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: str = "velocity",
                         scaling: str = "none", rtol: float = ob.RANK_RTOL_DEFAULT,
                         piece_s: float = 1.0, null_tol: float = 1e-9,

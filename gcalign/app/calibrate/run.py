@@ -31,6 +31,7 @@ from gcalign.calibrate import (
     flight_from_ideal,
     motion_spans,
     sampled_truth,
+    zero_velocity_aiding,
     zero_velocity_data,
 )
 from gcalign.calibrate.filter import warm_up
@@ -117,18 +118,9 @@ def simulated_case(sc: Scenario, seed: int | None = None, cache_key: str | None 
     if window[0] > 0 or window[2] < data.t[-1] - 1e-9:
         data = data.between(window[0], window[2])
     if cfg.aiding_for(sc) == "zero-velocity":
-        data = zero_velocity_reference(data)
+        data = zero_velocity_aiding(data)
     return Case(data, settings, "simulated", cfg.aiding_for(sc), n, sc.imu.rate_hz, seed,
                 cfg.truth, None, window)
-
-
-def zero_velocity_reference(data: FlightData) -> FlightData:
-    """The same data aided by zero velocity at the start position (a parked vehicle)."""
-    from dataclasses import replace
-
-    n = len(data.t)
-    return replace(data, ref_v_n=np.zeros((n, 3)),
-                   ref_pos=np.tile(np.asarray(data.start.pos, float), (n, 1)))
 
 
 def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
@@ -314,12 +306,15 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             compare: bool = False, progress=None) -> Outcome:
-    """Build the case, run the filter (or the six runs of `compare`), summarise."""
+    """Build the case, run the filter (or the six runs of `compare`), summarise; the
+    Outcome's result is the :class:`~gcalign.calibrate.CalibrationResult` (with `compare`: the
+    six, in the summary's order)."""
     from gcalign.app.calibrate.hdf5 import write_calibration
 
     case = scenario_case(sc, seed, cache_key)
     runs = (compare_runs(case, config_of(sc).conventional_segments, progress) if compare
             else [run_filter(case)])
     out = summary(sc, case, runs, compare)
+    result = tuple(r.result for r in runs) if compare else runs[0].result
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),
-                   case.seed)
+                   case.seed, result=result)

@@ -14,9 +14,10 @@ import numpy as np
 
 from gcalign.app.registry import Outcome
 from gcalign.calibrate import (
+    ObservabilitySettings,
     ObservabilityTable,
     motion_spans,
-    observability_table,
+    observability,
     sampled_truth,
     trajectory,
 )
@@ -55,8 +56,9 @@ def run_table(sc: Scenario, cache_key: str | None = None):
     settings = cal.settings(traj.pos[0], traj.earth)
     warm_up()
     t0 = time.perf_counter()
-    tab = observability_table(traj, spans, cfg.measure, cfg.scaling, cfg.rank_rtol,
-                              cfg.piece_s, cfg.null_tol, settings, cfg.covariance)
+    options = ObservabilitySettings(cfg.measure, cfg.scaling, cfg.rank_rtol, cfg.piece_s,
+                                    cfg.null_tol, cfg.covariance)
+    tab = observability(traj, spans, options, settings)
     return tab, traj, spans, time.perf_counter() - t0
 
 
@@ -102,4 +104,4 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None)
     tab, traj, spans, compute_s = run_table(sc, cache_key)
     truth = sampled_truth(traj, spans)
     return Outcome(summary(sc, tab, spans, compute_s),
-                   lambda f: write_observability(f, tab, truth, spans), truth, None)
+                   lambda f: write_observability(f, tab, truth, spans), truth, None, result=tab)
