@@ -58,7 +58,7 @@ def write_realtime(f: h5py.File, run) -> None:
     """/realtime: the run's settings, the filter, and the per-pulse arrays of every case."""
     s = run.settings
     g = f.create_group("realtime")
-    T = run.chain.delay if s.delay_s is None else float(s.delay_s)
+    T = run.result.delay
     g.attrs.update(reference=run.cfg.reference, delay=T, chain_delay=run.chain.delay,
                    solution_hz=s.solution_hz, fs_hz=s.filter.fs_hz,
                    predictors=",".join(s.predictors), settle_s=s.settle_s,
