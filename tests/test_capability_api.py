@@ -282,7 +282,7 @@ def test_realtime_array_route_gives_the_cli_numbers_bit_for_bit():
                      site=site)
     assert res["chain_delay_ms"] == r.chain_delay * 1e3
     for case, row, out in zip(r.cases, r.rows, res["cases"], strict=True):
-        assert out["n_pulses"] == row.n_pulses
+        assert (out["name"], out["n_pulses"]) == (case.case.name, row.n_pulses)
         assert out["before_max_arcsec"] == row.before_max["truth"] / u.ARCSEC
         for p, st in row.stats.items():
             assert out["after_max_arcsec"][p] == st.max["truth"] / u.ARCSEC, p
