@@ -312,3 +312,61 @@ def test_realtime_lag_at_uniform_rate_is_the_fir_group_delay(chain, order):
     if chain == "alignment":
         assert r.chain.notch_delay == 0.0 and r.chain_delay == pytest.approx(0.018, rel=1e-12)
     assert r.rows[0].lag == pytest.approx(r.chain_delay, rel=1e-3)
+
+
+# -------------------------------------------------------------------- rotation modulation
+
+PARITY = np.diag([-1.0, 1.0, 1.0])
+
+
+def test_modulate_array_route_gives_the_cli_numbers_bit_for_bit():
+    from gcalign.app.modulate.run import seed_scenario
+    from gcalign.app.registry import COMMANDS
+    from gcalign.modulate import ErrorTerms, analyse_scheme, builtin_scheme
+    from gcalign.nav.earth import SEED004
+
+    sc = seed_scenario(["fixed", "seed-12"], rate=1.0, hours=2.0)
+    res = gcalign.run("modulate", sc)
+    terms = ErrorTerms(gyro_bias=np.full(3, 0.01) * u.DPH,
+                       accel_bias=np.full(3, 100.00167) * u.UG)
+    typed = COMMANDS["modulate"].execute(sc).result
+    for name in ("fixed", "seed-12"):
+        a = analyse_scheme(builtin_scheme(name), terms, lat=45.7796 * u.DEG, earth=SEED004,
+                           att0=np.zeros(3), duration=2.0 * 3600.0, name=name)
+        out, lin = res["schemes"][name], a.linear
+        assert lin is not None
+        assert out["cycle_s"] == a.invariants.period
+        assert out["peak_integral_C_s"] == a.invariants.peak_integral_C.tolist()
+        assert out["scale_factor_net_arcsec"] == (a.invariants.scale_factor_net
+                                                  / u.ARCSEC).tolist()
+        assert out["linear"]["max_horizontal_error_m"] == float(lin.horizontal.max())
+        assert out["linear"]["horizontal_error_m"] == {
+            f"{h:g}h": float(lin.at(h)[0]) for h in res["report_hours"]}
+        mine = typed[name]
+        assert mine.linear is not None
+        assert np.array_equal(mine.invariants.integral_C, a.invariants.integral_C)
+        assert np.array_equal(mine.linear.horizontal, lin.horizontal)
+        assert np.array_equal(mine.cycle.q, a.cycle.q)
+
+
+def test_modulate_seed12_leaves_a_third_of_each_bias():
+    """Spec 004 §2: the literal 12-step scheme has ∫_cycle C_s^b dt = 4(Ts+Tz)·C0·diag(−1,1,1)
+    (C0 = I at position A), so the bias left is diag(−1,1,1)/3 of each constant bias; a
+    dwell of 250 s and the seed's 12 s turn."""
+    from gcalign.modulate import ErrorTerms, analyse_scheme, builtin_scheme
+
+    eps, nab = np.array([1.0, -2.0, 3.0]) * 0.01 * u.DPH, np.array([50.0, 20.0, -80.0]) * u.UG
+    a = analyse_scheme(builtin_scheme("seed-12", dwell=250.0),
+                       ErrorTerms(gyro_bias=eps, accel_bias=nab))
+    r = a.invariants
+    assert r.period == pytest.approx(12 * (250.0 + 12.0), rel=1e-15)
+    np.testing.assert_allclose(r.integral_C, 4 * (250.0 + 12.0) * PARITY, rtol=0,
+                               atol=1e-12 * r.period)
+    np.testing.assert_allclose(r.residual_gyro_bias, PARITY @ eps / 3, rtol=0,
+                               atol=1e-13 * np.abs(eps).max())
+    np.testing.assert_allclose(r.residual_accel_bias, PARITY @ nab / 3, rtol=0,
+                               atol=1e-13 * np.abs(nab).max())
+    assert a.linear is None  # no static base given: no linear model
+    # the sampled cycle closes: after the 12 steps the mechanism is back at A
+    assert a.cycle.t[0] == 0.0 and a.cycle.t[-1] < r.period
+    np.testing.assert_allclose(np.abs(a.cycle.q[-1]), [1.0, 0.0, 0.0, 0.0], atol=1e-9)

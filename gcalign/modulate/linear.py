@@ -147,11 +147,6 @@ class LinearErrors:
         """RMS horizontal error from noise, √(σ_N² + σ_E²) (N,), m."""
         return np.hypot(self.sigma_north, self.sigma_east)
 
-    @property
-    def sigma_phi(self) -> np.ndarray:
-        """1σ of φ from noise (N, 3), rad."""
-        return np.sqrt(np.stack([self._var(i) for i in range(3)], -1))
-
     def _var(self, i: int) -> np.ndarray:
         return np.zeros(len(self.t)) if self.P is None else np.maximum(self.P[:, i, i], 0.0)
 
