@@ -11,6 +11,7 @@ from :func:`gcalign.calibrate.filter.covariance_run`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -66,7 +67,7 @@ class Pieces:
     segment: np.ndarray
 
 
-def pieces(truth: Trajectory, segments, piece_s: float = 1.0) -> Pieces:
+def pieces(truth: Trajectory, segments: Sequence[Span], piece_s: float = 1.0) -> Pieces:
     """Cut each segment into pieces of `piece_s` and evaluate F at their midpoints."""
     if not (np.isfinite(piece_s) and piece_s > 0):
         raise ScenarioError(f"piece_s: must be a positive number of seconds, got {piece_s!r}")
