@@ -50,10 +50,14 @@ def test_northfind_array_route_gives_the_cli_numbers_bit_for_bit():
         assert m["estimates_deg"] == np.mod(np.degrees(est.azimuth[i].T), 360.0).ravel().tolist()
         assert m["errors_deg"] == np.degrees(est.azimuth_error[i].T).ravel().tolist()
     assert res["tilt_est_deg"] == np.degrees(est.tilt.T).ravel().tolist()
-    # the whole-run function on the same setup and seed: the same arrays
-    full = run_northfind(setup, np.random.default_rng(7))
-    assert np.array_equal(full.azimuth_est, est.azimuth)
-    assert np.array_equal(full.azimuth_error, est.azimuth_error)
+    # the whole-run function on the same setup and seed, and the command's typed result
+    from gcalign.app.registry import COMMANDS
+
+    for full in (run_northfind(setup, np.random.default_rng(7)),
+                 COMMANDS["northfind"].execute(sc, 7).result):
+        assert np.array_equal(full.azimuth_est, est.azimuth)
+        assert np.array_equal(full.azimuth_error, est.azimuth_error)
+        assert np.array_equal(full.tilt_est, est.tilt)
 
 
 def test_northfind_level_table_azimuth_is_exact_on_noise_free_means():

@@ -61,9 +61,7 @@ def run_northfind(sc: Scenario, seed: int | None = None) -> NorthfindRun:
             "(positions, dwell_s, azimuth_deg or sweep, tilt_deg, …)"
         )
     setup = cfg.to_setup(sc)
-    seed = sc.imu.seed if seed is None else int(seed)
-    if seed < 0:
-        raise ScenarioError(f"imu.seed (--seed): must be >= 0, got {seed}")
+    seed = sc.imu.seed if seed is None else int(seed)  # checked by the registry's run
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
     result = nf.run_northfind(setup, rng, methods=tuple(cfg.methods), samples=cfg.samples)
