@@ -36,8 +36,6 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.realtime import RealtimeConfig
 from gcalign.realtime.cases import Case
 from gcalign.realtime.chain import CaseResult
-from gcalign.realtime.filters import FilterChain
-from gcalign.realtime.settings import Settings
 from gcalign.realtime.table import CaseSummary, RealtimeResult
 from gcalign.realtime.table import run_realtime as core_run
 
@@ -54,22 +52,6 @@ class RealtimeRun:
     result: RealtimeResult
     seed: int
     compute_s: float
-
-    @property
-    def settings(self) -> Settings:
-        return self.result.settings
-
-    @property
-    def chain(self) -> FilterChain:
-        return self.result.chain
-
-    @property
-    def results(self) -> tuple[CaseResult, ...]:
-        return self.result.cases
-
-    @property
-    def rows(self) -> tuple[CaseSummary, ...]:
-        return self.result.rows
 
 
 def run_realtime(sc: Scenario, seed: int | None = None,
@@ -156,7 +138,7 @@ def case_summary(res: CaseResult, row: CaseSummary, reference: str) -> dict:
 
 def realtime_summary(run: RealtimeRun, sc: Scenario) -> dict:
     """Plain-number summary: the JSON contract of ``gcalign realtime --json``."""
-    s, chain, cfg = run.settings, run.chain, run.cfg
+    s, chain, cfg = run.result.settings, run.result.chain, run.cfg
     T = run.result.delay
     site = sc.site
     assert site is not None
@@ -194,7 +176,7 @@ def realtime_summary(run: RealtimeRun, sc: Scenario) -> dict:
         "settle_s": s.settle_s,
         "corner_ms": s.corner_s * 1e3,
         "cases": [case_summary(r, row, cfg.reference)
-                  for r, row in zip(run.results, run.rows, strict=True)],
+                  for r, row in zip(run.result.cases, run.result.rows, strict=True)],
         "compute_s": run.compute_s,
     }
 
