@@ -39,8 +39,10 @@ def _per_azimuth(name: str, value: object, m: int) -> np.ndarray:
 
 
 def _is_int(x: object) -> bool:
+    """A whole number (3 or 3.0, not True, 3.5 or inf)."""
     return (isinstance(x, (int, float, np.integer, np.floating))
-            and not isinstance(x, (bool, np.bool_)) and float(x) == int(x))
+            and not isinstance(x, (bool, np.bool_)) and bool(np.isfinite(x))
+            and float(x) == int(x))
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
