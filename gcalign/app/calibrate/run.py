@@ -16,6 +16,7 @@ common random numbers).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,10 +40,12 @@ from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig
+from gcalign.nav.earth import EarthModel
 from gcalign.nav.strapdown import NavState
 from gcalign.sim.motions import Truth
 
 MEASURES = ie.MEASUREMENTS
+Progress = Callable[[int, int, str], None]  # (done, total, what)
 
 
 @dataclass(frozen=True)
@@ -81,8 +84,8 @@ def config_of(sc: Scenario) -> CalibrateConfig:
     return sc.calibrate or CalibrateConfig()
 
 
-def injected_truth(sc: Scenario, cfg: CalibrateConfig, settings: Settings, site, earth,
-                   seed: int) -> np.ndarray:
+def injected_truth(sc: Scenario, cfg: CalibrateConfig, settings: Settings, site: np.ndarray,
+                   earth: EarthModel, seed: int) -> np.ndarray:
     """The 21 injected errors (SI): the imu section's biases and scale factors and
     ``calibrate.initial_error`` (truth: scenario), or a draw from the filter's P0."""
     if cfg.truth == "draw":
@@ -184,7 +187,7 @@ def run_filter(case: Case, measure: str | None = None, data: FlightData | None =
     return Run(label, data, result, time.perf_counter() - t0)
 
 
-def compare_runs(case: Case, segments: int, progress=None) -> list[Run]:
+def compare_runs(case: Case, segments: int, progress: Progress | None = None) -> list[Run]:
     """The seed's Table 3: velocity, position and both on the whole flight ("designed")
     and on its first `segments` segments ("conventional"), on the same data and noise;
     `progress(done, total, what)` hears of each of the six filter runs."""
@@ -305,7 +308,7 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            compare: bool = False, progress=None) -> Outcome:
+            compare: bool = False, progress: Progress | None = None) -> Outcome:
     """Build the case, run the filter (or the six runs of `compare`), summarise; the
     Outcome's result is the :class:`~gcalign.calibrate.CalibrationResult` (with `compare`: the
     six, in the summary's order)."""

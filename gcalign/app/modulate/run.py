@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
+from typing import Any
 
 import numpy as np
 
@@ -52,8 +53,10 @@ def default_rate_hz(duration_s: float, imu_rate_hz: float) -> float:
     return min(imu_rate_hz, 1.0 if duration_s <= 4 * HOUR else 0.1)
 
 
-def seed_scenario(compare, *, rate: float = 10.0, hours: float = 72.0, gyro=None, accel=None,
-                  mechanism=None, navigation=None, seed: int = 1, linear: bool = True,
+def seed_scenario(compare: Iterable[str], *, rate: float = 10.0,
+                  hours: float = 72.0, gyro: dict | None = None, accel: dict | None = None,
+                  mechanism: dict | None = None, navigation: dict | None = None, seed: int = 1,
+                  linear: bool = True,
                   source: str = "seed004") -> Scenario:
     """The built-in seed 004 scenario (gcalign/scenarios/seed004_modulation.yaml) with the
     given changes, errors in user units (``imu.gyro``/``imu.accel`` sections replace the
@@ -130,7 +133,7 @@ def error_terms(sc: Scenario, entry: Entry) -> ErrorTerms:
     return ErrorTerms.of_sensors(e.gyro, e.accel, (0.0, 0.0, 0.0) if lever is None else lever)
 
 
-def _arcsec(v) -> list[float]:
+def _arcsec(v: np.ndarray) -> list[float]:
     return (np.asarray(v, dtype=float) / ARCSEC).tolist()
 
 
@@ -170,7 +173,7 @@ def linear_summary(lin: LinearErrors, hours: list[float]) -> dict:
     }
 
 
-def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group=None,
+def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group: Any = None,
                linear: bool = True) -> tuple[dict, SchemeAnalysis]:
     """Navigate one scheme and analyse it (:func:`gcalign.modulate.analyse_scheme`); its
     summary and the analysis. `group`: an h5py group for the series, the invariants, the
@@ -212,7 +215,7 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group=N
     return out, analysis
 
 
-def errors_summary(sc: Scenario, lever_cm) -> dict:
+def errors_summary(sc: Scenario, lever_cm: Any) -> dict:
     e = sc.imu.errors()
     g, a = e.gyro, e.accel
     return {
@@ -226,7 +229,7 @@ def errors_summary(sc: Scenario, lever_cm) -> dict:
     }
 
 
-def run_modulate(sc: Scenario, seed: int | None = None, sink=None,
+def run_modulate(sc: Scenario, seed: int | None = None, sink: Any = None,
                  progress: Progress | None = None
                  ) -> tuple[dict, tuple[str, ...], dict[str, SchemeAnalysis]]:
     """Every scheme of the plan; the summary (plain numbers), the warnings and the analysis
@@ -274,8 +277,8 @@ def run_modulate(sc: Scenario, seed: int | None = None, sink=None,
     return summary, tuple(warnings), analyses
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None, sink=None,
-            progress: Progress | None = None) -> Outcome:
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+            sink: Any = None, progress: Progress | None = None) -> Outcome:
     """The registry's entry point: with `sink` (an open results file) the series go into
     its /modulate group as they are computed. The Outcome's result is the
     :class:`~gcalign.modulate.SchemeAnalysis` of each scheme, by name."""

@@ -69,21 +69,21 @@ def run_northfind(sc: Scenario, seed: int | None = None) -> NorthfindRun:
                         compute_s=time.perf_counter() - t0)
 
 
-def _num(x) -> float | None:
+def _num(x: float) -> float | None:
     x = float(x)
     return None if math.isnan(x) else x
 
 
-def _list(a) -> list:
+def _list(a: np.ndarray) -> list:
     """Plain floats (NaN -> None) of any array, flattened in C order."""
     return [_num(v) for v in np.asarray(a, float).ravel()]
 
 
-def _deg(a) -> list:
+def _deg(a: np.ndarray) -> list:
     return _list(np.degrees(a))
 
 
-def _deg360(a) -> list:
+def _deg360(a: np.ndarray) -> list:
     return _list(np.mod(np.degrees(a), 360.0))
 
 

@@ -16,6 +16,8 @@ from gcalign.app.registry import Outcome
 from gcalign.calibrate import (
     ObservabilitySettings,
     ObservabilityTable,
+    Span,
+    Trajectory,
     motion_spans,
     observability,
     sampled_truth,
@@ -28,7 +30,8 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 
 
-def flight_truth(sc: Scenario, cache_key: str | None = None):
+def flight_truth(sc: Scenario,
+                 cache_key: str | None = None) -> tuple[Trajectory, tuple[Span, ...]]:
     """The scenario's truth at the navigation rate (:class:`gcalign.calibrate.Trajectory`)
     and its manoeuvres."""
     from gcalign.app.data import cached_noise_free, noise_free
@@ -46,7 +49,8 @@ def flight_truth(sc: Scenario, cache_key: str | None = None):
     return traj, motion_spans(sc.motion.to_motion(), float(traj.t[-1]))
 
 
-def run_table(sc: Scenario, cache_key: str | None = None):
+def run_table(sc: Scenario, cache_key: str | None = None
+              ) -> tuple[ObservabilityTable, Trajectory, tuple[Span, ...], float]:
     """``(table, trajectory, spans, compute_s)``: the table's own time, without the
     simulation."""
     cfg = sc.observability or ObservabilityConfig()
@@ -66,7 +70,8 @@ def _degrees(values: np.ndarray) -> dict:
     return {n: float(v) for n, v in zip(ie.STATE_NAMES, values, strict=True)}
 
 
-def summary(sc: Scenario, tab: ObservabilityTable, spans, compute_s: float) -> dict:
+def summary(sc: Scenario, tab: ObservabilityTable, spans: tuple[Span, ...],
+            compute_s: float) -> dict:
     """Plain numbers: the JSON contract of ``gcalign observability``."""
     segs, cum = [], []
     for i, sp in enumerate(spans):
