@@ -160,18 +160,23 @@ def _calibration_errors():
     return x, ImuErrors(gyro=gyro, accel=accel)
 
 
+def _seed_p0(site: np.ndarray) -> tuple[float, ...]:
+    """The seed's P0 list (spec 002 §2) in SI at `site`, 1 m of position in radians."""
+    r_m, r_n = earth.WGS84.radii(site[0])
+    r_m, r_n = r_m + site[2], r_n + site[2]
+    return tuple(np.concatenate([np.array([20.0, 20.0, 1800.0]) * u.ARCSEC, [0.2] * 3,
+                                 [1.0 / r_m, 1.0 / (r_n * np.cos(site[0])), 1.0],
+                                 np.full(3, 0.01) * u.DPH, np.full(3, 50.0) * u.UG,
+                                 np.full(6, 100.0) * u.PPM]))
+
+
 def _calibration_arrays(seed: int):
     from gcalign.calibrate import Settings, calibrate, flight_from_ideal
 
     truth, ideal, spans, site = _flight_arrays()
     x, errors = _calibration_errors()
     data = flight_from_ideal(truth, ideal, x, errors, np.random.default_rng(seed), spans)
-    r_m, r_n = earth.WGS84.radii(site[0])  # the seed's P0 list, 1 m of position in rad
-    p0 = np.concatenate([np.array([20.0, 20.0, 1800.0]) * u.ARCSEC, [0.2] * 3,
-                         [1.0 / r_m, 1.0 / (r_n * np.cos(site[0])), 1.0],
-                         np.full(3, 0.01) * u.DPH, np.full(3, 50.0) * u.UG,
-                         np.full(6, 100.0) * u.PPM])
-    settings = Settings(p0_sigma=tuple(p0), arw=0.001 * u.DPSH, vrw=10.0 * u.UGPSHZ)
+    settings = Settings(p0_sigma=_seed_p0(site), arw=0.001 * u.DPSH, vrw=10.0 * u.UGPSHZ)
     return data, calibrate(data, settings, np.random.default_rng([seed, 3]))
 
 
@@ -210,6 +215,34 @@ def test_calibrate_heading_beats_the_static_floor_only_after_the_ground_roll():
     assert r.sigma[static_end, phi_u] > floor
     assert r.sigma[-1, phi_u] < floor / 3.0
     assert np.all(np.abs(r.error[-1] / r.sigma[-1]) < 3.0)
+
+
+def test_calibrate_recorded_array_route_gives_the_cli_numbers_bit_for_bit(lasergyro):
+    """Recorded data of a parked vehicle (the PSINS lasergyro file): the user's own arrays,
+    a coarse alignment over the first 60 s, then zero-velocity aiding to 120 s."""
+    from gcalign.align.coarse import inertial_frame_coarse
+    from gcalign.calibrate import Settings, calibrate, parked_data
+    from gcalign.estimation import ins_error as ie
+    from gcalign.io.imu_files import read_imu_file
+
+    res = gcalign.run("calibrate", gcalign.load({
+        "name": "parked", "imu_file": str(lasergyro),
+        "calibrate": {"aiding": "zero-velocity", "coarse": {"method": "inertial",
+                                                            "duration_s": 60},
+                      "duration_s": 120, "gnss_noise": False}}))
+    imu = read_imu_file(lasergyro)
+    assert imu.site is not None
+    n60 = int(round(60.0 / imu.ts))
+    att = inertial_frame_coarse(imu.dtheta[:n60], imu.dv[:n60], imu.ts, *imu.site)
+    n120 = int(round(120.0 / imu.ts))
+    data = parked_data(imu.dtheta[n60:n120], imu.dv[n60:n120], imu.ts, att, imu.site, t0=60.0)
+    r = calibrate(data, Settings(p0_sigma=_seed_p0(imu.site), gnss_noise=False))
+    assert res["coarse_attitude_deg"] == np.degrees(att).tolist()
+    for i, name in enumerate(ie.STATE_NAMES):
+        st = res["states"][name]
+        assert (st["estimate"], st["sigma"]) == (float(r.estimate[-1, i]),
+                                                 float(r.sigma[-1, i])), name
+    assert res["attitude_deg"] == np.degrees(r.att[-1]).tolist()
 
 
 def test_observability_array_route_gives_the_cli_numbers_bit_for_bit():

@@ -10,7 +10,8 @@ Modules
 -------
 - :mod:`gcalign.calibrate.data` -- inputs as plain arrays (:class:`FlightData`,
   :class:`Trajectory`, :class:`Span`) from a motion's truth and ideal increments with the
-  injected errors (navigation increments combined from IMU ones), zero-velocity data.
+  injected errors (navigation increments combined from IMU ones), recorded data of a
+  parked vehicle (:func:`parked_data`, zero-velocity aiding).
 - :mod:`gcalign.calibrate.filter` -- :func:`calibrate`, :func:`covariance_run` (the RTS
   smoother is :func:`gcalign.estimation.kalman.rts`).
 - :mod:`gcalign.calibrate.observability` -- :func:`observability` (settings
@@ -29,6 +30,7 @@ from gcalign.calibrate.data import (
     flight_from_ideal,
     imu_errors,
     motion_spans,
+    parked_data,
     perturb,
     proposed_truth,
     sampled_truth,
@@ -55,6 +57,6 @@ __all__ = [
     "CalibrationResult", "CovarianceRun", "FlightData", "ObservabilitySettings",
     "ObservabilityTable", "Settings", "Span", "Trajectory", "calibrate", "combine_increments",
     "covariance_run", "draw_truth", "flight_from_ideal", "imu_errors", "motion_spans",
-    "observability", "observability_table", "perturb", "proposed_truth", "sampled_truth",
-    "trajectory", "white_noise", "zero_velocity_aiding", "zero_velocity_data",
+    "observability", "observability_table", "parked_data", "perturb", "proposed_truth",
+    "sampled_truth", "trajectory", "white_noise", "zero_velocity_aiding", "zero_velocity_data",
 ]

@@ -315,3 +315,17 @@ def zero_velocity_aiding(data: FlightData) -> FlightData:
     n = len(data.t)
     return replace(data, ref_v_n=np.zeros((n, 3)),
                    ref_pos=np.tile(np.asarray(data.start.pos, float), (n, 1)))
+
+
+def parked_data(dtheta: np.ndarray, dv: np.ndarray, ts: float, att0: np.ndarray,
+                site: np.ndarray, *, t0: float = 0.0, subsamples: int = 1,
+                earth: EarthModel = WGS84) -> FlightData:
+    """Recorded IMU increments (N, 3) at interval `ts` (s) of a parked vehicle, from the
+    attitude `att0` ``[pitch, roll, yaw]`` (rad; e.g. a coarse alignment) at `site`
+    ``[L, λ, h]`` and data time `t0` (s): the navigation increments (`subsamples` IMU
+    increments per step, :func:`combine_increments`) aided by zero velocity at the site
+    (:func:`zero_velocity_data`). The array route of ``gcalign calibrate`` on recorded data."""
+    dth, dvb = combine_increments(dtheta, dv, subsamples)
+    t = t0 + np.arange(len(dth) + 1) * subsamples * ts
+    start = NavState.from_euler(np.asarray(att0, float), np.zeros(3), np.asarray(site, float))
+    return zero_velocity_data(t, dth, dvb, start, earth)

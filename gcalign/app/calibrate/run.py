@@ -27,13 +27,12 @@ from gcalign.calibrate import (
     FlightData,
     Settings,
     calibrate,
-    combine_increments,
     draw_truth,
     flight_from_ideal,
     motion_spans,
+    parked_data,
     sampled_truth,
     zero_velocity_aiding,
-    zero_velocity_data,
 )
 from gcalign.calibrate.filter import warm_up
 from gcalign.errors import ScenarioError
@@ -41,7 +40,6 @@ from gcalign.estimation import ins_error as ie
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig
 from gcalign.nav.earth import EarthModel
-from gcalign.nav.strapdown import NavState
 from gcalign.sim.motions import Truth
 
 MEASURES = ie.MEASUREMENTS
@@ -150,9 +148,8 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
                                                    earth=earth)
     except ValueError as err:
         raise ScenarioError(f"calibrate.coarse.duration_s: {err}") from None
-    dth, dv = combine_increments(imu.dtheta[i1:i2], imu.dv[i1:i2], n)
-    t = coarse_end + np.arange(len(dth) + 1) * n * ts
-    data = zero_velocity_data(t, dth, dv, NavState.from_euler(att, np.zeros(3), site), earth)
+    data = parked_data(imu.dtheta[i1:i2], imu.dv[i1:i2], ts, att, site, t0=coarse_end,
+                       subsamples=n, earth=earth)
     return Case(data, cfg.settings(site, earth), imu.source, "zero-velocity", n, rate, None,
                 None, att, (start, coarse_end, end))
 
