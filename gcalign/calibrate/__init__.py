@@ -10,10 +10,12 @@ Modules
 -------
 - :mod:`gcalign.calibrate.data` -- inputs as plain arrays (:class:`FlightData`,
   :class:`Trajectory`, :class:`Span`) from a motion's truth and ideal increments with the
-  injected errors (navigation increments combined from IMU ones), zero-velocity data.
+  injected errors (navigation increments combined from IMU ones), recorded data of a
+  parked vehicle (:func:`parked_data`, zero-velocity aiding).
 - :mod:`gcalign.calibrate.filter` -- :func:`calibrate`, :func:`covariance_run` (the RTS
   smoother is :func:`gcalign.estimation.kalman.rts`).
-- :mod:`gcalign.calibrate.observability` -- :func:`observability_table`.
+- :mod:`gcalign.calibrate.observability` -- :func:`observability` (settings
+  :class:`ObservabilitySettings`), :func:`observability_table`.
 
 The error model is :mod:`gcalign.estimation.ins_error`, the Kalman steps
 :mod:`gcalign.estimation.kalman`, the PWCS/SVD algebra :mod:`gcalign.estimation.observability`.
@@ -28,11 +30,13 @@ from gcalign.calibrate.data import (
     flight_from_ideal,
     imu_errors,
     motion_spans,
+    parked_data,
     perturb,
     proposed_truth,
     sampled_truth,
     trajectory,
     white_noise,
+    zero_velocity_aiding,
     zero_velocity_data,
 )
 from gcalign.calibrate.filter import (
@@ -42,11 +46,17 @@ from gcalign.calibrate.filter import (
     calibrate,
     covariance_run,
 )
-from gcalign.calibrate.observability import ObservabilityTable, observability_table
+from gcalign.calibrate.observability import (
+    ObservabilitySettings,
+    ObservabilityTable,
+    observability,
+    observability_table,
+)
 
 __all__ = [
-    "CalibrationResult", "CovarianceRun", "FlightData", "ObservabilityTable", "Settings", "Span",
-    "Trajectory", "calibrate", "combine_increments", "covariance_run", "draw_truth",
-    "flight_from_ideal", "imu_errors", "motion_spans", "observability_table", "perturb",
-    "proposed_truth", "sampled_truth", "trajectory", "white_noise", "zero_velocity_data",
+    "CalibrationResult", "CovarianceRun", "FlightData", "ObservabilitySettings",
+    "ObservabilityTable", "Settings", "Span", "Trajectory", "calibrate", "combine_increments",
+    "covariance_run", "draw_truth", "flight_from_ideal", "imu_errors", "motion_spans",
+    "observability", "observability_table", "parked_data", "perturb", "proposed_truth",
+    "sampled_truth", "trajectory", "white_noise", "zero_velocity_aiding", "zero_velocity_data",
 ]

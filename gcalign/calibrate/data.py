@@ -13,6 +13,7 @@ compensation chained over the group), as the seed's 25 Hz navigation of a 100 Hz
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -28,7 +29,8 @@ from gcalign.nav.rotation import (
 )
 from gcalign.nav.strapdown import NavState
 from gcalign.sim.errors import ImuErrors, SensorErrors
-from gcalign.sim.motions import Truth
+from gcalign.sim.imu import ImuData
+from gcalign.sim.motions import MotionType, Truth
 from gcalign.units import ARCMIN, ARCSEC, DPH, PPM, UG
 
 
@@ -64,7 +66,7 @@ class Trajectory:
     def ts(self) -> float:
         return float(self.t[1] - self.t[0])
 
-    def midpoints(self, k=None):
+    def midpoints(self, k: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
         """Kinematics at the middle of increments `k` (default all): ``C_nb (K, 3, 3)``,
         f_b, ω_ib^b, v_n, pos (K, 3). The attitude is the start attitude turned by half
         the body increment (the navigation-frame turn, ≤ 1e-6 rad, is left out)."""
@@ -190,7 +192,8 @@ def _rotate(r: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.einsum("...ij,...j->...i", quat_to_dcm(rotvec_to_quat(r)), v)
 
 
-def combine_increments(dtheta: np.ndarray, dv: np.ndarray, n: int):
+def combine_increments(dtheta: np.ndarray, dv: np.ndarray,
+                       n: int) -> tuple[np.ndarray, np.ndarray]:
     """Groups of `n` increments (N, 3) as one navigation increment each ((N // n, 3) twice):
     the strapdown step's own body-frame algebra chained over the group, so that one step
     with the result does in the body frame exactly what n steps would.
@@ -224,7 +227,8 @@ def combine_increments(dtheta: np.ndarray, dv: np.ndarray, n: int):
     return phi, _rotate(-0.5 * phi, V)
 
 
-def trajectory(t, att, v_n, pos, dtheta, dv, earth: EarthModel = WGS84,
+def trajectory(t: np.ndarray, att: np.ndarray, v_n: np.ndarray, pos: np.ndarray,
+               dtheta: np.ndarray, dv: np.ndarray, earth: EarthModel = WGS84,
                subsamples: int = 1) -> Trajectory:
     """The :class:`Trajectory` at the navigation rate from a truth (N+1 samples) and its
     ideal increments (N, 3) at the IMU rate, `subsamples` IMU increments per step."""
@@ -238,7 +242,7 @@ def trajectory(t, att, v_n, pos, dtheta, dv, earth: EarthModel = WGS84,
                       f_b=dvb / T, omega_ib_b=dth / T, earth=earth)
 
 
-def flight_from_ideal(truth, ideal, x_true: np.ndarray, errors: ImuErrors,
+def flight_from_ideal(truth: Truth, ideal: ImuData, x_true: np.ndarray, errors: ImuErrors,
                       rng: np.random.Generator, segments: tuple[Span, ...] = (),
                       subsamples: int = 1, earth: EarthModel = WGS84) -> FlightData:
     """:class:`FlightData` from a truth (``Truth``, N+1 samples) and its ideal increments
@@ -259,7 +263,7 @@ def flight_from_ideal(truth, ideal, x_true: np.ndarray, errors: ImuErrors,
                       x_true=np.array(x_true, dtype=float), earth=earth)
 
 
-def motion_spans(motion, t_end: float | None = None) -> tuple[Span, ...]:
+def motion_spans(motion: MotionType, t_end: float | None = None) -> tuple[Span, ...]:
     """The manoeuvres of a motion as :class:`Span` s: one per segment of a moving base (a
     flight target reached early and held, ``"X (held)"``, stays part of manoeuvre X;
     unnamed segments are ``"segment i"``), the whole run for the other kinds. `t_end`
@@ -285,7 +289,7 @@ def motion_spans(motion, t_end: float | None = None) -> tuple[Span, ...]:
     return tuple(spans)
 
 
-def sampled_truth(traj: Trajectory, spans) -> Truth:
+def sampled_truth(traj: Trajectory, spans: Sequence[Span]) -> Truth:
     """The trajectory as a :class:`gcalign.sim.motions.Truth` with the span of each sample
     (a sample on a boundary ends the earlier span's last increment, so belongs to it)."""
     seg = np.zeros(len(traj.t), np.int64)
@@ -294,7 +298,8 @@ def sampled_truth(traj: Trajectory, spans) -> Truth:
     return Truth(traj.t, traj.att, traj.v_n, traj.pos, seg)
 
 
-def zero_velocity_data(t, dtheta, dv, start: NavState, earth: EarthModel = WGS84) -> FlightData:
+def zero_velocity_data(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, start: NavState,
+                       earth: EarthModel = WGS84) -> FlightData:
     """Recorded increments on a parked vehicle: the aiding measures zero velocity at the
     start position (zero-velocity fine alignment). `t` (N+1,) from the navigation start."""
     n = len(t)
@@ -302,3 +307,25 @@ def zero_velocity_data(t, dtheta, dv, start: NavState, earth: EarthModel = WGS84
                       dv=np.asarray(dv, float), start=start, ref_v_n=np.zeros((n, 3)),
                       ref_pos=np.tile(np.asarray(start.pos, float), (n, 1)),
                       segments=(Span("static", float(t[0]), float(t[-1])),), earth=earth)
+
+
+def zero_velocity_aiding(data: FlightData) -> FlightData:
+    """The same data aided by zero velocity at the start position (a parked vehicle: the
+    aiding source measures v = 0 and the start position at every epoch)."""
+    n = len(data.t)
+    return replace(data, ref_v_n=np.zeros((n, 3)),
+                   ref_pos=np.tile(np.asarray(data.start.pos, float), (n, 1)))
+
+
+def parked_data(dtheta: np.ndarray, dv: np.ndarray, ts: float, att0: np.ndarray,
+                site: np.ndarray, *, t0: float = 0.0, subsamples: int = 1,
+                earth: EarthModel = WGS84) -> FlightData:
+    """Recorded IMU increments (N, 3) at interval `ts` (s) of a parked vehicle, from the
+    attitude `att0` ``[pitch, roll, yaw]`` (rad; e.g. a coarse alignment) at `site`
+    ``[L, λ, h]`` and data time `t0` (s): the navigation increments (`subsamples` IMU
+    increments per step, :func:`combine_increments`) aided by zero velocity at the site
+    (:func:`zero_velocity_data`). The array route of ``gcalign calibrate`` on recorded data."""
+    dth, dvb = combine_increments(dtheta, dv, subsamples)
+    t = t0 + np.arange(len(dth) + 1) * subsamples * ts
+    start = NavState.from_euler(np.asarray(att0, float), np.zeros(3), np.asarray(site, float))
+    return zero_velocity_data(t, dth, dvb, start, earth)

@@ -99,7 +99,8 @@ class Settings:
                                 f" got {self.filter_rate:g}")
         return int(round(ratio))
 
-    def covariances(self, pos, earth: EarthModel = WGS84):
+    def covariances(self, pos: np.ndarray,
+                    earth: EarthModel = WGS84) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(P0, Qc, R)`` at the start position `pos`."""
         sigma = None if self.p0_sigma is None else np.asarray(self.p0_sigma, dtype=float)
         return (ie.initial_covariance(pos, self.p0_scale, sigma, earth),
@@ -155,8 +156,9 @@ class CalibrationResult:
         return None if self.truth is None else self.estimate - self.truth
 
 
-def _transition(q_nb, v_n, pos, dtheta, dv, ts: float, Qc: np.ndarray, method: str,
-                E: np.ndarray):
+def _transition(q_nb: np.ndarray, v_n: np.ndarray, pos: np.ndarray, dtheta: np.ndarray,
+                dv: np.ndarray, ts: float, Qc: np.ndarray, method: str,
+                E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Φ, Q_d over one filter step from the navigation states (S+1, …) and the compensated
     increments (S, 3) (numba kernel; the NumPy route is ``ins_error.accumulate``); `E` is
     ``EarthModel.params()``."""
@@ -210,7 +212,8 @@ def _phi(q_est: np.ndarray, q_true: np.ndarray) -> np.ndarray:
     return quat_to_rotvec(quat_mult(q_true, quat_conj(q_est)))
 
 
-def _measurement(measure: str, v_n, pos, ref_v, ref_pos, noise, earth: EarthModel) -> np.ndarray:
+def _measurement(measure: str, v_n: np.ndarray, pos: np.ndarray, ref_v: np.ndarray,
+                 ref_pos: np.ndarray, noise: np.ndarray, earth: EarthModel) -> np.ndarray:
     """z = INS − reference − noise (seed eqs. 5–7); position in metres north, east."""
     dv = v_n[:2] - ref_v[:2]
     if measure == "velocity":

@@ -11,6 +11,7 @@ from :func:`gcalign.calibrate.filter.covariance_run`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -66,7 +67,7 @@ class Pieces:
     segment: np.ndarray
 
 
-def pieces(truth: Trajectory, segments, piece_s: float = 1.0) -> Pieces:
+def pieces(truth: Trajectory, segments: Sequence[Span], piece_s: float = 1.0) -> Pieces:
     """Cut each segment into pieces of `piece_s` and evaluate F at their midpoints."""
     if not (np.isfinite(piece_s) and piece_s > 0):
         raise ScenarioError(f"piece_s: must be a positive number of seconds, got {piece_s!r}")
@@ -90,6 +91,29 @@ def pieces(truth: Trajectory, segments, piece_s: float = 1.0) -> Pieces:
 def _stack_r(R: np.ndarray | None, rows: np.ndarray) -> np.ndarray:  # (≤ n, n)
     """Triangular factor of ``[R; rows]``: the SVD of a stack only needs it."""
     return ob.r_factor(rows if R is None else np.vstack([R, rows]))
+
+
+@dataclass(frozen=True)
+class ObservabilitySettings:
+    """Settings of :func:`observability` (see :func:`observability_table` for each)."""
+
+    measure: str = "velocity"
+    scaling: str = "none"
+    rtol: float = ob.RANK_RTOL_DEFAULT
+    piece_s: float = 1.0
+    null_tol: float = 1e-9
+    covariance: bool = True
+
+
+def observability(truth: Trajectory, segments: tuple[Span, ...],
+                  settings: ObservabilitySettings | None = None,
+                  filter_settings: Settings | None = None) -> ObservabilityTable:
+    """The observability table of `truth` cut into `segments` (spec 002 §3–4): the array
+    route of ``gcalign observability``. `filter_settings` give P0 (scaling ``p0``) and the
+    covariance degree."""
+    s = settings or ObservabilitySettings()
+    return observability_table(truth, segments, s.measure, s.scaling, s.rtol, s.piece_s,
+                               s.null_tol, filter_settings, s.covariance)
 
 
 def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: str = "velocity",

@@ -16,11 +16,19 @@ This package holds the numerical core of ``gcalign modulate``:
   terms, running-integral peaks, Schuler resonance warning.
 - :mod:`gcalign.modulate.linear` -- an independent linear (φ-angle) error model of a static
   INS whose IMU turns on the schedule, integrated exactly piece by piece to 72 h.
+- :mod:`gcalign.modulate.analysis` -- :func:`analyse_scheme`: the three above for one scheme
+  and one IMU (:class:`SchemeAnalysis`), with one cycle of the mechanism.
 
 Frames: n = ENU, s = sensor (IMU) frame; a scheme's schedule is C_s^r with r the body or
 the navigation frame at the start (``Scheme.reference``). SI and radians throughout.
 """
 
+from gcalign.modulate.analysis import (
+    MechanismCycle,
+    SchemeAnalysis,
+    analyse_scheme,
+    mechanism_cycle,
+)
 from gcalign.modulate.invariants import InvariantReport, invariant_report
 from gcalign.modulate.linear import REPORT_HOURS, LinearErrors, linear_errors
 from gcalign.modulate.schemes import (
@@ -40,7 +48,7 @@ from gcalign.modulate.terms import SEED004_LAT, ErrorTerms
 
 __all__ = [
     "BUILTIN_NAMES", "REPORT_HOURS", "SEED004_LAT", "SEED_DWELL", "SEED_TURN", "ErrorTerms",
-    "InvariantReport", "LinearErrors", "Row", "Scheme", "Turn", "builtin_rows",
-    "builtin_scheme", "invariant_report", "linear_errors", "row_from_dict", "rows_from_dicts",
-    "scheme_from_rows",
+    "InvariantReport", "LinearErrors", "MechanismCycle", "Row", "Scheme", "SchemeAnalysis",
+    "Turn", "analyse_scheme", "builtin_rows", "builtin_scheme", "invariant_report",
+    "linear_errors", "mechanism_cycle", "row_from_dict", "rows_from_dicts", "scheme_from_rows",
 ]

@@ -70,7 +70,8 @@ def split_count(span: float, duration: float, max_len: float | None,
     return k
 
 
-def gauss_legendre(a: np.ndarray, b: np.ndarray, n: int = N_NODES):
+def gauss_legendre(a: np.ndarray, b: np.ndarray,
+                   n: int = N_NODES) -> tuple[np.ndarray, np.ndarray]:
     """Nodes and weights on each interval [a_m, b_m], shapes (M, n)."""
     x, w = np.polynomial.legendre.leggauss(n)
     h = 0.5 * (b - a)[:, None]

@@ -142,11 +142,6 @@ class InvariantReport:
         """True when a modulation harmonic sits within ±20 % of the Schuler period."""
         return bool(self.warnings)
 
-    @property
-    def scale_factor_matrix(self) -> np.ndarray:
-        """(3, 3) rad: column j is the net scale-factor term per unit δk_j, W[:, j, j]."""
-        return np.einsum("aii->ai", self.rate_tensor)
-
 
 @dataclass(frozen=True)
 class Running:

@@ -46,6 +46,7 @@ Outputs: north ``R_M δL``, east ``R_N cos L δλ`` and horizontal error (m), φ
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -147,11 +148,6 @@ class LinearErrors:
         """RMS horizontal error from noise, √(σ_N² + σ_E²) (N,), m."""
         return np.hypot(self.sigma_north, self.sigma_east)
 
-    @property
-    def sigma_phi(self) -> np.ndarray:
-        """1σ of φ from noise (N, 3), rad."""
-        return np.sqrt(np.stack([self._var(i) for i in range(3)], -1))
-
     def _var(self, i: int) -> np.ndarray:
         return np.zeros(len(self.t)) if self.P is None else np.maximum(self.P[:, i, i], 0.0)
 
@@ -162,7 +158,8 @@ class LinearErrors:
             raise ValueError(f"{hours} h is not an output time")
         return k
 
-    def at(self, hours=REPORT_HOURS, quantity: str = "horizontal") -> np.ndarray:
+    def at(self, hours: float | Sequence[float] = REPORT_HOURS,
+           quantity: str = "horizontal") -> np.ndarray:
         """`quantity` (a property name) at each of `hours`."""
         v = getattr(self, quantity)
         return np.array([v[self.index(h)] for h in np.atleast_1d(hours)])
@@ -187,11 +184,11 @@ class _Modes:
     def _mat(self, diag: np.ndarray) -> np.ndarray:
         return np.real(np.einsum("ik,...k,kj->...ij", self.left, diag, self.right))
 
-    def exp(self, tau) -> np.ndarray:
+    def exp(self, tau: float | np.ndarray) -> np.ndarray:
         """e^{F τ}, shape (..., 7, 7)."""
         return self._mat(np.exp(np.multiply.outer(tau, self.lam)))
 
-    def gamma(self, h) -> np.ndarray:
+    def gamma(self, h: float | np.ndarray) -> np.ndarray:
         """∫_0^h e^{F s} ds = V diag(h φ1(λ h)) V⁻¹ with φ1(z) = (e^z − 1)/z."""
         z = np.multiply.outer(h, self.lam)
         small = np.abs(z) < 1e-8

@@ -152,7 +152,7 @@ def _row_error(i: int, field: str, msg: str) -> ScenarioError:
     return ScenarioError(f"scheme row {i + 1}: {field}: {msg}")
 
 
-def _axis(i: int, value) -> tuple[float, float, float]:
+def _axis(i: int, value: object) -> tuple[float, float, float]:
     if isinstance(value, str):
         key = value.strip().lower().lstrip("+")
         if key not in AXES:

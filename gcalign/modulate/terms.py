@@ -9,7 +9,9 @@ sensor frame s, SI.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -20,7 +22,7 @@ SEED004_LAT = math.radians(45.7796)  # seed 004 §4: 45.7796°N, 126.6705°E
 SEED004_G0 = 9.78049  # seed 004 §4: g0, m/s² (the accelerometer bias is 1e-4·g0)
 
 
-def _vec(v, shape) -> np.ndarray:
+def _vec(v: object, shape: tuple[int, ...]) -> np.ndarray:
     a = np.array(v, dtype=float)
     if a.shape != shape:
         a = np.broadcast_to(a, shape).copy()
@@ -58,7 +60,7 @@ class ErrorTerms:
     accel_asym: np.ndarray = field(default_factory=lambda: np.zeros(3))
     lever: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for name, shape in (("gyro_bias", (3,)), ("accel_bias", (3,)), ("gyro_scale", (3,)),
                             ("gyro_misalignment", (3, 3)), ("gyro_asym", (3,)),
                             ("accel_scale", (3,)), ("accel_misalignment", (3, 3)),
@@ -83,11 +85,11 @@ class ErrorTerms:
 
     @classmethod
     def of_sensors(cls, gyro: SensorErrors, accel: SensorErrors,
-                   lever=(0.0, 0.0, 0.0)) -> ErrorTerms:
+                   lever: Sequence[float] | np.ndarray = (0.0, 0.0, 0.0)) -> ErrorTerms:
         """The terms of the simulation's error model (:class:`gcalign.sim.errors.SensorErrors`,
         SI). Noise densities that differ between axes enter as their RMS (the model's noise
         is isotropic); quantisation is left out."""
-        def rms(v) -> float:
+        def rms(v: np.ndarray) -> float:
             return float(np.sqrt(np.mean(np.square(v))))
 
         return cls(gyro_bias=gyro.bias, accel_bias=accel.bias, gyro_scale=gyro.scale,
@@ -97,7 +99,7 @@ class ErrorTerms:
                    lever=np.asarray(lever, dtype=float))
 
     @classmethod
-    def seed004(cls, *, gyro: bool = True, accel: bool = True, **kw) -> ErrorTerms:
+    def seed004(cls, *, gyro: bool = True, accel: bool = True, **kw: Any) -> ErrorTerms:
         """The seed's simulation (seed 004 §4, all axes, positive): gyro drift 0.01 °/h and
         accelerometer bias 1e-4·g0 (g0 = 9.78049 m/s²); `kw` adds other terms."""
         return cls(gyro_bias=np.full(3, 0.01 * DPH if gyro else 0.0),

@@ -19,7 +19,8 @@ Modules
   kernel).
 - :mod:`gcalign.northfind.estimate` -- harmonic least squares (seed eqs. 4–7), tilt from
   the accelerometers (eq. 9) and the azimuth methods of :data:`METHODS` (eqs. 1–3, 8, 10,
-  11).
+  11); :func:`estimate_northfind` is the array route (dwell means of a recorded or
+  simulated turn → :class:`NorthfindEstimate`, with the errors when the truth is given).
 - :mod:`gcalign.northfind.theory` -- closed-form tilt-induced errors and noise predictions.
 - :mod:`gcalign.northfind.run` -- :func:`run_northfind`: simulate, estimate, and compare
   with the truth and the closed forms (:class:`NorthfindResult`).

@@ -7,7 +7,10 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def dwell_means(rng, ideal, bias, sigma, n_samples):  # pragma: no cover - numba
+def dwell_means(
+    rng: np.random.Generator, ideal: np.ndarray, bias: np.ndarray, sigma: np.ndarray,
+    n_samples: int,
+) -> np.ndarray:  # pragma: no cover - numba
     """Sample-level dwell means: every sample ``ideal + bias + sigma * w``, then averaged.
 
     ``ideal`` (K, n, S); draws are consumed in the C order of (K, n, S, n_samples).

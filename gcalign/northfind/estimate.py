@@ -10,13 +10,14 @@ chains them over arrays of any leading shape.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from gcalign.nav import earth
-from gcalign.nav.rotation import euler_to_dcm
-from gcalign.northfind.geometry import _uz, _wrap_2pi
+from gcalign.nav.rotation import euler_to_dcm, wrap_pi
+from gcalign.northfind.geometry import Values, _uz, _wrap_2pi
 
 __all__ = [
     "METHODS",
@@ -32,12 +33,12 @@ METHODS: tuple[str, ...] = ("coordinate", "vector", "naive", "none")
 _ALL_METHODS = METHODS + ("vector_literal",)
 
 
-def _design(theta):
+def _design(theta: Values) -> np.ndarray:
     theta = np.asarray(theta, float)
     return np.stack([np.ones_like(theta), np.cos(theta), np.sin(theta)], -1)
 
 
-def fit_harmonics(y, theta):
+def fit_harmonics(y: Values, theta: Values) -> tuple[np.ndarray, np.ndarray]:
     """Least squares of ``y_i = R + a cos θ_i + b sin θ_i`` (seed eqs. 4–7).
 
     Parameters
@@ -72,7 +73,7 @@ def fit_harmonics(y, theta):
     return coef, y - coef @ A.T
 
 
-def tilt_from_accel(accel_coef, g):
+def tilt_from_accel(accel_coef: Values, g: float) -> tuple[np.ndarray, np.ndarray]:
     """Up vector in table axes from the accelerometer harmonics (seed eq. 9).
 
     Parameters
@@ -100,7 +101,9 @@ def tilt_from_accel(accel_coef, g):
     return (ax - by) / (2.0 * g), (bx + ay) / (2.0 * g)
 
 
-def _azimuth_coordinate(a, b, ux, uy, w_up):
+def _azimuth_coordinate(
+    a: np.ndarray, b: np.ndarray, ux: np.ndarray, uy: np.ndarray, w_up: Values
+) -> np.ndarray:
     """Seed eqs. (1)–(3): level-frame earth rate by the Euler-matrix route."""
     uz = _uz(ux, uy)
     p = np.arcsin(np.clip(uy, -1.0, 1.0))
@@ -114,7 +117,9 @@ def _azimuth_coordinate(a, b, ux, uy, w_up):
     return np.arctan2(-wlx, wly)  # ω^l = Ω[-cos L sin ψ, cos L cos ψ, sin L]
 
 
-def _azimuth_vector(a, b, ux, uy, w_up):
+def _azimuth_vector(
+    a: np.ndarray, b: np.ndarray, ux: np.ndarray, uy: np.ndarray, w_up: Values
+) -> np.ndarray:
     """Seed eq. (10), corrected: projections of the horizontal earth rate."""
     uz = _uz(ux, uy)
     a1 = a - w_up * uy  # a' = ω_h·y_t   (vertical leakage removed)
@@ -125,13 +130,22 @@ def _azimuth_vector(a, b, ux, uy, w_up):
     return np.arctan2(bt, at)
 
 
-def _azimuth_vector_literal(a, b, ux, uy, w_up):
+def _azimuth_vector_literal(
+    a: np.ndarray, b: np.ndarray, ux: np.ndarray, uy: np.ndarray, w_up: Values
+) -> np.ndarray:
     """Seed eq. (10) as printed: b'/cos θ_b over a'/cos θ_a (exact only if ux·uy = 0)."""
     a1, b1 = a - w_up * uy, b + w_up * ux
     return np.arctan2(b1 / np.sqrt(1.0 - ux * ux), a1 / np.sqrt(1.0 - uy * uy))
 
 
-def azimuth_from_harmonics(a, b, ux, uy, lat, method: str = "coordinate"):
+def azimuth_from_harmonics(
+    a: Values,
+    b: Values,
+    ux: Values,
+    uy: Values,
+    lat: Values,
+    method: str = "coordinate",
+) -> np.ndarray:
     """Azimuth of the reference axis from gyro harmonics and the estimated tilt.
 
     Parameters
@@ -230,6 +244,8 @@ class NorthfindEstimate:
     accel_coef : (*S, 2, 3) float, m/s². ``[R, a, b]`` of the x and y accelerometers.
     gyro_residual : (*S, n) float, rad/s. Least-squares residuals of the gyro.
     accel_residual : (*S, n, 2) float, m/s². Residuals of the accelerometers.
+    azimuth_error : (P, *S) float, rad, or None. ``azimuth - truth`` wrapped to [-π, π),
+        when the truth was given.
     """
 
     methods: tuple[str, ...]
@@ -244,30 +260,65 @@ class NorthfindEstimate:
     accel_coef: np.ndarray
     gyro_residual: np.ndarray
     accel_residual: np.ndarray
+    azimuth_error: np.ndarray | None = None
 
 
-def estimate_northfind(gyro, accel, theta, lat, g, methods=METHODS) -> NorthfindEstimate:
-    """Harmonic fits, tilt and azimuth by each method.
+def estimate_northfind(
+    gyro: np.ndarray,
+    accel: np.ndarray,
+    theta: np.ndarray,
+    lat: float,
+    g: float,
+    methods: Sequence[str] = METHODS,
+    *,
+    azimuth_true: Values | None = None,
+) -> NorthfindEstimate:
+    """Harmonic fits, tilt and azimuth by each method, from the dwell means of one turn.
+
+    The array route of north-finding: a recorded north-finder gives these means directly
+    (:func:`gcalign.northfind.run_northfind` simulates them first).
 
     Parameters
     ----------
     gyro : (..., n) float, rad/s
-        Gyro dwell means.
+        Gyro dwell means (leading shape ``S``, e.g. (M, R) azimuths × repeats).
     accel : (..., n, 2) float, m/s²
-        Dwell means of the [x, y] accelerometers.
+        Dwell means of the [x, y] accelerometers, the same leading shape.
     theta : (n,) float, rad
-        Nominal table angles.
+        Nominal table angles, n >= 3.
     lat : float, rad
-        Latitude.
+        Latitude, ``|lat| < π/2``.
     g : float, m/s²
-        Gravity magnitude used to scale the accelerometer harmonics.
+        Gravity magnitude used to scale the accelerometer harmonics (> 0).
     methods : sequence of str
         Subset of :data:`METHODS` (and ``"vector_literal"``).
+    azimuth_true : float or array broadcastable to ``S``, rad, optional
+        The truth; gives :attr:`NorthfindEstimate.azimuth_error`.
 
     Returns
     -------
     NorthfindEstimate
+
+    Raises
+    ------
+    ValueError
+        An input of the wrong shape, not finite, or out of range (names the argument).
+
+    >>> from gcalign.northfind.geometry import position_angles
+    >>> th, lat, g = position_angles(4), np.radians(40.0), 9.8
+    >>> w = 7.2921151467e-5 * np.cos(lat)  # level table, reference axis at azimuth 30°
+    >>> gyro = w * np.cos(th - np.radians(30.0))  # a = w cos ψ, b = w sin ψ
+    >>> est = estimate_northfind(gyro, np.zeros((4, 2)), th, lat, g, ["none"],
+    ...                          azimuth_true=np.radians(29.0))
+    >>> np.degrees([est.azimuth[0], est.azimuth_error[0]]).round(9).tolist()
+    [30.0, 1.0]
     """
+    gyro, accel, theta = _check_means(gyro, accel, theta)
+    if not (np.isfinite(lat) and abs(lat) < 0.5 * np.pi):
+        raise ValueError(f"lat must satisfy |lat| < pi/2 rad (north is undefined at the "
+                         f"poles), got {lat!r}")
+    if not (np.isfinite(g) and g > 0.0):
+        raise ValueError(f"g must be a finite gravity > 0 m/s², got {g!r}")
     methods = tuple(methods)
     for name in methods:
         if name not in _ALL_METHODS:
@@ -284,6 +335,16 @@ def estimate_northfind(gyro, accel, theta, lat, g, methods=METHODS) -> Northfind
         if "coordinate" in methods
         else azimuth_from_harmonics(a, b, ux, uy, lat, "coordinate")
     )
+    error = None
+    if azimuth_true is not None:
+        truth = np.asarray(azimuth_true, dtype=float)
+        if not np.all(np.isfinite(truth)):
+            raise ValueError(f"azimuth_true must be finite, got {truth.tolist()}")
+        try:
+            error = wrap_pi(az - np.broadcast_to(truth, gyro.shape[:-1]))
+        except ValueError:
+            raise ValueError(f"azimuth_true must broadcast to the leading shape "
+                             f"{gyro.shape[:-1]} of gyro, got {truth.shape}") from None
     return NorthfindEstimate(
         methods=methods,
         azimuth=az,
@@ -297,4 +358,28 @@ def estimate_northfind(gyro, accel, theta, lat, g, methods=METHODS) -> Northfind
         accel_coef=accel_coef,
         gyro_residual=gyro_res,
         accel_residual=np.moveaxis(accel_res, -2, -1),
+        azimuth_error=error,
     )
+
+
+def _check_means(
+    gyro: np.ndarray, accel: np.ndarray, theta: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The dwell means and angles as float arrays of matching shapes, all finite."""
+    out = []
+    for name, value in (("gyro", gyro), ("accel", accel), ("theta", theta)):
+        a = np.asarray(value, dtype=float)
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"{name} must be finite, got a non-finite entry")
+        out.append(a)
+    gyro, accel, theta = out
+    if theta.ndim != 1 or theta.size < 3:
+        raise ValueError(f"theta must have shape (n,) with n >= 3 positions, got {theta.shape}")
+    n = theta.size
+    if gyro.shape[-1:] != (n,):
+        raise ValueError(f"gyro must have shape (..., {n}) (one mean per position), "
+                         f"got {gyro.shape}")
+    if accel.shape != (*gyro.shape, 2):
+        raise ValueError(f"accel must have shape {(*gyro.shape, 2)} (gyro's, then [x, y]), "
+                         f"got {accel.shape}")
+    return gyro, accel, theta

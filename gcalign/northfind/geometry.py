@@ -16,10 +16,12 @@ from gcalign.nav import earth
 
 __all__ = ["pitch_roll_from_tilt", "position_angles", "table_dcm", "tilt_from_pitch_roll"]
 
+#: A scalar or an array of any shape (broadcast together), in the unit the parameter names.
+Values = float | np.ndarray
 _TWO_PI = 2.0 * np.pi
 
 
-def _wrap_2pi(a):
+def _wrap_2pi(a: Values) -> np.ndarray:
     """Wrap angles (rad) to [0, 2π)."""
     return np.mod(a, _TWO_PI)
 
@@ -33,7 +35,7 @@ def position_angles(n: int) -> np.ndarray:
     return np.arange(n) * (_TWO_PI / n)
 
 
-def table_dcm(azimuth, tilt, tilt_direction):
+def table_dcm(azimuth: Values, tilt: Values, tilt_direction: Values) -> np.ndarray:
     """Attitude ``C_nt`` of the table frame (columns x_t, y_t, z_t in ENU).
 
     Parameters
@@ -73,7 +75,9 @@ def table_dcm(azimuth, tilt, tilt_direction):
     return np.stack([x_t, y_t, z_t], -1)
 
 
-def pitch_roll_from_tilt(tilt, tilt_direction_rel):
+def pitch_roll_from_tilt(
+    tilt: Values, tilt_direction_rel: Values
+) -> tuple[np.ndarray, np.ndarray]:
     """PSINS pitch and roll of a table tilted by ε toward ζ_rel (relative to its axis).
 
     Parameters
@@ -105,7 +109,7 @@ def pitch_roll_from_tilt(tilt, tilt_direction_rel):
     return np.arcsin(np.clip(uy, -1.0, 1.0)), np.arctan2(-ux, uz)
 
 
-def tilt_from_pitch_roll(pitch, roll):
+def tilt_from_pitch_roll(pitch: Values, roll: Values) -> tuple[np.ndarray, np.ndarray]:
     """Tilt ε and relative tilt direction ζ_rel from PSINS table pitch and roll.
 
     Parameters
@@ -130,11 +134,11 @@ def tilt_from_pitch_roll(pitch, roll):
     return tilt, _wrap_2pi(np.arctan2(-ux, -uy * uz))
 
 
-def _uz(ux, uy):
+def _uz(ux: np.ndarray, uy: np.ndarray) -> np.ndarray:
     return np.sqrt(np.clip(1.0 - ux * ux - uy * uy, 0.0, 1.0))
 
 
-def _ideal_readings(C_nt, theta, lat, g):
+def _ideal_readings(C_nt: np.ndarray, theta: np.ndarray, lat: float, g: float) -> np.ndarray:
     """Noise-free gyro and accelerometer readings.
 
     Parameters

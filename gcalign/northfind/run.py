@@ -8,11 +8,11 @@ and returns the errors against the truth beside the closed-form predictions
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from gcalign.nav.rotation import wrap_pi
 from gcalign.northfind.estimate import METHODS, estimate_northfind
 from gcalign.northfind.simulate import NorthfindSetup, simulate_table
 from gcalign.northfind.theory import predict_azimuth_std, predicted_error
@@ -92,7 +92,7 @@ def run_northfind(
     setup: NorthfindSetup,
     rng: np.random.Generator,
     *,
-    methods=METHODS,
+    methods: Sequence[str] = METHODS,
     samples: bool = False,
 ) -> NorthfindResult:
     """Simulate a multi-position north-finder and estimate the azimuth by each method.
@@ -114,9 +114,10 @@ def run_northfind(
     NorthfindResult
     """
     data = simulate_table(setup, rng, samples=samples)
-    est = estimate_northfind(data.gyro, data.accel, data.theta, setup.lat, data.gravity, methods)
+    est = estimate_northfind(data.gyro, data.accel, data.theta, setup.lat, data.gravity, methods,
+                             azimuth_true=setup.azimuths[:, None])
     methods = est.methods
-    err = wrap_pi(est.azimuth - setup.azimuths[None, :, None])
+    assert est.azimuth_error is not None  # the truth was given
     std_pred = np.stack(
         [
             predict_azimuth_std(setup, m) if m in METHODS else np.full(setup.azimuths.size, np.nan)
@@ -129,7 +130,7 @@ def run_northfind(
         tilt_true=np.array(setup.tilt, dtype=float),
         tilt_direction_true=setup.tilt_direction_north,
         azimuth_est=est.azimuth,
-        azimuth_error=err,
+        azimuth_error=est.azimuth_error,
         error_pred=predicted_error(setup, methods),
         azimuth_std_pred=std_pred,
         tilt_est=est.tilt,

@@ -18,8 +18,31 @@ from gcalign.northfind.geometry import _ideal_readings, _wrap_2pi, position_angl
 __all__ = ["NorthfindSetup", "TableData", "simulate_table"]
 
 
-def _deg(x) -> str:
+def _deg(x: float) -> str:
     return f"{np.degrees(x):.6g} deg"
+
+
+def _finite(name: str, value: object) -> np.ndarray:
+    """`value` as a float array; ValueError naming `name` unless every entry is finite."""
+    a = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite, got {a.tolist()}")
+    return a
+
+
+def _per_azimuth(name: str, value: object, m: int) -> np.ndarray:
+    """A scalar or (M,) value broadcast to (M,)."""
+    a = np.asarray(value, dtype=float)
+    if a.ndim > 1 or (a.ndim == 1 and a.size != m):
+        raise ValueError(f"{name} must be a scalar or have shape ({m},), got {a.shape}")
+    return np.broadcast_to(a, (m,)).copy()
+
+
+def _is_int(x: object) -> bool:
+    """A whole number (3 or 3.0, not True, 3.5 or inf)."""
+    return (isinstance(x, (int, float, np.integer, np.floating))
+            and not isinstance(x, (bool, np.bool_)) and bool(np.isfinite(x))
+            and float(x) == int(x))
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -84,94 +107,54 @@ class NorthfindSetup:
     index_error: float = 0.0
 
     def __post_init__(self) -> None:
-        def setf(name, value):
-            object.__setattr__(self, name, value)
-
-        az = np.atleast_1d(np.asarray(self.azimuths, dtype=float))
+        az = _finite("azimuths", np.atleast_1d(np.asarray(self.azimuths, dtype=float)))
         if az.ndim != 1:
             raise ValueError(f"azimuths must have shape (M,), got {az.shape}")
         if az.size == 0:
             raise ValueError("azimuths must hold at least one azimuth (empty sweep), got []")
-        if not np.all(np.isfinite(az)):
-            raise ValueError(f"azimuths must be finite, got {az.tolist()}")
-        setf("azimuths", _wrap_2pi(az))
         m = az.size
-
-        lat = float(self.lat)
-        if not np.isfinite(lat) or abs(lat) >= 0.5 * np.pi:
-            raise ValueError(
-                f"lat must satisfy |lat| < pi/2 rad (north is undefined at the poles), "
-                f"got {lat!r} rad ({_deg(lat)})"
-            )
-        setf("lat", lat)
-
-        pos = self.positions
-        if isinstance(pos, (bool, np.bool_)) or int(pos) != pos or int(pos) < 3:
-            raise ValueError(
-                f"positions must be an integer >= 3 (three unknowns R, a, b per sensor), "
-                f"got {pos!r}"
-            )
-        setf("positions", int(pos))
-
-        for name in ("dwell_s", "rate_hz"):
-            v = float(getattr(self, name))
-            if not np.isfinite(v) or v <= 0.0:
-                raise ValueError(f"{name} must be > 0, got {getattr(self, name)!r}")
-            setf(name, v)
-        if round(self.dwell_s * self.rate_hz) < 1:
+        lat = float(_finite("lat", self.lat))
+        tilt = _finite("tilt", _per_azimuth("tilt", self.tilt, m))
+        tdir = _finite("tilt_direction", _per_azimuth("tilt_direction", self.tilt_direction, m))
+        accel_bias = _finite("accel_bias", self.accel_bias)
+        numbers = {name: float(_finite(name, getattr(self, name)))
+                   for name in ("dwell_s", "rate_hz", "height", "gyro_bias", "gyro_arw",
+                                "gyro_scale", "accel_vrw", "index_error")}
+        bad_tilt = (tilt < 0.0) | (tilt >= 0.5 * np.pi)
+        t_bad = float(tilt[np.argmax(bad_tilt)])
+        rules = [
+            ("positions", _is_int(self.positions) and self.positions >= 3,
+             "be an integer >= 3 (three unknowns R, a, b per sensor)", self.positions),
+            ("repeats", _is_int(self.repeats) and self.repeats >= 1, "be an integer >= 1",
+             self.repeats),
+            ("lat", abs(lat) < 0.5 * np.pi, "satisfy |lat| < pi/2 rad (north is undefined at "
+             "the poles)", f"{lat!r} rad ({_deg(lat)})"),
+            ("tilt", not np.any(bad_tilt), "satisfy 0 <= tilt < pi/2 rad (0 <= tilt < 90 deg)",
+             f"{t_bad!r} rad ({_deg(t_bad)})"),
+            ("tilt_direction_ref", self.tilt_direction_ref in ("north", "table"),
+             "be 'north' or 'table'", repr(self.tilt_direction_ref)),
+            ("accel_bias", accel_bias.shape in ((), (2,)), "be a scalar or shape (2,) [x, y]",
+             accel_bias.shape),
+            ("gyro_scale", numbers["gyro_scale"] > -1.0, "be > -1", numbers["gyro_scale"]),
+        ]
+        rules += [(name, numbers[name] > 0.0, "be > 0", getattr(self, name))
+                  for name in ("dwell_s", "rate_hz")]
+        rules += [(name, numbers[name] >= 0.0, "be >= 0", getattr(self, name))
+                  for name in ("gyro_arw", "accel_vrw", "index_error")]
+        for name, ok, allowed, got in rules:
+            if not ok:
+                raise ValueError(f"{name} must {allowed}, got {got}")
+        if round(numbers["dwell_s"] * numbers["rate_hz"]) < 1:
             raise ValueError(
                 f"dwell_s * rate_hz must give at least one sample per position, got "
                 f"dwell_s={self.dwell_s!r} s at rate_hz={self.rate_hz!r} Hz"
             )
-
-        tilt = np.asarray(self.tilt, dtype=float)
-        if tilt.ndim > 1 or (tilt.ndim == 1 and tilt.size != m):
-            raise ValueError(f"tilt must be a scalar or have shape ({m},), got {tilt.shape}")
-        bad = ~np.isfinite(tilt) | (tilt < 0.0) | (tilt >= 0.5 * np.pi)
-        if np.any(bad):
-            v = float(np.atleast_1d(tilt)[np.argmax(np.atleast_1d(bad))])
-            raise ValueError(
-                f"tilt must satisfy 0 <= tilt < pi/2 rad (0 <= tilt < 90 deg), "
-                f"got {v!r} rad ({_deg(v)})"
-            )
-        setf("tilt", np.broadcast_to(tilt, (m,)).copy())
-
-        tdir = np.asarray(self.tilt_direction, dtype=float)
-        if tdir.ndim > 1 or (tdir.ndim == 1 and tdir.size != m):
-            raise ValueError(
-                f"tilt_direction must be a scalar or have shape ({m},), got {tdir.shape}"
-            )
-        if not np.all(np.isfinite(tdir)):
-            raise ValueError(f"tilt_direction must be finite, got {tdir.tolist()}")
-        setf("tilt_direction", np.broadcast_to(tdir, (m,)).copy())
-        if self.tilt_direction_ref not in ("north", "table"):
-            raise ValueError(
-                f"tilt_direction_ref must be 'north' or 'table', got {self.tilt_direction_ref!r}"
-            )
-
-        rep = self.repeats
-        if isinstance(rep, (bool, np.bool_)) or int(rep) != rep or int(rep) < 1:
-            raise ValueError(f"repeats must be an integer >= 1, got {rep!r}")
-        setf("repeats", int(rep))
-
-        for name in ("height", "gyro_bias", "gyro_scale"):
-            v = float(getattr(self, name))
-            if not np.isfinite(v):
-                raise ValueError(f"{name} must be finite, got {getattr(self, name)!r}")
-            setf(name, v)
-        if self.gyro_scale <= -1.0:
-            raise ValueError(f"gyro_scale must be > -1, got {self.gyro_scale!r}")
-        for name in ("gyro_arw", "accel_vrw", "index_error"):
-            v = float(getattr(self, name))
-            if not np.isfinite(v) or v < 0.0:
-                raise ValueError(f"{name} must be >= 0, got {getattr(self, name)!r}")
-            setf(name, v)
-        ab = np.asarray(self.accel_bias, dtype=float)
-        if ab.shape not in ((), (2,)) or not np.all(np.isfinite(ab)):
-            raise ValueError(
-                f"accel_bias must be a finite scalar or shape (2,) [x, y], got {ab.tolist()}"
-            )
-        setf("accel_bias", np.broadcast_to(ab, (2,)).copy())
+        for name, value in (("azimuths", _wrap_2pi(az)), ("lat", lat), ("tilt", tilt),
+                            ("tilt_direction", tdir), ("positions", int(self.positions)),
+                            ("repeats", int(self.repeats)),
+                            ("accel_bias", np.broadcast_to(accel_bias, (2,)).copy()),
+                            *numbers.items()):
+            object.__setattr__(self, name, value)
 
     @property
     def theta(self) -> np.ndarray:
@@ -220,7 +203,9 @@ class TableData:
     gravity: float
 
 
-def simulate_table(setup: NorthfindSetup, rng: np.random.Generator, *, samples: bool = False):
+def simulate_table(
+    setup: NorthfindSetup, rng: np.random.Generator, *, samples: bool = False
+) -> TableData:
     """Simulate the dwell means of the gyro and accelerometers for every azimuth and repeat.
 
     Parameters

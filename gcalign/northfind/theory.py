@@ -8,6 +8,8 @@ squares (:func:`azimuth_std_level`, :func:`predict_azimuth_std`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from gcalign.nav import earth
@@ -18,7 +20,7 @@ from gcalign.northfind.estimate import (
     azimuth_from_harmonics,
     tilt_from_accel,
 )
-from gcalign.northfind.geometry import _ideal_readings, table_dcm
+from gcalign.northfind.geometry import Values, _ideal_readings, table_dcm
 from gcalign.northfind.simulate import NorthfindSetup
 
 __all__ = [
@@ -30,7 +32,9 @@ __all__ = [
 ]
 
 
-def _tilt_error(azimuth, tilt, tilt_direction, tan_lat):
+def _tilt_error(
+    azimuth: Values, tilt: Values, tilt_direction: Values, tan_lat: Values
+) -> np.ndarray:
     psi = np.asarray(azimuth, float)
     eps = np.asarray(tilt, float)
     zeta = np.asarray(tilt_direction, float)
@@ -41,7 +45,9 @@ def _tilt_error(azimuth, tilt, tilt_direction, tan_lat):
     return wrap_pi(np.arctan2(y, x) - psi)
 
 
-def none_error(azimuth, tilt, tilt_direction, lat):
+def none_error(
+    azimuth: Values, tilt: Values, tilt_direction: Values, lat: Values
+) -> np.ndarray:
     """Exact azimuth error of the uncompensated (``none``) method on a tilted table.
 
     Parameters
@@ -87,7 +93,7 @@ def none_error(azimuth, tilt, tilt_direction, lat):
     return _tilt_error(azimuth, tilt, tilt_direction, np.tan(lat))
 
 
-def naive_error(azimuth, tilt, tilt_direction):
+def naive_error(azimuth: Values, tilt: Values, tilt_direction: Values) -> np.ndarray:
     """Azimuth error of the ``naive`` method (seed eq. 11) with an exact tilt estimate.
 
     Same parameters as :func:`none_error` (no latitude dependence). Returns (...) rad:
@@ -98,7 +104,7 @@ def naive_error(azimuth, tilt, tilt_direction):
     return _tilt_error(azimuth, tilt, tilt_direction, 0.0)
 
 
-def predicted_error(setup: NorthfindSetup, methods=METHODS) -> np.ndarray:
+def predicted_error(setup: NorthfindSetup, methods: Sequence[str] = METHODS) -> np.ndarray:
     """Deterministic tilt-induced error of each method for an error-free instrument.
 
     Returns
@@ -121,7 +127,9 @@ def predicted_error(setup: NorthfindSetup, methods=METHODS) -> np.ndarray:
     return np.stack(out)
 
 
-def azimuth_std_level(gyro_arw, dwell_s, rate_hz, positions, lat):
+def azimuth_std_level(
+    gyro_arw: float, dwell_s: float, rate_hz: float, positions: int, lat: float
+) -> float:
     """Azimuth standard deviation from gyro white noise, level table, equally spaced.
 
     Parameters
@@ -141,7 +149,7 @@ def azimuth_std_level(gyro_arw, dwell_s, rate_hz, positions, lat):
     """
     n_samples = round(dwell_s * rate_hz)
     sigma_m = gyro_arw * np.sqrt(rate_hz / n_samples)
-    return sigma_m * np.sqrt(2.0 / positions) / (earth.OMEGA_IE * np.cos(lat))
+    return float(sigma_m * np.sqrt(2.0 / positions) / (earth.OMEGA_IE * np.cos(lat)))
 
 
 def predict_azimuth_std(setup: NorthfindSetup, method: str = "coordinate") -> np.ndarray:

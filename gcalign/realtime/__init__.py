@@ -19,7 +19,8 @@ Modules
 - :mod:`~gcalign.realtime.cases` -- turntable motions, the seed's Table 1 cases.
 - :mod:`~gcalign.realtime.chain` -- :func:`run_case`: one case end to end on the core
   (ideal increments, sensor, filter, attitude-only strapdown with coning correction).
-- :mod:`~gcalign.realtime.table` -- :func:`table1`, :func:`summarise`: our Table 1.
+- :mod:`~gcalign.realtime.table` -- :func:`run_realtime` (:class:`RealtimeResult`): every
+  case and its row of our Table 1 (:func:`table1`, :func:`summarise`).
 
 Angles are radians, times seconds, Euler angles ``[pitch, roll, yaw]`` (PSINS order).
 
@@ -44,8 +45,8 @@ _WHERE = {
     "PREDICTORS": "settings", "FilterSettings": "settings", "PulseSettings": "settings",
     "SensorSettings": "settings", "Settings": "settings", "TrackerSettings": "settings",
     "seed_semi_physical": "settings",
-    "CaseSummary": "table", "PredictorStats": "table", "summarise": "table",
-    "table1": "table",
+    "CaseSummary": "table", "PredictorStats": "table", "RealtimeResult": "table",
+    "run_realtime": "table", "summarise": "table", "table1": "table",
 }
 
 __all__ = sorted(_WHERE)

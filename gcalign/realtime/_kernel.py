@@ -7,8 +7,9 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def track_kernel(z, Phi, Qd, R, x, P, x_out, P_out, innov_out, S_out,
-                 store_P):  # pragma: no cover - numba
+def track_kernel(z: np.ndarray, Phi: np.ndarray, Qd: np.ndarray, R: float, x: np.ndarray,
+                 P: np.ndarray, x_out: np.ndarray, P_out: np.ndarray, innov_out: np.ndarray,
+                 S_out: np.ndarray, store_P: bool) -> None:  # pragma: no cover - numba
     """Kalman predict/update of ``X = [θ, ω, α]`` with the scalar measurement ``z_k = θ_k + v``.
 
     ``x`` (3,), ``P`` (3, 3): the posterior before the first sample, updated in place to

@@ -31,6 +31,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -213,7 +214,7 @@ class Case:
 
 
 def rate_case(name: str, rate: float, duration: float, *,
-              axis: tuple[float, float, float] = Z_AXIS, **kw) -> Case:
+              axis: tuple[float, float, float] = Z_AXIS, **kw: Any) -> Case:
     """Uniform rate `rate` (rad/s) about `axis` for `duration` (s), at speed from t = 0."""
     return Case(name=name, steps=(Step(axis, AngleProfile.constant_rate(rate, duration)),),
                 **kw)
@@ -221,7 +222,7 @@ def rate_case(name: str, rate: float, duration: float, *,
 
 def accel_case(name: str, accel: float, rate_limit: float, duration: float, *,
                rest_s: float = 1.0, jerk: float | None = None,
-               axis: tuple[float, float, float] = Z_AXIS, **kw) -> Case:
+               axis: tuple[float, float, float] = Z_AXIS, **kw: Any) -> Case:
     """Rest `rest_s`, then from rest uniform acceleration `accel` (rad/s², optional finite
     `jerk`, rad/s³) up to `rate_limit` (rad/s), held to the end; `duration` (s) in all."""
     if not 0 <= rest_s < duration:
@@ -232,7 +233,8 @@ def accel_case(name: str, accel: float, rate_limit: float, duration: float, *,
 
 
 def swing_case(name: str, amplitude: float, frequency: float, duration: float, *,
-               phase: float = 0.0, axis: tuple[float, float, float] = Z_AXIS, **kw) -> Case:
+               phase: float = 0.0, axis: tuple[float, float, float] = Z_AXIS,
+               **kw: Any) -> Case:
     """``θ = A (sin(2π f t + φ) − sin φ)`` (rad, Hz, rad) about `axis` for `duration` (s)."""
     return Case(name=name, steps=(Step(axis, AngleProfile.swing(amplitude, frequency, duration,
                                                                 phase)),), **kw)

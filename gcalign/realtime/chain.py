@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -167,7 +168,8 @@ def _lagrange4(u: np.ndarray) -> np.ndarray:
 
 
 def run_case(case: Case, settings: Settings, rng: np.random.Generator, *,
-             site=SITE, earth: EarthModel = WGS84, keep_series: bool = False) -> CaseResult:
+             site: Sequence[float] | np.ndarray = SITE, earth: EarthModel = WGS84,
+             keep_series: bool = False) -> CaseResult:
     """Run `case` with `settings` at `site` ``[lat, lon (rad), h (m)]`` on `earth` (see the
     module docstring); `rng` draws, in this order, the counter and dither phases, the
     asynchronous pulse clock, the warm-up noise, and block by block the gyro noise (the

@@ -13,17 +13,19 @@ table (seed Fig. 4: 4.4 ms) is measured from the error before prediction, ``−e
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.realtime.cases import TABLE1, Case
-from gcalign.realtime.chain import METRICS, SITE, CaseResult, run_case
+from gcalign.realtime.chain import METRICS, SITE, CaseResult, build_chain, run_case
+from gcalign.realtime.filters import FilterChain
 from gcalign.realtime.settings import Settings
 
-__all__ = ["CaseSummary", "PredictorStats", "summarise", "table1"]
+__all__ = ["CaseSummary", "PredictorStats", "RealtimeResult", "run_realtime", "summarise",
+           "table1"]
 
 
 @dataclass(frozen=True)
@@ -115,7 +117,8 @@ def summarise(res: CaseResult) -> CaseSummary:
 
 
 def table1(settings: Settings, rng: np.random.Generator, cases: Sequence[Case] = TABLE1, *,
-           site=SITE, earth: EarthModel = WGS84, progress=None) -> list[CaseResult]:
+           site: Sequence[float] | np.ndarray = SITE, earth: EarthModel = WGS84,
+           progress: Callable[[int, int, str], None] | None = None) -> list[CaseResult]:
     """Run the seed's 12 cases (or `cases`) with `settings` at `site`; each case draws from
     its own child generator (``rng.spawn``), so a case's numbers do not depend on the
     others. `progress(done, total, what)`, if given, hears of each case finished."""
@@ -126,3 +129,36 @@ def table1(settings: Settings, rng: np.random.Generator, cases: Sequence[Case] =
         if progress is not None:
             progress(i + 1, len(cases), "cases")
     return out
+
+
+@dataclass(frozen=True)
+class RealtimeResult:
+    """A run of :func:`run_realtime` (SI, rad).
+
+    settings : the settings the cases ran with. chain : the filter chain (taps, notch).
+    chain_delay : s, the chain's low-frequency group delay (FIR ``N/(2 Fs)`` plus the
+    notch's). delay : s, the T the predictors used (``settings.delay_s`` or `chain_delay`).
+    cases : per case its pulse records (:class:`~gcalign.realtime.chain.CaseResult`).
+    rows : per case its row of our Table 1 (:class:`CaseSummary`).
+    """
+
+    settings: Settings
+    chain: FilterChain
+    chain_delay: float
+    delay: float
+    cases: tuple[CaseResult, ...]
+    rows: tuple[CaseSummary, ...]
+
+
+def run_realtime(settings: Settings, rng: np.random.Generator,
+                 cases: Sequence[Case] = TABLE1, *,
+                 site: Sequence[float] | np.ndarray = SITE, earth: EarthModel = WGS84,
+                 progress: Callable[[int, int, str], None] | None = None) -> RealtimeResult:
+    """Every case through the chain (:func:`table1`) and its row of the table
+    (:func:`summarise`): the library route of ``gcalign realtime``. `site` is
+    ``[lat, lon (rad), h (m)]``; `progress(done, total, what)` hears of each case."""
+    chain = build_chain(settings)
+    results = table1(settings, rng, cases, site=site, earth=earth, progress=progress)
+    delay = chain.delay if settings.delay_s is None else float(settings.delay_s)
+    return RealtimeResult(settings=settings, chain=chain, chain_delay=chain.delay, delay=delay,
+                          cases=tuple(results), rows=tuple(summarise(r) for r in results))

@@ -16,6 +16,7 @@ common random numbers).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,22 +27,23 @@ from gcalign.calibrate import (
     FlightData,
     Settings,
     calibrate,
-    combine_increments,
     draw_truth,
     flight_from_ideal,
     motion_spans,
+    parked_data,
     sampled_truth,
-    zero_velocity_data,
+    zero_velocity_aiding,
 )
 from gcalign.calibrate.filter import warm_up
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig
-from gcalign.nav.strapdown import NavState
+from gcalign.nav.earth import EarthModel
 from gcalign.sim.motions import Truth
 
 MEASURES = ie.MEASUREMENTS
+Progress = Callable[[int, int, str], None]  # (done, total, what)
 
 
 @dataclass(frozen=True)
@@ -80,8 +82,8 @@ def config_of(sc: Scenario) -> CalibrateConfig:
     return sc.calibrate or CalibrateConfig()
 
 
-def injected_truth(sc: Scenario, cfg: CalibrateConfig, settings: Settings, site, earth,
-                   seed: int) -> np.ndarray:
+def injected_truth(sc: Scenario, cfg: CalibrateConfig, settings: Settings, site: np.ndarray,
+                   earth: EarthModel, seed: int) -> np.ndarray:
     """The 21 injected errors (SI): the imu section's biases and scale factors and
     ``calibrate.initial_error`` (truth: scenario), or a draw from the filter's P0."""
     if cfg.truth == "draw":
@@ -117,18 +119,9 @@ def simulated_case(sc: Scenario, seed: int | None = None, cache_key: str | None 
     if window[0] > 0 or window[2] < data.t[-1] - 1e-9:
         data = data.between(window[0], window[2])
     if cfg.aiding_for(sc) == "zero-velocity":
-        data = zero_velocity_reference(data)
+        data = zero_velocity_aiding(data)
     return Case(data, settings, "simulated", cfg.aiding_for(sc), n, sc.imu.rate_hz, seed,
                 cfg.truth, None, window)
-
-
-def zero_velocity_reference(data: FlightData) -> FlightData:
-    """The same data aided by zero velocity at the start position (a parked vehicle)."""
-    from dataclasses import replace
-
-    n = len(data.t)
-    return replace(data, ref_v_n=np.zeros((n, 3)),
-                   ref_pos=np.tile(np.asarray(data.start.pos, float), (n, 1)))
 
 
 def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
@@ -155,9 +148,8 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
                                                    earth=earth)
     except ValueError as err:
         raise ScenarioError(f"calibrate.coarse.duration_s: {err}") from None
-    dth, dv = combine_increments(imu.dtheta[i1:i2], imu.dv[i1:i2], n)
-    t = coarse_end + np.arange(len(dth) + 1) * n * ts
-    data = zero_velocity_data(t, dth, dv, NavState.from_euler(att, np.zeros(3), site), earth)
+    data = parked_data(imu.dtheta[i1:i2], imu.dv[i1:i2], ts, att, site, t0=coarse_end,
+                       subsamples=n, earth=earth)
     return Case(data, cfg.settings(site, earth), imu.source, "zero-velocity", n, rate, None,
                 None, att, (start, coarse_end, end))
 
@@ -192,7 +184,7 @@ def run_filter(case: Case, measure: str | None = None, data: FlightData | None =
     return Run(label, data, result, time.perf_counter() - t0)
 
 
-def compare_runs(case: Case, segments: int, progress=None) -> list[Run]:
+def compare_runs(case: Case, segments: int, progress: Progress | None = None) -> list[Run]:
     """The seed's Table 3: velocity, position and both on the whole flight ("designed")
     and on its first `segments` segments ("conventional"), on the same data and noise;
     `progress(done, total, what)` hears of each of the six filter runs."""
@@ -313,13 +305,16 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            compare: bool = False, progress=None) -> Outcome:
-    """Build the case, run the filter (or the six runs of `compare`), summarise."""
+            compare: bool = False, progress: Progress | None = None) -> Outcome:
+    """Build the case, run the filter (or the six runs of `compare`), summarise; the
+    Outcome's result is the :class:`~gcalign.calibrate.CalibrationResult` (with `compare`: the
+    six, in the summary's order)."""
     from gcalign.app.calibrate.hdf5 import write_calibration
 
     case = scenario_case(sc, seed, cache_key)
     runs = (compare_runs(case, config_of(sc).conventional_segments, progress) if compare
             else [run_filter(case)])
     out = summary(sc, case, runs, compare)
+    result = tuple(r.result for r in runs) if compare else runs[0].result
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),
-                   case.seed)
+                   case.seed, result=result)

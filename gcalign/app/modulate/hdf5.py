@@ -17,8 +17,7 @@ import numpy as np
 
 from gcalign.io.results import put
 from gcalign.io.scenario.modulate import Entry
-from gcalign.modulate.invariants import InvariantReport
-from gcalign.modulate.linear import LinearErrors
+from gcalign.modulate.analysis import SchemeAnalysis
 
 REF = "reference frame of the scheme (body or navigation), sensor axes in columns"
 
@@ -33,8 +32,8 @@ def _packed(group, name: str, data, units: str, frame: str | None = None, **attr
         ds.attrs[k] = v
 
 
-def write_scheme(g, entry: Entry, r: InvariantReport, lin: LinearErrors | None,
-                 cycle: dict[str, np.ndarray], ts: float) -> None:
+def write_scheme(g, entry: Entry, analysis: SchemeAnalysis, ts: float) -> None:
+    r, lin, cycle = analysis.invariants, analysis.linear, analysis.cycle
     s = entry.scheme
     g.attrs["scheme"] = entry.name
     g.attrs["reference"] = s.reference
@@ -43,11 +42,11 @@ def write_scheme(g, entry: Entry, r: InvariantReport, lin: LinearErrors | None,
     g.attrs["imu_ts"] = ts
     g.attrs["mechanism"] = entry.mechanism is not None
     m = g.create_group("mechanism")
-    _packed(m, "t", cycle["t"], "s", description="time in the cycle")
-    _packed(m, "angle", cycle["angle"], "rad", "sensor axes x, y, z",
+    _packed(m, "t", cycle.t, "s", description="time in the cycle")
+    _packed(m, "angle", cycle.angle, "rad", "sensor axes x, y, z",
             description="angle turned about each sensor axis since the start of the cycle")
-    _packed(m, "C_diag", cycle["C_diag"], "", REF, description="diagonal of C_s^r(t)")
-    _packed(m, "q", cycle["q"], "", REF, description="quaternion of C_s^r(t), scalar first")
+    _packed(m, "C_diag", cycle.C_diag, "", REF, description="diagonal of C_s^r(t)")
+    _packed(m, "q", cycle.q, "", REF, description="quaternion of C_s^r(t), scalar first")
     inv = g.create_group("invariants")
     inv.attrs["period_s"] = r.period
     inv.attrs["schuler_period_s"] = r.schuler_period

@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
+from typing import Any
 
 import numpy as np
 
@@ -30,14 +31,12 @@ from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.modulate import Entry, Plan, plan_of
 from gcalign.io.scenario.navigation import NavigationConfig, OutputConfig
-from gcalign.modulate.invariants import InvariantReport, invariant_report
-from gcalign.modulate.linear import REPORT_HOURS, LinearErrors, linear_errors
+from gcalign.modulate.analysis import SchemeAnalysis, analyse_scheme
+from gcalign.modulate.invariants import InvariantReport
+from gcalign.modulate.linear import REPORT_HOURS, LinearErrors
 from gcalign.modulate.terms import ErrorTerms
-from gcalign.nav.rotation import euler_to_dcm, quat_to_dcm
 from gcalign.units import ARCSEC, DPH, DPSH, HOUR, PPM, UG, UGPSHZ
 
-LINEAR_DT_S = 60.0  # output interval of the linear model (its report hours are exact)
-CYCLE_DT_S = 0.25  # mechanism angles over one cycle: sample interval (at most)
 Progress = Callable[[str, int, int], None]  # (scheme, index, count)
 
 
@@ -54,8 +53,10 @@ def default_rate_hz(duration_s: float, imu_rate_hz: float) -> float:
     return min(imu_rate_hz, 1.0 if duration_s <= 4 * HOUR else 0.1)
 
 
-def seed_scenario(compare, *, rate: float = 10.0, hours: float = 72.0, gyro=None, accel=None,
-                  mechanism=None, navigation=None, seed: int = 1, linear: bool = True,
+def seed_scenario(compare: Iterable[str], *, rate: float = 10.0,
+                  hours: float = 72.0, gyro: dict | None = None, accel: dict | None = None,
+                  mechanism: dict | None = None, navigation: dict | None = None, seed: int = 1,
+                  linear: bool = True,
                   source: str = "seed004") -> Scenario:
     """The built-in seed 004 scenario (gcalign/scenarios/seed004_modulation.yaml) with the
     given changes, errors in user units (``imu.gyro``/``imu.accel`` sections replace the
@@ -132,33 +133,7 @@ def error_terms(sc: Scenario, entry: Entry) -> ErrorTerms:
     return ErrorTerms.of_sensors(e.gyro, e.accel, (0.0, 0.0, 0.0) if lever is None else lever)
 
 
-def linear_C0(sc: Scenario, entry: Entry) -> np.ndarray:
-    """C_s^n = C0 · S(t) of the linear model: the schedule S starts at its own q0 (the body's
-    attitude for a navigation-referenced scheme), so C0 is I there and C_b^n otherwise."""
-    if entry.scheme.reference == "navigation":
-        return np.eye(3)
-    assert sc.motion is not None
-    return euler_to_dcm(np.radians(sc.motion.attitude_deg))
-
-
-def mechanism_cycle(schedule, dt: float = CYCLE_DT_S) -> dict[str, np.ndarray]:
-    """One cycle of the schedule: t (s), the angle turned about each sensor axis since the
-    start of the cycle (rad, exact: completed steps plus the current one), the diagonal of
-    C(t) (where each sensor axis points) and q (C(t))."""
-    T = schedule.period
-    n = max(2, int(math.ceil(T / min(dt, T / 2000.0))) + 1)
-    t = np.linspace(0.0, T, n)
-    t[-1] = np.nextafter(T, 0.0)  # the end of the cycle, not the start of the next
-    theta, _, _, step = schedule.angle_rate_accel(t)
-    tb = schedule.tables()
-    done = np.cumsum([[0.0, 0.0, 0.0]] + [np.asarray(tb["axis"][i]) * st.profile.angle
-                                          for i, st in enumerate(schedule.steps)], axis=0)
-    angle = done[step] + tb["axis"][step] * theta[:, None]
-    q = schedule.quat(t)
-    return {"t": t, "angle": angle, "C_diag": np.einsum("nii->ni", quat_to_dcm(q)), "q": q}
-
-
-def _arcsec(v) -> list[float]:
+def _arcsec(v: np.ndarray) -> list[float]:
     return (np.asarray(v, dtype=float) / ARCSEC).tolist()
 
 
@@ -198,10 +173,11 @@ def linear_summary(lin: LinearErrors, hours: list[float]) -> dict:
     }
 
 
-def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group=None,
-               linear: bool = True) -> dict:
-    """Navigate one scheme (and its linear model); its summary. `group`: an h5py group for
-    the series, the invariants, the mechanism cycle and the linear model."""
+def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group: Any = None,
+               linear: bool = True) -> tuple[dict, SchemeAnalysis]:
+    """Navigate one scheme and analyse it (:func:`gcalign.modulate.analyse_scheme`); its
+    summary and the analysis. `group`: an h5py group for the series, the invariants, the
+    mechanism cycle and the linear model."""
     from gcalign.app.modulate.hdf5 import write_scheme
 
     hours = report_hours(plan.hours)
@@ -210,14 +186,13 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group=N
     probe = HourProbe(hours)
     nav, stream = run_navigation(v, seed, None, group, on_rows=probe)
     terms = error_terms(sc, entry)
-    assert sc.site is not None
-    lat = float(sc.site.to_si()[0])
-    report = invariant_report(entry.scheme, terms, earth=sc.earth_model, lat=lat)
-    lin = None
-    if linear and sc.motion is not None and sc.motion.kind == "static":
-        lin = linear_errors(entry.scheme.schedule, terms,
-                            duration=plan.duration_s, dt_out=LINEAR_DT_S, lat=lat,
-                            earth=sc.earth_model, C0=linear_C0(sc, entry), name=entry.name)
+    assert sc.site is not None and sc.motion is not None
+    static = linear and sc.motion.kind == "static"
+    analysis = analyse_scheme(entry.scheme, terms, lat=float(sc.site.to_si()[0]),
+                              earth=sc.earth_model,
+                              att0=np.radians(sc.motion.attitude_deg) if static else None,
+                              duration=plan.duration_s, name=entry.name)
+    report, lin = analysis.invariants, analysis.linear
     me, fe = nav["max_error"], nav["final_error"]
     s = entry.scheme
     out = {
@@ -236,12 +211,11 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group=N
         "compute_s": nav["compute_s"],
     }
     if group is not None:
-        cycle = mechanism_cycle(s.schedule)
-        write_scheme(group, entry, report, lin, cycle, stream.ts)
-    return out
+        write_scheme(group, entry, analysis, stream.ts)
+    return out, analysis
 
 
-def errors_summary(sc: Scenario, lever_cm) -> dict:
+def errors_summary(sc: Scenario, lever_cm: Any) -> dict:
     e = sc.imu.errors()
     g, a = e.gyro, e.accel
     return {
@@ -255,21 +229,25 @@ def errors_summary(sc: Scenario, lever_cm) -> dict:
     }
 
 
-def run_modulate(sc: Scenario, seed: int | None = None, sink=None,
-                 progress: Progress | None = None) -> tuple[dict, tuple[str, ...]]:
-    """Every scheme of the plan; the summary (plain numbers) and the warnings."""
+def run_modulate(sc: Scenario, seed: int | None = None, sink: Any = None,
+                 progress: Progress | None = None
+                 ) -> tuple[dict, tuple[str, ...], dict[str, SchemeAnalysis]]:
+    """Every scheme of the plan; the summary (plain numbers), the warnings and the analysis
+    of each scheme by name."""
     t0 = time.perf_counter()
     plan = plan_of(sc)
     cfg = sc.modulate
     linear = True if cfg is None else cfg.linear
     root = None if sink is None else sink.create_group("modulate")
     schemes: dict[str, dict] = {}
+    analyses: dict[str, SchemeAnalysis] = {}
     warnings: list[str] = []
     for i, entry in enumerate(plan.entries):
         if progress is not None:
             progress(entry.name, i, len(plan.entries))
         group = None if root is None else root.create_group(entry.name)
-        schemes[entry.name] = r = run_scheme(sc, entry, plan, seed, group, linear)
+        r, analyses[entry.name] = run_scheme(sc, entry, plan, seed, group, linear)
+        schemes[entry.name] = r
         warnings += [f"{entry.name}: {w}" for w in r["schuler_warnings"]]
     assert sc.site is not None and sc.motion is not None
     if linear and sc.motion.kind != "static":
@@ -296,12 +274,13 @@ def run_modulate(sc: Scenario, seed: int | None = None, sink=None,
         "max_horizontal_error_m": [schemes[n]["max_horizontal_error_m"] for n in names],
         "wall_s": time.perf_counter() - t0,
     }
-    return summary, tuple(warnings)
+    return summary, tuple(warnings), analyses
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None, sink=None,
-            progress: Progress | None = None) -> Outcome:
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+            sink: Any = None, progress: Progress | None = None) -> Outcome:
     """The registry's entry point: with `sink` (an open results file) the series go into
-    its /modulate group as they are computed."""
-    summary, warnings = run_modulate(sc, seed, sink, progress)
-    return Outcome(summary, lambda f: None, None, summary["seed"], warnings)
+    its /modulate group as they are computed. The Outcome's result is the
+    :class:`~gcalign.modulate.SchemeAnalysis` of each scheme, by name."""
+    summary, warnings, analyses = run_modulate(sc, seed, sink, progress)
+    return Outcome(summary, lambda f: None, None, summary["seed"], warnings, result=analyses)

@@ -25,7 +25,7 @@ from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.northfind import NorthfindConfig, axis
 
-__all__ = ["NorthfindRun", "northfind_summary", "run_northfind", "run_northfind_scenario"]
+__all__ = ["NorthfindRun", "execute", "northfind_summary", "run_northfind"]
 
 
 @dataclass(frozen=True)
@@ -61,9 +61,7 @@ def run_northfind(sc: Scenario, seed: int | None = None) -> NorthfindRun:
             "(positions, dwell_s, azimuth_deg or sweep, tilt_deg, …)"
         )
     setup = cfg.to_setup(sc)
-    seed = sc.imu.seed if seed is None else int(seed)
-    if seed < 0:
-        raise ScenarioError(f"imu.seed (--seed): must be >= 0, got {seed}")
+    seed = sc.imu.seed if seed is None else int(seed)  # checked by the registry's run
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
     result = nf.run_northfind(setup, rng, methods=tuple(cfg.methods), samples=cfg.samples)
@@ -71,25 +69,21 @@ def run_northfind(sc: Scenario, seed: int | None = None) -> NorthfindRun:
                         compute_s=time.perf_counter() - t0)
 
 
-#: The name the brief and older callers use.
-run_northfind_scenario = run_northfind
-
-
-def _num(x) -> float | None:
+def _num(x: float) -> float | None:
     x = float(x)
     return None if math.isnan(x) else x
 
 
-def _list(a) -> list:
+def _list(a: np.ndarray) -> list:
     """Plain floats (NaN -> None) of any array, flattened in C order."""
     return [_num(v) for v in np.asarray(a, float).ravel()]
 
 
-def _deg(a) -> list:
+def _deg(a: np.ndarray) -> list:
     return _list(np.degrees(a))
 
 
-def _deg360(a) -> list:
+def _deg360(a: np.ndarray) -> list:
     return _list(np.mod(np.degrees(a), 360.0))
 
 
@@ -177,4 +171,5 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None)
     from gcalign.app.northfind.hdf5 import write_northfind
 
     run = run_northfind(sc, seed)
-    return Outcome(northfind_summary(run, sc), lambda f: write_northfind(f, run), None, run.seed)
+    return Outcome(northfind_summary(run, sc), lambda f: write_northfind(f, run), None, run.seed,
+                   result=run.result)

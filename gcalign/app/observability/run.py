@@ -14,9 +14,12 @@ import numpy as np
 
 from gcalign.app.registry import Outcome
 from gcalign.calibrate import (
+    ObservabilitySettings,
     ObservabilityTable,
+    Span,
+    Trajectory,
     motion_spans,
-    observability_table,
+    observability,
     sampled_truth,
     trajectory,
 )
@@ -27,7 +30,8 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 
 
-def flight_truth(sc: Scenario, cache_key: str | None = None):
+def flight_truth(sc: Scenario,
+                 cache_key: str | None = None) -> tuple[Trajectory, tuple[Span, ...]]:
     """The scenario's truth at the navigation rate (:class:`gcalign.calibrate.Trajectory`)
     and its manoeuvres."""
     from gcalign.app.data import cached_noise_free, noise_free
@@ -45,7 +49,8 @@ def flight_truth(sc: Scenario, cache_key: str | None = None):
     return traj, motion_spans(sc.motion.to_motion(), float(traj.t[-1]))
 
 
-def run_table(sc: Scenario, cache_key: str | None = None):
+def run_table(sc: Scenario, cache_key: str | None = None
+              ) -> tuple[ObservabilityTable, Trajectory, tuple[Span, ...], float]:
     """``(table, trajectory, spans, compute_s)``: the table's own time, without the
     simulation."""
     cfg = sc.observability or ObservabilityConfig()
@@ -55,8 +60,9 @@ def run_table(sc: Scenario, cache_key: str | None = None):
     settings = cal.settings(traj.pos[0], traj.earth)
     warm_up()
     t0 = time.perf_counter()
-    tab = observability_table(traj, spans, cfg.measure, cfg.scaling, cfg.rank_rtol,
-                              cfg.piece_s, cfg.null_tol, settings, cfg.covariance)
+    options = ObservabilitySettings(cfg.measure, cfg.scaling, cfg.rank_rtol, cfg.piece_s,
+                                    cfg.null_tol, cfg.covariance)
+    tab = observability(traj, spans, options, settings)
     return tab, traj, spans, time.perf_counter() - t0
 
 
@@ -64,7 +70,8 @@ def _degrees(values: np.ndarray) -> dict:
     return {n: float(v) for n, v in zip(ie.STATE_NAMES, values, strict=True)}
 
 
-def summary(sc: Scenario, tab: ObservabilityTable, spans, compute_s: float) -> dict:
+def summary(sc: Scenario, tab: ObservabilityTable, spans: tuple[Span, ...],
+            compute_s: float) -> dict:
     """Plain numbers: the JSON contract of ``gcalign observability``."""
     segs, cum = [], []
     for i, sp in enumerate(spans):
@@ -102,4 +109,4 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None)
     tab, traj, spans, compute_s = run_table(sc, cache_key)
     truth = sampled_truth(traj, spans)
     return Outcome(summary(sc, tab, spans, compute_s),
-                   lambda f: write_observability(f, tab, truth, spans), truth, None)
+                   lambda f: write_observability(f, tab, truth, spans), truth, None, result=tab)

@@ -56,17 +56,17 @@ def write_filter(g: h5py.Group, chain) -> None:
 
 def write_realtime(f: h5py.File, run) -> None:
     """/realtime: the run's settings, the filter, and the per-pulse arrays of every case."""
-    s = run.settings
+    s = run.result.settings
     g = f.create_group("realtime")
-    T = run.chain.delay if s.delay_s is None else float(s.delay_s)
-    g.attrs.update(reference=run.cfg.reference, delay=T, chain_delay=run.chain.delay,
+    T = run.result.delay
+    g.attrs.update(reference=run.cfg.reference, delay=T, chain_delay=run.result.chain_delay,
                    solution_hz=s.solution_hz, fs_hz=s.filter.fs_hz,
                    predictors=",".join(s.predictors), settle_s=s.settle_s,
                    corner_s=s.corner_s,
                    units="delay, chain_delay, settle_s, corner_s: s; solution_hz, fs_hz: Hz")
-    write_filter(g.create_group("filter"), run.chain)
+    write_filter(g.create_group("filter"), run.result.chain)
     cases = g.create_group("cases")
-    for i, res in enumerate(run.results):
+    for i, res in enumerate(run.result.cases):
         c = cases.create_group(f"{i:02d}")
         case, p = res.case, res.pulses
         train = case.pulses or s.pulses

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,10 +35,9 @@ from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.realtime import RealtimeConfig
 from gcalign.realtime.cases import Case
-from gcalign.realtime.chain import CaseResult, build_chain
-from gcalign.realtime.filters import FilterChain
-from gcalign.realtime.settings import Settings
-from gcalign.realtime.table import CaseSummary, summarise, table1
+from gcalign.realtime.chain import CaseResult
+from gcalign.realtime.table import CaseSummary, RealtimeResult
+from gcalign.realtime.table import run_realtime as core_run
 
 __all__ = ["RealtimeRun", "execute", "realtime_summary", "run_realtime"]
 
@@ -46,19 +46,16 @@ COMPONENTS = ("pitch", "roll", "yaw")
 
 @dataclass(frozen=True)
 class RealtimeRun:
-    """A run: configuration, SI settings, the filter chain, per case its result and its
-    row of the table, the seed and the compute time."""
+    """A run: configuration, the core's result (SI), the seed and the compute time."""
 
     cfg: RealtimeConfig
-    settings: Settings
-    chain: FilterChain
-    results: list[CaseResult]
-    rows: list[CaseSummary]
+    result: RealtimeResult
     seed: int
     compute_s: float
 
 
-def run_realtime(sc: Scenario, seed: int | None = None, progress=None) -> RealtimeRun:
+def run_realtime(sc: Scenario, seed: int | None = None,
+                 progress: Callable[[int, int, str], None] | None = None) -> RealtimeRun:
     """Run every case of the scenario's ``realtime`` section.
 
     Raises
@@ -72,17 +69,12 @@ def run_realtime(sc: Scenario, seed: int | None = None, progress=None) -> Realti
                             "(cases or a turntable motion, filter, sensor, tracker, pulses)")
     cases = cfg.cases_of(sc)
     settings = cfg.to_settings()
-    seed = sc.imu.seed if seed is None else int(seed)
-    if seed < 0:
-        raise ScenarioError(f"imu.seed (--seed): must be ≥ 0, got {seed}")
+    seed = sc.imu.seed if seed is None else int(seed)  # checked by the registry's run
     assert sc.site is not None  # checked by cases_of
     t0 = time.perf_counter()
-    results = table1(settings, np.random.default_rng(seed), cases, site=sc.site.to_si(),
-                     earth=sc.earth_model, progress=progress)
-    rows = [summarise(r) for r in results]
-    return RealtimeRun(cfg=cfg, settings=settings, chain=build_chain(settings),
-                       results=results, rows=rows, seed=seed,
-                       compute_s=time.perf_counter() - t0)
+    result = core_run(settings, np.random.default_rng(seed), cases, site=sc.site.to_si(),
+                      earth=sc.earth_model, progress=progress)
+    return RealtimeRun(cfg=cfg, result=result, seed=seed, compute_s=time.perf_counter() - t0)
 
 
 def _as(x: float) -> float | None:
@@ -146,8 +138,8 @@ def case_summary(res: CaseResult, row: CaseSummary, reference: str) -> dict:
 
 def realtime_summary(run: RealtimeRun, sc: Scenario) -> dict:
     """Plain-number summary: the JSON contract of ``gcalign realtime --json``."""
-    s, chain, cfg = run.settings, run.chain, run.cfg
-    T = chain.delay if s.delay_s is None else float(s.delay_s)
+    s, chain, cfg = run.result.settings, run.result.chain, run.cfg
+    T = run.result.delay
     site = sc.site
     assert site is not None
     f, sen, tr = s.filter, s.sensor, s.tracker
@@ -184,16 +176,16 @@ def realtime_summary(run: RealtimeRun, sc: Scenario) -> dict:
         "settle_s": s.settle_s,
         "corner_ms": s.corner_s * 1e3,
         "cases": [case_summary(r, row, cfg.reference)
-                  for r, row in zip(run.results, run.rows, strict=True)],
+                  for r, row in zip(run.result.cases, run.result.rows, strict=True)],
         "compute_s": run.compute_s,
     }
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            progress=None) -> Outcome:
+            progress: Callable[[int, int, str], None] | None = None) -> Outcome:
     """Run, summarise; the registry's entry point (`progress`: one report per case)."""
     from gcalign.app.realtime.hdf5 import write_realtime
 
     run = run_realtime(sc, seed, progress)
     return Outcome(realtime_summary(run, sc), lambda f: write_realtime(f, run), None,
-                   run.seed)
+                   run.seed, result=run.result)
