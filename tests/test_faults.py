@@ -121,6 +121,27 @@ def test_sigterm_of_a_run_removes_its_temp_file(tmp_path):
     assert temps(tmp_path) == [] and not (tmp_path / "l.h5").exists()
 
 
+class _Signal(BaseException):
+    """What the SIGTERM handler raises (the command line's Terminated), anywhere."""
+
+
+@pytest.mark.parametrize("where", ["fchmod", "_GuardedFile"])
+def test_a_signal_right_after_the_temporary_file_exists_removes_it(tmp_path, monkeypatch,
+                                                                   where):
+    """The windows between creating the temporary file and the writer's cleanup (its mode
+    set, its Python file object made): a SIGTERM landing there left the file behind."""
+    def interrupted(*a, **k):
+        raise _Signal
+
+    if where == "fchmod":
+        monkeypatch.setattr(results.os, "fchmod", interrupted)
+    else:
+        monkeypatch.setattr(results, "_GuardedFile", interrupted)
+    with pytest.raises(_Signal), results.atomic_h5(tmp_path / "o.h5"):
+        pass
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_the_guard_is_silent_once_a_failed_run_closed_its_file(tmp_path):
     """A SIGTERM that lands inside h5py can leave HDF5 objects to be freed after the failed
     run closed and deleted its temporary file; freeing them writes and truncates through the

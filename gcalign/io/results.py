@@ -137,7 +137,7 @@ def make_temp(path: Path) -> tuple[int, Path]:
                                     dir=path.parent)
         try:  # mkstemp makes it private (0600); the renamed file is an ordinary one
             os.fchmod(fd, 0o666 & ~_umask())
-        except OSError:
+        except BaseException:  # SIGTERM raises here too: leave no temporary file
             os.close(fd)
             os.unlink(name)
             raise
@@ -235,10 +235,10 @@ def atomic_h5(path: Path) -> Iterator[h5py.File]:
     """
     path = check_output(path)
     fd, tmp = make_temp(path)
-    raw = os.fdopen(fd, "w+b")
-    guard = _GuardedFile(raw)
-    f = None
-    try:
+    raw = guard = f = None
+    try:  # everything after the file exists, so that a SIGTERM anywhere removes it
+        raw = os.fdopen(fd, "w+b")
+        guard = _GuardedFile(raw)
         f = h5py.File(guard, "w")
         yield f
         f.close()
@@ -249,6 +249,8 @@ def atomic_h5(path: Path) -> Iterator[h5py.File]:
             raise guard.error
         os.replace(tmp, path)
     except BaseException as err:
+        if raw is None:
+            os.close(fd)
         for closing in (f, raw):
             try:
                 if closing is not None:
@@ -256,8 +258,9 @@ def atomic_h5(path: Path) -> Iterator[h5py.File]:
             except Exception:  # noqa: BLE001 - the file is deleted anyway
                 pass
         tmp.unlink(missing_ok=True)
-        refused = guard.error if guard.error is not None else err
-        if guard.error is not None or (isinstance(err, OSError) and (
+        guard_error = guard.error if guard is not None else None
+        refused = guard_error if guard_error is not None else err
+        if guard_error is not None or (isinstance(err, OSError) and (
                 _from_h5py(err) or err.errno in _WRITE_ERRNOS)):
             if not isinstance(err, (KeyboardInterrupt, SystemExit)):
                 raise write_error(path, refused) from None
