@@ -26,6 +26,7 @@ from typing import Literal
 import numpy as np
 from matplotlib.figure import Figure
 
+from gcalign import units
 from gcalign.errors import ScenarioError
 
 ANGLES = ("pitch", "roll", "yaw")
@@ -94,17 +95,12 @@ def time_axis(t: np.ndarray) -> tuple[np.ndarray, str]:
 
 
 def angle_scale(values_rad: np.ndarray) -> tuple[float, str]:
-    """Multiplier from rad and the unit: deg from 1°, arc-minutes from 1′, else ″ (the
-    table's rule, :func:`gcalign.app.report.angle_unit`)."""
+    """Multiplier from rad and the unit: the rule of :func:`gcalign.units.angle_unit` (deg
+    from 1°, arc-minutes from 1′, else ″), applied to the largest finite |value|."""
     v = np.asarray(values_rad, float)
     v = v[np.isfinite(v)]
-    peak = float(np.max(np.abs(v))) if v.size else 0.0
-    deg = math.degrees(peak)
-    if deg >= 1.0:
-        return math.degrees(1.0), "deg"
-    if deg * 60.0 >= 1.0:
-        return math.degrees(1.0) * 60.0, "arcmin"
-    return math.degrees(1.0) * 3600.0, "arcsec"
+    unit = units.angle_unit(float(np.max(np.abs(v))) if v.size else 0.0)
+    return 1.0 / units.ANGLE_UNITS[unit][0], unit
 
 
 def rate_scale(values_rad_s: np.ndarray) -> tuple[float, str]:
