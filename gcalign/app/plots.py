@@ -215,7 +215,7 @@ def figures_for(path: Path) -> dict[str, Figure]:
     if not isinstance(name, str):
         name = path.stem
     with results.open_results(path) as f:
-        figs: dict[str, Figure] = COMMANDS[kind].load().figures(f, name) if kind in COMMANDS else {}
+        figs: dict[str, Figure] = COMMANDS[kind].figures(f, name) if kind in COMMANDS else {}
         if not figs:
             figs = truth_and_imu(f, name)
     if not figs:

@@ -181,7 +181,7 @@ def summary_table(kind: str, summary: dict) -> RenderableType:
         raise ScenarioError(f"kind: {kind!r} is not a gcalign command ({', '.join(COMMANDS)}); "
                             "a results file from another version, or a damaged one")
     try:
-        table = COMMANDS[kind].load().table(summary)
+        table = COMMANDS[kind].table(summary)
     except (KeyError, IndexError, TypeError, ValueError, AttributeError) as err:
         raise ScenarioError(f"summary_json: not the summary of a {kind!r} run "
                             f"({type(err).__name__}: {str(err)[:60]}); a damaged results "

@@ -145,7 +145,7 @@ def batch(
         if bar is not None:
             bar.stop()
     summary = result.summary
-    consoles(as_json).print(engine.table(summary))
+    consoles(as_json).print(engine.COMMAND.table(summary))
     if as_json:
         emit_json(summary)
     if summary["failed"]:  # the file records them: a result, but not a success

@@ -122,7 +122,7 @@ def install(app: typer.Typer) -> None:
         if cmd is not None and info.help is None and info.short_help is None:
             info.short_help = cmd.help  # the command list shows the registry's line
         if (cmd is not None and name != "batch") or name == "validate":
-            recorded = cmd.recorded if cmd is not None else True
+            recorded = cmd.options.recorded if cmd is not None else True
             info.callback = with_common_options(info.callback, recorded)
             info.callback._common = True  # type: ignore[attr-defined]
 

@@ -374,19 +374,6 @@ def write_truth(f: h5py.File, truth: Truth):
     put(g, "pos", truth.pos, "rad, rad, m", "[latitude, longitude, height], WGS-84")
 
 
-def write_imu(f: h5py.File, imu: ImuData):
-    g = f.create_group("imu")
-    g.attrs["ts"] = imu.ts
-    g.attrs["source"] = imu.source
-    put(g, "t", imu.t, "s", description="end time of each increment")
-    put(g, "dtheta", imu.dtheta, "rad", "body: x right, y forward, z up")
-    put(g, "dv", imu.dv, "m/s", "body: x right, y forward, z up")
-    for name in ("site", "att0", "v0_n"):
-        value = getattr(imu, name)
-        if value is not None:
-            g.attrs[name] = value
-
-
 def open_results(path: Path) -> h5py.File:
     """Open a gcalign results file for reading; ScenarioError if it is missing or not ours."""
     path = Path(path)

@@ -23,14 +23,18 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from gcalign.app.batch.overrides import apply_override
-from gcalign.app.preflight import total_runs
-from gcalign.app.registry import batchable
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.loader import _cut
 from gcalign.limits import SEED_MAX
 
-COMMANDS = tuple(batchable())
-DEFAULT_METRICS = {name: c.batch_metrics for name, c in batchable().items()}
+
+def batchable() -> dict[str, tuple[str, ...]]:
+    """The commands a sweep can run -> their default metrics (from the registry)."""
+    from gcalign.app.registry import batchable as registered
+
+    return {name: c.options.batch_metrics for name, c in registered().items()}
+
+
 SWEEP_KEYS = ("name", "base", "command", "cases", "grid", "seeds", "seed_start", "metrics")
 CASE_KEY = "case"  # the pseudo grid key of a variant's case (not a scenario key)
 
@@ -152,14 +156,14 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
 
     command = data.get("command")
     if command is None:
-        has = [c for c in COMMANDS if isinstance(base_data, dict) and c in base_data]
+        has = [c for c in batchable() if isinstance(base_data, dict) and c in base_data]
         if len(has) > 1:
             raise ScenarioError(f"{source}: command: the base has sections for "
                                 f"{', '.join(has)}; say which to run (command: "
                                 f"{' | '.join(has)})")
         command = has[0] if has else "align"
-    if command not in COMMANDS:
-        raise ScenarioError(f"{source}: command: must be one of {', '.join(COMMANDS)}, "
+    if command not in batchable():
+        raise ScenarioError(f"{source}: command: must be one of {', '.join(batchable())}, "
                             f"got {_cut(command)}")
 
     seeds = data.get("seeds", 1)
@@ -174,7 +178,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
         raise ScenarioError(f"{source}: seed_start: the seeds {seed_start} .. "
                             f"{seed_start + seeds - 1} pass 2^63 - 1 (seeds are signed 64-bit)")
 
-    metrics = data.get("metrics", list(DEFAULT_METRICS[command]))
+    metrics = data.get("metrics", list(batchable()[command]))
     if isinstance(metrics, str):
         metrics = [metrics]
     if not isinstance(metrics, list) or not metrics:
@@ -212,6 +216,8 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
         axes[key] = values
 
     n_variants = math.prod(len(v) for v in axes.values()) * max(1, len(cases))
+    from gcalign.app.preflight import total_runs
+
     total_runs(n_variants, seeds, source)
 
     # Each case alone, then each grid key and value alone against the base: a message that
@@ -335,20 +341,20 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
         datas.append(data)
         texts.append(path.read_text(encoding="utf-8"))
     if command is None:
-        found = {c for d in datas for c in COMMANDS if isinstance(d, dict) and c in d}
+        found = {c for d in datas for c in batchable() if isinstance(d, dict) and c in d}
         if len(found) > 1:
             raise ScenarioError(f"batch: the files have sections of {', '.join(sorted(found))}; "
                                 "say which command to run (--command)")
         command = found.pop() if found else "align"
-    if command not in COMMANDS:
-        raise ScenarioError(f"--command: must be one of {', '.join(COMMANDS)}, got {command!r}")
+    if command not in batchable():
+        raise ScenarioError(f"--command: must be one of {', '.join(batchable())}, got {command!r}")
     labels = [p.name for p in paths]
     if len(set(labels)) < len(labels):
         labels = [str(p) for p in paths]
     if len(set(labels)) < len(labels):
         raise ScenarioError("batch: a scenario file is listed twice")
     spec = {"files": [str(p) for p in paths], "command": command, "seeds": seeds,
-            "seed_start": seed_start, "metrics": list(metrics or DEFAULT_METRICS[command])}
+            "seed_start": seed_start, "metrics": list(metrics or batchable()[command])}
     stems = [p.name.split(".")[0] for p in paths]
     name = "+".join(stems) if len(stems) <= 3 else f"{stems[0]}+{len(stems) - 1}-more"
     # The checks of seeds, seed_start and metrics are the sweep's (one variant: file 1).
