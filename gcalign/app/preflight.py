@@ -75,7 +75,8 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
     scenario has (``gcalign validate``)."""
     commands = [command(name)] if name else _commands_of(sc)
     check_seed(sc.imu.seed, "imu.seed")
-    ext = extent(sc, read_recorded)
+    # recorded data are read only for a command that can use them (the others refuse them)
+    ext = extent(sc, read_recorded and any(c.options.recorded for c in commands))
     if ext is not None and not ext.recorded:
         sensor_errors(sc)
     if ext is None and sc.imu_file is None and not all(
