@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 
 from gcalign import __version__, limits
 from gcalign.app import preflight, registry
-from gcalign.app.command import BaseCommand, Command, Cost, Extent
+from gcalign.app.command import Command, Cost, Extent
 from gcalign.app.registry import COMMANDS, Outcome
 from gcalign.cli import app
 from gcalign.errors import ScenarioError
@@ -61,7 +61,7 @@ def test_python_m_gcalign_runs_the_command_line():
 # ---------------------------------------------------------------------- a toy command
 
 
-class Count(BaseCommand):
+class Count(Command):
     """A small command: counts the samples of the scenario's motion; its check refuses a
     motion shorter than 1 s, its cost is one operation per sample."""
 

@@ -9,8 +9,7 @@ HDF5 layout, batch metrics). The registry (:mod:`gcalign.app.registry`) holds on
 per command; adding a command is a new folder with such an object and one registry line.
 
 A command imports its heavy parts (numba kernels, scipy, matplotlib) inside its methods,
-so that ``gcalign show`` and ``gcalign validate`` never load them. :class:`BaseCommand`
-gives the defaults a command overrides.
+so that ``gcalign show`` and ``gcalign validate`` never load them.
 """
 
 from __future__ import annotations
@@ -19,7 +18,7 @@ import importlib
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from gcalign.app.registry import Outcome
@@ -83,79 +82,34 @@ class Options:
     batch_metrics: tuple[str, ...] = ()
 
 
-@runtime_checkable
-class Command(Protocol):
-    """One command (its name is also the ``kind`` of its results file)."""
-
-    name: str
-    help: str
-    section: str | None  # the scenario section it reads
-    builtin: str | None  # its built-in scenario (package data gcalign/scenarios)
-    options: Options
-    layout: tuple[str, ...]  # the HDF5 groups its results file holds beside /truth
-
-    def check(self, sc: Scenario, ext: Extent | None) -> None:
-        """Refuse (ScenarioError, one line naming the field) what the run would refuse;
-        `ext` is the scenario's data (None: it has none, or a recorded file not read)."""
-
-    def cost(self, sc: Scenario, ext: Extent | None) -> Cost:
-        """What a run costs (checked against :mod:`gcalign.limits` before any work)."""
-
-    def execute(self, sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-                **options: Any) -> Outcome:
-        """Run the scenario (after the preflight): the summary and the writer."""
-
-    def accepts(self, option: str) -> bool:
-        """Does :meth:`execute` take keyword `option` (``progress``, ``sink``, ...)?"""
-
-    def table(self, summary: dict) -> Any:
-        """The table the command prints (and ``gcalign show``): a rich renderable."""
-
-    def figures(self, f: Any, name: str) -> dict:
-        """The figures of its results file (an open h5py.File) by file stem."""
-
-    def components(self, metric: str, k: int) -> list[str]:
-        """Names of the `k` components of a vector batch metric."""
-
-    def label(self, metric: str) -> str:
-        """A metric's name in batch tables and figures."""
-
-    def warm_up(self) -> None:
-        """Load the kernels a run uses (a tiny run), before a batch's workers start."""
-
-
-def _attr(path: str) -> Any:
-    module, _, name = path.rpartition(".")
-    return getattr(importlib.import_module(module), name)
-
-
-class BaseCommand:
-    """The defaults of :class:`Command`: the room's functions named by dotted path
-    (imported when called), the section's own ``check(sc)``, the cost of reading the data.
-    """
+class Command:
+    """One command: what it reads, refuses, costs, runs, shows and stores. A command folder
+    subclasses it once (its name is also the ``kind`` of its results file); the defaults
+    reach the room's functions by dotted path, imported when called, and run the section's
+    own ``check(sc)``."""
 
     name: str = ""
     help: str = ""
-    section: str | None = None
-    builtin: str | None = None
+    section: str | None = None  #: the scenario section it reads
+    builtin: str | None = None  #: its built-in scenario (package data gcalign/scenarios)
     options: Options = Options()
-    layout: tuple[str, ...] = ()
+    layout: tuple[str, ...] = ()  #: the HDF5 groups of its results file beside /truth
     run: str = ""  #: the module whose ``execute(sc, seed, cache_key, **options)`` runs it
     table_of: str = ""  #: dotted path of ``table(summary)``
     figures_of: str = ""  #: dotted path of ``figures(f, name)``
 
     # ------------------------------------------------------------------ checks and cost
 
-    def section_of(self, sc: Scenario) -> Any:
-        return getattr(sc, self.section) if self.section else None
-
     def check(self, sc: Scenario, ext: Extent | None) -> None:
-        section = self.section_of(sc)
+        """Refuse (ScenarioError, one line naming the field) what the run would refuse;
+        `ext` is the scenario's data (None: it has none, or a recorded file not read)."""
+        section = getattr(sc, self.section) if self.section else None
         check = getattr(section, "check", None)
         if callable(check):
             check(sc)
 
     def cost(self, sc: Scenario, ext: Extent | None) -> Cost:
+        """What a run costs, checked against :mod:`gcalign.limits` before any work."""
         return Cost(samples=0.0 if ext is None else float(ext.samples))
 
     # ------------------------------------------------------------------ run
@@ -165,26 +119,34 @@ class BaseCommand:
 
     def execute(self, sc: Scenario, seed: int | None = None, cache_key: str | None = None,
                 **options: Any) -> Outcome:
+        """Run the scenario (after its preflight: :func:`gcalign.app.preflight.checked_execute`):
+        the summary and the writer of its results."""
         return self._execute()(sc, seed, cache_key, **options)
 
     def accepts(self, option: str) -> bool:
+        """Does :meth:`execute` take keyword `option` (``progress``, ``sink``, ...)?"""
         return option in inspect.signature(self._execute()).parameters
 
     # ------------------------------------------------------------------ show and store
 
     def table(self, summary: dict) -> Any:
+        """The table the command prints (and ``gcalign show``): a rich renderable."""
         return _attr(self.table_of)(summary)
 
     def figures(self, f: Any, name: str) -> dict:
+        """The figures of its results file (an open h5py.File), by file stem."""
         return _attr(self.figures_of)(f, name) if self.figures_of else {}  # type: ignore[no-any-return]
 
     def components(self, metric: str, k: int) -> list[str]:
+        """Names of the `k` components of a vector batch metric."""
         return [str(i) for i in range(k)]
 
     def label(self, metric: str) -> str:
+        """A metric's name in batch tables and figures."""
         return metric
 
     def warm_up(self) -> None:
+        """Load the kernels a run uses (a tiny run), before a batch's workers start."""
         return None
 
     def builtin_text(self) -> str:
@@ -192,6 +154,11 @@ class BaseCommand:
         if not self.builtin:
             raise KeyError(f"{self.name!r} has no built-in scenario")
         return builtin_text(self.builtin)
+
+
+def _attr(path: str) -> Any:
+    module, _, name = path.rpartition(".")
+    return getattr(importlib.import_module(module), name)
 
 
 def builtin_text(name: str) -> str:
@@ -211,7 +178,7 @@ def stride(sc: Scenario, ext: Extent) -> int:
         raise ScenarioError(str(err)) from None
 
 
-def warm_run(command: BaseCommand, scenario: dict) -> None:
+def warm_run(command: Command, scenario: dict) -> None:
     """A tiny run of `command` on `scenario` (a mapping), so that its kernels are loaded."""
     import copy
 

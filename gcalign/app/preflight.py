@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from gcalign import limits
-from gcalign.app.command import DOUBLE, BaseCommand, Cost, Extent
+from gcalign.app.command import DOUBLE, Command, Cost, Extent
 from gcalign.app.registry import COMMANDS, Outcome, command
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
@@ -89,7 +89,7 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
         budget(sc, c, ext)
 
 
-def _commands_of(sc: Scenario) -> list[BaseCommand]:
+def _commands_of(sc: Scenario) -> list[Command]:
     """The commands a scenario's sections ask for: simulate (a motion), navigate (a
     navigation section or recorded data), and every command whose section it has."""
     out = [COMMANDS["simulate"]] if sc.motion is not None else []
@@ -144,7 +144,7 @@ def sensor_errors(sc: Scenario) -> None:
                                     "input; check the units")
 
 
-def budget(sc: Scenario, cmd: BaseCommand, ext: Extent | None, workers: int = 1,
+def budget(sc: Scenario, cmd: Command, ext: Extent | None, workers: int = 1,
            where: str | None = None, batch: bool = False) -> Cost:
     """Refuse a run whose estimated cost (:meth:`Command.cost`) exceeds a limit: one line
     naming the estimate, the limit and the variable that raises it. `workers` runs at once

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from gcalign.app.command import BaseCommand, builtin_text
+from gcalign.app.command import Command, builtin_text
 
 
 @dataclass(frozen=True)
@@ -34,7 +34,7 @@ class Outcome:
     result: Any = None
 
 
-def _registered() -> dict[str, BaseCommand]:
+def _registered() -> dict[str, Command]:
     from gcalign.app.align import COMMAND as align
     from gcalign.app.batch import COMMAND as batch
     from gcalign.app.calibrate import COMMAND as calibrate
@@ -50,11 +50,11 @@ def _registered() -> dict[str, BaseCommand]:
     return {c.name: c for c in commands}
 
 
-COMMANDS: dict[str, BaseCommand] = _registered()
+COMMANDS: dict[str, Command] = _registered()
 __all__ = ["COMMANDS", "Outcome", "batchable", "builtin_text", "command", "register"]
 
 
-def command(name: str) -> BaseCommand:
+def command(name: str) -> Command:
     """The registered command `name`; KeyError names the ones that exist."""
     try:
         return COMMANDS[name]
@@ -62,12 +62,12 @@ def command(name: str) -> BaseCommand:
         raise KeyError(f"unknown command {name!r}; commands: {', '.join(COMMANDS)}") from None
 
 
-def batchable() -> dict[str, BaseCommand]:
+def batchable() -> dict[str, Command]:
     """Commands a sweep can run, with their default metrics."""
     return {n: c for n, c in COMMANDS.items() if c.options.batch_metrics}
 
 
-def register(cmd: BaseCommand) -> None:
+def register(cmd: Command) -> None:
     """Add (or replace) a command at run time, before the command line is built: how a
     test, or a plug-in, adds one without a line above."""
     COMMANDS[cmd.name] = cmd

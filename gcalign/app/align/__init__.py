@@ -8,7 +8,7 @@ from gcalign.app.command import (
     DOUBLE,
     SIMULATE_OPS,
     STRAPDOWN_OPS,
-    BaseCommand,
+    Command,
     Cost,
     Extent,
     Options,
@@ -57,7 +57,7 @@ def window(sc, ext: Extent) -> tuple[int, int]:
     return int(round(cfg.start_s / ext.ts)), max(his)
 
 
-class Align(BaseCommand):
+class Align(Command):
     name = "align"
     help = "Gyrocompass alignment (seed 000)."
     section = "align"

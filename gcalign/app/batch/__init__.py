@@ -74,10 +74,10 @@ from gcalign.app.batch.sweep import (
     load_sweep,
     sweep_from_mapping,
 )
-from gcalign.app.command import BaseCommand
+from gcalign.app.command import Command
 
 
-class Batch(BaseCommand):
+class Batch(Command):
     """``gcalign batch`` in the registry: its table and figures (``show``, ``plot``); a
     batch runs sweeps, not a scenario (:func:`run_batch`)."""
 

@@ -7,7 +7,7 @@ from gcalign.app.command import (
     KALMAN_OPS,
     SIMULATE_OPS,
     STRAPDOWN_OPS,
-    BaseCommand,
+    Command,
     Cost,
     Extent,
     Options,
@@ -66,7 +66,7 @@ def state_components(metric: str, k: int) -> list[str]:
     return [str(i) for i in range(k)]
 
 
-class Calibrate(BaseCommand):
+class Calibrate(Command):
     name = "calibrate"
     help = "In-flight calibration, 21-state Kalman filter (seed 002)."
     section = "calibrate"

@@ -7,7 +7,7 @@ from gcalign.app.command import (
     DOUBLE,
     SIMULATE_OPS,
     STRAPDOWN_OPS,
-    BaseCommand,
+    Command,
     Cost,
     Extent,
     Options,
@@ -18,7 +18,7 @@ MECHANISM_OPS = 100.0  #: per sample: the mechanism's C_s^b and the increments i
 BLOCK = 1 << 16  #: samples simulated and navigated at a time (the stream's blocks)
 
 
-class Modulate(BaseCommand):
+class Modulate(Command):
     name = "modulate"
     help = ("Rotation modulation: navigation on a turning IMU, schemes compared on the same "
             "data (seed 004).")

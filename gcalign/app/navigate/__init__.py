@@ -6,7 +6,7 @@ from gcalign.app.command import (
     DOUBLE,
     SIMULATE_OPS,
     STRAPDOWN_OPS,
-    BaseCommand,
+    Command,
     Cost,
     Extent,
     Options,
@@ -18,7 +18,7 @@ from gcalign.errors import ScenarioError
 ROW_DOUBLES = 30
 
 
-class Navigate(BaseCommand):
+class Navigate(Command):
     name = "navigate"
     help = "Strapdown navigation of simulated or recorded data."
     section = "navigation"

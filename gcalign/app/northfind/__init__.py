@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from gcalign.app.command import DOUBLE, SIMULATE_OPS, BaseCommand, Cost, Extent, Options
+from gcalign.app.command import DOUBLE, SIMULATE_OPS, Command, Cost, Extent, Options
 from gcalign.errors import ScenarioError
 
 READING_DOUBLES = 16  #: per dwell reading: gyro and accelerometer means, per method results
 
 
-class Northfind(BaseCommand):
+class Northfind(Command):
     name = "northfind"
     help = "Multi-position north-finding (seed 001)."
     section = "northfind"

@@ -9,13 +9,13 @@ from gcalign.app.calibrate import (
     state_components,
     steps,
 )
-from gcalign.app.command import DOUBLE, KALMAN_OPS, BaseCommand, Cost, Extent, Options
+from gcalign.app.command import DOUBLE, KALMAN_OPS, Command, Cost, Extent, Options
 
 N = 21  #: states
 PIECE_OPS = 40.0 * N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, its QR
 
 
-class Observability(BaseCommand):
+class Observability(Command):
     name = "observability"
     help = "PWCS/SVD observability table of a flight (seed 002)."
     section = "observability"

@@ -3,14 +3,14 @@
 
 from __future__ import annotations
 
-from gcalign.app.command import DOUBLE, BaseCommand, Cost, Extent, Options
+from gcalign.app.command import DOUBLE, Command, Cost, Extent, Options
 from gcalign.errors import ScenarioError
 
 NOTCH_OPS = 5.0  #: a second-order IIR section per sample
 SOLUTION_DOUBLES = 24  #: per attitude solution: truth, output and each predictor's error
 
 
-class Realtime(BaseCommand):
+class Realtime(Command):
     name = "realtime"
     help = "Attitude at sync pulses: filter delay and prediction (seed 003)."
     section = "realtime"

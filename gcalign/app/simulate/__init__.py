@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from typing import Any
 
-from gcalign.app.command import DOUBLE, SIMULATE_OPS, BaseCommand, Cost, Extent, Options, stride
+from gcalign.app.command import DOUBLE, SIMULATE_OPS, Command, Cost, Extent, Options, stride
 
 #: doubles stored per row: /truth t, att, v_n, pos, segment and /imu t, dtheta, dv, q_bs
 ROW_DOUBLES = 26
 
 
-class Simulate(BaseCommand):
+class Simulate(Command):
     name = "simulate"
     help = "Simulate truth and IMU data."
     options = Options(streams=True)
