@@ -10,7 +10,6 @@ from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
-from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["calibrate"].builtin or ""
 SCENARIO_HELP = "Scenario YAML; without it, the built-in seed 002 designed 590 s take-off."
@@ -18,15 +17,9 @@ MEASURE_HELP = "DGNSS measurement: velocity | position | both."
 
 
 def load_checked(path: Path | None, section: str, overrides: dict, sets: list[str] | None):
-    """Scenario and text with the options written into `section`, then the section's
-    checks across the scenario (rates, window, recorded data), named by the source."""
-    sc, text, source = load_with_overrides(path, BUILTIN, section, overrides, sets=sets)
-    cfg = getattr(sc, section)
-    if cfg is not None:
-        try:
-            cfg.check(sc)
-        except ScenarioError as err:
-            raise ScenarioError(f"{source}: {err}") from None
+    """Scenario and text with the options written into `section` (the command's check
+    runs in its preflight)."""
+    sc, text, _ = load_with_overrides(path, BUILTIN, section, overrides, sets=sets)
     return sc, text
 
 

@@ -43,16 +43,11 @@ def _one_azimuth_source(section: dict, given: dict) -> None:
 
 
 def load_northfind(path: Path | None, overrides: dict, sets: list[str] | None = None):
-    """Scenario and text with the options written into ``northfind`` before validation,
-    then the checks across sections (site, sensors) of :meth:`NorthfindConfig.check`."""
-    sc, text, source = load_with_overrides(
+    """Scenario and text with the options written into ``northfind`` before validation (the
+    command's check runs in its preflight)."""
+    sc, text, _ = load_with_overrides(
         path, BUILTIN, "northfind", overrides, _one_azimuth_source, sets=sets
     )
-    if sc.northfind is not None:
-        try:
-            sc.northfind.check(sc)
-        except ScenarioError as err:
-            raise ScenarioError(f"{source}: {err}") from None
     return sc, text
 
 

@@ -11,7 +11,6 @@ from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
-from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["realtime"].builtin or ""
 
@@ -22,16 +21,9 @@ def builtin_scenario_text() -> str:
 
 
 def load_realtime(path: Path | None, overrides: dict, sets: list[str] | None = None):
-    """Scenario and text with the options written into ``realtime`` before validation, then
-    the checks across sections (site, motion, imu) of :meth:`RealtimeConfig.check`."""
-    sc, text, source = load_with_overrides(path, BUILTIN, "realtime", overrides, sets=sets)
-    if sc.realtime is None:
-        raise ScenarioError(f"{source}: realtime: missing; the scenario needs a 'realtime' "
-                            f"section (see configs/seed003_table1.yaml)")
-    try:
-        sc.realtime.check(sc)
-    except ScenarioError as err:
-        raise ScenarioError(f"{source}: {err}") from None
+    """Scenario and text with the options written into ``realtime`` before validation (the
+    command's check runs in its preflight)."""
+    sc, text, _ = load_with_overrides(path, BUILTIN, "realtime", overrides, sets=sets)
     return sc, text
 
 
