@@ -200,8 +200,8 @@ def truth_and_imu(f, name: str) -> dict[str, Figure]:
 
 
 def figures_for(path: Path) -> dict[str, Figure]:
-    """The figures of a results file, by name (file stem of the PNG), from the room of the
-    command that wrote it (its ``figures(f, name)``), else the truth and the IMU output if
+    """The figures of a results file, by name (file stem of the PNG), from the command
+    that wrote it (its ``figures(f, name)``), else the truth and the IMU output if
     the file holds them; a recorded data file (``.imu``, CSV, compressed) gives its IMU
     figure."""
     from gcalign.app.registry import COMMANDS

@@ -79,8 +79,8 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
     ext = extent(sc, read_recorded and any(c.options.recorded for c in commands))
     if ext is not None and not ext.recorded:
         sensor_errors(sc)
-    if ext is None and sc.imu_file is None and not all(
-            c.options.self_contained for c in commands):
+    if ext is None and sc.imu_file is None and not (
+            commands and all(c.options.self_contained for c in commands)):
         raise ScenarioError("motion: missing; the scenario needs 'motion' (simulated data) "
                             "or 'imu_file' (recorded data)"
                             + ("" if name else ", or a northfind/realtime section"))

@@ -13,7 +13,7 @@ Every command of the registry gets the same habits here, not by hand:
   them and the ``--set`` items.
 * A default results file named after every override that changes the result
   (:func:`output_name`), and a warning when it replaces a run of other inputs.
-* A progress bar on stderr for long runs (:class:`ProgressBar`; a room's ``execute`` that
+* A progress bar on stderr for long runs (:class:`ProgressBar`; a command whose ``execute``
   takes ``progress=`` reports to it), keys that cannot matter as warnings (stderr, table,
   JSON), the wall time beside what ``compute`` measured.
 
@@ -397,12 +397,12 @@ class ProgressBar:
 
 def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: Path | None,
                  as_json: bool, **options) -> None:
-    """Run command `name` on a loaded scenario through its room, write the results file
-    and show its table. Default file name: :func:`output_name` with the overrides of the
-    command line (and `options`, e.g. ``--init``). A streaming command writes its series
-    into the (temporary) file while it runs; `options` go to its ``execute``, a progress
-    bar to a room that reports progress (:func:`gcalign.app.runner.run_command`). Keys that
-    cannot matter become warnings."""
+    """Run command `name` on a loaded scenario (its preflight, then its execute), write the
+    results file and show its table. Default file name: :func:`output_name` with the
+    overrides of the command line (and `options`, e.g. ``--init``). A streaming command
+    writes its series into the (temporary) file while it runs; `options` go to its
+    ``execute``, a progress bar to a command that reports progress
+    (:func:`gcalign.app.runner.run_command`). Keys that cannot matter become warnings."""
     from gcalign.app.runner import run_command
 
     inv = _INVOCATION.get() or Invocation()
