@@ -100,15 +100,19 @@ def _commands_of(sc: Scenario) -> list[Command]:
 
 
 def checked_execute(name: str, sc: Scenario, seed: int | None = None, *args: Any,
-                    **options: Any) -> Outcome:
+                    progress: Any = None, **options: Any) -> Outcome:
     """Command `name`'s ``execute`` after its preflight (the checks and the cost estimate
     ``gcalign validate`` makes), with the seed checked to lie in [0, 2^63); the summary is
-    checked to be finite."""
+    checked to be finite. `progress` goes to a command whose ``execute`` takes it (asked
+    after the preflight: the run's modules load only for a run that will happen)."""
     from gcalign.io.results import finite_summary
 
     check_seed(seed)
     preflight(sc, name)
-    outcome = command(name).execute(sc, seed, *args, **options)
+    cmd = command(name)
+    if progress is not None and cmd.accepts("progress"):
+        options["progress"] = progress
+    outcome = cmd.execute(sc, seed, *args, **options)
     finite_summary(outcome.summary, name)
     return outcome
 

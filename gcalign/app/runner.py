@@ -29,9 +29,7 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
     done, before the file is finished (the command line closes its progress bar there).
     """
     cmd = command(name)
-    kwargs = dict(options)
-    if progress is not None and cmd.accepts("progress"):
-        kwargs["progress"] = progress
+    kwargs = dict(options, progress=progress)
     t0 = time.perf_counter()
     try:
         with results.atomic_h5(out) as f:
