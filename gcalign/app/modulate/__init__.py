@@ -49,7 +49,8 @@ class Modulate(Command):
                     memory_bytes=min(n, BLOCK) * 2 * ROW_DOUBLES * DOUBLE,
                     output_bytes=schemes * rows * ROW_DOUBLES * DOUBLE,
                     work=schemes * n * (SIMULATE_OPS + MECHANISM_OPS + STRAPDOWN_OPS),
-                    work_what="schemes × samples × (mechanism, simulation, strapdown)")
+                    work_what="schemes × samples × (mechanism, simulation, strapdown)",
+                    memory_what="the blocks of the stream")
 
 
 COMMAND = Modulate()
