@@ -70,7 +70,7 @@ class Options:
     """How a command runs.
 
     recorded : it can run on recorded data (the command line adds the recorded-data
-        options, :data:`gcalign.cli.common.RECORDED_OPTIONS`).
+        options, :func:`gcalign.cli.common.recorded_parameters`).
     streams : its ``execute`` writes series into an open results file (``sink=``).
     self_contained : it simulates its own data from its section (no motion needed).
     batch_metrics : default metrics of a batch; () = not batchable.
@@ -85,7 +85,7 @@ class Options:
 class Command:
     """One command: what it reads, refuses, costs, runs, shows and stores. A command folder
     subclasses it once (its name is also the ``kind`` of its results file); the defaults
-    reach the room's functions by dotted path, imported when called, and run the section's
+    reach the folder's modules by dotted path, imported when called, and run the section's
     own ``check(sc)``."""
 
     name: str = ""
