@@ -8,7 +8,7 @@ that loads the numba cache), contenders interleaved:
 * ``core``: :func:`gcalign.realtime.table1` + ``summarise`` (the chain on the core);
 * ``ideal_blocks``: the core's ideal increments alone for the same 12 cases (its share);
 * ``command``: what ``gcalign realtime`` does in-process — the built-in scenario (the 12
-  cases and the 13th asynchronous one) through the room's ``execute``, the results file
+  cases and the 13th asynchronous one) through the command's ``execute``, the results file
   written (per-pulse arrays, compressed) and the table rendered;
 * ``CLI``: ``gcalign realtime`` as a new process (median of 3; imports and cache loads).
 
@@ -29,7 +29,7 @@ import numpy as np
 import yaml
 from rich.console import Console
 
-from gcalign.app.realtime import execute, table
+from gcalign.app.realtime import COMMAND
 from gcalign.cli.common import builtin_text
 from gcalign.io import results
 from gcalign.io.scenario import parse_scenario
@@ -54,10 +54,10 @@ def _ideal() -> None:
 
 def _command(sc, out: Path) -> None:
     with results.atomic_h5(out) as f:
-        outcome = execute(sc, None)
+        outcome = COMMAND.execute(sc, None)
         results.write_header(f, "realtime", "", outcome.seed, outcome.summary)
         outcome.write(f)
-    Console(file=io.StringIO(), width=160).print(table(outcome.summary))
+    Console(file=io.StringIO(), width=160).print(COMMAND.table(outcome.summary))
 
 
 def main() -> None:

@@ -74,3 +74,15 @@ MAX_VARIANTS = Limit("GCALIGN_MAX_VARIANTS", 20_000, "variants")
 MAX_YAML_NODES = Limit("GCALIGN_MAX_YAML_NODES", 1e6, "YAML values after expanding aliases")
 MAX_YAML_MB = Limit("GCALIGN_MAX_YAML_MB", 4, "of YAML", " MB")
 MAX_WORKERS = Limit("GCALIGN_MAX_WORKERS", float(2 * (os.cpu_count() or 1)), "worker processes")
+#: Arithmetic of one run, as its command's cost model counts it (multiply-adds: filter
+#: taps × samples, PWCS pieces × 21³, strapdown steps × their operations); 1e12 is about a
+#: quarter of an hour on one core of this project's machines.
+MAX_WORK = Limit("GCALIGN_MAX_WORK", 1e12, "operations")
+#: realtime holds every sensor sample of its cases at once (its pulses are drawn from them).
+MAX_REALTIME_SAMPLES = Limit("GCALIGN_MAX_REALTIME_SAMPLES", 5e7,
+                             "sensor samples of all realtime cases together")
+#: northfind with ``samples: true`` simulates every sample of every dwell.
+MAX_NORTHFIND_SAMPLES = Limit("GCALIGN_MAX_NORTHFIND_SAMPLES", 2e8,
+                              "simulated samples per sensor")
+#: northfind keeps azimuths × repeats × positions dwell readings (its result arrays).
+MAX_NORTHFIND_READINGS = Limit("GCALIGN_MAX_NORTHFIND_READINGS", 2e6, "dwell readings")

@@ -899,6 +899,7 @@ class Outcome:
     elapsed_s: float = 0.0
     summary: object = None  # a successful run's summary (from its results file), if any
     validate_exit: int | None = None
+    validate_stderr: str = ""
     note: str = ""  # killed by the time or memory limit, exception type, ...
 
 
@@ -942,11 +943,21 @@ def violations(case: Case, out: Outcome) -> list[str]:
     if "pwned" in out.new_files:
         v.append("a YAML tag executed code")
     if case.validate is not None and out.validate_exit is not None:
-        if (out.exit_code == 2) != (out.validate_exit == 2):
+        if (out.exit_code == 2) != (out.validate_exit == 2) and not _another_command(
+                out.validate_stderr, case.argv[0]):
             v.append(f"validate exit {out.validate_exit}, the run {out.exit_code}")
     if out.elapsed_s > TIME_LIMIT_S:
         v.append(f"took {out.elapsed_s:.1f} s")
     return v
+
+
+def _another_command(stderr: str, command: str) -> bool:
+    """Did validate refuse what another command of the scenario would cost (``error:
+    observability: needs ...`` beside a calibrate run)? validate checks every section."""
+    from gcalign.app.registry import COMMANDS
+
+    head = stderr.removeprefix("error: ").split(":", 1)[0]
+    return head in COMMANDS and head != command and " needs " in stderr
 
 
 def _non_finite(x) -> bool:

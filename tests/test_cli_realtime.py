@@ -261,7 +261,7 @@ def test_batch_metric_and_run_task(tmp_path):
     from gcalign.app.batch.runs import run_task
     from gcalign.app.registry import batchable
 
-    metric = batchable()["realtime"].batch_metrics[0]
+    metric = batchable()["realtime"].options.batch_metrics[0]
     assert metric == "cases.0.after_max_arcsec.kalman-ls"
     scenario = yaml.safe_load(_small(tmp_path).read_text())
     rec = run_task({"command": "realtime", "variant": 0, "vkey": "v", "seed": 1,

@@ -44,7 +44,8 @@ def run_case(case: F.Case, folder) -> F.Outcome:
     if res.exit_code in (0, 1):  # 1: a batch with failed runs keeps its file
         out.summary = F.read_summary(folder, case)
     if case.validate is not None:
-        out.validate_exit = runner.invoke(app, ["validate", case.validate]).exit_code
+        check = runner.invoke(app, ["validate", case.validate])
+        out.validate_exit, out.validate_stderr = check.exit_code, check.stderr
     return out
 
 

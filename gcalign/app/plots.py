@@ -26,6 +26,7 @@ from typing import Literal
 import numpy as np
 from matplotlib.figure import Figure
 
+from gcalign import units
 from gcalign.errors import ScenarioError
 
 ANGLES = ("pitch", "roll", "yaw")
@@ -94,17 +95,12 @@ def time_axis(t: np.ndarray) -> tuple[np.ndarray, str]:
 
 
 def angle_scale(values_rad: np.ndarray) -> tuple[float, str]:
-    """Multiplier from rad and the unit: deg from 1°, arc-minutes from 1′, else ″ (the
-    table's rule, :func:`gcalign.app.report.angle_unit`)."""
+    """Multiplier from rad and the unit: the rule of :func:`gcalign.units.angle_unit` (deg
+    from 1°, arc-minutes from 1′, else ″), applied to the largest finite |value|."""
     v = np.asarray(values_rad, float)
     v = v[np.isfinite(v)]
-    peak = float(np.max(np.abs(v))) if v.size else 0.0
-    deg = math.degrees(peak)
-    if deg >= 1.0:
-        return math.degrees(1.0), "deg"
-    if deg * 60.0 >= 1.0:
-        return math.degrees(1.0) * 60.0, "arcmin"
-    return math.degrees(1.0) * 3600.0, "arcsec"
+    unit = units.angle_unit(float(np.max(np.abs(v))) if v.size else 0.0)
+    return 1.0 / units.ANGLE_UNITS[unit][0], unit
 
 
 def rate_scale(values_rad_s: np.ndarray) -> tuple[float, str]:
@@ -204,8 +200,8 @@ def truth_and_imu(f, name: str) -> dict[str, Figure]:
 
 
 def figures_for(path: Path) -> dict[str, Figure]:
-    """The figures of a results file, by name (file stem of the PNG), from the room of the
-    command that wrote it (its ``figures(f, name)``), else the truth and the IMU output if
+    """The figures of a results file, by name (file stem of the PNG), from the command
+    that wrote it (its ``figures(f, name)``), else the truth and the IMU output if
     the file holds them; a recorded data file (``.imu``, CSV, compressed) gives its IMU
     figure."""
     from gcalign.app.registry import COMMANDS
@@ -219,7 +215,7 @@ def figures_for(path: Path) -> dict[str, Figure]:
     if not isinstance(name, str):
         name = path.stem
     with results.open_results(path) as f:
-        figs: dict[str, Figure] = COMMANDS[kind].load().figures(f, name) if kind in COMMANDS else {}
+        figs: dict[str, Figure] = COMMANDS[kind].figures(f, name) if kind in COMMANDS else {}
         if not figs:
             figs = truth_and_imu(f, name)
     if not figs:

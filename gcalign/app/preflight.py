@@ -1,161 +1,120 @@
-"""Checks before a run: what `gcalign validate` and every command run first.
+"""Checks before a run: what `gcalign validate`, every command run and a batch's variants
+run first.
 
 :func:`preflight` looks at a parsed scenario the way a command is about to use it -- where
-its data come from (simulated motion or a recorded file, read and validated), the times
-its sections name against the length of those data, each section's own ``check(sc)`` --
-and estimates what the run will cost (samples to generate or read, memory it holds at once,
-series it stores), refusing it with one line when a limit of :mod:`gcalign.limits` would be
-exceeded. ``gcalign validate`` calls it for every section of the scenario; a command calls it
-for its own section through :meth:`gcalign.app.registry.Command.execute`, so both take the
-same decisions. Nothing here imports numba or scipy.
+its data come from (simulated motion or a recorded file, read and validated), then each
+command's own :meth:`~gcalign.app.command.Command.check` and
+:meth:`~gcalign.app.command.Command.cost`, refusing a run with one line when a limit of
+:mod:`gcalign.limits` would be exceeded (:func:`budget`). ``gcalign validate`` calls it for
+every section of the scenario; a run calls it for its own command (:func:`checked_execute`),
+so both take the same decisions. Nothing here imports numba or scipy.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import os
+from pathlib import Path
+from typing import Any
 
 from gcalign import limits
+from gcalign.app.command import DOUBLE, Command, Cost, Extent
+from gcalign.app.registry import COMMANDS, Outcome, command
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 
-#: commands that simulate their own data from their section (no motion or imu_file needed)
-SELF_CONTAINED = ("northfind", "realtime")
-#: commands that need a motion or an imu_file
-DATA_COMMANDS = ("simulate", "navigate", "align")
+__all__ = ["Extent", "budget", "check_seed", "checked_execute", "extent", "preflight",
+           "sensor_errors", "total_runs"]
 
-_FLOAT = 8
-#: doubles stored per output row: simulate (/truth t, att, v_n, pos, segment and /imu t,
-#: dtheta, dv, q_bs), navigate (t, att, v_n, pos, errors, phi, ...)
-_ROW_DOUBLES = {"simulate": 26, "navigate": 30}
-_MEMORY_PER_SAMPLE = {  # doubles per sample held at once by runs that keep the whole window
-    "align": 24,  # increments, reference velocity, stored truth rows
-    "batch": 30,  # a batch variant's noise-free run (truth + ideal increments) + its errors
-}
-
-
-@dataclass(frozen=True)
-class Extent:
-    """The data a scenario gives: sample count, interval (s), whether recorded, truth."""
-
-    samples: int
-    ts: float
-    recorded: bool
-    has_truth: bool
+BATCH_DOUBLES = 30  #: per sample held by a batch variant: its noise-free run and its errors
+_RECORDED: dict[tuple[str, int, int, str], Extent] = {}  # path, size, mtime, layout -> extent
 
 
 def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
     """Samples and interval of the scenario's data, or None if it has none. A recorded file
-    is read and validated when `read_recorded` (validate), else only checked to exist."""
+    is read and validated when `read_recorded` (once per process and file version), else
+    only checked to exist."""
     if sc.imu_file is not None:
-        from gcalign.app.data import read_data_file
-
         if not read_recorded:
             if not sc.imu_file.is_file():
                 raise ScenarioError(f"imu_file: {sc.imu_file}: file not found")
             return None
-        imu, truth = read_data_file(sc.imu_file, sc.recording_layout())
-        if sc.site is None and imu.site is None:
-            raise ScenarioError(f"site: missing; {sc.imu_file} does not give the site, so "
-                                "the scenario must (site: {lat_deg, lon_deg, height_m})")
-        return Extent(len(imu), float(imu.ts), True, truth is not None)
+        ext = _recorded_extent(Path(sc.imu_file), sc.recording_layout())
+        if sc.site is None and ext.lat is None:
+            raise ScenarioError(
+                f"site: missing: {sc.imu_file} does not give the site (a CSV file has no "
+                "header); give --lat/--lon/--height, or a site section in the scenario")
+        return ext
     if sc.motion is None:
         return None
     ts = sc.imu.ts
     return Extent(int(round(sc.motion.duration() / ts)), ts, False, True)
 
 
-def preflight(sc: Scenario, command: str | None = None, read_recorded: bool = True) -> None:
-    """Refuse (ScenarioError, one line naming the field) what the run of `command` would
-    refuse, and what would exceed a resource limit. ``command=None``: every section the
+def _recorded_extent(path: Path, layout=None) -> Extent:
+    from gcalign.app.data import read_data_file
+
+    try:
+        st = os.stat(path)
+        key = (str(path.resolve()), st.st_size, st.st_mtime_ns, repr(layout))
+    except OSError:
+        key = None
+    if key is not None and key in _RECORDED:
+        return _RECORDED[key]
+    imu, truth = read_data_file(path, layout)
+    lat = None if imu.site is None else float(imu.site[0])
+    ext = Extent(len(imu), float(imu.ts), True, truth is not None, lat)
+    if key is not None:
+        _RECORDED.clear()  # the last file only: a batch reads one file over and over
+        _RECORDED[key] = ext
+    return ext
+
+
+def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True) -> None:
+    """Refuse (ScenarioError, one line naming the field) what the run of command `name`
+    would refuse, and what would exceed a resource limit. ``name=None``: every section the
     scenario has (``gcalign validate``)."""
-    commands = [command] if command else _commands_of(sc)
+    commands = [command(name)] if name else _commands_of(sc)
     check_seed(sc.imu.seed, "imu.seed")
-    ext = extent(sc, read_recorded)
+    # recorded data are read only for a command that can use them (the others refuse them)
+    ext = extent(sc, read_recorded and any(c.options.recorded for c in commands))
     if ext is not None and not ext.recorded:
         sensor_errors(sc)
-    if ext is None and sc.imu_file is None:
-        needs = [c for c in commands if c in DATA_COMMANDS]
-        if needs or not any(c in SELF_CONTAINED for c in commands):
-            raise ScenarioError("motion: missing; the scenario needs 'motion' (simulated data) "
-                                "or 'imu_file' (recorded data)"
-                                + ("" if command else ", or a northfind/realtime section"))
+    if ext is None and sc.imu_file is None and not (
+            commands and all(c.options.self_contained for c in commands)):
+        raise ScenarioError("motion: missing; the scenario needs 'motion' (simulated data) "
+                            "or 'imu_file' (recorded data)"
+                            + ("" if name else ", or a northfind/realtime section"))
     for c in commands:
-        section = getattr(sc, c, None) if c not in ("simulate", "navigate") else None
-        check = getattr(section, "check", None)
-        if callable(check):
-            check(sc)
-        if ext is not None:
-            if c == "align":
-                _align(sc, ext)
-            elif c == "navigate":
-                _navigate(sc, ext)
-            budget(sc, c, ext)
+        c.check(sc, ext)
+        budget(sc, c, ext)
 
 
-def _commands_of(sc: Scenario) -> list[str]:
-    out = ["simulate"] if sc.motion is not None else []
-    out += ["navigate"] if sc.navigation is not None or sc.imu_file is not None else []
-    from gcalign.app.registry import COMMANDS
-
-    out += [c for c in COMMANDS if c not in ("simulate", "navigate", "batch")
-            and getattr(sc, c, None) is not None]
-    return out
-
-
-def _stride(sc: Scenario, ext: Extent) -> int:
-    try:
-        return sc.output.stride(1.0 / ext.ts, ext.samples * ext.ts)
-    except ValueError as err:
-        raise ScenarioError(str(err)) from None
+def _commands_of(sc: Scenario) -> list[Command]:
+    """The commands a scenario's sections ask for: simulate (a motion), navigate (a
+    navigation section or recorded data), and every command whose section it has."""
+    out = [COMMANDS["simulate"]] if sc.motion is not None else []
+    if sc.navigation is not None or sc.imu_file is not None:
+        out.append(COMMANDS["navigate"])
+    return out + [c for c in COMMANDS.values() if c.name not in ("simulate", "navigate")
+                  and c.section is not None and getattr(sc, c.section, None) is not None]
 
 
-def _align_window(sc: Scenario, ext: Extent) -> tuple[int, int]:
-    """First and last sample the alignment reads (as ``app.align.run``: ``_index``)."""
-    from gcalign.io.scenario.align import AlignConfig
+def checked_execute(name: str, sc: Scenario, seed: int | None = None, *args: Any,
+                    progress: Any = None, **options: Any) -> Outcome:
+    """Command `name`'s ``execute`` after its preflight (the checks and the cost estimate
+    ``gcalign validate`` makes), with the seed checked to lie in [0, 2^63); the summary is
+    checked to be finite. `progress` goes to a command whose ``execute`` takes it (asked
+    after the preflight: the run's modules load only for a run that will happen)."""
+    from gcalign.io.results import finite_summary
 
-    cfg = sc.align or AlignConfig()
-    his = []
-    for field in ("start_s", "t1_s", "t2_s", "t3_s"):
-        t = 0.0 if field == "start_s" else getattr(cfg, field)
-        if t == "measured":
-            continue
-        k = int(round((cfg.start_s + t) / ext.ts))
-        if k > ext.samples:
-            raise ScenarioError(
-                f"align.{field}: {t} s (+ start_s {cfg.start_s} s) is past the end of the data "
-                f"({ext.samples * ext.ts:.2f} s); lengthen motion.duration_s or choose an "
-                "earlier time")
-        his.append(k)
-    return int(round(cfg.start_s / ext.ts)), max(his)
-
-
-def _align(sc: Scenario, ext: Extent) -> None:
-    from gcalign.io.scenario.align import AlignConfig
-
-    cfg = sc.align or AlignConfig()
-    if sc.site is not None and abs(sc.site.lat_deg) > 85.0:
-        raise ScenarioError(f"site.lat_deg: gyrocompassing needs |latitude| < 85°, got "
-                            f"{sc.site.lat_deg:.4f}° (the horizontal earth rate vanishes)")
-    if not ext.has_truth:
-        if cfg.aiding.source != "none":
-            raise ScenarioError(f"align.aiding.source: {cfg.aiding.source!r} needs a simulated "
-                                "motion (truth); recorded data supports 'none'")
-        if cfg.coarse.method == "given":
-            raise ScenarioError("align.coarse.method: 'given' needs truth; use 'analytic' or "
-                                "'inertial' for recorded data")
-    _align_window(sc, ext)
-    _stride(sc, ext)
-
-
-def _navigate(sc: Scenario, ext: Extent) -> None:
-    from gcalign.io.scenario.navigation import NavigationConfig
-
-    cfg = sc.navigation or NavigationConfig()
-    k = int(round(cfg.start_s / ext.ts))
-    if k >= ext.samples:
-        raise ScenarioError(f"navigation.start_s: {cfg.start_s:g} s is past the end of the "
-                            f"data ({ext.samples * ext.ts:g} s)")
-    _stride(sc, ext)
+    check_seed(seed)
+    preflight(sc, name)
+    cmd = command(name)
+    if progress is not None and cmd.accepts("progress"):
+        options["progress"] = progress
+    outcome = cmd.execute(sc, seed, *args, **options)
+    finite_summary(outcome.summary, name)
+    return outcome
 
 
 def sensor_errors(sc: Scenario) -> None:
@@ -189,33 +148,26 @@ def sensor_errors(sc: Scenario) -> None:
                                     "input; check the units")
 
 
-def cost(sc: Scenario, command: str, ext: Extent) -> tuple[float, float, float]:
-    """(samples processed, bytes held at once, bytes of stored series) of one run."""
-    n = float(ext.samples)
-    held = 0.0
-    stored = 0.0
-    if command == "align":
-        lo, hi = _align_window(sc, ext)
-        n = float(hi)
-        held = (hi - lo) * _MEMORY_PER_SAMPLE["align"] * _FLOAT
-        passes = getattr(sc.align, "pass_count", 5) if sc.align is not None else 5
-        stored = passes * (hi - lo) / _stride(sc, ext) * 12 * _FLOAT
-    elif command in _ROW_DOUBLES:
-        stored = n / _stride(sc, ext) * _ROW_DOUBLES[command] * _FLOAT
-    return n, held, stored
-
-
-def budget(sc: Scenario, command: str, ext: Extent, workers: int = 1,
-           where: str | None = None) -> None:
-    """Refuse a run whose estimated cost exceeds a limit (one line, the variable to raise)."""
-    n, held, stored = cost(sc, command, ext)
-    where = where or f"{command}"
-    limits.MAX_SAMPLES.check(n, where, f"{n * ext.ts:.3g} s of data at {1 / ext.ts:g} Hz")
-    if command == "batch" or workers > 1:
-        held = max(held, ext.samples * _MEMORY_PER_SAMPLE["batch"] * _FLOAT) * workers
-    limits.MAX_MEMORY_MB.check(held / 2**20, where,
-                               f"{workers} worker(s)" if workers > 1 else "")
-    limits.MAX_OUTPUT_MB.check(stored / 2**20, where, "store fewer rows with output.rate_hz")
+def budget(sc: Scenario, cmd: Command, ext: Extent | None, workers: int = 1,
+           where: str | None = None, batch: bool = False) -> Cost:
+    """Refuse a run whose estimated cost (:meth:`Command.cost`) exceeds a limit: one line
+    naming the estimate, the limit and the variable that raises it. `workers` runs at once
+    (a batch: each holds its variant's noise-free simulation)."""
+    cost = cmd.cost(sc, ext)
+    where = where or cmd.name
+    seconds = "" if ext is None else f"{cost.samples * ext.ts:.3g} s of data at {1 / ext.ts:g} Hz"
+    limits.MAX_SAMPLES.check(cost.samples, where, seconds)
+    held = cost.memory_bytes
+    if batch or workers > 1:
+        per_run = 0.0 if ext is None else ext.samples * BATCH_DOUBLES * DOUBLE
+        held = max(held, per_run) * workers
+    hint = ", ".join(x for x in (cost.memory_what and f"held by {cost.memory_what}",
+                                 f"{workers} worker(s)" if workers > 1 else "") if x)
+    limits.MAX_MEMORY_MB.check(held / 2**20, where, hint)
+    limits.MAX_OUTPUT_MB.check(cost.output_bytes / 2**20, where,
+                               "store fewer rows with output.rate_hz")
+    limits.MAX_WORK.check(cost.work, where, cost.work_what)
+    return cost
 
 
 def check_seed(seed: int | None, what: str = "--seed") -> int | None:

@@ -21,6 +21,8 @@ from rich.console import Group, RenderableType
 from rich.table import Table
 from rich.text import Text
 
+from gcalign import units
+
 DASH = "—"
 
 
@@ -83,14 +85,15 @@ def vector(values: Sequence | None, sig: int = 4, most: int = 6) -> str:
 
 #: Angle units: factor from degrees and the decimals shown (resolution 0.36″, 0.06″, 0.01″).
 ANGLE_UNITS = {"deg": (1.0, 4), "′": (60.0, 3), "″": (3600.0, 2)}
-#: Their names in headers and labels.
+#: Their names in headers and labels (those of :data:`gcalign.units.ANGLE_UNITS`).
 UNIT_NAME = {"deg": "deg", "′": "arcmin", "″": "arcsec"}
+_SYMBOL = {name: symbol for symbol, name in UNIT_NAME.items()}
 
 
 def angle_unit(values_deg: Iterable) -> str:
-    """deg when the largest |value| reaches 1°, arc-minutes from 1′, else arc-seconds."""
-    top = max(_finite(values_deg), default=0.0)
-    return "deg" if top >= 1.0 else "′" if top * 60.0 >= 1.0 else "″"
+    """The table's symbol of the unit the largest |value| (deg) reads best in: the rule of
+    :func:`gcalign.units.angle_unit` (deg from 1°, arc-minutes from 1′, else arc-seconds)."""
+    return _SYMBOL[units.angle_unit(max(_finite(values_deg), default=0.0) * units.DEG)]
 
 
 def angles(values_deg: Sequence, unit: str) -> list[str]:
@@ -178,7 +181,7 @@ def summary_table(kind: str, summary: dict) -> RenderableType:
         raise ScenarioError(f"kind: {kind!r} is not a gcalign command ({', '.join(COMMANDS)}); "
                             "a results file from another version, or a damaged one")
     try:
-        table = COMMANDS[kind].load().table(summary)
+        table = COMMANDS[kind].table(summary)
     except (KeyError, IndexError, TypeError, ValueError, AttributeError) as err:
         raise ScenarioError(f"summary_json: not the summary of a {kind!r} run "
                             f"({type(err).__name__}: {str(err)[:60]}); a damaged results "

@@ -6,51 +6,42 @@ No typer, no rich: progress is a plain callable and warnings are strings.
 
 from __future__ import annotations
 
-import inspect
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from gcalign.app.preflight import checked_execute
 from gcalign.app.registry import Outcome, command
 from gcalign.errors import ScenarioError
 from gcalign.io import results
 from gcalign.io.scenario import Scenario
 
 
-def accepts(fn: Callable, name: str) -> bool:
-    """Does `fn` name the keyword `name` in its signature? (A ``**options`` that a room
-    passes on does not count: a room opts in to ``progress`` by naming it.)"""
-    return name in inspect.signature(fn).parameters
-
-
 def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path, *,
                 progress: Callable | None = None, notes: Sequence[str] = (),
                 before_write: Callable[[], None] | None = None,
                 on_outcome: Callable[[Outcome], None] | None = None, **options) -> dict:
-    """Run command `name` through its room, write the results file `out` (atomically: an
-    interrupted run leaves no file) and return the summary it stored.
+    """Run command `name` (its preflight, then its ``execute``), write the results file
+    `out` (atomically: an interrupted run leaves no file) and return the summary it stored.
 
     The summary gets ``warnings`` (`notes`, the scenario's keys that cannot matter, and the
     run's own), ``wall_s`` (the whole call) and ``output``. `progress(done, total, what)`
-    goes to a room whose ``execute`` takes it; `before_write` is called when the run is
+    goes to a command whose ``execute`` takes it; `before_write` is called when the run is
     done, before the file is finished (the command line closes its progress bar there);
-    `on_outcome` hears of the room's :class:`Outcome` (the Python API keeps its typed result).
+    `on_outcome` hears of the command's :class:`Outcome` (the Python API keeps its typed
+    result).
     """
     from gcalign.app.data import recording_record
 
     cmd = command(name)
-    room = cmd.load()
-    kwargs = dict(options)
-    if progress is not None and accepts(room.execute, "progress"):
-        kwargs["progress"] = progress
+    kwargs = dict(options, progress=progress)
     t0 = time.perf_counter()
     try:
         with results.atomic_h5(out) as f:
-            # the registry's execute: preflight checks, the seed's range, a finite summary
-            if cmd.streams:
-                outcome = cmd.execute(sc, seed, sink=f, **kwargs)
-            else:
-                outcome = cmd.execute(sc, seed, **kwargs)
+            # preflight checks, the seed's range, a finite summary
+            if cmd.options.streams:
+                kwargs["sink"] = f
+            outcome = checked_execute(name, sc, seed, **kwargs)
             if on_outcome is not None:
                 on_outcome(outcome)
             if before_write is not None:

@@ -10,7 +10,7 @@ import typer
 from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
-from gcalign.cli.data import JSON_HELP, OUT_HELP, SEED_HELP
+from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["align"].builtin or ""
@@ -69,9 +69,10 @@ def align(
         "align.stages.N.passes)."),
     t2: float | None = typer.Option(None, "--t2", help="End of the stored data block T2 (s)."),
     t3: str | None = typer.Option(None, "--t3", help="Result time T3 (s) or 'measured'."),
-    seed: int | None = typer.Option(None, "--seed", help=SEED_HELP),
-    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    seed: Seed = None,
+    output: Output = None,
+    as_json: Json = False,
+    set_: Sets = None,
 ):
     """Gyrocompass fine alignment with forward/reverse passes and T2 -> T3 compensation."""
     overrides = {
@@ -82,5 +83,5 @@ def align(
         "t3_s": _t3(t3),
     }
     sc, text, _ = load_with_overrides(scenario, BUILTIN, "align", overrides,
-                                      passes_into_stages)
+                                      passes_into_stages, sets=set_)
     run_and_show("align", sc, text, seed, output, as_json)

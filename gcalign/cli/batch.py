@@ -15,7 +15,7 @@ import typer
 from gcalign.app import batch as engine
 from gcalign.app.batch.sweep import sweep_from_files
 from gcalign.cli import app, consoles, default_output, emit_json, user_errors
-from gcalign.cli.data import JSON_HELP
+from gcalign.cli.options import Json
 from gcalign.errors import ScenarioError
 
 
@@ -102,7 +102,7 @@ def batch(
     resume: bool = typer.Option(
         False, "--resume", help="Run only what an earlier, interrupted batch did not finish."
     ),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    as_json: Json = False,
 ):
     """Run a sweep (variants × seeds), or the same seeds on several scenario files; aggregate
     each metric per variant into one HDF5 file. One batch starts Python once: far cheaper
@@ -145,7 +145,7 @@ def batch(
         if bar is not None:
             bar.stop()
     summary = result.summary
-    consoles(as_json).print(engine.table(summary))
+    consoles(as_json).print(engine.COMMAND.table(summary))
     if as_json:
         emit_json(summary)
     if summary["failed"]:  # the file records them: a result, but not a success

@@ -9,24 +9,17 @@ import typer
 from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
-from gcalign.cli.data import JSON_HELP, OUT_HELP
-from gcalign.errors import ScenarioError
+from gcalign.cli.options import Json, Output, Seed, Sets
 
 BUILTIN = COMMANDS["calibrate"].builtin or ""
 SCENARIO_HELP = "Scenario YAML; without it, the built-in seed 002 designed 590 s take-off."
 MEASURE_HELP = "DGNSS measurement: velocity | position | both."
 
 
-def load_checked(path: Path | None, section: str, overrides: dict):
-    """Scenario and text with the options written into `section`, then the section's
-    checks across the scenario (rates, window, recorded data), named by the source."""
-    sc, text, source = load_with_overrides(path, BUILTIN, section, overrides)
-    cfg = getattr(sc, section)
-    if cfg is not None:
-        try:
-            cfg.check(sc)
-        except ScenarioError as err:
-            raise ScenarioError(f"{source}: {err}") from None
+def load_checked(path: Path | None, section: str, overrides: dict, sets: list[str] | None):
+    """Scenario and text with the options written into `section` (the command's check
+    runs in its preflight)."""
+    sc, text, _ = load_with_overrides(path, BUILTIN, section, overrides, sets=sets)
     return sc, text
 
 
@@ -42,14 +35,15 @@ def calibrate(
         None, "--smoother/--no-smoother", help="Also run the RTS smoother (post-flight)."),
     truth: str | None = typer.Option(
         None, "--truth", help="Injected errors: scenario | draw (from P0 with the seed)."),
-    seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
-    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    seed: Seed = None,
+    output: Output = None,
+    as_json: Json = False,
+    set_: Sets = None,
 ):
     """In-flight calibration: the 21-state Kalman filter aided by DGNSS (or zero velocity
     on recorded data); per state the injected truth, estimate, error and final σ."""
     overrides = {"measure": measure, "smoother": smoother, "truth": truth}
-    sc, text = load_checked(scenario, "calibrate", overrides)
+    sc, text = load_checked(scenario, "calibrate", overrides, set_)
     run_and_show("calibrate", sc, text, seed, output, as_json, compare=compare)
 
 
@@ -60,11 +54,12 @@ def observability(
     measure: str | None = typer.Option(None, "--measure", help=MEASURE_HELP),
     scaling: str | None = typer.Option(
         None, "--scaling", help="none (the paper: unscaled states) | p0 (columns × initial σ)."),
-    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    output: Output = None,
+    as_json: Json = False,
+    set_: Sets = None,
 ):
     """Observability of the flight's manoeuvres: PWCS pieces, SOM/TOM ranks and the seed's
     SVD degree η per segment and cumulative (Table 1 analogue)."""
     overrides = {"measure": measure, "scaling": scaling}
-    sc, text = load_checked(scenario, "observability", overrides)
+    sc, text = load_checked(scenario, "observability", overrides, set_)
     run_and_show("observability", sc, text, None, output, as_json)

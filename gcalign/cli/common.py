@@ -3,13 +3,17 @@ output names, progress, warnings, saving and showing.
 
 Every command of the registry gets the same habits here, not by hand:
 
-* ``--set KEY=VALUE`` (any scenario key, dotted as in a sweep's grid) and, for commands that
-  read recorded data (``Command.recorded``), ``--imu-file``, ``--lat``, ``--lon``,
-  ``--height``: :func:`install` adds them to every registered command that does not declare
-  them itself; :func:`load_with_overrides` applies them.
+* ``--seed``, ``-o/--output``, ``--json`` and ``--set KEY=VALUE`` (any scenario key,
+  dotted as in a sweep's grid) are declared once, as annotated types in
+  :mod:`gcalign.cli.options`, that each command names in its signature.
+* The recorded-data options (:func:`recorded_parameters`: ``--imu-file``, ``--lat``,
+  ``--lon``, ``--height``), one list for every command whose registry object reads recorded
+  data (``options.recorded``) and ``validate``: :func:`install` adds them, so that a new
+  option of recorded data is one line of that list. :func:`load_with_overrides` applies
+  them and the ``--set`` items.
 * A default results file named after every override that changes the result
   (:func:`output_name`), and a warning when it replaces a run of other inputs.
-* A progress bar on stderr for long runs (:class:`ProgressBar`; a room's ``execute`` that
+* A progress bar on stderr for long runs (:class:`ProgressBar`; a command whose ``execute``
   takes ``progress=`` reports to it), keys that cannot matter as warnings (stderr, table,
   JSON), the wall time beside what ``compute`` measured.
 
@@ -45,8 +49,6 @@ from gcalign.io.scenario.loader import parse_override, read_yaml
 
 # --------------------------------------------------------------------------- options
 
-SET_HELP = ("Set any scenario key, dotted as in a sweep grid; VALUE is YAML "
-            "(--set align.stages.0.t_z_s=200 --set imu.gyro.bias_dph=0.01). Repeatable.")
 IMU_FILE_HELP = ("Recorded IMU data (PSINS .imu, CSV/text, gcalign HDF5; .gz/.xz "
                  "compressed) instead of the scenario's simulation: it replaces the motion, "
                  "mechanism, imu and site sections; the site then comes from the file's "
@@ -78,8 +80,8 @@ def _option(name: str, annotation, metavar: str, *decls: str, help: str) -> insp
                              default=typer.Option(None, *decls, help=help, metavar=metavar))
 
 
-def _common_parameters(recorded: bool) -> list[inspect.Parameter]:
-    params = [_option("set_", list[str] | None, "KEY=VALUE", "--set", help=SET_HELP)]
+def recorded_parameters(recorded: bool) -> list[inspect.Parameter]:
+    params: list[inspect.Parameter] = []
     if recorded:
         params += [
             _option("imu_file", Path | None, "FILE", "--imu-file", help=IMU_FILE_HELP),
@@ -98,14 +100,14 @@ def with_common_options(fn: Callable, recorded: bool) -> Callable:
     """`fn` with the common options added to its signature (those it does not declare);
     their values are kept in :data:`_INVOCATION` while `fn` runs."""
     sig = inspect.signature(fn, eval_str=True)
-    extra = [p for p in _common_parameters(recorded) if p.name not in sig.parameters]
+    extra = [p for p in recorded_parameters(recorded) if p.name not in sig.parameters]
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
         given = {p.name: kwargs.pop(p.name, None) for p in extra}
         site = {k: given.get(o) for k, o in (("lat_deg", "lat"), ("lon_deg", "lon"),
                                              ("height_m", "height"))}
-        inv = Invocation(sets=list(given.get("set_") or []), imu_file=given.get("imu_file"),
+        inv = Invocation(imu_file=given.get("imu_file"),
                          site={k: v for k, v in site.items() if v is not None},
                          imu_layout={k: given[o] for k, o in (("format", "imu_format"),
                                      ("axes", "imu_axes")) if given.get(o) is not None})
@@ -131,7 +133,7 @@ def install(app: typer.Typer) -> None:
         if cmd is not None and info.help is None and info.short_help is None:
             info.short_help = cmd.help  # the command list shows the registry's line
         if (cmd is not None and name != "batch") or name == "validate":
-            recorded = cmd.recorded if cmd is not None else True
+            recorded = cmd.options.recorded if cmd is not None else True
             info.callback = with_common_options(info.callback, recorded)
             info.callback._common = True  # type: ignore[attr-defined]
 
@@ -195,11 +197,13 @@ def load_with_overrides(
     adjust: Callable[[dict, dict], None] | None = None,
     data: dict | None = None,
     text: str | None = None,
+    sets: Sequence[str] | None = None,
 ) -> tuple[Scenario, str, str]:
     """Scenario (the file, the built-in one, or a given mapping `data` with its `text`),
     its text and its source name, with the options that were given written into `section`
     before validation, so that a bad option is reported like a bad key in the file; then
-    the common options of the running command (``--set``, ``--imu-file``, site).
+    the ``--set KEY=VALUE`` items `sets` and the recorded-data options of the running
+    command (``--imu-file``, site).
     `adjust(section, given)` may drop keys of the section that a given option replaces, and
     may take options out of `given` that it wrote elsewhere in the section. The text stored
     in results files records the overrides.
@@ -221,6 +225,7 @@ def load_with_overrides(
         text = Path(path).read_text(encoding="utf-8")
     assert text is not None
     inv = _INVOCATION.get() or Invocation()
+    inv.sets = list(sets or [])
     given = {k: v for k, v in overrides.items() if v is not None}
     named = dict(given)  # what the file name and the stored text record
     recorded: list = []
@@ -401,12 +406,12 @@ class ProgressBar:
 
 def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: Path | None,
                  as_json: bool, **options) -> None:
-    """Run command `name` on a loaded scenario through its room, write the results file
-    and show its table. Default file name: :func:`output_name` with the overrides of the
-    command line (and `options`, e.g. ``--init``). A streaming command writes its series
-    into the (temporary) file while it runs; `options` go to its ``execute``, a progress
-    bar to a room that reports progress (:func:`gcalign.app.runner.run_command`). Keys that
-    cannot matter become warnings."""
+    """Run command `name` on a loaded scenario (its preflight, then its execute), write the
+    results file and show its table. Default file name: :func:`output_name` with the
+    overrides of the command line (and `options`, e.g. ``--init``). A streaming command
+    writes its series into the (temporary) file while it runs; `options` go to its
+    ``execute``, a progress bar to a command that reports progress
+    (:func:`gcalign.app.runner.run_command`). Keys that cannot matter become warnings."""
     from gcalign.app.runner import run_command
 
     inv = _INVOCATION.get() or Invocation()

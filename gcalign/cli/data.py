@@ -14,6 +14,7 @@ from gcalign.app.registry import COMMANDS
 from gcalign.app.report import kv_table, summary_table, with_warnings
 from gcalign.cli import app, consoles, emit_json, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
+from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.io import results
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario.resolve import resolved_rows
@@ -28,22 +29,21 @@ def data_suffix(path: Path) -> str:
     if suffixes and suffixes[-1] in COMPRESSED:
         suffixes = suffixes[:-1]
     return suffixes[-1] if suffixes else ""
-JSON_HELP = "Print one JSON object on stdout (tables go to stderr)."
-OUT_HELP = ("Results file; default runs/NAME-COMMAND[-OVERRIDES][-rngN].h5, with every option "
-            "that changes the result in the name and N the random seed.")
-SEED_HELP = "Random seed of the simulated sensor noise (overrides imu.seed)."
+
+
 
 
 @app.command()
 @user_errors
 def simulate(
     scenario: Path = typer.Argument(..., help="Scenario YAML."),
-    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    seed: int | None = typer.Option(None, "--seed", help=SEED_HELP),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    output: Output = None,
+    seed: Seed = None,
+    as_json: Json = False,
+    set_: Sets = None,
 ):
     """Simulate truth and IMU data; write /truth and /imu."""
-    sc, text, _ = load_with_overrides(scenario, "", "", {})
+    sc, text, _ = load_with_overrides(scenario, "", "", {}, sets=set_)
     run_and_show("simulate", sc, text, seed, output, as_json)
 
 
@@ -61,9 +61,10 @@ def navigate(
         None, "--vertical", help="Vertical channel: auto | free | hold | damped."),
     start: float | None = typer.Option(None, "--start", help="Data time to start at (s)."),
     duration: float | None = typer.Option(None, "--duration", help="How long to navigate (s)."),
-    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    seed: int | None = typer.Option(None, "--seed", help=SEED_HELP),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    output: Output = None,
+    seed: Seed = None,
+    as_json: Json = False,
+    set_: Sets = None,
 ):
     """Strapdown navigation, streamed block by block; errors against truth at every sample.
 
@@ -88,7 +89,8 @@ def navigate(
                 if key in stored:
                     data[key] = stored[key]
         text = text or yaml.safe_dump(data)
-    sc, text, _ = load_with_overrides(source, "", "navigation", overrides, data=data, text=text)
+    sc, text, _ = load_with_overrides(source, "", "navigation", overrides, data=data, text=text,
+                                      sets=set_)
     run_and_show("navigate", sc, text, seed, output, as_json, init=init)
 
 
@@ -96,7 +98,7 @@ def navigate(
 @user_errors
 def show(
     file: Path = typer.Argument(..., help="A gcalign results file."),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    as_json: Json = False,
 ):
     """Print the summary of a results file again, from the file alone."""
     kind, summary, attrs = results.read_summary(file)
@@ -114,11 +116,12 @@ def show(
 @user_errors
 def validate(
     scenario: Path = typer.Argument(..., help="Scenario YAML."),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    as_json: Json = False,
+    set_: Sets = None,
 ):
     """Check a scenario and print its resolved values in user units and SI, and the keys
     that cannot matter (as warnings)."""
-    sc, _, _ = load_with_overrides(scenario, "", "", {})
+    sc, _, _ = load_with_overrides(scenario, "", "", {}, sets=set_)
     preflight(sc)  # the checks every command runs first, for every section
     rows = resolved_rows(sc)
     sections = [c.section for c in COMMANDS.values() if c.section]

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from gcalign.cli import app, consoles, emit_json, user_errors
-from gcalign.cli.data import JSON_HELP
+from gcalign.cli.options import Json
 
 
 @app.command()
@@ -23,7 +23,7 @@ def export(
         None, "--group", help="Group of the series (default: the command's, e.g. navigate)."),
     week: int = typer.Option(0, "--week", help="GNSS week written by i2nav-nav (the results "
                              "keep seconds only).", min=0, max=9999),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    as_json: Json = False,
 ):
     """Write the time series of a results file in another tool's format: csv (units in the
     header), mat (scipy.io.savemat, units in a struct), i2nav-nav (KF-GINS: NED, degrees),

@@ -10,7 +10,7 @@ import yaml
 from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
-from gcalign.cli.data import JSON_HELP, OUT_HELP
+from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.io.scenario.loader import read_yaml
 
 BUILTIN = COMMANDS["modulate"].builtin or ""
@@ -22,7 +22,7 @@ def builtin_scenario_text() -> str:
 
 
 def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
-                  dwell: float | None):
+                  dwell: float | None, sets: list[str] | None = None):
     """Scenario and text with --scheme/--dwell written into ``mechanism`` and the other
     options into ``modulate`` before validation. --scheme replaces the scenario's mechanism
     (a table too; its timing keys stay) and, without --compare, is the one scheme run."""
@@ -45,7 +45,7 @@ def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
         text += "\n# command-line overrides of mechanism:\n" + yaml.safe_dump(
             {"mechanism": given}, sort_keys=False)
     sc, text, _ = load_with_overrides(path, BUILTIN, "modulate", overrides, data=data,
-                                      text=text)
+                                      text=text, sets=sets)
     return sc, text
 
 
@@ -63,14 +63,15 @@ def modulate(
         "(e.g. fixed,seed-12,four-position-12)."),
     hours: float | None = typer.Option(None, "--hours", help="How long to navigate (h)."),
     dwell: float | None = typer.Option(None, "--dwell", help="Dwell after each turn (s)."),
-    seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
-    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    seed: Seed = None,
+    output: Output = None,
+    as_json: Json = False,
+    set_: Sets = None,
 ):
     """Strapdown navigation with the IMU on a rotation mechanism: per scheme the horizontal
     error at 1, 4, 12, 24, 72 h, the attitude-error maxima, the linear model beside it and
     the invariant report (mean C over the cycle, residual biases, Schuler warning)."""
     names = None if compare is None else [x.strip() for x in compare.split(",") if x.strip()]
     overrides = {"compare": names, "hours": hours}
-    sc, text = load_modulate(scenario, overrides, scheme, dwell)
+    sc, text = load_modulate(scenario, overrides, scheme, dwell, set_)
     run_and_show("modulate", sc, text, seed, output, as_json)

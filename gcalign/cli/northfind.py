@@ -9,7 +9,7 @@ import typer
 from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
-from gcalign.cli.data import JSON_HELP, OUT_HELP
+from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["northfind"].builtin or ""
@@ -46,17 +46,12 @@ def _one_azimuth_source(section: dict, given: dict) -> None:
         section.pop("azimuth_deg", None)
 
 
-def load_northfind(path: Path | None, overrides: dict):
-    """Scenario and text with the options written into ``northfind`` before validation,
-    then the checks across sections (site, sensors) of :meth:`NorthfindConfig.check`."""
-    sc, text, source = load_with_overrides(
-        path, BUILTIN, "northfind", overrides, _one_azimuth_source
+def load_northfind(path: Path | None, overrides: dict, sets: list[str] | None = None):
+    """Scenario and text with the options written into ``northfind`` before validation (the
+    command's check runs in its preflight)."""
+    sc, text, _ = load_with_overrides(
+        path, BUILTIN, "northfind", overrides, _one_azimuth_source, sets=sets
     )
-    if sc.northfind is not None:
-        try:
-            sc.northfind.check(sc)
-        except ScenarioError as err:
-            raise ScenarioError(f"{source}: {err}") from None
     return sc, text
 
 
@@ -85,9 +80,10 @@ def northfind(
     repeats: int | None = typer.Option(
         None, "--repeats", help="Independent determinations per azimuth."
     ),
-    seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
-    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    seed: Seed = None,
+    output: Output = None,
+    as_json: Json = False,
+    set_: Sets = None,
 ):
     """Multi-position north-finding on a tilted table: coordinate, vector, naive and none."""
     overrides = {
@@ -99,5 +95,5 @@ def northfind(
         "sweep": parse_sweep(sweep),
         "repeats": repeats,
     }
-    sc, text = load_northfind(scenario, overrides)
+    sc, text = load_northfind(scenario, overrides, set_)
     run_and_show("northfind", sc, text, seed, output, as_json)

@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from gcalign.cli import app, consoles, emit_json, user_errors
-from gcalign.cli.data import JSON_HELP
+from gcalign.cli.options import Json
 
 
 @app.command()
@@ -23,7 +23,7 @@ def plot(
         help="Folder for the PNG files (default: FILE without its "
         "suffixes + '_plots/', next to the file).",
     ),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    as_json: Json = False,
 ):
     """Write PNG figures: every figure the command that wrote FILE draws (alignment error
     and attitude per pass, navigation errors, north-finding error against azimuth, batch

@@ -10,8 +10,7 @@ import typer
 from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
-from gcalign.cli.data import JSON_HELP, OUT_HELP
-from gcalign.errors import ScenarioError
+from gcalign.cli.options import Json, Output, Seed, Sets
 
 BUILTIN = COMMANDS["realtime"].builtin or ""
 
@@ -21,17 +20,10 @@ def builtin_scenario_text() -> str:
     return builtin_text(BUILTIN)
 
 
-def load_realtime(path: Path | None, overrides: dict):
-    """Scenario and text with the options written into ``realtime`` before validation, then
-    the checks across sections (site, motion, imu) of :meth:`RealtimeConfig.check`."""
-    sc, text, source = load_with_overrides(path, BUILTIN, "realtime", overrides)
-    if sc.realtime is None:
-        raise ScenarioError(f"{source}: realtime: missing; the scenario needs a 'realtime' "
-                            f"section (see configs/seed003_table1.yaml)")
-    try:
-        sc.realtime.check(sc)
-    except ScenarioError as err:
-        raise ScenarioError(f"{source}: {err}") from None
+def load_realtime(path: Path | None, overrides: dict, sets: list[str] | None = None):
+    """Scenario and text with the options written into ``realtime`` before validation (the
+    command's check runs in its preflight)."""
+    sc, text, _ = load_with_overrides(path, BUILTIN, "realtime", overrides, sets=sets)
     return sc, text
 
 
@@ -47,10 +39,12 @@ def realtime(
         None, "--predictor",
         help="none | taylor | kalman-ls (repeat the option for several; default all three).",
     ),
-    seed: int | None = typer.Option(None, "--seed", help="Override imu.seed."),
-    output: Path | None = typer.Option(None, "-o", "--output", help=OUT_HELP),
-    as_json: bool = typer.Option(False, "--json", help=JSON_HELP),
+    seed: Seed = None,
+    output: Output = None,
+    as_json: Json = False,
+    set_: Sets = None,
 ):
     """Attitude at sync pulses: filter delay T + Δt, and prediction to the pulse time."""
-    sc, text = load_realtime(scenario, {"predictors": list(predictor) if predictor else None})
+    sc, text = load_realtime(scenario, {"predictors": list(predictor) if predictor else None},
+                             set_)
     run_and_show("realtime", sc, text, seed, output, as_json)

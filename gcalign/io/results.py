@@ -377,19 +377,6 @@ def write_truth(f: h5py.File, truth: Truth):
     put(g, "pos", truth.pos, "rad, rad, m", "[latitude, longitude, height], WGS-84")
 
 
-def write_imu(f: h5py.File, imu: ImuData):
-    g = f.create_group("imu")
-    g.attrs["ts"] = imu.ts
-    g.attrs["source"] = imu.source
-    put(g, "t", imu.t, "s", description="end time of each increment")
-    put(g, "dtheta", imu.dtheta, "rad", "body: x right, y forward, z up")
-    put(g, "dv", imu.dv, "m/s", "body: x right, y forward, z up")
-    for name in ("site", "att0", "v0_n"):
-        value = getattr(imu, name)
-        if value is not None:
-            g.attrs[name] = value
-
-
 def write_recording(f: h5py.File, record: dict) -> None:
     """``/recording``: what the reader of a recorded file assumed (format, axes, units, time
     origin, rate, gaps, gravity check; :func:`gcalign.io.recorded.read_recording`), one

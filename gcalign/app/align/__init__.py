@@ -1,48 +1,26 @@
-"""`gcalign align`: gyrocompass alignment with forward/reverse passes (seed 000).
-
-The room's interface for the registry (:mod:`gcalign.app.registry`); each function imports
-its module when called, so tables and figures never load the numerical kernels.
-"""
+"""`gcalign align`: gyrocompass alignment with forward/reverse passes (seed 000)."""
 
 from __future__ import annotations
 
-from gcalign.app.registry import Outcome
+import math
 
+from gcalign.app.command import (
+    DOUBLE,
+    SIMULATE_OPS,
+    STRAPDOWN_OPS,
+    Command,
+    Cost,
+    Extent,
+    Options,
+    stride,
+    warm_run,
+)
+from gcalign.errors import ScenarioError
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None,
-            progress=None) -> Outcome:
-    from gcalign.app.align.run import execute as run
-
-    return run(sc, seed, cache_key, progress)
-
-
-def table(summary: dict):
-    from gcalign.app.align.tables import align_table
-
-    return align_table(summary)
-
-
-def figures(f, name: str) -> dict:
-    from gcalign.app.align.plots import figures
-
-    return figures(f, name)
-
-
-def components(metric: str, k: int) -> list[str]:
-    """Names of a batch metric's components: attitude triples are pitch, roll, yaw."""
-    if k == 3 and metric.endswith("_deg"):
-        return ["pitch", "roll", "yaw"]
-    return [str(i) for i in range(k)]
-
-
-def label(metric: str) -> str:
-    """A metric's name in tables and figures: one component of an attitude triple by its
-    name (``error_t3_deg.2`` -> ``error_t3_deg yaw``)."""
-    head, _, tail = metric.rpartition(".")
-    if head.endswith("_deg") and tail in ("0", "1", "2"):
-        return f"{head} {components(head, 3)[int(tail)]}"
-    return metric
-
+MAX_LAT_DEG = 85.0  #: gyrocompassing needs the horizontal earth rate
+HELD_DOUBLES = 24  #: per sample of the window: increments, reference velocity, truth rows
+ROW_DOUBLES = 12  #: per stored row of a pass
+GYROCOMPASS_OPS = 2 * STRAPDOWN_OPS  #: a strapdown step and the loops
 
 WARM_SCENARIO = {  # a tiny align scenario: every align kernel, in milliseconds
     "name": "warm-up",
@@ -55,10 +33,90 @@ WARM_SCENARIO = {  # a tiny align scenario: every align kernel, in milliseconds
 }
 
 
-def warm_up() -> None:
-    """Run a tiny alignment so that every align kernel is loaded in this process."""
-    import copy
+def _config(sc):
+    from gcalign.io.scenario.align import AlignConfig
 
-    from gcalign.io.scenario import parse_scenario
+    return sc.align or AlignConfig()
 
-    execute(parse_scenario(copy.deepcopy(WARM_SCENARIO), "warm-up"), 1)
+
+def window(sc, ext: Extent) -> tuple[int, int]:
+    """First and last sample the alignment reads; ScenarioError for a time past the end."""
+    cfg = _config(sc)
+    his = []
+    for field in ("start_s", "t1_s", "t2_s", "t3_s"):
+        t = 0.0 if field == "start_s" else getattr(cfg, field)
+        if t == "measured":
+            continue
+        k = int(round((cfg.start_s + t) / ext.ts))
+        if k > ext.samples:
+            raise ScenarioError(
+                f"align.{field}: {t} s (+ start_s {cfg.start_s} s) is past the end of the data "
+                f"({ext.samples * ext.ts:.2f} s); lengthen motion.duration_s or choose an "
+                "earlier time")
+        his.append(k)
+    return int(round(cfg.start_s / ext.ts)), max(his)
+
+
+class Align(Command):
+    name = "align"
+    help = "Gyrocompass alignment (seed 000)."
+    section = "align"
+    builtin = "seed000_moving_full_cycle.yaml"
+    options = Options(recorded=True, batch_metrics=("error_t3_deg",))
+    layout = ("align",)
+    run = "gcalign.app.align.run"
+    table_of = "gcalign.app.align.tables.align_table"
+    figures_of = "gcalign.app.align.plots.figures"
+
+    def check(self, sc, ext: Extent | None) -> None:
+        """The latitude (the scenario's site, else the data file's), what needs truth, the
+        times against the data, the stored-row stride."""
+        cfg = _config(sc)
+        lat = sc.site.lat_deg if sc.site is not None else (
+            None if ext is None or ext.lat is None else math.degrees(ext.lat))
+        if lat is not None and abs(lat) > MAX_LAT_DEG:
+            raise ScenarioError(f"site.lat_deg: gyrocompassing needs |latitude| < "
+                                f"{MAX_LAT_DEG:g}°, got {lat:.4f}° (the horizontal earth "
+                                "rate vanishes)")
+        if ext is None:
+            return
+        if not ext.has_truth:
+            if cfg.aiding.source != "none":
+                raise ScenarioError(f"align.aiding.source: {cfg.aiding.source!r} needs a "
+                                    "simulated motion (truth); recorded data supports 'none'")
+            if cfg.coarse.method == "given":
+                raise ScenarioError("align.coarse.method: 'given' needs truth; use 'analytic' "
+                                    "or 'inertial' for recorded data")
+        window(sc, ext)
+        stride(sc, ext)
+
+    def cost(self, sc, ext: Extent | None) -> Cost:
+        if ext is None:
+            return Cost()
+        lo, hi = window(sc, ext)
+        passes = _config(sc).pass_count
+        ops = passes * (hi - lo) * GYROCOMPASS_OPS + (0 if ext.recorded else hi * SIMULATE_OPS)
+        return Cost(samples=float(hi), memory_bytes=(hi - lo) * HELD_DOUBLES * DOUBLE,
+                    output_bytes=passes * (hi - lo) / stride(sc, ext) * ROW_DOUBLES * DOUBLE,
+                    work=ops, work_what="passes × samples × a gyrocompass step",
+                    memory_what="the alignment window")
+
+    def components(self, metric: str, k: int) -> list[str]:
+        """Attitude triples are pitch, roll, yaw."""
+        if k == 3 and metric.endswith("_deg"):
+            return ["pitch", "roll", "yaw"]
+        return [str(i) for i in range(k)]
+
+    def label(self, metric: str) -> str:
+        """One component of an attitude triple by its name (``error_t3_deg.2`` ->
+        ``error_t3_deg yaw``)."""
+        head, _, tail = metric.rpartition(".")
+        if head.endswith("_deg") and tail in ("0", "1", "2"):
+            return f"{head} {self.components(head, 3)[int(tail)]}"
+        return metric
+
+    def warm_up(self) -> None:
+        warm_run(self, WARM_SCENARIO)
+
+
+COMMAND = Align()

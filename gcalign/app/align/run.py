@@ -28,6 +28,7 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import Aiding, AlignConfig
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.rotation import euler_to_dcm, quat_to_euler
+from gcalign.units import angle_text
 
 Progress = Callable[[float, float, str], None]
 
@@ -152,16 +153,11 @@ def still_base_warnings(dtheta: np.ndarray, dv: np.ndarray, ts: float, lat: floa
         wander = np.cumsum(inc, axis=0) - k * inc.mean(axis=0)
         return float(np.max(np.linalg.norm(wander, axis=1))) if len(inc) else 0.0
 
-    def angle(rad: float) -> str:  # in the unit that reads best for its size
-        deg = math.degrees(rad)
-        return (f"{deg:.3g}°" if deg >= 1.0 else f"{deg * 60:.3g}′" if deg * 60 >= 1.0
-                else f"{deg * 3600:.3g}″")
-
     turn, limit = excursion(dtheta), STILL_SHARE * earth.omega_ie * math.cos(lat) * T
     if turn > limit:
         return [f"align.coarse.method: 'analytic' assumes a still base, but the base turned "
-                f"by up to {angle(turn)} about its mean rate during the {T:g} s coarse "
-                f"window (1 % of the earth's rotation over it: {angle(limit)}); expect "
+                f"by up to {angle_text(turn)} about its mean rate during the {T:g} s coarse "
+                f"window (1 % of the earth's rotation over it: {angle_text(limit)}); expect "
                 "a wrong heading: use 'inertial' on a moving or swinging base"]
     shift, limit = excursion(dv), STILL_TILT_RAD * float(earth.gravity(lat)) * T
     if shift > limit:

@@ -67,38 +67,39 @@ from gcalign.app.batch.store import (
     write_batch_h5,
 )
 from gcalign.app.batch.sweep import (
-    COMMANDS,
-    DEFAULT_METRICS,
     SWEEP_KEYS,
     Sweep,
     Variant,
+    batchable,
     load_sweep,
     sweep_from_mapping,
 )
+from gcalign.app.command import Command
 
 
-def table(summary: dict):
-    """The batch table (the registry's interface, as for every command's room)."""
-    from gcalign.app.batch.tables import batch_table
+class Batch(Command):
+    """``gcalign batch`` in the registry: its table and figures (``show``, ``plot``); a
+    batch runs sweeps, not a scenario (:func:`run_batch`)."""
 
-    return batch_table(summary)
+    name = "batch"
+    help = "Sweeps and Monte Carlo over any batchable command."
+    layout = ("batch",)
+    table_of = "gcalign.app.batch.tables.batch_table"
+    figures_of = "gcalign.app.batch.plots.figures"
 
 
-def figures(f, name: str) -> dict:
-    from gcalign.app.batch.plots import figures as batch_figures
-
-    return batch_figures(f, name)
+COMMAND = Batch()
 
 
 __all__ = [
-    "COMMANDS",
-    "DEFAULT_METRICS",
     "JOURNAL_SUFFIX",
     "MAX_ATTEMPTS",
     "REBUILD_EVERY_S",
     "SCHEDULER_TIMEOUT_S",
     "STATS",
     "SWEEP_KEYS",
+    "COMMAND",
+    "Batch",
     "BatchResult",
     "DaskBackend",
     "Journal",
@@ -111,6 +112,7 @@ __all__ = [
     "aggregate",
     "apply_override",
     "batch_summary",
+    "batchable",
     "components",
     "dask_client",
     "journal_path",
@@ -130,7 +132,5 @@ __all__ = [
     "stats_of",
     "sweep_from_mapping",
     "warm_up",
-    "table",
-    "figures",
     "write_batch_h5",
 ]

@@ -30,9 +30,8 @@ def components(command: str, metric: str, k: int | None) -> list[str] | None:
         return None
     from gcalign.app.registry import COMMANDS
 
-    room = COMMANDS[command].load() if command in COMMANDS else None
-    if room is not None and hasattr(room, "components"):
-        return room.components(metric, k)
+    if command in COMMANDS:
+        return COMMANDS[command].components(metric, k)
     return [str(i) for i in range(k)]
 
 
@@ -41,8 +40,7 @@ def metric_label(command: str, metric: str) -> str:
     (``error_t3_deg.2`` -> ``error_t3_deg yaw`` in align)."""
     from gcalign.app.registry import COMMANDS
 
-    room = COMMANDS[command].load() if command in COMMANDS else None
-    return room.label(metric) if room is not None and hasattr(room, "label") else metric
+    return COMMANDS[command].label(metric) if command in COMMANDS else metric
 
 
 def metric_units(metric: str) -> str:

@@ -140,13 +140,15 @@ def budget_check(sweep: Sweep, workers: int) -> None:
     """The memory of `workers` runs held at once (each worker keeps its variant's
     noise-free simulation) against the limit, before anything runs."""
     from gcalign.app.preflight import budget, extent
+    from gcalign.app.registry import command
     from gcalign.io.scenario import parse_scenario
 
     v = max(sweep.variants, key=lambda v: _duration(v.scenario))
     sc = parse_scenario(v.scenario, f"{sweep.source}: variant {v.label}")
     ext = extent(sc, read_recorded=False)
     if ext is not None:
-        budget(sc, "batch", ext, workers, where=f"{sweep.source}: variant {v.label}")
+        budget(sc, command(sweep.command), ext, workers,
+               where=f"{sweep.source}: variant {v.label}", batch=True)
 
 
 def _duration(scenario: dict) -> float:

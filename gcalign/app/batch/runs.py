@@ -55,13 +55,12 @@ def run_summary(command: str, sc, seed: int, cache_key: str | None = None) -> di
     `cache_key` (:func:`noise_free_key`) lets successive runs share the noise-free
     simulation.
     """
-    from gcalign.app.registry import command as lookup
+    from gcalign.app.preflight import checked_execute
+    from gcalign.app.registry import COMMANDS
 
-    try:
-        cmd = lookup(command)
-    except KeyError as err:
-        raise GcalignError(str(err.args[0])) from None
-    return cmd.execute(sc, seed, cache_key).summary
+    if command not in COMMANDS:
+        raise GcalignError(f"unknown command {command!r}; commands: {', '.join(COMMANDS)}")
+    return checked_execute(command, sc, seed, cache_key).summary
 
 
 def metric_value(summary: dict, path: str):
@@ -152,10 +151,9 @@ def warm_up(command: str = "align") -> dict:
     its room's ``warm_up()``, if it has one; once per process."""
     from gcalign.app.registry import COMMANDS
 
-    room = COMMANDS[command].load() if command in COMMANDS else None
-    if room is not None and hasattr(room, "warm_up"):
+    if command in COMMANDS:
         try:
-            room.warm_up()
+            COMMANDS[command].warm_up()
         except Exception:  # noqa: BLE001 - warming is an optimisation only
             pass
     return kernel_cache_stats()

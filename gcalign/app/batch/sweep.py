@@ -21,17 +21,25 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
+
+from pydantic import Field, ValidationError, field_validator, model_validator
 
 from gcalign.app.batch.overrides import apply_override
-from gcalign.app.preflight import total_runs
-from gcalign.app.registry import batchable
 from gcalign.errors import ScenarioError
+from gcalign.io.scenario.base import Model
 from gcalign.io.scenario.loader import _cut
 from gcalign.io.scenario.recording import absolute_paths
 from gcalign.limits import SEED_MAX
 
-COMMANDS = tuple(batchable())
-DEFAULT_METRICS = {name: c.batch_metrics for name, c in batchable().items()}
+
+def batchable() -> dict[str, tuple[str, ...]]:
+    """The commands a sweep can run -> their default metrics (from the registry)."""
+    from gcalign.app.registry import batchable as registered
+
+    return {name: c.options.batch_metrics for name, c in registered().items()}
+
+
 SWEEP_KEYS = ("name", "base", "command", "cases", "grid", "seeds", "seed_start", "metrics")
 CASE_KEY = "case"  # the pseudo grid key of a variant's case (not a scenario key)
 
@@ -103,136 +111,232 @@ def load_sweep(path: Path) -> Sweep:
                               default_name=path.stem)
 
 
-def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None,
-                       text: str | None = None, default_name: str = "sweep") -> Sweep:
-    """Validate a parsed sweep mapping; every variant is parsed before anything runs.
+def _whole(v: Any, least: int, what: str) -> int:
+    if isinstance(v, bool) or not isinstance(v, int) or v < least:
+        raise ValueError(f"must be a whole number ≥ {least}{what}, got {_cut(v)}")
+    return v
 
-    Raises ScenarioError with one line naming the key and the value that is wrong.
-    """
+
+class SweepFile(Model):
+    """The keys of a sweep file, checked for shape (docs/batch.md); what they mean for the
+    base scenario is checked by :func:`sweep_from_mapping`."""
+
+    name: str | None = None
+    base: Any = None
+    command: Any = None
+    cases: dict[str, dict[str, Any]] = Field(default_factory=dict)
+    grid: dict[str, list[Any]] = Field(default_factory=dict)
+    seeds: int = 1
+    seed_start: int = 1
+    metrics: list[str] | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _keys(cls, data: Any) -> Any:
+        for k in data:
+            if k not in SWEEP_KEYS:
+                raise ValueError(f"{k}: unknown key (a sweep has: {', '.join(SWEEP_KEYS)})")
+        if "base" not in data:
+            raise ValueError("base: missing; give a scenario file (relative to the sweep "
+                             "file) or an inline scenario mapping")
+        return data
+
+    @field_validator("name", mode="before")
+    @classmethod
+    def _word(cls, v: Any) -> Any:
+        if v is not None and (not isinstance(v, str) or not v or any(c in v for c in "/\\ \t")):
+            raise ValueError(f"must be a non-empty word (used in file names), got {_cut(v)}")
+        return v
+
+    @field_validator("base", mode="before")
+    @classmethod
+    def _base(cls, v: Any) -> Any:
+        if not isinstance(v, (str, dict)):
+            raise ValueError(f"must be a scenario file name or a mapping, got "
+                             f"{type(v).__name__} {_cut(v)}")
+        return v
+
+    @field_validator("seeds", mode="before")
+    @classmethod
+    def _seeds(cls, v: Any) -> int:
+        return _whole(v, 1, " (the seed count)")
+
+    @field_validator("seed_start", mode="before")
+    @classmethod
+    def _seed_start(cls, v: Any) -> int:
+        return _whole(v, 0, "")
+
+    @field_validator("metrics", mode="before")
+    @classmethod
+    def _metrics(cls, v: Any) -> Any:
+        if v is None:
+            return v
+        v = [v] if isinstance(v, str) else v
+        if not isinstance(v, list) or not v:
+            raise ValueError("must be a non-empty list of dotted paths into the run summary "
+                             f"(e.g. [error_t3_deg]), got {_cut(v)}")
+        for m in v:
+            if not isinstance(m, str) or not m or "/" in m or "" in m.split("."):
+                raise ValueError(f"{_cut(m)} is not a dotted path (e.g. error_t3_deg, "
+                                 "passes.2.error_deg)")
+        if len(set(v)) != len(v):
+            raise ValueError(f"{_cut(v)} names a metric twice")
+        return v
+
+    @field_validator("grid", mode="before")
+    @classmethod
+    def _grid(cls, v: Any) -> dict:
+        if not v:
+            return {}
+        if not isinstance(v, dict):
+            raise ValueError("must be a mapping of dotted key -> list of values, got "
+                             f"{type(v).__name__}")
+        axes = {}
+        for key, values in v.items():
+            if not isinstance(key, str) or not key:
+                raise ValueError(f"{_cut(key)}: keys must be dotted paths (e.g. align.mode)")
+            if key == CASE_KEY:
+                raise ValueError(f"{CASE_KEY}: reserved for the names of the sweep's cases; "
+                                 "give settings under 'cases:'")
+            values = values if isinstance(values, list) else [values]  # one fixed value
+            if not values:
+                raise ValueError(f"{key} = []: empty list of values; give at least one value")
+            seen = [json.dumps(x, sort_keys=True, default=str) for x in values]
+            for i, text in enumerate(seen):
+                if text in seen[:i]:
+                    raise ValueError(f"{key}: value {_cut(values[i])} appears twice")
+            axes[key] = values
+        return axes
+
+    @field_validator("cases", mode="before")
+    @classmethod
+    def _cases(cls, v: Any) -> dict:
+        """name -> mapping of dotted key -> value."""
+        if v is None:
+            return {}
+        if not isinstance(v, dict) or not v:
+            raise ValueError("must be a non-empty mapping of case name -> overrides (dotted "
+                             f"key -> value), got {_cut(v)}")
+        out: dict[str, dict] = {}
+        for name, over in v.items():
+            if not isinstance(name, str) or not name.strip():
+                raise ValueError(f"{_cut(name)}: a case name must be a non-empty string")
+            over = {} if over is None else over
+            if not isinstance(over, dict):
+                raise ValueError(f"{name}: must be a mapping of dotted key -> value (or "
+                                 f"empty), got {_cut(over)}")
+            for key in over:
+                if not isinstance(key, str) or not key:
+                    raise ValueError(f"{name}: {_cut(key)}: keys must be dotted paths (e.g. "
+                                     "imu.gyro.arw_dprh)")
+            out[name] = dict(over)
+        return out
+
+    @model_validator(mode="after")
+    def _seed_range(self) -> SweepFile:
+        last = self.seed_start + self.seeds - 1
+        if last > SEED_MAX:
+            raise ValueError(f"seed_start: the seeds {self.seed_start} .. {last} pass 2^63 - 1 "
+                             "(seeds are signed 64-bit)")
+        return self
+
+
+def _errors(err: ValidationError, source: str) -> str:
+    """One line per error: ``source: key: what is wrong`` (a validator's message may name a
+    part of the key first: ``cases: q: must be a mapping ...``)."""
+    lines = []
+    for e in err.errors():
+        msg = e["msg"].removeprefix("Value error, ")
+        if e["type"] != "value_error":
+            msg += f", got {_cut(e.get('input'))}"
+        lines.append(": ".join([source, *(str(x) for x in e["loc"][:1]), msg]))
+    return "\n".join(lines)
+
+
+def _read_base(spec: SweepFile, source: str, base_dir: Path) -> tuple[dict, str, str, Path]:
+    """The base scenario's mapping (``imu_file`` made absolute), source and text, and the
+    folder its relative paths start from."""
     import yaml
 
-    from gcalign.io.scenario import parse_scenario
     from gcalign.io.scenario.loader import read_yaml
 
-    base_dir = Path(base_dir or ".")
-    if not isinstance(data, dict):
-        raise ScenarioError(f"{source}: a sweep must be a YAML mapping, got {type(data).__name__}")
-    for k in data:
-        if k not in SWEEP_KEYS:
-            raise ScenarioError(f"{source}: {k}: unknown key (a sweep has: "
-                                f"{', '.join(SWEEP_KEYS)})")
-    text = text if text is not None else yaml.safe_dump(data, sort_keys=False)
-
-    name = data.get("name", default_name)
-    if not isinstance(name, str) or not name or any(c in name for c in "/\\ \t"):
-        raise ScenarioError(f"{source}: name: must be a non-empty word (used in file names), "
-                            f"got {_cut(name)}")
-
-    # Base scenario: a file relative to the sweep, or an inline mapping.
-    if "base" not in data:
-        raise ScenarioError(f"{source}: base: missing; give a scenario file (relative to the "
-                            "sweep file) or an inline scenario mapping")
-    base = data["base"]
+    base = spec.base
     if isinstance(base, str):
-        base_path = (base_dir / base) if not Path(base).is_absolute() else Path(base)
-        if not base_path.is_file():
-            raise ScenarioError(f"{source}: base: {_cut(base)}: file not found ({base_path})")
-        base_data = read_yaml(base_path)
-        base_source, base_text = str(base_path), base_path.read_text(encoding="utf-8")
-        imu_dir = base_path.parent
-    elif isinstance(base, dict):
-        base_data, base_source = copy.deepcopy(base), f"{source}: base"
-        base_text, imu_dir = yaml.safe_dump(base, sort_keys=False), base_dir
+        path = (base_dir / base) if not Path(base).is_absolute() else Path(base)
+        if not path.is_file():
+            raise ScenarioError(f"{source}: base: {_cut(base)}: file not found ({path})")
+        data, where, text, folder = read_yaml(path), str(path), path.read_text(
+            encoding="utf-8"), path.parent
     else:
-        raise ScenarioError(f"{source}: base: must be a scenario file name or a mapping, "
-                            f"got {type(base).__name__} {_cut(base)}")
-    absolute_paths(base_data, imu_dir)  # workers may run elsewhere
-    base_model = parse_scenario(base_data, base_source)
+        data, where = copy.deepcopy(base), f"{source}: base"
+        text, folder = yaml.safe_dump(base, sort_keys=False), base_dir
+    absolute_paths(data, folder)  # workers may run elsewhere
+    return data, where, text, folder
 
-    command = data.get("command")
+
+def _command_of(spec: SweepFile, base_data: Any, source: str) -> str:
+    """The sweep's command, or the one batchable command whose section the base has."""
+    commands = batchable()
+    command = spec.command
     if command is None:
-        has = [c for c in COMMANDS if isinstance(base_data, dict) and c in base_data]
+        has = [c for c in commands if isinstance(base_data, dict) and c in base_data]
         if len(has) > 1:
             raise ScenarioError(f"{source}: command: the base has sections for "
                                 f"{', '.join(has)}; say which to run (command: "
                                 f"{' | '.join(has)})")
         command = has[0] if has else "align"
-    if command not in COMMANDS:
-        raise ScenarioError(f"{source}: command: must be one of {', '.join(COMMANDS)}, "
+    if command not in commands:
+        raise ScenarioError(f"{source}: command: must be one of {', '.join(commands)}, "
                             f"got {_cut(command)}")
+    return str(command)
 
-    seeds = data.get("seeds", 1)
-    if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
-        raise ScenarioError(f"{source}: seeds: must be a whole number ≥ 1 (the seed count), "
-                            f"got {_cut(seeds)}")
-    seed_start = data.get("seed_start", 1)
-    if isinstance(seed_start, bool) or not isinstance(seed_start, int) or seed_start < 0:
-        raise ScenarioError(f"{source}: seed_start: must be a whole number ≥ 0, got "
-                            f"{_cut(seed_start)}")
-    if seed_start + seeds - 1 > SEED_MAX:
-        raise ScenarioError(f"{source}: seed_start: the seeds {seed_start} .. "
-                            f"{seed_start + seeds - 1} pass 2^63 - 1 (seeds are signed 64-bit)")
 
-    metrics = data.get("metrics", list(DEFAULT_METRICS[command]))
-    if isinstance(metrics, str):
-        metrics = [metrics]
-    if not isinstance(metrics, list) or not metrics:
-        raise ScenarioError(f"{source}: metrics: must be a non-empty list of dotted paths into "
-                            f"the run summary (e.g. [error_t3_deg]), got {_cut(metrics)}")
-    for m in metrics:
-        if not isinstance(m, str) or not m or "/" in m or any(p == "" for p in m.split(".")):
-            raise ScenarioError(f"{source}: metrics: {_cut(m)} is not a dotted path "
-                                "(e.g. error_t3_deg, passes.2.error_deg)")
-    if len(set(metrics)) != len(metrics):
-        raise ScenarioError(f"{source}: metrics: {_cut(metrics)} names a metric twice")
+def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None,
+                       text: str | None = None, default_name: str = "sweep") -> Sweep:
+    """Validate a parsed sweep mapping (:class:`SweepFile`); every variant is parsed and
+    preflighted before anything runs.
 
-    grid = data.get("grid") or {}
-    if not isinstance(grid, dict):
-        raise ScenarioError(f"{source}: grid: must be a mapping of dotted key -> list of values, "
-                            f"got {type(grid).__name__}")
-    cases = _cases(data.get("cases"), source)
-    axes: dict[str, list] = {}
-    for key, values in grid.items():
-        if not isinstance(key, str) or not key:
-            raise ScenarioError(f"{source}: grid: {_cut(key)}: keys must be dotted paths "
-                                "(e.g. align.mode)")
-        if key == CASE_KEY:
-            raise ScenarioError(f"{source}: grid: {CASE_KEY}: reserved for the names of the "
-                                "sweep's cases; give settings under 'cases:'")
-        if not isinstance(values, list):
-            values = [values]  # one fixed value
-        if not values:
-            raise ScenarioError(f"{source}: grid: {key} = []: empty list of values; give at "
-                                "least one value")
-        seen = [json.dumps(v, sort_keys=True, default=str) for v in values]
-        for i, s in enumerate(seen):
-            if s in seen[:i]:
-                raise ScenarioError(f"{source}: grid: {key}: value {_cut(values[i])} appears twice")
-        axes[key] = values
+    Raises ScenarioError with one line naming the key and the value that is wrong.
+    """
+    import yaml
 
-    n_variants = math.prod(len(v) for v in axes.values()) * max(1, len(cases))
-    total_runs(n_variants, seeds, source)
+    from gcalign.app.preflight import total_runs
+    from gcalign.io.scenario import parse_scenario
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{source}: a sweep must be a YAML mapping, got {type(data).__name__}")
+    try:
+        spec = SweepFile.model_validate(data)
+    except ValidationError as err:
+        raise ScenarioError(_errors(err, source)) from None
+    text = text if text is not None else yaml.safe_dump(data, sort_keys=False)
+    base_data, base_source, base_text, _ = _read_base(spec, source, Path(base_dir or "."))
+    base_model = parse_scenario(base_data, base_source)
+    command = _command_of(spec, base_data, source)
+    metrics = spec.metrics or list(batchable()[command])
+    axes, cases = dict(spec.grid), spec.cases
+    total_runs(math.prod(len(v) for v in axes.values()) * max(1, len(cases)), spec.seeds,
+               source)
+
+    def variant(applied, where: str, name_key: bool = False) -> dict:
+        """The base with `applied` (key, value) overrides, parsed and preflighted; a bad
+        override is reported at `where` (and by its key and value with `name_key`)."""
+        scenario = copy.deepcopy(base_data)
+        for key, value in applied:
+            try:
+                apply_override(scenario, key, value, base_model)
+            except ScenarioError as err:
+                at = f"{where}: {key} = {_cut(value)}" if name_key else where
+                raise ScenarioError(f"{at}: {err}") from None
+        _check_section(parse_scenario(scenario, where), command, where)
+        return scenario
 
     # Each case alone, then each grid key and value alone against the base: a message that
     # names exactly that case or pair.
     for case, over in cases.items():
-        trial = copy.deepcopy(base_data)
-        where = f"{source}: cases: {case}"
-        for key, value in over.items():
-            try:
-                apply_override(trial, key, value, base_model)
-            except ScenarioError as err:
-                raise ScenarioError(f"{where}: {key} = {_cut(value)}: {err}") from None
-        _check_section(parse_scenario(trial, where), command, where)
+        variant(over.items(), f"{source}: cases: {case}", name_key=True)
     for key, values in axes.items():
         for value in values:
-            trial = copy.deepcopy(base_data)
-            try:
-                apply_override(trial, key, value, base_model)
-            except ScenarioError as err:
-                raise ScenarioError(f"{source}: grid: {key} = {_cut(value)}: {err}") from None
-            where = f"{source}: grid: {key} = {_cut(value)}"
-            _check_section(parse_scenario(trial, where), command, where)
+            variant([(key, value)], f"{source}: grid: {key} = {_cut(value)}")
 
     # Then every combination (a value may be valid alone but not with another one). A case's
     # overrides are applied first, then the grid's.
@@ -242,47 +346,15 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     variants = []
     for i, combo in enumerate(itertools.product(*(axes[k] for k in keys))):
         overrides = dict(zip(keys, combo, strict=True))
-        scenario = copy.deepcopy(base_data)
         label = ", ".join(f"{k} = {_cut(v)}" for k, v in overrides.items())
         applied = [*cases.get(str(overrides.get(CASE_KEY)), {}).items(),
                    *((k, v) for k, v in overrides.items() if k != CASE_KEY)]
-        try:
-            for k, v in applied:
-                apply_override(scenario, k, v, base_model)
-        except ScenarioError as err:
-            raise ScenarioError(f"{source}: grid: variant {label}: {err}") from None
-        where = f"{source}: grid: variant {label}"
-        _check_section(parse_scenario(scenario, where), command, where)
-        variants.append(Variant(i, overrides, scenario,
-                                _hash(command, list(metrics), scenario)))
-    return Sweep(name=name, command=command, source=source, text=text,
+        scenario = variant(applied, f"{source}: grid: variant {label}")
+        variants.append(Variant(i, overrides, scenario, _hash(command, list(metrics), scenario)))
+    return Sweep(name=spec.name or default_name, command=command, source=source, text=text,
                  base_source=base_source, base_text=base_text, grid=axes, cases=cases,
-                 seeds=seeds,
-                 seed_start=seed_start, metrics=tuple(metrics), variants=tuple(variants))
-
-
-def _cases(cases, source: str) -> dict[str, dict]:
-    """The ``cases:`` mapping checked for shape: name -> mapping of dotted key -> value."""
-    if cases is None:
-        return {}
-    if not isinstance(cases, dict) or not cases:
-        raise ScenarioError(f"{source}: cases: must be a non-empty mapping of case name -> "
-                            f"overrides (dotted key -> value), got {_cut(cases)}")
-    out: dict[str, dict] = {}
-    for name, over in cases.items():
-        if not isinstance(name, str) or not name.strip():
-            raise ScenarioError(f"{source}: cases: {_cut(name)}: a case name must be a non-empty "
-                                "string")
-        over = {} if over is None else over
-        if not isinstance(over, dict):
-            raise ScenarioError(f"{source}: cases: {name}: must be a mapping of dotted key -> "
-                                f"value (or empty), got {_cut(over)}")
-        for key in over:
-            if not isinstance(key, str) or not key:
-                raise ScenarioError(f"{source}: cases: {name}: {_cut(key)}: keys must be dotted "
-                                    "paths (e.g. imu.gyro.arw_dprh)")
-        out[name] = dict(over)
-    return out
+                 seeds=spec.seeds, seed_start=spec.seed_start, metrics=tuple(metrics),
+                 variants=tuple(variants))
 
 
 def _check_section(sc, command: str, where: str) -> None:
@@ -332,20 +404,20 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
         datas.append(data)
         texts.append(path.read_text(encoding="utf-8"))
     if command is None:
-        found = {c for d in datas for c in COMMANDS if isinstance(d, dict) and c in d}
+        found = {c for d in datas for c in batchable() if isinstance(d, dict) and c in d}
         if len(found) > 1:
             raise ScenarioError(f"batch: the files have sections of {', '.join(sorted(found))}; "
                                 "say which command to run (--command)")
         command = found.pop() if found else "align"
-    if command not in COMMANDS:
-        raise ScenarioError(f"--command: must be one of {', '.join(COMMANDS)}, got {command!r}")
+    if command not in batchable():
+        raise ScenarioError(f"--command: must be one of {', '.join(batchable())}, got {command!r}")
     labels = [p.name for p in paths]
     if len(set(labels)) < len(labels):
         labels = [str(p) for p in paths]
     if len(set(labels)) < len(labels):
         raise ScenarioError("batch: a scenario file is listed twice")
     spec = {"files": [str(p) for p in paths], "command": command, "seeds": seeds,
-            "seed_start": seed_start, "metrics": list(metrics or DEFAULT_METRICS[command])}
+            "seed_start": seed_start, "metrics": list(metrics or batchable()[command])}
     stems = [p.name.split(".")[0] for p in paths]
     name = "+".join(stems) if len(stems) <= 3 else f"{stems[0]}+{len(stems) - 1}-more"
     # The checks of seeds, seed_start and metrics are the sweep's (one variant: file 1).

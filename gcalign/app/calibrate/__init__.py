@@ -1,45 +1,28 @@
-"""`gcalign calibrate`: in-flight calibration of an airborne SINS (seed 002).
-
-The room's interface for the registry (:mod:`gcalign.app.registry`); each function imports
-its module when called, so tables and figures never load the numerical kernels.
-"""
+"""`gcalign calibrate`: in-flight calibration of an airborne SINS (seed 002)."""
 
 from __future__ import annotations
 
-from gcalign.app.registry import Outcome
+from gcalign.app.command import (
+    DOUBLE,
+    KALMAN_OPS,
+    SIMULATE_OPS,
+    STRAPDOWN_OPS,
+    Command,
+    Cost,
+    Extent,
+    Options,
+    warm_run,
+)
 
 UNIT_TEXT = {"arcsec": "″", "arcmin": "′", "deg/h": "°/h", "ug": "µg", "ppm": "ppm",
              "m/s": "m/s", "m": "m"}
 """Printed symbols of the display units (:data:`gcalign.estimation.ins_error.DISPLAY_UNITS`)."""
 
-
-def execute(sc, seed: int | None = None, cache_key: str | None = None, progress=None,
-            **options) -> Outcome:
-    from gcalign.app.calibrate.run import execute as run
-
-    return run(sc, seed, cache_key, progress=progress, **options)
-
-
-def table(summary: dict):
-    from gcalign.app.calibrate.tables import calibrate_table
-
-    return calibrate_table(summary)
-
-
-def figures(f, name: str) -> dict:
-    from gcalign.app.calibrate.plots import figures
-
-    return figures(f, name)
-
-
-def components(metric: str, k: int) -> list[str]:
-    """Names of a batch metric's components: 21-vectors are the states."""
-    from gcalign.estimation.ins_error import STATE_NAMES
-
-    if k == len(STATE_NAMES):
-        return list(STATE_NAMES)
-    return [str(i) for i in range(k)]
-
+SIMULATION_DOUBLES = 24  #: per IMU sample of the noise-free simulation held (truth + IMU)
+RECORDED_DOUBLES = 7  #: per sample of recorded data (t, increments)
+STEP_DOUBLES = 16  #: per navigation step of the flight data (increments, truth)
+EPOCH_DOUBLES = 100  #: per filter epoch: estimate, σ, truth, error, state, NIS, NEES
+SMOOTHER_DOUBLES = 2 * 21 * 21  #: per epoch kept for the smoother: P and Φ
 
 WARM_SCENARIO = {  # a tiny flight: every kernel of a calibration, in milliseconds
     "name": "warm-up",
@@ -52,10 +35,72 @@ WARM_SCENARIO = {  # a tiny flight: every kernel of a calibration, in millisecon
 }
 
 
-def warm_up() -> None:
-    """Run a tiny calibration so that every kernel is loaded in this process."""
-    import copy
+def config(sc):
+    from gcalign.io.scenario.calibrate import CalibrateConfig
 
-    from gcalign.io.scenario import parse_scenario
+    return sc.calibrate or CalibrateConfig()
 
-    execute(parse_scenario(copy.deepcopy(WARM_SCENARIO), "warm-up"), 1)
+
+def steps(sc, ext: Extent | None) -> tuple[float, float, float]:
+    """(IMU samples, navigation steps, filter epochs) of the calibration window."""
+    cfg = config(sc)
+    if ext is None:
+        return 0.0, 0.0, 0.0
+    rate = 1.0 / ext.ts
+    duration = ext.samples * ext.ts
+    try:
+        _, coarse_end, end = cfg.window(duration, ext.ts)
+        nav = (end - coarse_end) * rate / cfg.subsamples(rate)
+        epochs = nav / cfg.steps_per_update(rate)
+    except Exception:  # noqa: BLE001 - the check names what does not fit; the cost is rough
+        nav, epochs = float(ext.samples), float(ext.samples)
+    return float(ext.samples), nav, epochs
+
+
+def state_components(metric: str, k: int) -> list[str]:
+    """Names of a batch metric's components: 21-vectors are the states."""
+    from gcalign.estimation.ins_error import STATE_NAMES
+
+    if k == len(STATE_NAMES):
+        return list(STATE_NAMES)
+    return [str(i) for i in range(k)]
+
+
+class Calibrate(Command):
+    name = "calibrate"
+    help = "In-flight calibration, 21-state Kalman filter (seed 002)."
+    section = "calibrate"
+    builtin = "seed002_designed.yaml"
+    options = Options(recorded=True, batch_metrics=("nees.final", "normalized_error"))
+    layout = ("calibrate",)
+    run = "gcalign.app.calibrate.run"
+    table_of = "gcalign.app.calibrate.tables.calibrate_table"
+    figures_of = "gcalign.app.calibrate.plots.figures"
+
+    def check(self, sc, ext: Extent | None) -> None:
+        config(sc).check(sc)
+
+    def cost(self, sc, ext: Extent | None) -> Cost:
+        """The simulation (or the recorded data) held whole, the flight at the navigation
+        rate, the filter's epochs (and the smoother's P and Φ per epoch)."""
+        n, nav, epochs = steps(sc, ext)
+        cfg = config(sc)
+        recorded = ext is not None and ext.recorded
+        per_epoch = EPOCH_DOUBLES + (SMOOTHER_DOUBLES if cfg.smoother else 0)
+        memory = n * (RECORDED_DOUBLES if recorded else SIMULATION_DOUBLES) + (
+            nav * STEP_DOUBLES + epochs * per_epoch)
+        work = (0.0 if recorded else n * SIMULATE_OPS) + nav * STRAPDOWN_OPS + (
+            epochs * KALMAN_OPS * (2 if cfg.smoother else 1))
+        return Cost(samples=n, memory_bytes=memory * DOUBLE,
+                    output_bytes=epochs * EPOCH_DOUBLES * DOUBLE, work=work,
+                    work_what="navigation steps and 21-state filter epochs",
+                    memory_what="the simulation and the filter's epochs")
+
+    def components(self, metric: str, k: int) -> list[str]:
+        return state_components(metric, k)
+
+    def warm_up(self) -> None:
+        warm_run(self, WARM_SCENARIO)
+
+
+COMMAND = Calibrate()

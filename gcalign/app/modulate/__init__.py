@@ -1,28 +1,56 @@
 """`gcalign modulate`: navigation on a turning IMU, several rotation schemes on the same data
-(seed 004).
-
-The room's interface for the registry (:mod:`gcalign.app.registry`); each function imports
-its module when called, so tables and figures never load the numerical kernels.
-"""
+(seed 004)."""
 
 from __future__ import annotations
 
-from gcalign.app.registry import Outcome
+from gcalign.app.command import (
+    DOUBLE,
+    SIMULATE_OPS,
+    STRAPDOWN_OPS,
+    Command,
+    Cost,
+    Extent,
+    Options,
+)
+from gcalign.app.navigate import ROW_DOUBLES
+
+MECHANISM_OPS = 100.0  #: per sample: the mechanism's C_s^b and the increments it turns
+BLOCK = 1 << 16  #: samples simulated and navigated at a time (the stream's blocks)
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None, **options) -> Outcome:
-    from gcalign.app.modulate.run import execute as run
+class Modulate(Command):
+    name = "modulate"
+    help = ("Rotation modulation: navigation on a turning IMU, schemes compared on the same "
+            "data (seed 004).")
+    section = "modulate"
+    builtin = "seed004_modulation.yaml"
+    options = Options(streams=True, batch_metrics=("max_horizontal_error_m",))
+    layout = ("modulate",)
+    run = "gcalign.app.modulate.run"
+    table_of = "gcalign.app.modulate.tables.modulate_table"
+    figures_of = "gcalign.app.modulate.plots.figures"
 
-    return run(sc, seed, cache_key, **options)
+    def check(self, sc, ext: Extent | None) -> None:
+        from gcalign.io.scenario.modulate import plan_of
+
+        plan_of(sc)
+
+    def cost(self, sc, ext: Extent | None) -> Cost:
+        """Each scheme simulates and navigates the plan's duration, streamed in blocks, and
+        stores its series at ``output.rate_hz`` (default 1 Hz up to 4 h, 0.1 Hz beyond)."""
+        from gcalign.io.scenario.modulate import default_rate_hz, plan_of
+
+        plan = plan_of(sc)
+        rate = sc.imu.rate_hz
+        n = plan.duration_s * rate
+        schemes = len(plan.entries)
+        rows = plan.duration_s * (sc.output.rate_hz or default_rate_hz(plan.duration_s, rate))
+        return Cost(samples=n * schemes,
+                    memory_bytes=min(n, BLOCK) * 2 * ROW_DOUBLES * DOUBLE,
+                    output_bytes=schemes * rows * ROW_DOUBLES * DOUBLE,
+                    work=schemes * n * (SIMULATE_OPS + MECHANISM_OPS + STRAPDOWN_OPS),
+                    work_what="schemes × samples × (mechanism, simulation, strapdown)",
+                    memory_what="the blocks of the stream")
 
 
-def table(summary: dict):
-    from gcalign.app.modulate.tables import modulate_table
-
-    return modulate_table(summary)
-
-
-def figures(f, name: str) -> dict:
-    from gcalign.app.modulate.plots import figures
-
-    return figures(f, name)
+COMMAND = Modulate()

@@ -29,7 +29,7 @@ from gcalign.app.navigate.run import run_navigation
 from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
-from gcalign.io.scenario.modulate import Entry, Plan, plan_of
+from gcalign.io.scenario.modulate import Entry, Plan, default_rate_hz, plan_of
 from gcalign.io.scenario.navigation import NavigationConfig, OutputConfig
 from gcalign.modulate.analysis import SchemeAnalysis, analyse_scheme
 from gcalign.modulate.invariants import InvariantReport
@@ -46,11 +46,6 @@ def hour_key(h: float) -> str:
 
 def report_hours(hours: float) -> list[float]:
     return [h for h in REPORT_HOURS if h <= hours + 1e-9]
-
-
-def default_rate_hz(duration_s: float, imu_rate_hz: float) -> float:
-    """Stored-series rate without ``output.rate_hz``: 1 Hz up to 4 h, 0.1 Hz beyond."""
-    return min(imu_rate_hz, 1.0 if duration_s <= 4 * HOUR else 0.1)
 
 
 def seed_scenario(compare: Iterable[str], *, rate: float = 10.0,

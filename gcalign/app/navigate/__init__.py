@@ -1,28 +1,52 @@
-"""`gcalign navigate`: strapdown navigation of simulated or recorded data.
-
-The room's interface for the registry (:mod:`gcalign.app.registry`); each function imports
-its module when called, so tables and figures never load the numerical kernels.
-"""
+"""`gcalign navigate`: strapdown navigation of simulated or recorded data."""
 
 from __future__ import annotations
 
-from gcalign.app.registry import Outcome
+from gcalign.app.command import (
+    DOUBLE,
+    SIMULATE_OPS,
+    STRAPDOWN_OPS,
+    Command,
+    Cost,
+    Extent,
+    Options,
+    stride,
+)
+from gcalign.errors import ScenarioError
+
+#: doubles stored per row (t, att, v_n, pos, their errors, phi, ...)
+ROW_DOUBLES = 30
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None, progress=None,
-            **options) -> Outcome:
-    from gcalign.app.navigate.run import execute as run
+class Navigate(Command):
+    name = "navigate"
+    help = "Strapdown navigation of simulated or recorded data."
+    section = "navigation"
+    options = Options(recorded=True, streams=True)
+    layout = ("navigate",)
+    run = "gcalign.app.navigate.run"
+    table_of = "gcalign.app.navigate.tables.navigate_table"
+    figures_of = "gcalign.app.navigate.plots.figures"
 
-    return run(sc, seed, cache_key, progress=progress, **options)
+    def check(self, sc, ext: Extent | None) -> None:
+        if ext is None:
+            return
+        from gcalign.io.scenario.navigation import NavigationConfig
+
+        cfg = sc.navigation or NavigationConfig()
+        if int(round(cfg.start_s / ext.ts)) >= ext.samples:
+            raise ScenarioError(f"navigation.start_s: {cfg.start_s:g} s is past the end of the "
+                                f"data ({ext.samples * ext.ts:g} s)")
+        stride(sc, ext)
+
+    def cost(self, sc, ext: Extent | None) -> Cost:
+        if ext is None:
+            return Cost()
+        n = float(ext.samples)
+        ops = STRAPDOWN_OPS + (0.0 if ext.recorded else SIMULATE_OPS)
+        return Cost(samples=n, memory_bytes=min(n, 1 << 16) * ROW_DOUBLES * DOUBLE,
+                    output_bytes=n / stride(sc, ext) * ROW_DOUBLES * DOUBLE,
+                    work=n * ops, work_what="strapdown steps")
 
 
-def table(summary: dict):
-    from gcalign.app.navigate.tables import navigate_table
-
-    return navigate_table(summary)
-
-
-def figures(f, name: str) -> dict:
-    from gcalign.app.navigate.plots import figures
-
-    return figures(f, name)
+COMMAND = Navigate()

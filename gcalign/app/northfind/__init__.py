@@ -1,27 +1,40 @@
-"""`gcalign northfind`: multi-position north-finding with tilt compensation (seed 001).
-
-The room's interface for the registry (:mod:`gcalign.app.registry`); each function imports
-its module when called, so tables and figures never load the numerical kernels.
-"""
+"""`gcalign northfind`: multi-position north-finding with tilt compensation (seed 001)."""
 
 from __future__ import annotations
 
-from gcalign.app.registry import Outcome
+from gcalign.app.command import DOUBLE, SIMULATE_OPS, Command, Cost, Extent, Options
+from gcalign.errors import ScenarioError
+
+READING_DOUBLES = 16  #: per dwell reading: gyro and accelerometer means, per method results
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None) -> Outcome:
-    from gcalign.app.northfind.run import execute as run
+class Northfind(Command):
+    name = "northfind"
+    help = "Multi-position north-finding (seed 001)."
+    section = "northfind"
+    builtin = "seed001_simulation.yaml"
+    options = Options(self_contained=True,
+                      batch_metrics=("methods.coordinate.rms_error_deg",))
+    layout = ("northfind",)
+    run = "gcalign.app.northfind.run"
+    table_of = "gcalign.app.northfind.tables.northfind_table"
+    figures_of = "gcalign.app.northfind.plots.figures"
 
-    return run(sc, seed, cache_key)
+    def check(self, sc, ext: Extent | None) -> None:
+        if sc.northfind is None:
+            raise ScenarioError("northfind: missing; the scenario needs a 'northfind' section "
+                                "(positions, dwell_s, azimuth_deg or sweep, tilt_deg, …)")
+        sc.northfind.check(sc)
+
+    def cost(self, sc, ext: Extent | None) -> Cost:
+        cfg = sc.northfind
+        readings = float(cfg.azimuths_deg().size * cfg.repeats * cfg.positions)
+        per_dwell = float(round(cfg.dwell_s * sc.imu.rate_hz)) if cfg.samples else 1.0
+        return Cost(samples=readings * per_dwell if cfg.samples else 0.0,
+                    memory_bytes=readings * READING_DOUBLES * DOUBLE + per_dwell * 6 * DOUBLE,
+                    output_bytes=readings * READING_DOUBLES * DOUBLE,
+                    work=readings * per_dwell * SIMULATE_OPS,
+                    work_what="dwell readings × their samples", memory_what="dwell readings")
 
 
-def table(summary: dict):
-    from gcalign.app.northfind.tables import northfind_table
-
-    return northfind_table(summary)
-
-
-def figures(f, name: str) -> dict:
-    from gcalign.app.northfind.plots import figures
-
-    return figures(f, name)
+COMMAND = Northfind()

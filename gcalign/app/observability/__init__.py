@@ -1,39 +1,63 @@
-"""`gcalign observability`: the PWCS/SVD observability table of a flight (seed 002 §4).
-
-The room's interface for the registry (:mod:`gcalign.app.registry`); each function imports
-its module when called, so tables and figures never load the numerical kernels.
-"""
+"""`gcalign observability`: the PWCS/SVD observability table of a flight (seed 002 §4)."""
 
 from __future__ import annotations
 
-from gcalign.app.registry import Outcome
+from gcalign.app.calibrate import COMMAND as CALIBRATE
+from gcalign.app.calibrate import (
+    SIMULATION_DOUBLES,
+    STEP_DOUBLES,
+    state_components,
+    steps,
+)
+from gcalign.app.command import DOUBLE, KALMAN_OPS, Command, Cost, Extent, Options
+
+N = 21  #: states
+PIECE_OPS = 40.0 * N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, its QR
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None) -> Outcome:
-    from gcalign.app.observability.run import execute as run
+class Observability(Command):
+    name = "observability"
+    help = "PWCS/SVD observability table of a flight (seed 002)."
+    section = "observability"
+    builtin = "seed002_designed.yaml"
+    options = Options(batch_metrics=("rank_final",))
+    layout = ("observability",)
+    run = "gcalign.app.observability.run"
+    table_of = "gcalign.app.observability.tables.observability_table"
+    figures_of = "gcalign.app.observability.plots.figures"
 
-    return run(sc, seed, cache_key)
+    def check(self, sc, ext: Extent | None) -> None:
+        from gcalign.io.scenario.calibrate import ObservabilityConfig
+
+        (sc.observability or ObservabilityConfig()).check(sc)
+
+    def cost(self, sc, ext: Extent | None) -> Cost:
+        """Per PWCS piece F, Φ, R and the stacked observability matrix (measurements × 21
+        rows of 21) held at once, and their products; the flight at the navigation rate;
+        the covariance run's epochs."""
+        from gcalign.io.scenario.calibrate import ObservabilityConfig
+
+        cfg = sc.observability or ObservabilityConfig()
+        n, nav, epochs = steps(sc, ext)
+        segments = len(sc.motion.segments) if sc.motion is not None and hasattr(
+            sc.motion, "segments") else 1
+        pieces = (0.0 if ext is None else ext.samples * ext.ts) / cfg.piece_s + segments
+        measured = 6 if cfg.measure == "both" else 3
+        per_piece = 4 * N * N + N * measured * N
+        covariance = epochs * KALMAN_OPS if cfg.covariance else 0.0
+        return Cost(samples=n,
+                    memory_bytes=(pieces * per_piece + n * SIMULATION_DOUBLES
+                                  + nav * STEP_DOUBLES) * DOUBLE,
+                    output_bytes=(segments * 4 * N + nav * STEP_DOUBLES / 10) * DOUBLE,
+                    work=pieces * PIECE_OPS + covariance,
+                    work_what="PWCS pieces × 40 · 21³",
+                    memory_what="the PWCS pieces (observability.piece_s)")
+
+    def components(self, metric: str, k: int) -> list[str]:
+        return state_components(metric, k)
+
+    def warm_up(self) -> None:
+        CALIBRATE.warm_up()
 
 
-def table(summary: dict):
-    from gcalign.app.observability.tables import observability_table
-
-    return observability_table(summary)
-
-
-def figures(f, name: str) -> dict:
-    from gcalign.app.observability.plots import figures
-
-    return figures(f, name)
-
-
-def components(metric: str, k: int) -> list[str]:
-    from gcalign.app.calibrate import components as state_components
-
-    return state_components(metric, k)
-
-
-def warm_up() -> None:
-    from gcalign.app.calibrate import warm_up as calibrate_warm_up
-
-    calibrate_warm_up()
+COMMAND = Observability()

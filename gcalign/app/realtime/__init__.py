@@ -1,29 +1,49 @@
 """`gcalign realtime`: attitude at external sync pulses, filter delay and prediction
-(seed 003).
-
-The room's interface for the registry (:mod:`gcalign.app.registry`); each function imports
-its module when called, so tables and figures never load scipy or the numba kernels.
-"""
+(seed 003)."""
 
 from __future__ import annotations
 
-from gcalign.app.registry import Outcome
+from gcalign.app.command import DOUBLE, Command, Cost, Extent, Options
+from gcalign.errors import ScenarioError
+
+NOTCH_OPS = 5.0  #: a second-order IIR section per sample
+SOLUTION_DOUBLES = 24  #: per attitude solution: truth, output and each predictor's error
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None,
-            progress=None) -> Outcome:
-    from gcalign.app.realtime.run import execute as run
+class Realtime(Command):
+    name = "realtime"
+    help = "Attitude at sync pulses: filter delay and prediction (seed 003)."
+    section = "realtime"
+    builtin = "seed003_table1.yaml"
+    options = Options(self_contained=True,
+                      batch_metrics=("cases.0.after_max_arcsec.kalman-ls",))
+    layout = ("realtime",)
+    run = "gcalign.app.realtime.run"
+    table_of = "gcalign.app.realtime.tables.realtime_table"
+    figures_of = "gcalign.app.realtime.plots.figures"
 
-    return run(sc, seed, cache_key, progress)
+    def check(self, sc, ext: Extent | None) -> None:
+        if sc.realtime is None:
+            raise ScenarioError("realtime: missing; the scenario needs a 'realtime' section "
+                                "(cases or a turntable motion, filter, sensor, tracker, pulses)")
+        sc.realtime.check(sc)
+
+    def cost(self, sc, ext: Extent | None) -> Cost:
+        """Three gyro channels through the chain's FIR (taps × samples, a direct
+        convolution) and notch; the attitude solutions held for the pulses."""
+        cfg = sc.realtime
+        s = cfg.to_settings()
+        f = s.filter
+        n = float(cfg.samples(sc))
+        taps = (f.nav_order if f.chain == "navigation" else f.align_order) + 1.0
+        chunk = min(n, s.chunk_s * f.fs_hz)
+        solutions = n / f.fs_hz * s.solution_hz
+        return Cost(samples=n,
+                    memory_bytes=(chunk * 3 * 6 + taps * 3 * 2) * DOUBLE
+                    + solutions * SOLUTION_DOUBLES * DOUBLE,
+                    output_bytes=solutions * SOLUTION_DOUBLES * DOUBLE,
+                    work=3 * n * (taps + NOTCH_OPS), work_what="3 channels × FIR taps × samples",
+                    memory_what="the attitude solutions")
 
 
-def table(summary: dict):
-    from gcalign.app.realtime.tables import realtime_table
-
-    return realtime_table(summary)
-
-
-def figures(f, name: str) -> dict:
-    from gcalign.app.realtime.plots import figures
-
-    return figures(f, name)
+COMMAND = Realtime()

@@ -1,29 +1,40 @@
-"""`gcalign simulate`: truth and IMU data of a scenario.
-
-The room's interface for the registry (:mod:`gcalign.app.registry`); each function imports
-its module when called, so tables and figures never load the numerical kernels.
-"""
+"""`gcalign simulate`: truth and IMU data of a scenario."""
 
 from __future__ import annotations
 
-from gcalign.app.registry import Outcome
+from typing import Any
+
+from gcalign.app.command import DOUBLE, SIMULATE_OPS, Command, Cost, Extent, Options, stride
+
+#: doubles stored per row: /truth t, att, v_n, pos, segment and /imu t, dtheta, dv, q_bs
+ROW_DOUBLES = 26
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None, progress=None,
-            **options) -> Outcome:
-    from gcalign.app.simulate.run import execute as run
+class Simulate(Command):
+    name = "simulate"
+    help = "Simulate truth and IMU data."
+    options = Options(streams=True)
+    layout = ("truth", "imu")
+    run = "gcalign.app.simulate.run"
+    table_of = "gcalign.app.simulate.tables.simulate_table"
 
-    return run(sc, seed, cache_key, progress=progress, **options)
+    def check(self, sc, ext: Extent | None) -> None:
+        if ext is not None:
+            stride(sc, ext)
+
+    def cost(self, sc, ext: Extent | None) -> Cost:
+        if ext is None:
+            return Cost()
+        n = float(ext.samples)
+        return Cost(samples=n, memory_bytes=min(n, 1 << 16) * ROW_DOUBLES * DOUBLE,
+                    output_bytes=n / stride(sc, ext) * ROW_DOUBLES * DOUBLE,
+                    work=n * SIMULATE_OPS, work_what="samples × their simulation")
+
+    def figures(self, f: Any, name: str) -> dict:
+        """The truth and the IMU output (the shared figures of :mod:`gcalign.app.plots`)."""
+        from gcalign.app.plots import truth_and_imu
+
+        return truth_and_imu(f, name)
 
 
-def table(summary: dict):
-    from gcalign.app.simulate.tables import simulate_table
-
-    return simulate_table(summary)
-
-
-def figures(f, name: str) -> dict:
-    """The truth and the IMU output (the shared figures of :mod:`gcalign.app.plots`)."""
-    from gcalign.app.plots import truth_and_imu
-
-    return truth_and_imu(f, name)
+COMMAND = Simulate()

@@ -20,7 +20,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gcalign.align.stages import Stage, stage_of_passes
+from gcalign.align.stages import Stage
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, Vec3
 
@@ -167,10 +167,6 @@ class AlignConfig(Model):
     @property
     def pass_count(self) -> int:
         return sum(int(s.passes or 0) for s in self.stage_list())
-
-    def stage_of_pass(self) -> list[int]:
-        """Index of the stage each pass uses (0-based)."""
-        return stage_of_passes(self.stage_list(), self.pass_count)
 
     @property
     def level_phase_s(self) -> float:

@@ -39,6 +39,11 @@ CYCLE_TOL = 1e-9  # rad: a table's cycle rotation below this returns the IMU to 
 MAX_HOURS = 1e6 / 3600.0  # the longest motion a scenario may have (1e6 s)
 
 
+def default_rate_hz(duration_s: float, imu_rate_hz: float) -> float:
+    """Stored-series rate without ``output.rate_hz``: 1 Hz up to 4 h, 0.1 Hz beyond."""
+    return min(imu_rate_hz, 1.0 if duration_s <= 4 * 3600.0 else 0.1)
+
+
 def _names(v):
     if isinstance(v, str):
         return [x.strip() for x in v.split(",") if x.strip()]

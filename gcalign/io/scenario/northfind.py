@@ -54,6 +54,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
+from gcalign import limits
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.base import Model
@@ -62,8 +63,6 @@ from gcalign.northfind import NorthfindSetup, tilt_from_pitch_roll
 MethodName = Literal["coordinate", "vector", "naive", "none", "vector_literal"]
 DEFAULT_METHODS: list[MethodName] = ["coordinate", "vector", "naive", "none"]
 MAX_AZIMUTHS = 100_000
-MAX_READINGS = 2_000_000  # azimuths × repeats × positions (memory of the result arrays)
-MAX_SAMPLES = 200_000_000  # with samples: true, simulated samples per sensor
 _TOL = 1e-9
 
 
@@ -225,17 +224,13 @@ class NorthfindConfig(Model):
             )
         n = round(self.dwell_s * sc.imu.rate_hz)
         readings = self.azimuths_deg().size * self.repeats * self.positions
-        if readings > MAX_READINGS:
-            raise ScenarioError(
-                f"northfind.repeats: azimuths × repeats × positions = {readings} dwell readings, "
-                f"at most {MAX_READINGS} allowed; got repeats {self.repeats}"
-            )
-        if self.samples and readings * n > MAX_SAMPLES:
-            raise ScenarioError(
-                f"northfind.samples: true would simulate {readings * n} samples per sensor, at "
-                f"most {MAX_SAMPLES} allowed; use samples: false (exact dwell means, "
-                f"statistically identical), got true"
-            )
+        limits.MAX_NORTHFIND_READINGS.check(
+            readings, "northfind.repeats", f"azimuths × repeats × positions, repeats "
+            f"{self.repeats}")
+        if self.samples:
+            limits.MAX_NORTHFIND_SAMPLES.check(
+                readings * n, "northfind.samples", "use samples: false (exact dwell means, "
+                "statistically identical)")
         if n < 1:
             raise ScenarioError(
                 f"northfind.dwell_s: {_fmt(self.dwell_s)} s holds no sample at imu.rate_hz "

@@ -70,6 +70,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
+from gcalign import limits
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
@@ -90,7 +91,6 @@ PredictorName = Literal["none", "taylor", "kalman-ls"]
 DEFAULT_PREDICTORS: list[PredictorName] = ["none", "taylor", "kalman-ls"]  # = core PREDICTORS
 SEED_DELAY_MS = 4.0  #: the seed's T (§3.2: n = 4 solution intervals of 1 ms)
 MAX_CASES = 100
-MAX_SAMPLES = 50_000_000  #: sensor samples of all cases together (a run holds its pulses)
 
 
 def _us(x: float | None) -> float | None:
@@ -303,10 +303,12 @@ class RealtimeConfig(Model):
                     raise ScenarioError(
                         f"imu.{name}.{key}: not used by realtime (its gyro model is "
                         f"realtime.sensor: quantum, ARW, dither); allowed: 0, got {value}")
-        n = sum(round(c.duration * self.filter.fs_hz) for c in self._cases(sc))
-        if n > MAX_SAMPLES:
-            raise ScenarioError(f"realtime.cases: {n} sensor samples in all, at most "
-                                f"{MAX_SAMPLES} allowed (shorten the cases)")
+        limits.MAX_REALTIME_SAMPLES.check(self.samples(sc), "realtime.cases",
+                                          "shorten the cases")
+
+    def samples(self, sc) -> int:
+        """Sensor samples of all cases together (at the filter rate)."""
+        return sum(round(c.duration * self.filter.fs_hz) for c in self._cases(sc))
 
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
         """Rows for `gcalign validate` (runs the cross-section checks too)."""

@@ -174,7 +174,3 @@ def schedule_of(rows: list[RowModel], repeat: bool, start_deg=None) -> Schedule:
         q = euler_to_quat(np.radians(start_deg))
         q0 = (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
     return Schedule(tuple(steps), repeat=repeat, q0=q0)
-
-
-def schedule_duration(rows: list[RowModel]) -> float:
-    return float(sum(r.to_step().duration for r in rows))

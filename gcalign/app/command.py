@@ -1,0 +1,187 @@
+"""What a command is: one object per command, written once in its folder's ``__init__``.
+
+A command (:class:`Command`) says what it reads (its scenario section, its built-in
+scenario), what it refuses (:meth:`~Command.check`, the one code path of ``gcalign
+validate``, the preflight of every run and a batch's check of its variants), what a run
+costs (:meth:`~Command.cost`, held against :mod:`gcalign.limits` before any work), how it
+runs (:meth:`~Command.execute`) and how it shows and stores its results (table, figures,
+HDF5 layout, batch metrics). The registry (:mod:`gcalign.app.registry`) holds one object
+per command; adding a command is a new folder with such an object and one registry line.
+
+A command imports its heavy parts (numba kernels, scipy, matplotlib) inside its methods,
+so that ``gcalign show`` and ``gcalign validate`` never load them.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from gcalign.app.registry import Outcome
+    from gcalign.io.scenario import Scenario
+
+DOUBLE = 8  #: bytes of one float64
+#: Operations (multiply-adds) of one step, for the work of the cost models: a strapdown
+#: update (quaternion, velocity, position and the earth terms), the simulation of one IMU
+#: sample with its sensor errors, a 21-state Kalman predict + update (Φ P Φᵀ and the gain).
+STRAPDOWN_OPS = 200.0
+SIMULATE_OPS = 400.0
+KALMAN_OPS = 4.0 * 21**3
+
+
+@dataclass(frozen=True)
+class Extent:
+    """The data a scenario gives: sample count, interval (s), whether recorded, truth, and
+    the site latitude (rad) where it is known (a recorded file's header)."""
+
+    samples: int
+    ts: float
+    recorded: bool
+    has_truth: bool
+    lat: float | None = None
+
+
+@dataclass(frozen=True)
+class Cost:
+    """What one run of a command costs, estimated before it starts.
+
+    samples : IMU samples generated or read.
+    memory_bytes : bytes held at once.
+    output_bytes : bytes of the series stored in the results file.
+    work : arithmetic, in operations (multiply-adds), as ``work_what`` counts them.
+    work_what : how the work is counted, for the refusal (``"pieces × 21³ × 40"``).
+    memory_what : what dominates the memory, for the refusal.
+    """
+
+    samples: float = 0.0
+    memory_bytes: float = 0.0
+    output_bytes: float = 0.0
+    work: float = 0.0
+    work_what: str = ""
+    memory_what: str = ""
+
+
+@dataclass(frozen=True)
+class Options:
+    """How a command runs.
+
+    recorded : it can run on recorded data (the command line adds the recorded-data
+        options, :func:`gcalign.cli.common.recorded_parameters`).
+    streams : its ``execute`` writes series into an open results file (``sink=``).
+    self_contained : it simulates its own data from its section (no motion needed).
+    batch_metrics : default metrics of a batch; () = not batchable.
+    """
+
+    recorded: bool = False
+    streams: bool = False
+    self_contained: bool = False
+    batch_metrics: tuple[str, ...] = ()
+
+
+class Command:
+    """One command: what it reads, refuses, costs, runs, shows and stores. A command folder
+    subclasses it once (its name is also the ``kind`` of its results file); the defaults
+    reach the folder's modules by dotted path, imported when called, and run the section's
+    own ``check(sc)``."""
+
+    name: str = ""
+    help: str = ""
+    section: str | None = None  #: the scenario section it reads
+    builtin: str | None = None  #: its built-in scenario (package data gcalign/scenarios)
+    options: Options = Options()
+    layout: tuple[str, ...] = ()  #: the HDF5 groups of its results file beside /truth
+    run: str = ""  #: the module whose ``execute(sc, seed, cache_key, **options)`` runs it
+    table_of: str = ""  #: dotted path of ``table(summary)``
+    figures_of: str = ""  #: dotted path of ``figures(f, name)``
+
+    # ------------------------------------------------------------------ checks and cost
+
+    def check(self, sc: Scenario, ext: Extent | None) -> None:
+        """Refuse (ScenarioError, one line naming the field) what the run would refuse;
+        `ext` is the scenario's data (None: it has none, or a recorded file not read)."""
+        section = getattr(sc, self.section) if self.section else None
+        check = getattr(section, "check", None)
+        if callable(check):
+            check(sc)
+
+    def cost(self, sc: Scenario, ext: Extent | None) -> Cost:
+        """What a run costs, checked against :mod:`gcalign.limits` before any work."""
+        return Cost(samples=0.0 if ext is None else float(ext.samples))
+
+    # ------------------------------------------------------------------ run
+
+    def _execute(self) -> Callable[..., Outcome]:
+        return importlib.import_module(self.run).execute  # type: ignore[no-any-return]
+
+    def execute(self, sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+                **options: Any) -> Outcome:
+        """Run the scenario (after its preflight: :func:`gcalign.app.preflight.checked_execute`):
+        the summary and the writer of its results."""
+        return self._execute()(sc, seed, cache_key, **options)
+
+    def accepts(self, option: str) -> bool:
+        """Does :meth:`execute` take keyword `option` (``progress``, ``sink``, ...)?"""
+        return option in inspect.signature(self._execute()).parameters
+
+    # ------------------------------------------------------------------ show and store
+
+    def table(self, summary: dict) -> Any:
+        """The table the command prints (and ``gcalign show``): a rich renderable."""
+        return _attr(self.table_of)(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        """The figures of its results file (an open h5py.File), by file stem."""
+        return _attr(self.figures_of)(f, name) if self.figures_of else {}  # type: ignore[no-any-return]
+
+    def components(self, metric: str, k: int) -> list[str]:
+        """Names of the `k` components of a vector batch metric."""
+        return [str(i) for i in range(k)]
+
+    def label(self, metric: str) -> str:
+        """A metric's name in batch tables and figures."""
+        return metric
+
+    def warm_up(self) -> None:
+        """Load the kernels a run uses (a tiny run), before a batch's workers start."""
+        return None
+
+    def builtin_text(self) -> str:
+        """YAML text of the built-in scenario (`gcalign example NAME`); KeyError if none."""
+        if not self.builtin:
+            raise KeyError(f"{self.name!r} has no built-in scenario")
+        return builtin_text(self.builtin)
+
+
+def _attr(path: str) -> Any:
+    module, _, name = path.rpartition(".")
+    return getattr(importlib.import_module(module), name)
+
+
+def builtin_text(name: str) -> str:
+    """YAML text of a built-in scenario file (package data in gcalign/scenarios)."""
+    from importlib import resources
+
+    return resources.files("gcalign.scenarios").joinpath(name).read_text(encoding="utf-8")
+
+
+def stride(sc: Scenario, ext: Extent) -> int:
+    """Samples per stored row (``output.rate_hz``); ScenarioError naming the field."""
+    from gcalign.errors import ScenarioError
+
+    try:
+        return sc.output.stride(1.0 / ext.ts, ext.samples * ext.ts)
+    except ValueError as err:
+        raise ScenarioError(str(err)) from None
+
+
+def warm_run(command: Command, scenario: dict) -> None:
+    """A tiny run of `command` on `scenario` (a mapping), so that its kernels are loaded."""
+    import copy
+
+    from gcalign.io.scenario import parse_scenario
+
+    command.execute(parse_scenario(copy.deepcopy(scenario), "warm-up"), 1)
