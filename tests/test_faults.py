@@ -267,6 +267,7 @@ import os, sys, time
 from gcalign.app.batch.store import OutputLock
 with OutputLock(sys.argv[1]):
     if os.fork() == 0:  # a pool worker's place: a forked child that outlives its parent
+        print("child", flush=True)  # the fork hooks have run by now
         time.sleep(30)
         os._exit(0)
     print("locked", flush=True)
@@ -284,7 +285,8 @@ def test_the_batch_lock_dies_with_its_holder_not_with_its_forked_children(tmp_pa
     holder = subprocess.Popen([sys.executable, "-c", HOLDER, str(out)], stdout=subprocess.PIPE,
                               text=True)
     try:
-        assert holder.stdout.readline().strip() == "locked"
+        said = {holder.stdout.readline().strip(), holder.stdout.readline().strip()}
+        assert said == {"locked", "child"}
         children += [int(p) for p in Path(f"/proc/{holder.pid}/task/{holder.pid}/children")
                     .read_text().split()]
         assert len(children) == 1
