@@ -267,10 +267,10 @@ import os, sys, time
 from gcalign.app.batch.store import OutputLock
 with OutputLock(sys.argv[1]):
     if os.fork() == 0:  # a pool worker's place: a forked child that outlives its parent
-        print("child", flush=True)  # the fork hooks have run by now
+        os.write(1, b"child\\n")  # the fork hooks have run by now (one write: no interleaving)
         time.sleep(30)
         os._exit(0)
-    print("locked", flush=True)
+    os.write(1, b"locked\\n")
     time.sleep(30)
 """
 
