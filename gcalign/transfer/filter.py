@@ -153,7 +153,7 @@ class TransferResult:
     """Per master epoch after its update (SI).
 
     t (K,) s; x (K, n) estimates, the biases being the totals fed back plus what is left in
-    the state; sigma (K, n) √diag P; sigma0 (n,) the P0 σ; names (n,); bias_fed (K, 6) the
+    the state; sigma (K, n) √diag P; P (K, n, n) the covariance; sigma0 (n,) the P0 σ; names (n,); bias_fed (K, 6) the
     ε, ∇ fed back so far; nis (K,) and its degrees of freedom m; q_slave (K, 4) and
     att_slave (K, 3) the slave attitude corrected by φ̂; v_slave (K, 3); q_master (K, 4) the
     master at the measurement epochs; attitude_error (K, 3) rad, the corrected slave against
@@ -163,6 +163,7 @@ class TransferResult:
     t: np.ndarray
     x: np.ndarray
     sigma: np.ndarray
+    P: np.ndarray
     sigma0: np.ndarray
     names: tuple[str, ...]
     bias_fed: np.ndarray
@@ -262,7 +263,8 @@ def _epochs(t_imu: np.ndarray, master: MasterSeries):
 
 
 def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: MasterSeries,
-                   settings: TransferSettings | None = None) -> TransferResult:
+                   settings: TransferSettings | None = None,
+                   att0: np.ndarray | None = None) -> TransferResult:
     """Align and calibrate a slave IMU against a master INS (spec 006; PSINS demo
     ``test_align_transfer_fog_mems``).
 
@@ -274,6 +276,9 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
     master : the master solution (:class:`MasterSeries`); must cover the IMU run to within
         one of its intervals at either end.
     settings : :class:`TransferSettings`, the demo's by default.
+    att0 : (3,) rad, the slave's initial ``[pitch, roll, yaw]`` (its own coarse alignment);
+        by default the master's at the start, as the demo (then the initial φ is −C_nb μ,
+        fully correlated with μ, which P0 does not say).
     """
     s = settings or TransferSettings()
     dtheta, dv, t = (np.asarray(a, dtype=float) for a in (dtheta, dv, t))
@@ -295,7 +300,10 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
 
     # the slave starts from the master (the demo: a2qua(fogavp(1,1:3)), fogavp(1,4:6));
     # without a master attitude (velocity matching), from level and north-pointing
-    q_s = qm0[0].copy() if qm0 is not None else np.array([1.0, 0.0, 0.0, 0.0])
+    if att0 is not None:
+        q_s = euler_to_quat(np.asarray(att0, dtype=float))
+    else:
+        q_s = qm0[0].copy() if qm0 is not None else np.array([1.0, 0.0, 0.0, 0.0])
     v_s = vm0[0].copy()
     w_in, g_cc = earth_terms(pm0[0], vm0[0])
 
@@ -311,7 +319,7 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
     fed = np.zeros(6)
 
     K = len(k_meas)
-    out_x, out_sig = np.zeros((K, n)), np.zeros((K, n))
+    out_x, out_P = np.zeros((K, n)), np.zeros((K, n, n))
     out_fed, out_nis = np.zeros((K, 6)), np.zeros(K)
     out_q, out_v, out_err = np.zeros((K, 4)), np.zeros((K, 3)), np.zeros((K, 3))
     C_nb = np.zeros((3, 3))
@@ -347,10 +355,11 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
             out_err[j] = np.nan
         out_x[j] = x
         out_x[j, BIASES] += fed
-        out_sig[j] = np.sqrt(np.diag(P))
+        out_P[j] = P
         out_fed[j], out_nis[j], out_q[j], out_v[j] = fed, u.nis, q_corr, v_s
     return TransferResult(
-        t=t_meas, x=out_x, sigma=out_sig, sigma0=np.asarray(s.p0_sigma[:n], dtype=float),
+        t=t_meas, x=out_x, sigma=np.sqrt(np.diagonal(out_P, axis1=1, axis2=2)), P=out_P,
+        sigma0=np.asarray(s.p0_sigma[:n], dtype=float),
         names=s.names, bias_fed=out_fed, nis=out_nis, m=len(rows), q_slave=out_q,
         att_slave=quat_to_euler(out_q), v_slave=out_v,
         q_master=qm_meas if qm_meas is not None else np.full((K, 4), np.nan),
