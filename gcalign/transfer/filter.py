@@ -152,12 +152,13 @@ class TransferSettings:
 class TransferResult:
     """Per master epoch after its update (SI).
 
-    t (K,) s; x (K, n) estimates, the biases being the totals fed back plus what is left in
-    the state; sigma (K, n) √diag P; P (K, n, n) the covariance; sigma0 (n,) the P0 σ; names (n,); bias_fed (K, 6) the
-    ε, ∇ fed back so far; nis (K,) and its degrees of freedom m; q_slave (K, 4) and
-    att_slave (K, 3) the slave attitude corrected by φ̂; v_slave (K, 3); q_master (K, 4) the
-    master at the measurement epochs; attitude_error (K, 3) rad, the corrected slave against
-    master ∘ (μ̂ + θ̂); t0 the start of the run (s).
+    t (K,) s; x (K, n) estimates, the biases being the totals fed back plus what is left
+    in the state; sigma (K, n) √diag P; P (K, n, n) the covariance; sigma0 (n,) the P0 σ;
+    names (n,); bias_fed (K, 6) the ε, ∇ fed back so far; nis (K,) and its degrees of
+    freedom m; q_slave (K, 4) and att_slave (K, 3) the slave attitude corrected by φ̂;
+    v_slave (K, 3); q_master (K, 4) the master at the measurement epochs;
+    attitude_error (K, 3) rad, the corrected slave against master ∘ (μ̂ + θ̂); t0 the
+    start of the run (s).
     """
 
     t: np.ndarray
