@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "gcalign"
-CORE = ("nav", "sim", "estimation", "align", "northfind", "modulate", "realtime", "calibrate")
+CORE = ("nav", "sim", "estimation", "align", "northfind", "modulate", "realtime", "calibrate",
+        "transfer")
 # Each layer may import itself and what is listed (plus the leaf modules units, errors,
 # limits).
 ALLOWED = {

@@ -511,6 +511,9 @@ def alignment_summary(run: AlignRun, stream: Stream | RunData, name: str) -> dic
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             progress=None) -> Outcome:
     """Simulate (or read) the data, align, summarise; the registry's entry point."""
+    if sc.align is not None and sc.align.mode == "transfer":  # spec 006: its own room
+        from gcalign.app.align import transfer
+        return transfer.execute(sc, seed, cache_key, progress)
     from gcalign.app.align.hdf5 import write_alignment
 
     if cache_key is not None:  # a batch: the noise-free simulation is shared by the seeds

@@ -22,6 +22,7 @@ from pydantic import Field, model_validator
 
 from gcalign.align.stages import Stage, stage_of_passes
 from gcalign.io.scenario.base import Model, Vec3
+from gcalign.io.scenario.transfer import TransferConfig, check_align_mode
 
 #: Passes in all when the last stage does not say: 3 forward + 2 reverse in the cycle
 #: modes (seed 000 §5.3), one forward pass in conventional mode.
@@ -84,7 +85,7 @@ class StageModel(Model):
 
 class AlignConfig(Model):
     coarse: Coarse = Field(default_factory=Coarse)
-    mode: Literal["conventional", "full-cycle", "half-cycle"] = "full-cycle"
+    mode: Literal["conventional", "full-cycle", "half-cycle", "transfer"] = "full-cycle"
     start_s: float = Field(
         0.0, ge=0, description="offset from the first sample taken as t = 0 (data windows)"
     )
@@ -101,6 +102,7 @@ class AlignConfig(Model):
     aiding: Aiding = Field(default_factory=Aiding)
     level_s: float | None = Field(None, ge=0, description="level-only phase; default 3·T_xy")
     stages: list[StageModel] = Field(default_factory=lambda: [StageModel()], min_length=1)
+    transfer: TransferConfig | None = None  # mode transfer (spec 006)
 
     @model_validator(mode="before")
     @classmethod
@@ -110,6 +112,8 @@ class AlignConfig(Model):
 
     @model_validator(mode="after")
     def _timeline(self):
+        if self.mode == "transfer" or self.transfer is not None:
+            return check_align_mode(self)
         if self.t2_s <= self.t1_s:
             raise ValueError(f"t2_s: must be greater than t1_s ({self.t1_s} s), got {self.t2_s}")
         if self.t3_s != "measured" and self.t3_s < self.t2_s:
