@@ -57,6 +57,7 @@ from gcalign.nav.rotation import (
     rotvec_to_quat,
 )
 from gcalign.transfer import _kernel
+from gcalign.transfer.model import measurement_matrix
 from gcalign.units import ARCMIN, DEG, DPH, DPSH, G0, UG, UGPSHZ
 
 MATCHINGS = ("attitude+velocity", "velocity", "attitude")
@@ -331,11 +332,7 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
                           Phi, Qd, C_nb)
         k_prev = k + 1
         w_in, g_cc = earth_terms(pm_meas[j], vm_meas[j])
-        H = np.zeros((6, n))
-        H[:, :6] = np.eye(6)
-        H[PHI, MU] = -C_nb
-        if s.flexure:
-            H[PHI, TH] = -C_nb
+        H = measurement_matrix(C_nb, "attitude+velocity", n)
         omega_ib_b = dtheta[k] / ts - fed[:3]
         v_lever = C_nb @ np.cross(omega_ib_b, lever)
         phi_meas = (misalignment_q(q_s, qm_meas[j]) if qm_meas is not None else np.zeros(3))
