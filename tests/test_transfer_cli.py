@@ -144,3 +144,16 @@ def test_attitude_matching_with_a_reference_without_attitude(tmp_path):
 def test_misspelt_key_is_an_error(tmp_path):
     p = _scenario(tmp_path, _mat(tmp_path), matchng="velocity")
     assert_bad_run(_align, tmp_path, [p, "--mode", "transfer"], "matchng")
+
+
+def test_validate_and_void_gyrocompass_keys(tmp_path):
+    res = runner.invoke(app, ["validate", str(CONFIG)])
+    assert res.exit_code == 0, res.output
+    p = _scenario(tmp_path, _mat(tmp_path, fog=lambda f: f[f[:, 9] <= 10.0 + 1e-9]))
+    sc = yaml.safe_load(p.read_text())
+    sc["align"] |= {"mode": "transfer", "t2_s": 50}
+    p.write_text(yaml.safe_dump(sc))
+    res = _align(p, "--json", "-o", tmp_path / "w.h5")
+    assert res.exit_code == 0, res.output
+    w = json.loads(res.stdout)["warnings"]
+    assert any(x.startswith("align.t2_s: cannot matter") for x in w), w

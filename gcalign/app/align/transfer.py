@@ -194,7 +194,7 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None,
         raise ScenarioError(f"align.transfer.{err} ({ref_path} against {sc.imu_file})"
                             ) from None
     out = summary(sc, result, stored, ref_path, time.process_time() - start)
-    warnings = tuple(cfg.unused())
+    warnings = tuple(sc.align.unused(sc))
     out["warnings"] = list(warnings)
     return Outcome(out, lambda f: write(f, result, stored), None, None, warnings)
 

@@ -21,6 +21,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from gcalign.align.stages import Stage, stage_of_passes
+from gcalign.io.scenario import transfer as transfer_section
 from gcalign.io.scenario.base import Model, Vec3
 from gcalign.io.scenario.transfer import TransferConfig, check_align_mode
 
@@ -188,6 +189,8 @@ class AlignConfig(Model):
     def unused(self, sc=None) -> list[str]:
         """Keys set in the scenario that this mode makes void, one line each (shown as
         warnings; see the module docstring)."""
+        if self.mode == "transfer":
+            return transfer_section.unused(self)
         out = []
         if self.realtime_conventional and "compensation" in self.model_fields_set:
             out.append(f"align.compensation: {self.compensation!r} cannot matter in real-time "
@@ -210,6 +213,8 @@ class AlignConfig(Model):
         return out
 
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
+        if self.mode == "transfer":
+            return transfer_section.resolved_rows(self)
         kind = sc.motion.kind if sc.motion is not None else None
         realtime = self.realtime_conventional
         c = self.coarse

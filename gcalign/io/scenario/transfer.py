@@ -128,6 +128,35 @@ class TransferConfig(Model):
         return out
 
 
+def resolved_rows(cfg) -> list[tuple[str, str, str]]:
+    """The resolved `align` rows of mode transfer (``gcalign validate``): key, value, note."""
+    t = cfg.transfer
+    p0, r, q = t.p0, t.r, t.q
+    return [
+        ("align.mode", "transfer", "slave against master (spec 006)"),
+        ("align.transfer.reference", f"{t.reference.path or 'imu_file'} "
+         f"({t.reference.format}: {t.reference.variable})", f"slave: {t.imu_variable}"),
+        ("align.transfer.matching", t.matching, ""),
+        ("align.transfer.flexure", str(t.flexure), "21 states" if t.flexure else "15 states"),
+        ("align.transfer.feedback", f"bias {t.feedback.bias}, attitude {t.feedback.attitude}",
+         ""),
+        ("align.transfer.lever_arm_m", str(t.lever_arm_m), "body frame"),
+        ("align.transfer.gravity", t.gravity, ""),
+        ("align.transfer.p0", f"{p0.attitude_deg}°, {p0.velocity_mps} m/s, "
+         f"{p0.gyro_bias_dph} °/h, {p0.accel_bias_ug} µg, μ {p0.mounting_deg}°", ""),
+        ("align.transfer.r", f"{r.attitude_arcmin}′, {r.velocity_mps} m/s", ""),
+        ("align.transfer.q", f"ARW {q.arw_dpsh} °/√h, VRW {q.vrw_ugpshz} µg/√Hz", ""),
+    ]
+
+
+def unused(cfg) -> list[str]:
+    """The keys of `align` that mode transfer makes void, then the section's own."""
+    void = sorted(cfg.model_fields_set - {"mode", "transfer"})
+    out = [f"align.{k}: cannot matter in align.mode 'transfer' (a gyrocompass key)"
+           for k in void]
+    return out + cfg.transfer.unused()
+
+
 def check_align_mode(cfg):
     """The rule between `align.mode` and `align.transfer` (AlignConfig's validator calls
     it): mode transfer needs the section, and the section needs mode transfer."""
