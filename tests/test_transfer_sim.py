@@ -110,3 +110,22 @@ def test_same_seed_same_numbers():
     _, b = _run(7, 5.0)
     np.testing.assert_array_equal(a.x, b.x)
     np.testing.assert_array_equal(a.P, b.P)
+
+
+def test_lever_arm_is_compensated_and_matters():
+    """A slave 2 m ahead of the master (0.5, 2.0, 0.3) m: with the lever arm set, NEES in
+    its band over 8 runs (measured 15.0 final); with it ignored, the ω × l velocity
+    (0.35 m/s at the ±10 °/s roll reversals) is outside the model: NIS ≈ 20 for 6 dof."""
+    lever = (0.5, 2.0, 0.3)
+    nees_end, nis_off = [], []
+    for i in range(8):
+        c = transfer_case(np.random.default_rng(1000 + i), duration=20.0, lever_arm_b=lever)
+        s = replace(c.settings, attitude_feedback=True)
+        r = transfer_align(c.dtheta, c.dv, c.t, c.master, s, att0=c.att0)
+        nees_end.append(nees(estimation_error(r, c)[-1], r.P[-1]))
+        off = transfer_align(c.dtheta, c.dv, c.t, c.master,
+                             replace(s, lever_arm_b=(0.0, 0.0, 0.0)), att0=c.att0)
+        nis_off.append(off.nis.mean())
+    lo, hi = _band(8, 15)
+    assert lo < np.mean(nees_end) < hi, (np.mean(nees_end), (lo, hi))
+    assert np.mean(nis_off) > 3 * 6, np.mean(nis_off)
