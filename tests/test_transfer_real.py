@@ -11,6 +11,7 @@ from functools import cache
 from pathlib import Path
 
 import numpy as np
+import pytest
 from scipy.linalg import expm
 
 from gcalign.transfer import MasterSeries, TransferSettings, transfer_align
@@ -224,3 +225,15 @@ def test_second_route_plain_loop_of_the_demo_agrees():
     np.testing.assert_allclose(x[6:9] / DPH, x_ref[6:9] / DPH, atol=1e-3)
     np.testing.assert_allclose(x[9:12] / UG, x_ref[9:12] / UG, atol=0.05)
     np.testing.assert_allclose(s[:18], s_ref[:18], rtol=1e-4)
+
+
+def test_master_with_no_epoch_inside_the_run_is_refused():
+    from gcalign.errors import ScenarioError
+
+    dtheta, dv, t, m = _inputs(10.0)
+    two = MasterSeries(np.array([-5.0, 20.0]), m.att[:2], m.v_n[:2], m.pos[:2])
+    with pytest.raises(ScenarioError, match="epoch"):
+        transfer_align(dtheta, dv, t, two)
+    back = MasterSeries(m.t[::-1], m.att, m.v_n, m.pos)
+    with pytest.raises(ScenarioError, match="increase"):
+        transfer_align(dtheta, dv, t, back)

@@ -12,7 +12,6 @@ of the demo's lines). The covariance step is :func:`gcalign.estimation.kalman.pr
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from gcalign.nav._kernels import attitude_update, specific_force_increment
@@ -57,10 +56,3 @@ def propagate(q, v, x, P, dtheta, dv, k_from, k_to, fed, w_in, g_cc, ts, Phi, Qd
         Pn = Phi @ P @ Phi.T + Qd
         P[:, :] = 0.5 * (Pn + Pn.T)
 
-
-def warm_up() -> None:
-    """Compile (or load) the kernel on a tiny input."""
-    n = 15
-    propagate(np.array([1.0, 0, 0, 0]), np.zeros(3), np.zeros(n), np.eye(n), np.zeros((2, 3)),
-              np.zeros((2, 3)), 0, 2, np.zeros(6), np.zeros(3), np.zeros(3), 0.01, np.eye(n),
-              np.zeros((n, n)), np.zeros((3, 3)))

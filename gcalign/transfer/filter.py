@@ -245,6 +245,8 @@ def _epochs(t_imu: np.ndarray, master: MasterSeries):
     tm = np.asarray(master.t, dtype=float)
     ts = float(np.median(np.diff(t_imu)))
     dtm = float(np.median(np.diff(tm))) if len(tm) > 1 else np.inf
+    if len(tm) > 1 and not np.all(np.diff(tm) > 0):
+        raise ScenarioError("reference: its times must increase strictly")
     if len(tm) < 2 or tm[-1] < t_imu[0] or tm[0] > t_imu[-1]:
         raise ScenarioError(f"reference: no overlap with the IMU run: the reference covers "
                             f"{tm[0]:.3f}–{tm[-1]:.3f} s, the IMU {t_imu[0]:.3f}–"
@@ -258,6 +260,10 @@ def _epochs(t_imu: np.ndarray, master: MasterSeries):
     k_of = np.clip(np.searchsorted(t_imu, tm - 0.5 * ts), 0, len(t_imu) - 1)
     inside = (tm >= t_imu[0] - 0.5 * ts) & (tm <= t_imu[-1] + 0.5 * ts)
     k_of = k_of[inside]
+    if len(k_of) < 2:
+        raise ScenarioError(f"reference: {len(k_of)} epoch(s) inside the IMU run "
+                            f"{t_imu[0]:.3f}–{t_imu[-1]:.3f} s; at least 2 are needed (a start "
+                            "and a measurement)")
     k0 = int(k_of[0])
     k_meas = np.unique(k_of[k_of > k0])
     t_meas = np.clip(t_imu[k_meas], tm[0], tm[-1])
