@@ -103,7 +103,7 @@ class AlignConfig(Model):
     aiding: Aiding = Field(default_factory=Aiding)
     level_s: float | None = Field(None, ge=0, description="level-only phase; default 3·T_xy")
     stages: list[StageModel] = Field(default_factory=lambda: [StageModel()], min_length=1)
-    transfer: TransferConfig | None = None  # mode transfer (spec 006)
+    transfer: transfer_section.TransferConfig | None = None  # mode transfer (spec 006)
 
     @model_validator(mode="before")
     @classmethod
@@ -114,7 +114,7 @@ class AlignConfig(Model):
     @model_validator(mode="after")
     def _timeline(self):
         if self.mode == "transfer" or self.transfer is not None:
-            return check_align_mode(self)
+            return transfer_section.check_align_mode(self)
         if self.t2_s <= self.t1_s:
             raise ValueError(f"t2_s: must be greater than t1_s ({self.t1_s} s), got {self.t2_s}")
         if self.t3_s != "measured" and self.t3_s < self.t2_s:
