@@ -23,7 +23,6 @@ from pydantic import Field, model_validator
 from gcalign.align.stages import Stage, stage_of_passes
 from gcalign.io.scenario import transfer as transfer_section
 from gcalign.io.scenario.base import Model, Vec3
-from gcalign.io.scenario.transfer import TransferConfig, check_align_mode
 
 #: Passes in all when the last stage does not say: 3 forward + 2 reverse in the cycle
 #: modes (seed 000 §5.3), one forward pass in conventional mode.
