@@ -20,7 +20,7 @@ LAYERS = (
     ("units", "errors", "limits"),
     ("nav",),
     ("sim", "estimation"),
-    ("align", "northfind", "calibrate", "realtime", "modulate"),  # the capabilities
+    ("align", "northfind", "calibrate", "realtime", "modulate", "transfer"),  # capabilities
     ("io",),
     ("app",),
     ("cli", "api", "__main__"),

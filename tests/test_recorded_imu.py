@@ -235,7 +235,7 @@ def test_bad_recordings_exit_2_with_one_line(tmp_path, edit, options, field, mor
 def test_a_key_the_format_fixes_is_refused(tmp_path):
     """Units of a PSINS file come from its header: declaring them is an error (and --set
     cannot reach into imu_file, which the override checker knows as a path: --format,
-    --axes or the mapping in the scenario declare a layout; decision 010)."""
+    --axes or the mapping in the scenario declare a layout; decision 011)."""
     out = tmp_path / "n.h5"
     res = runner.invoke(app, ["align", "--imu-file", str(LASERGYRO_XZ), "--set",
                               "imu_file.units={gyro: deg}", "-o", str(out)])

@@ -60,7 +60,8 @@ def align(
         None, help="Scenario YAML; without it, the built-in seed 000 §5.3 moving-base case "
         "(`gcalign example align` prints it)."
     ),
-    mode: str | None = typer.Option(None, "--mode", help="conventional | full-cycle | half-cycle"),
+    mode: str | None = typer.Option(
+        None, "--mode", help="conventional | full-cycle | half-cycle | transfer"),
     compensation: str | None = typer.Option(
         None, "--compensation", help="none | one-off | continued (T2 -> T3)"
     ),

@@ -173,6 +173,9 @@ def figures(f, name: str) -> dict[str, Figure]:
     figs: dict[str, Figure] = {}
     if "align" not in f:
         return figs
+    if "transfer" in f["align"]:
+        from gcalign.app.align.transfer import figures as transfer_figures
+        return transfer_figures(f, name)
     passes = read_passes(f)
     mode = _s(f["align"].attrs.get("mode", ""))
     head = f"{name}: {mode}, {len(passes)} pass(es)"

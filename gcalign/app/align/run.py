@@ -35,11 +35,15 @@ Progress = Callable[[float, float, str], None]
 
 def settings_of(cfg: AlignConfig, motion_kind: str | None) -> AlignSettings:
     """The core's settings (SI) of a scenario's align section; the motion kind picks the
-    default pole set (data simulated earlier carry it along)."""
+    default pole set (data simulated earlier carry it along). Not for transfer mode (its
+    own filter, :mod:`gcalign.app.align.transfer`)."""
+    mode = cfg.mode
+    if mode == "transfer":
+        raise ValueError("settings_of: transfer mode has no gyrocompass settings")
     c = cfg.coarse
     off = np.radians(c.error_deg if c.method == "given" else c.offset_deg)
     return AlignSettings(
-        mode=cfg.mode, start_s=cfg.start_s, t1_s=cfg.t1_s, t2_s=cfg.t2_s, t3_s=cfg.t3_s,
+        mode=mode, start_s=cfg.start_s, t1_s=cfg.t1_s, t2_s=cfg.t2_s, t3_s=cfg.t3_s,
         realtime=cfg.realtime, compensation=cfg.compensation, coarse=c.method,
         coarse_offset=(float(off[0]), float(off[1]), float(off[2])),
         azimuth_poles=cfg.poles_for(motion_kind),  # type: ignore[arg-type]
@@ -276,6 +280,9 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             progress: Progress | None = None) -> Outcome:
     """Simulate (or read) the data, align, summarise; the registry's entry point."""
+    if sc.align is not None and sc.align.mode == "transfer":  # spec 006: its own room
+        from gcalign.app.align import transfer
+        return transfer.execute(sc, seed, cache_key, progress)
     from gcalign.app.align.hdf5 import write_alignment
 
     if cache_key is not None:  # a batch: the noise-free simulation is shared by the seeds

@@ -24,6 +24,9 @@ def _numbered(p: dict) -> dict:
 
 def align_table(s: dict) -> Table:
     """See the module docstring; every number of a section in one unit and format."""
+    if s.get("mode") == "transfer":
+        from gcalign.app.align.transfer import table as transfer_table
+        return transfer_table(s)
     passes = [_numbered(p) for p in s["passes"]]
     n_fwd = sum(p["direction"] == "forward" for p in passes)
     plan = (f"{len(passes)} passes ({n_fwd} forward + {len(passes) - n_fwd} reverse)"

@@ -22,6 +22,7 @@ from pydantic import Field, model_validator
 
 from gcalign.align.stages import Stage
 from gcalign.io.scenario import bounds as B
+from gcalign.io.scenario import transfer as transfer_section
 from gcalign.io.scenario.base import Model, Vec3
 
 #: Passes in all when the last stage does not say: 3 forward + 2 reverse in the cycle
@@ -86,7 +87,7 @@ class StageModel(Model):
 
 class AlignConfig(Model):
     coarse: Coarse = Field(default_factory=Coarse)
-    mode: Literal["conventional", "full-cycle", "half-cycle"] = "full-cycle"
+    mode: Literal["conventional", "full-cycle", "half-cycle", "transfer"] = "full-cycle"
     start_s: float = Field(
         0.0, ge=0, description="offset from the first sample taken as t = 0 (data windows)"
     )
@@ -103,6 +104,7 @@ class AlignConfig(Model):
     aiding: Aiding = Field(default_factory=Aiding)
     level_s: float | None = Field(None, ge=0, description="level-only phase; default 3·T_xy")
     stages: list[StageModel] = Field(default_factory=lambda: [StageModel()], min_length=1)
+    transfer: transfer_section.TransferConfig | None = None  # mode transfer (spec 006)
 
     @model_validator(mode="before")
     @classmethod
@@ -112,6 +114,8 @@ class AlignConfig(Model):
 
     @model_validator(mode="after")
     def _timeline(self):
+        if self.mode == "transfer" or self.transfer is not None:
+            return transfer_section.check_align_mode(self)
         if self.t2_s <= self.t1_s:
             raise ValueError(f"t2_s: must be greater than t1_s ({self.t1_s} s), got {self.t2_s}")
         if self.t3_s != "measured" and self.t3_s < self.t2_s:
@@ -182,6 +186,8 @@ class AlignConfig(Model):
     def unused(self, sc=None) -> list[str]:
         """Keys set in the scenario that this mode makes void, one line each (shown as
         warnings; see the module docstring)."""
+        if self.mode == "transfer":
+            return transfer_section.unused(self)
         out = []
         if self.realtime_conventional and "compensation" in self.model_fields_set:
             out.append(f"align.compensation: {self.compensation!r} cannot matter in real-time "
@@ -204,6 +210,8 @@ class AlignConfig(Model):
         return out
 
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
+        if self.mode == "transfer":
+            return transfer_section.resolved_rows(self)
         kind = sc.motion.kind if sc.motion is not None else None
         realtime = self.realtime_conventional
         c = self.coarse

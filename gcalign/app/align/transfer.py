@@ -1,0 +1,303 @@
+"""`gcalign align --mode transfer`: a slave IMU aligned against a master INS (spec 006).
+
+Scenario -> arrays (the slave's increments from ``imu_file``, the master from
+``align.transfer.reference``) -> :func:`gcalign.transfer.transfer_align` -> an
+:class:`~gcalign.app.registry.Outcome`: the summary (SI in ``states``, in calibrate's shape
+``{name: {estimate, sigma, sigma0}}``), the HDF5 group ``/align/transfer``, a table and
+figures in the manner of PSINS's ``kfplot`` (estimates with ±σ against time, the file's
+stored ``eb0``, ``db0``, ``mu0`` as reference lines).
+
+PSINS ``.mat`` files are read here by :func:`_read_mat` (``scipy.io.loadmat``).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from gcalign.app.registry import Outcome
+from gcalign.errors import ScenarioError
+from gcalign.units import ARCMIN, DPH, UG
+
+#: display unit and the factor from SI, per state group (the table's and figures')
+DISPLAY = {"phi": ("arcmin", 1 / ARCMIN), "dv": ("m/s", 1.0), "eb": ("deg/h", 1 / DPH),
+           "db": ("ug", 1 / UG), "mu": ("arcmin", 1 / ARCMIN), "th": ("arcmin", 1 / ARCMIN),
+           "w": ("arcmin/s", 1 / ARCMIN)}
+DECIMALS = {"arcmin": 2, "m/s": 3, "deg/h": 2, "ug": 0, "arcmin/s": 2}
+SI_UNIT = {"phi": "rad", "dv": "m/s", "eb": "rad/s", "db": "m/s^2", "mu": "rad", "th": "rad",
+           "w": "rad/s"}
+
+
+def group_of(name: str) -> str:
+    """The state group of a state name (``phiE`` -> ``phi``, ``dbx`` -> ``db``)."""
+    return next(g for g in ("phi", "dv", "eb", "db", "mu", "th", "w") if name.startswith(g))
+
+
+def _read_mat(path: Path, field: str) -> dict:
+    """The numeric variables of a PSINS ``.mat`` file (MATLAB v5), as float arrays."""
+    import scipy.io
+
+    try:
+        d = scipy.io.loadmat(path)
+    except (OSError, ValueError, NotImplementedError) as err:
+        raise ScenarioError(f"{field}: {path}: not a readable MATLAB file ({err})") from None
+    return {k: np.asarray(v, dtype=float) for k, v in d.items()
+            if not k.startswith("__") and isinstance(v, np.ndarray) and v.dtype.kind in "fiu"}
+
+
+def _variable(d: dict, name: str, cols: tuple[int, ...], field: str, path: Path) -> np.ndarray:
+    if name not in d:
+        raise ScenarioError(f"{field}: {name!r} is not a variable of {path} (it has: "
+                            f"{', '.join(sorted(d)) or 'none'})")
+    a = d[name]
+    if a.ndim != 2 or a.shape[1] not in cols or len(a) < 2:
+        raise ScenarioError(f"{field}: {name!r} in {path} has shape {a.shape}; allowed: "
+                            f"(N ≥ 2, {' or '.join(map(str, cols))})")
+    return a
+
+
+def load_inputs(sc):
+    """The slave's increments, the master series and the file's stored PSINS values
+    (``eb0``, ``db0``, ``mu0`` in SI, those present)."""
+    from gcalign.transfer import MasterSeries
+
+    cfg = sc.align.transfer
+    if sc.imu_file is None or sc.imu_file.suffix.lower() != ".mat":
+        raise ScenarioError(f"imu_file: align.mode 'transfer' reads the slave from a PSINS "
+                            f".mat file (variable align.transfer.imu_variable), got "
+                            f"{sc.imu_file}")
+    if not sc.imu_file.is_file():
+        raise ScenarioError(f"imu_file: {sc.imu_file}: file not found")
+    imu_vars = _read_mat(sc.imu_file, "imu_file")
+    imu = _variable(imu_vars, cfg.imu_variable, (7,), "align.transfer.imu_variable",
+                    sc.imu_file)
+    ref = cfg.reference
+    path = sc.imu_file if ref.path is None else (
+        ref.path if ref.path.is_absolute() else sc.imu_file.parent / ref.path)
+    if not path.is_file():
+        raise ScenarioError(f"align.transfer.reference.path: {path}: file not found")
+    ref_vars = imu_vars if path == sc.imu_file else _read_mat(path, "align.transfer.reference")
+    avp = _variable(ref_vars, ref.variable, (10, 7), "align.transfer.reference.variable", path)
+    has_att = avp.shape[1] == 10
+    if cfg.matching != "velocity" and not has_att:
+        raise ScenarioError(f"align.transfer.matching: {cfg.matching!r} needs the reference's "
+                            f"attitude; {ref.variable!r} in {path} has 7 columns [v pos t], "
+                            "no attitude (allowed: 'velocity')")
+    a0 = 3 if has_att else 0
+    master = MasterSeries(t=avp[:, -1], att=avp[:, :3] if has_att else None,
+                          v_n=avp[:, a0:a0 + 3], pos=avp[:, a0 + 3:a0 + 6])
+    stored = {k: ref_vars.get(k, imu_vars.get(k)) for k in ("eb0", "db0", "mu0")}
+    stored = {k: v.ravel() for k, v in stored.items() if v is not None and v.size == 3}
+    return imu[:, 0:3], imu[:, 3:6], imu[:, 6], master, stored, path
+
+
+def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
+    """The run's summary: ``states`` in SI, the rest in the units their keys name."""
+    from gcalign.transfer import attitude_error_vs
+
+    r, s = result, result.settings
+    conv = r.convergence_s()
+    err = r.attitude_error_summary(10.0)
+    states = {n: {"estimate": float(r.x[-1, i]), "sigma": float(r.sigma[-1, i]),
+                  "sigma0": float(r.sigma0[i])} for i, n in enumerate(r.names)}
+    lo, hi = _chi2_band(r.m)
+    out = {
+        "scenario": sc.name,
+        "mode": "transfer",
+        "source": str(sc.imu_file),
+        "reference": str(ref_path),
+        "matching": s.matching,
+        "flexure": s.flexure,
+        "feedback": {"bias": s.bias_feedback, "attitude": s.attitude_feedback},
+        "gravity": s.gravity,
+        "lever_arm_m": list(s.lever_arm_b),
+        "t0_s": r.t0,
+        "duration_s": float(r.t[-1] - r.t0),
+        "epochs": len(r.t),
+        "states": states,
+        "units": {n: SI_UNIT[group_of(n)] for n in r.names},
+        "display_units": {n: DISPLAY[group_of(n)][0] for n in r.names},
+        "display_scale": {n: DISPLAY[group_of(n)][1] for n in r.names},
+        "convergence_s": conv,
+        "attitude_error_vs_reference_arcmin": None if r.settings.matching == "velocity"
+        and np.isnan(r.q_master).any() else {
+            "final": (err["final"] / ARCMIN).tolist(),
+            "rms_last_10s": (err["rms_last"] / ARCMIN).tolist()},
+        "nis": {"mean": float(r.nis.mean()), "dof": r.m, "band_95": [lo, hi]},
+        "slave_attitude_deg": np.degrees(r.att_slave[-1]).tolist(),
+        "psins_stored": {"eb0_dph": (stored["eb0"] / DPH).tolist() if "eb0" in stored else None,
+                         "db0_ug": (stored["db0"] / UG).tolist() if "db0" in stored else None,
+                         "mu0_arcmin": (stored["mu0"] / ARCMIN).tolist() if "mu0" in stored
+                         else None},
+        "compute_s": compute_s,
+    }
+    if "mu0" in stored and not np.isnan(r.q_master).any():
+        e = attitude_error_vs(r, stored["mu0"])
+        w = r.t >= r.t[-1] - 10.0
+        out["attitude_error_vs_psins_mu0_arcmin"] = {
+            "final": (e[-1] / ARCMIN).tolist(),
+            "rms_last_10s": (np.sqrt(np.mean(e[w] ** 2, axis=0)) / ARCMIN).tolist()}
+    return out
+
+
+def _chi2_band(dof: int, level: float = 0.95) -> tuple[float, float]:
+    from scipy.stats import chi2
+
+    return float(chi2.ppf((1 - level) / 2, dof)), float(chi2.ppf((1 + level) / 2, dof))
+
+
+def write(f, result, stored: dict) -> None:
+    """``/align/transfer``: per-epoch estimates and σ (SI, columns in the order of the
+    ``states`` attribute), NIS, the corrected slave attitude and velocity, its error against
+    master ∘ μ̂, the bias totals fed back; the file's stored PSINS values as attributes."""
+    from gcalign.io.results import ATT_FRAME, put
+
+    r = result
+    g = f.require_group("align").create_group("transfer")
+    g.attrs["mode"] = "transfer"
+    g.attrs["matching"] = r.settings.matching
+    g.attrs["states"] = ",".join(r.names)
+    g.attrs["state_units"] = ",".join(SI_UNIT[group_of(n)] for n in r.names)
+    g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in r.names)
+    g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in r.names])
+    for k, v in stored.items():
+        g.attrs[f"psins_{k}"] = v
+        g.attrs[f"psins_{k}_units"] = {"eb0": "rad/s", "db0": "m/s^2", "mu0": "rad"}[k]
+    shape = "(epochs, states) in the order of the 'states' attribute, units 'state_units'"
+    put(g, "t", r.t, "s")
+    put(g, "estimate", r.x, "SI", description=shape)
+    put(g, "sigma", r.sigma, "SI", description=shape)
+    put(g, "sigma0", r.sigma0, "SI")
+    put(g, "nis", r.nis, "1", dof=r.m)
+    put(g, "att", r.att_slave, "rad", frame=ATT_FRAME,
+        description="slave attitude corrected by the φ estimate")
+    put(g, "v_n", r.v_slave, "m/s", frame="ENU")
+    put(g, "attitude_error", r.attitude_error, "rad", frame="ENU",
+        description="corrected slave against master ∘ (μ + θ estimates), misalignment φ")
+    put(g, "bias_fed", r.bias_fed, "rad/s, m/s^2",
+        description="ε (3), ∇ (3) fed back into the compensation so far")
+
+
+def execute(sc, seed: int | None = None, cache_key: str | None = None,
+            progress=None) -> Outcome:
+    """Read the slave and the master, align, summarise (the align room's mode transfer)."""
+    from gcalign.transfer import transfer_align
+
+    cfg = sc.align.transfer
+    dtheta, dv, t, master, stored, ref_path = load_inputs(sc)
+    start = time.process_time()
+    try:
+        result = transfer_align(dtheta, dv, t, master, cfg.settings(sc.earth_model))
+    except ScenarioError as err:  # coverage of the run: name the file and the key
+        raise ScenarioError(f"align.transfer.{err} ({ref_path} against {sc.imu_file})"
+                            ) from None
+    out = summary(sc, result, stored, ref_path, time.process_time() - start)
+    warnings = tuple(sc.align.unused(sc))
+    out["warnings"] = list(warnings)
+    return Outcome(out, lambda f: write(f, result, stored), None, None, warnings)
+
+
+# -- table and figures (rich and matplotlib loaded by the caller's import of this module) --
+
+def table(s: dict):
+    """One row per state: estimate ± σ (display units), σ0, convergence, PSINS's stored
+    value where the file has one."""
+    from rich.table import Table
+
+    stored = s.get("psins_stored") or {}
+    ref = {"eb": stored.get("eb0_dph"), "db": stored.get("db0_ug"),
+           "mu": stored.get("mu0_arcmin")}
+    fb = s["feedback"]
+    loop = ("bias" if fb["bias"] else "no bias") + (" + attitude" if fb["attitude"] else "")
+    t = Table(title=f"gcalign align --mode transfer: {s['scenario']} — {s['matching']} "
+              f"matching over {s['duration_s']:.1f} s, {len(s['states'])} states, "
+              f"{loop} feedback, gravity {s['gravity']}", title_justify="left",
+              header_style="bold")
+    for head in ("state", "unit", "estimate", "σ", "σ0", "conv. s", "PSINS", "− PSINS"):
+        t.add_column(head, justify="left" if head in ("state", "unit") else "right")
+    for name, v in s["states"].items():
+        k, unit = s["display_scale"][name], s["display_units"][name]
+        g = group_of(name)
+        vals = ref.get(g)
+        st = vals["xyz".index(name[-1])] if vals is not None and name[-1] in "xyz" else None
+        est, d = v["estimate"] * k, DECIMALS[unit]
+        t.add_row(name, unit, f"{est:.{d}f}", f"{v['sigma'] * k:.{d}f}",
+                  f"{v['sigma0'] * k:.{d}f}", f"{s['convergence_s'][name]:.1f}",
+                  "—" if st is None else f"{st:.{d}f}", "—" if st is None else f"{est - st:+.{d}f}")
+        if name in ("phiU", "dvU", "ebz", "dbz", "muz", "thz"):
+            t.add_section()
+    e = s["attitude_error_vs_reference_arcmin"]
+    notes = ["corrected slave vs master ∘ μ̂: the reference has no attitude" if e is None
+             else f"corrected slave vs master ∘ μ̂ (φ E, N, U, ′): final "
+             f"{_three(e['final'])}, RMS last 10 s {_three(e['rms_last_10s'])}",
+             f"NIS mean {s['nis']['mean']:.2f} (dof {s['nis']['dof']}, 95 % band of one "
+             f"epoch {s['nis']['band_95'][0]:.2f}–{s['nis']['band_95'][1]:.2f})",
+             "conv. s: first time after which the estimate stays within 2σ of its final "
+             "value; PSINS: the file's eb0, db0, mu0 (PSINS's own end-of-run estimates, "
+             "not a truth)"]
+    if "attitude_error_vs_psins_mu0_arcmin" in s:
+        e0 = s["attitude_error_vs_psins_mu0_arcmin"]
+        notes.insert(1, f"corrected slave vs master ∘ PSINS mu0 (′): final "
+                        f"{_three(e0['final'])}, RMS last 10 s {_three(e0['rms_last_10s'])}")
+    notes += [f"warning: {w}" for w in s.get("warnings", [])]
+    t.caption = "\n".join(notes)
+    t.caption_justify = "left"
+    return t
+
+
+def _three(v) -> str:
+    return "(" + ", ".join(f"{x:+.2f}" for x in v) + ")"
+
+
+def figures(f, name: str) -> dict:
+    """kfplot-like panels: per state group, the estimate with ±σ against time and, for ε,
+    ∇, μ, PSINS's stored value as a dashed line."""
+    from gcalign.app.plots import finish, new_figure
+
+    g = f["align/transfer"]
+    names = g.attrs["states"]
+    names = (names.decode() if isinstance(names, bytes) else str(names)).split(",")
+    units = str(g.attrs["display_units"]).split(",")
+    scale = np.asarray(g.attrs["display_scale"], dtype=float)
+    t, x, sig = g["t"][()], g["estimate"][()], g["sigma"][()]
+    groups = [gr for gr in ("phi", "dv", "eb", "db", "mu", "th", "w")
+              if any(group_of(n) == gr for n in names)]
+    label = {"phi": "φ attitude error", "dv": "δv velocity error", "eb": "ε gyro bias",
+             "db": "∇ accel bias", "mu": "μ mounting misalignment", "th": "θ flexure angle",
+             "w": "ω flexure rate"}
+    stored = {"eb": "psins_eb0", "db": "psins_db0", "mu": "psins_mu0"}
+    colours = ("tab:blue", "tab:orange", "tab:green")
+    fig, axes = new_figure(len(groups), width=9.0, height=2.2 * len(groups) + 1.2)
+    ylabels = []
+    for ax, gr in zip(axes, groups, strict=True):
+        idx = [i for i, n in enumerate(names) if group_of(n) == gr]
+        for c, i in zip(colours, idx, strict=True):
+            k = scale[i]
+            ax.plot(t, x[:, i] * k, color=c, linewidth=1.0, label=names[i])
+            ax.fill_between(t, (x[:, i] - sig[:, i]) * k, (x[:, i] + sig[:, i]) * k,
+                            color=c, alpha=0.18, linewidth=0)
+        key = stored.get(gr, "")
+        has_ref = bool(key) and key in g.attrs
+        if has_ref:
+            ref = np.asarray(g.attrs[key], dtype=float)
+            for c, i, v in zip(colours, idx, ref, strict=True):
+                ax.axhline(v * scale[i], color=c, linestyle="--", linewidth=0.9,
+                           label=f"PSINS {key[6:]} {names[i][-1]}")
+        # the ±σ band of the first seconds spans P0: the axis shows the estimates after
+        # the first 10 % of the run, ±2σ at the end, and the stored values
+        k0 = int(np.searchsorted(t, t[0] + 0.1 * (t[-1] - t[0])))
+        vals = [x[k0:, idx] * scale[idx], (x[-1, idx] + 2 * sig[-1, idx]) * scale[idx],
+                (x[-1, idx] - 2 * sig[-1, idx]) * scale[idx]]
+        if has_ref:
+            vals.append(np.asarray(g.attrs[key], dtype=float) * scale[idx])
+        v = np.concatenate([np.ravel(a) for a in vals])
+        pad = 0.1 * (np.nanmax(v) - np.nanmin(v)) + 1e-9
+        ax.set_ylim(np.nanmin(v) - pad, np.nanmax(v) + pad)
+        ylabels.append(f"{label[gr]}\n({units[idx[0]]})")
+    matching = g.attrs.get("matching", "")
+    return {"transfer_states": finish(
+        fig, axes, "time (s)",
+        f"{name}: transfer alignment ({matching} matching) — estimates ± 1σ; dashed: the "
+        "file's stored PSINS values", ylabels)}
