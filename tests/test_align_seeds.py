@@ -61,6 +61,7 @@ def transient_deg(psi0_deg: float, t: float, t_z: float) -> float:
 # ------------------------------------------------------------- §5.3: the mechanism
 
 
+@pytest.mark.slow
 def test_cycles_converge_where_one_pass_cannot_ideal_imu_tz300():
     """T_z = 300 s, ideal IMU and speed reference, the (1, 1, 10)° coarse error, one data
     set for the three modes. The conventional loop (60 s level phase, then compass from

@@ -50,6 +50,7 @@ def designed_cov():
 # --------------------------------------------------------------------------- ideal data
 
 
+@pytest.mark.slow
 def test_ideal_data_estimates_stay_at_zero():
     """Must-show 3: no sensor errors, no noise, no initial errors: the estimates stay 0.
     What is left is the strapdown's own error in fast turns (25 Hz: 9°/s at 26 m/s²),
@@ -123,6 +124,7 @@ def test_monte_carlo_consistency():
 # --------------------------------------------------------------------------- covariance
 
 
+@pytest.mark.slow
 def test_more_measurements_never_increase_sigma(designed_cov):
     """Must-show 3, spec §6 item 11: along the same trajectory P(both) ≤ P(velocity) and
     ≤ P(position) for every state at every epoch (Riccati monotonicity)."""
@@ -131,6 +133,7 @@ def test_more_measurements_never_increase_sigma(designed_cov):
         assert np.all(both <= designed_cov[other].sigma * (1 + 1e-9))
 
 
+@pytest.mark.slow
 def test_filter_sigma_ranks_the_same(designed_cov):
     """The filter's own σ (linearised on its estimate, not on the truth) keeps the order to
     1e-3 and equals the truth-linearised covariance run to 1 %."""

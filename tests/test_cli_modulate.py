@@ -48,6 +48,7 @@ def test_builtin_equals_configs_copy():
     assert BASE["imu"]["rate_hz"] == 100 and BASE["earth"] == "seed004"
 
 
+@pytest.mark.slow
 def test_builtin_run_json_contract_show_and_plot(tmp_path):
     """The built-in case for 1 h at the seed's 100 Hz: the JSON holds every scheme with its
     cycle, cycle mean, horizontal error at 1 h and maximum; the file holds the series, the
@@ -92,6 +93,7 @@ def test_builtin_run_json_contract_show_and_plot(tmp_path):
                      "modulate_mechanism.png"}
 
 
+@pytest.mark.slow
 def test_72h_json_has_every_report_hour(tmp_path):
     """At 10 Hz (the physics allows it, tests/test_modulate_navigation.py) the 72 h run:
     horizontal_error_m holds 1, 4, 12, 24 and 72 h, and the spec's table holds (10 %)."""

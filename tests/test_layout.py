@@ -46,6 +46,7 @@ def imports(path: Path):
                 yield node.module, node.lineno
 
 
+@pytest.mark.slow
 def test_imports_go_one_way():
     bad = []
     for path in PKG.rglob("*.py"):
@@ -73,6 +74,7 @@ def test_imports_go_one_way():
     assert not bad, "\n".join(bad)
 
 
+@pytest.mark.slow
 def test_the_check_sees_a_violation(tmp_path):
     """The scanner reports an upward import (so the test above can fail)."""
     f = PKG / "nav" / "_probe_layout.py"
@@ -84,6 +86,7 @@ def test_the_check_sees_a_violation(tmp_path):
         f.unlink()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [["validate", "configs/seed000_moving_full_cycle.yaml"],
                                   ["--help"]])
 def test_commands_without_kernels_do_not_import_numba(argv):
@@ -101,6 +104,7 @@ def test_commands_without_kernels_do_not_import_numba(argv):
     assert code_ == 0 and not numba and not scipy
 
 
+@pytest.mark.slow
 def test_show_does_not_import_numba(tmp_path):
     root = PKG.parent
     out = tmp_path / "a.h5"
