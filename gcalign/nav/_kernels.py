@@ -25,10 +25,49 @@ time constant √(R/2g) ≈ 570 s); ``HOLD`` keeps h at the reference height and
 
 from __future__ import annotations
 
+import importlib.machinery
+import importlib.util
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 from numba import njit
+
+
+def _numba_targets_without_scipy() -> None:
+    """Initialise numba's array functions without importing scipy.linalg.
+
+    On its first kernel call (cached or compiled) numba imports ``numba.np.arraymath``,
+    whose module-level BLAS probe imports ``scipy.linalg.cython_blas`` and with it all of
+    scipy.linalg: a quarter of a second of every command's start-up, for a probe whose
+    answer only says whether the BLAS extension is there. The probe is given that answer
+    (the extension file in scipy's install) while the module loads; the linear algebra
+    inside kernels, if any, still imports and checks scipy's BLAS when it is compiled.
+    """
+    import numba.np.linalg as nb_linalg
+
+    if "numba.np.arraymath" in sys.modules:
+        return
+    spec = importlib.util.find_spec("scipy")
+    linalg = Path(spec.origin).parent / "linalg" if spec and spec.origin else None
+    has_blas = linalg is not None and any(
+        (linalg / f"cython_blas{suffix}").is_file()
+        for suffix in importlib.machinery.EXTENSION_SUFFIXES)
+
+    def probe() -> None:
+        if not has_blas:
+            raise ImportError("scipy.linalg.cython_blas")
+
+    real = nb_linalg.ensure_blas
+    nb_linalg.ensure_blas = probe
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        nb_linalg.ensure_blas = real
+
+
+_numba_targets_without_scipy()
 
 Q = slice(0, 4)  #: q_nb in the state vector
 V = slice(4, 7)  #: v_n, ENU, m/s
