@@ -284,6 +284,7 @@ def test_same_aggregate_with_one_and_two_workers(reference, tmp_path):
     assert "half-cycle" in res.stdout
 
 
+@pytest.mark.slow
 def test_numba_cache_is_loaded_not_compiled_in_fresh_processes():
     """A fresh process (a single CLI run) loads the align kernels from the on-disk cache;
     pool workers forked after the parent's warm-up inherit them: no cache load, no compile."""
@@ -387,6 +388,7 @@ def test_resume_skips_a_torn_journal_line(tmp_path):
     assert fresh.summary["variants"] == res.summary["variants"]
 
 
+@pytest.mark.slow
 def test_resume_from_the_file_with_more_seeds_reuses_what_is_there(reference, tmp_path):
     ref, sweep, ref_out = reference
     out = tmp_path / "grow.h5"

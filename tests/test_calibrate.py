@@ -67,6 +67,7 @@ def test_ideal_data_estimates_stay_at_zero():
     assert np.abs(r.estimate / r.sigma).max() < 1e-2
 
 
+@pytest.mark.slow
 def test_noise_free_dgnss_converges_to_the_injected_errors():
     """Must-show 3: the spec's injected errors, exact DGNSS and no sensor noise on the 590 s
     designed take-off: every state stays within 3σ at every epoch, and every sensor error
@@ -261,6 +262,7 @@ def test_seed_findings_in_direction(designed_cov):
         assert d_end[ie.IDX[k]] < 0.2 * conv[0, ie.IDX[k]]
 
 
+@pytest.mark.slow
 def test_calibration_time_590_s():
     """Must-show 6: one 590 s calibration (25 Hz navigation, 1 Hz filter, NEES against the
     truth) within 0.5 s warm; asserted here as at most 1 s of this process's CPU time, best

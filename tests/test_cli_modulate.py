@@ -123,6 +123,7 @@ def test_scheme_option_runs_one_scheme_and_dwell_sets_its_timing(tmp_path):
         assert "mechanism:\n  scheme: dual-16" in f.attrs["scenario_yaml"]
 
 
+@pytest.mark.slow
 def test_a_user_table_that_returns_runs(tmp_path):
     """A single-axis table of rows, its own name in the comparison beside a built-in."""
     row = {"axis": "z", "profile": "trapezoid", "accel_s": 2, "const_s": 8, "decel_s": 2,
@@ -194,6 +195,7 @@ def test_dwell_sweep_config_validates():
     assert sweep.command == "modulate" and len(sweep.variants) >= 5
 
 
+@pytest.mark.slow
 def test_batch_over_modulate_scenarios(tmp_path):
     """A dwell sweep (dual-16 around the Schuler period, 0.5 h at 10 Hz): every run ok, the
     metrics read from the modulate summary, the batch equal to the single runs."""

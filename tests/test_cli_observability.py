@@ -82,6 +82,7 @@ def test_results_file_show_and_heat_maps(builtin, tmp_path):
                      "covariance_degree"}
 
 
+@pytest.mark.slow
 def test_position_observes_longitude_and_scaling_changes_degrees(builtin, tmp_path):
     """--measure position: δλ observable (η > 0 once the flight moves), cumulative rank 21;
     --scaling p0 changes the degrees but not the ranks of velocity matching."""

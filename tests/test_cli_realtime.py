@@ -190,6 +190,7 @@ def test_builtin_show_file_and_plot(builtin, tmp_path):
                            + ["realtime_filter", "realtime_lag"])
 
 
+@pytest.mark.slow
 def test_figures_carry_the_data(builtin):
     """The case figure's before panel is the latched error; the filter figure's magnitude
     is 0 dB at DC; the lag figure's first line is the first case's measured lag."""
@@ -272,6 +273,7 @@ def test_batch_metric_and_run_task(tmp_path):
     assert 0 < rec["metrics"][metric] < 1.0
 
 
+@pytest.mark.slow
 def test_validate_does_not_load_scipy_or_numba():
     """`gcalign validate` reads the realtime section without importing scipy or numba."""
     cfg = str(ROOT / "configs/seed003_table1.yaml")
