@@ -142,6 +142,24 @@ def test_stored_pass_is_the_previous_to_the_bit(block, data, mode, reverse, body
     assert np.array_equal(q_all_new, q_all_old) and np.array_equal(s_new, s_old)
 
 
+@pytest.mark.parametrize("reverse", [False, True])
+@pytest.mark.parametrize("stride", [1, 7])
+def test_kernel_calls_of_a_long_pass_are_the_previous_to_the_bit(block, data, reverse,
+                                                                 stride, monkeypatch):
+    """A pass longer than one kernel call (here calls of 1000 steps): the same calls, the
+    same rows (the end of each call is kept), the same final state."""
+    monkeypatch.setattr(cycles, "CHUNK", 1000)
+    monkeypatch.setattr(prev, "CHUNK", 1000)
+    b = block[True]
+    s0 = AK.new_state(data[2][K.Q], [0.3, 0.5, 0.0], data[2][K.P])
+    gains = loop_gains(Stage(20.0, 100.0, 0.707), SITE[0], SITE[2], "double-oscillator")
+    s_new, s_old = s0.copy(), s0.copy()
+    i_new, q_new = cycles.run_stored(s_new, b, 0, N, reverse, gains, AK.COMPASS, stride)
+    i_old, q_old = prev.run_stored(s_old, b, 0, N, reverse, gains, AK.COMPASS, stride)
+    assert np.array_equal(i_new, i_old) and np.array_equal(q_new, q_old)
+    assert np.array_equal(s_new, s_old)
+
+
 @pytest.mark.parametrize("mode", ["full-cycle", "half-cycle", "conventional"])
 def test_passes_are_the_previous_to_the_bit(block, data, mode, monkeypatch):
     """The whole sequence of passes (level phase, direction changes, stages)."""

@@ -102,20 +102,34 @@ def _range(state: np.ndarray, block: Block, lo: int, hi: int, reverse: bool,
         reverse, sign, sign, earth.params(), gains, int(mode), int(stride), idx, q)
 
 
+#: Steps per kernel call of a pass. Each call starts its loops' control rates afresh from
+#: the state (with the radii at its first sample; within a call they carry the radii of the
+#: step before), so the call boundaries are part of the results, which are kept to the bit.
+CHUNK = 1 << 16
+
+
 def run_stored(state: np.ndarray, block: Block, lo: int, hi: int, reverse: bool,
                gains: np.ndarray, mode: int, stride: int,
                earth: EarthModel = WGS84) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`run_block` keeping only the attitude at the block samples that are multiples
-    of `stride` from the block's start, and at both ends of the range (only those rows are
-    written: memory grows with the stored rows, not with the range).
+    """:func:`run_block` in calls of :data:`CHUNK` steps, keeping only the attitude at the
+    block samples that are multiples of `stride` from the block's start, at both ends of
+    the range and at the end of each call (only those rows are written).
 
     Returns (block sample indices in processing order, q_nb there (m, 4)).
     """
-    m = K.stored_rows(lo, hi, stride)
-    idx, q = np.empty(m, np.int64), np.empty((m, 4))
-    rows = _range(state, block, lo, hi, reverse, gains, mode, stride, idx, q, earth)
-    assert rows == m
-    return idx, q
+    idx: list[np.ndarray] = []
+    qs: list[np.ndarray] = []
+    order = range(hi, lo, -CHUNK) if reverse else range(lo, hi, CHUNK)
+    for a in order if hi > lo else [lo]:
+        c_lo, c_hi = (max(a - CHUNK, lo), a) if reverse else (a, min(a + CHUNK, hi))
+        m = K.stored_rows(c_lo, c_hi, stride)
+        i, q = np.empty(m, np.int64), np.empty((m, 4))
+        rows = _range(state, block, c_lo, c_hi, reverse, gains, mode, stride, i, q, earth)
+        assert rows == m
+        start = 1 if idx else 0  # a call's first row is the previous call's last
+        idx.append(i[start:])
+        qs.append(q[start:])
+    return np.concatenate(idx), np.concatenate(qs)
 
 
 def run_passes(
