@@ -6,7 +6,8 @@ one worker process and once with two, end to end (``gcalign batch`` as a subproc
 interpreter start, pool start, JIT cache load in each worker, journal, HDF5). Targets on
 this 2-core machine: two workers ≥ 1.7× faster than one, and ≤ 15 s wall time with two.
 It also checks that the workers load the numba kernels from the on-disk cache instead of
-compiling them again (cache misses must be 0), and that both runs give the same aggregate.
+compiling them again (cache misses must be 0), that both runs give the same aggregate, and
+how fast a Dask scheduler that refuses or never answers is given up (README: ≤ 15 s).
 
 Run: ``python benchmarks/bench_batch.py [--seeds 100]``
 """
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -22,8 +24,10 @@ import time
 from importlib import resources
 from pathlib import Path
 
+SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 TARGET_RATIO = 1.7
 TARGET_WALL_S = 15.0
+FAIL_FAST_S = 15.0  #: README: a scheduler that does not answer fails within this
 
 
 def sweep_file(folder: Path, seeds: int) -> Path:
@@ -66,9 +70,48 @@ def worker_cache_stats() -> list[dict]:
         backend.close()
 
 
+def scheduler_fail_fast(sweep: Path, folder: Path) -> dict[str, float]:
+    """Wall time (s) until `gcalign batch --scheduler` gives up on a scheduler that refuses
+    the connection, and on one that accepts it and never answers (README: within 15 s)."""
+    import socket
+    import threading
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        refused = s.getsockname()[1]
+    silent = socket.socket()
+    silent.bind(("127.0.0.1", 0))
+    silent.listen(8)
+    held: list[socket.socket] = []
+
+    def accept() -> None:
+        try:
+            while True:
+                held.append(silent.accept()[0])
+        except OSError:
+            pass
+
+    threading.Thread(target=accept, daemon=True).start()
+    out = {}
+    try:
+        for what, port in (("refused", refused), ("silent", silent.getsockname()[1])):
+            cmd = [sys.executable, "-m", "gcalign", "batch", str(sweep), "-o",
+                   str(folder / f"{what}.h5"), "--scheduler", f"tcp://127.0.0.1:{port}"]
+            t0 = time.perf_counter()
+            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+            out[what] = time.perf_counter() - t0
+            if proc.returncode != 1:
+                sys.exit(f"gcalign batch on a {what} scheduler: exit {proc.returncode}, not 1")
+    finally:
+        silent.close()
+        for c in held:
+            c.close()
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=100)
+    ap.add_argument("--seeds", type=int, default=4 if SMOKE else 100)
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -80,6 +123,7 @@ def main() -> None:
         t2, s2 = run(sweep, 2, tmp / "w2.h5")
         r1, r2 = per_run_s(tmp / "w1.h5"), per_run_s(tmp / "w2.h5")
         stats = worker_cache_stats()
+        fail = scheduler_fail_fast(sweep, tmp)
     ratio = t1 / t2
     engine_ratio = s1["wall_s"] / s2["wall_s"]
     print(f"gcalign batch, {args.seeds} seeds of seed000-moving-full-cycle "
@@ -97,6 +141,9 @@ def main() -> None:
     misses = sum(s["cache_misses"] for s in stats)
     print(f"  numba cache in pool workers: hits {[s['cache_hits'] for s in stats]}, "
           f"misses {misses} ({'reused' if misses == 0 else 'RECOMPILED'})")
+    for what, t in fail.items():
+        print(f"  a {what} Dask scheduler: exit 1 after {t:5.2f} s   target ≤ {FAIL_FAST_S:g} s  "
+              f"{'OK' if t <= FAIL_FAST_S else 'MISSED'}")
     yaw = s2["variants"][0]["stats"]["error_t3_deg"]
     print(f"  heading error at T3 over {yaw['n']} seeds: mean {yaw['mean'][2]:.4f}°, "
           f"std {yaw['std'][2]:.4f}°, RMS {yaw['rms'][2]:.4f}°")

@@ -37,6 +37,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
+SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 ROOT = Path(__file__).resolve().parents[1]
 DESIGNED = ROOT / "configs" / "seed002_designed.yaml"
 
@@ -44,7 +45,7 @@ DESIGNED = ROOT / "configs" / "seed002_designed.yaml"
 def _median(fn, repeats: int = 5) -> float:
     fn()
     times = []
-    for _ in range(repeats):
+    for _ in range(1 if SMOKE else repeats):
         start = time.perf_counter()
         fn()
         times.append(time.perf_counter() - start)
@@ -78,11 +79,12 @@ def main() -> None:
     base = yaml.safe_load(DESIGNED.read_text(encoding="utf-8"))
     base["calibrate"] |= {"truth": "draw", "p0_scale": 1}
     sweep = sweep_from_mapping({"name": "mc", "base": copy.deepcopy(base),
-                                "command": "calibrate", "seeds": 100}, "bench")
+                                "command": "calibrate", "seeds": 4 if SMOKE else 100}, "bench")
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
         res = run_batch(sweep, Path(tmp) / "mc.h5", workers=2)
-        rows.append(("gcalign batch: 100 runs, 2 workers", time.perf_counter() - start, 60.0))
+        rows.append((f"gcalign batch: {sweep.seeds} runs, 2 workers",
+                     time.perf_counter() - start, 60.0))
     stats = res.summary["variants"][0]["stats"]["nees.final"]
     print(f"{'row':38s} {'time s':>8s} {'target s':>9s} {'margin':>7s}")
     for name, t, target in rows:

@@ -32,13 +32,15 @@ from pathlib import Path
 
 import numpy as np
 
+SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
+HOURS = 0.1 if SMOKE else 72.0  #: of the end-to-end runs and of the stages
 TARGET_ALL_S, TARGET_ONE_S, TARGET_RSS_MB = 60.0, 20.0, 800.0
 
 
 def _gcalign(args: list[str], out: Path) -> tuple[float, float]:
     """Wall time (s) and peak RSS (MB) of one `gcalign` subprocess."""
-    exe = Path(sys.executable).parent / "gcalign"  # the console script of this environment
-    cmd = ["/usr/bin/time", "-v", str(exe), *args, "-o", str(out), "--json"]
+    cmd = ["/usr/bin/time", "-v", sys.executable, "-m", "gcalign", *args, "-o", str(out),
+           "--json"]
     t0 = time.perf_counter()
     res = subprocess.run(cmd, capture_output=True, text=True,
                          env=dict(os.environ, NUMBA_NUM_THREADS="1"))
@@ -58,10 +60,11 @@ def end_to_end(runs: int) -> None:
         _gcalign(["modulate", "--hours", "1"], Path(tmp) / "warm.h5")
         for i in range(runs):
             for name, extra in cases.items():
-                w, r = _gcalign(["modulate", *extra], Path(tmp) / f"{i}.h5")
+                w, r = _gcalign(["modulate", *extra, "--hours", str(HOURS)],
+                                Path(tmp) / f"{i}.h5")
                 wall[name].append(w)
                 rss[name].append(r)
-    print(f"gcalign modulate end to end, 72 h at 100 Hz, median of {runs} (interleaved)")
+    print(f"gcalign modulate end to end, {HOURS:g} h at 100 Hz, median of {runs} (interleaved)")
     print(f"{'case':<26}{'median s':>10}{'min s':>8}{'max s':>8}{'target s':>10}"
           f"{'margin':>8}{'peak RSS MB':>13}{'RSS margin':>12}")
     for name in cases:
@@ -122,7 +125,7 @@ def stage_times(hours: float) -> tuple[int, dict[str, float]]:
         t["errors against truth"] += c3 - c2
 
 
-def stages(hours: float = 72.0) -> None:
+def stages(hours: float = HOURS) -> None:
     stage_times(0.05)  # warm-up (JIT cache)
     n, t = stage_times(hours)
     total = sum(t.values())
@@ -136,7 +139,7 @@ def stages(hours: float = 72.0) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument("--runs", type=int, default=1 if SMOKE else 5)
     ap.add_argument("--skip-e2e", action="store_true", help="only the in-process stages")
     args = ap.parse_args()
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}")

@@ -16,6 +16,7 @@ Run: ``python benchmarks/bench_northfind.py``
 
 from __future__ import annotations
 
+import os
 import time
 
 import numpy as np
@@ -23,12 +24,13 @@ import numpy as np
 from gcalign.northfind import METHODS, NorthfindSetup, run_northfind
 from gcalign.units import ARCSEC, DEG, DPSH, UGPSHZ
 
+SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 TARGET_S = 2.0
 
 
 def _setup(repeats: int) -> NorthfindSetup:
     return NorthfindSetup(
-        azimuths=np.arange(0.0, 360.0, 5.0) * DEG,
+        azimuths=np.arange(0.0, 360.0, 90.0 if SMOKE else 5.0) * DEG,
         lat=40.0 * DEG,
         positions=24,
         dwell_s=60.0,
@@ -61,7 +63,7 @@ def main() -> None:
     for samples in (False, True):
         for repeats in (1, 7):
             setup = _setup(repeats)
-            best, res = _time(setup, samples, n_best=3 if samples else 10)
+            best, res = _time(setup, samples, n_best=1 if SMOKE else 3 if samples else 10)
             runs = setup.azimuths.size * repeats
             per_run = 3 * setup.positions * setup.n_samples  # gyro + 2 accelerometers
             path = "samples" if samples else "averaged"

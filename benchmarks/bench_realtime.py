@@ -18,6 +18,7 @@ Target: ≤ 5 s warm end to end. Run: ``python benchmarks/bench_realtime.py``
 from __future__ import annotations
 
 import io
+import os
 import statistics
 import subprocess
 import sys
@@ -37,8 +38,9 @@ from gcalign.realtime import TABLE1, Settings, summarise, table1
 from gcalign.realtime.chain import SITE
 from gcalign.sim.ideal import ideal_blocks
 
+SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 TARGET_S = 5.0
-RUNS = 7
+RUNS = 1 if SMOKE else 7
 
 
 def _core(settings: Settings, seed: int) -> None:
@@ -79,7 +81,7 @@ def main() -> None:
                 _command(sc, out)
             times[name].append(time.perf_counter() - t0)
     cli = []
-    for _ in range(3):
+    for _ in range(1 if SMOKE else 3):
         t0 = time.perf_counter()
         subprocess.run([sys.executable, "-c", "from gcalign.cli import main; main()",
                         "realtime", "-o", str(out)], check=True, capture_output=True)

@@ -4,6 +4,8 @@ real-data test skips in a plain clone."""
 from __future__ import annotations
 
 import lzma
+import re
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -20,3 +22,32 @@ def lasergyro(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("data") / "lasergyro.imu"
     path.write_bytes(lzma.decompress(LASERGYRO_XZ.read_bytes()))
     return path
+
+
+def _untracked() -> set[str] | None:
+    """Files of the checkout that git does not track (ignored ones included: runs/ is), or
+    None outside a git checkout."""
+    try:
+        out = subprocess.run(["git", "ls-files", "--others", "-z"], cwd=ROOT,
+                             capture_output=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return {p for p in out.decode().split("\0") if p and not _BUILD_PRODUCT.search(p)}
+
+
+#: What running Python and the tools leave by design: byte code and caches.
+_BUILD_PRODUCT = re.compile(r"(^|/)(__pycache__|\.pytest_cache|\.ruff_cache|\.mypy_cache|"
+                            r"\.benchmarks|\.venv|[^/]*\.egg-info)(/|$)|\.nbi$|\.nbc$")
+
+
+@pytest.fixture(scope="session", autouse=True)
+def checkout_stays_clean():
+    """No test leaves a file in the checkout (a results file in runs/, a plot, a journal):
+    the session fails at its end naming the files that appeared."""
+    before = _untracked()
+    yield
+    after = _untracked()
+    if before is not None and after is not None and after - before:
+        new = sorted(after - before)
+        pytest.fail(f"the tests left {len(new)} file(s) in the checkout: {new[:10]}",
+                    pytrace=False)

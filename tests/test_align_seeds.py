@@ -61,6 +61,7 @@ def transient_deg(psi0_deg: float, t: float, t_z: float) -> float:
 # ------------------------------------------------------------- §5.3: the mechanism
 
 
+@pytest.mark.slow
 def test_cycles_converge_where_one_pass_cannot_ideal_imu_tz300():
     """T_z = 300 s, ideal IMU and speed reference, the (1, 1, 10)° coarse error, one data
     set for the three modes. The conventional loop (60 s level phase, then compass from
@@ -76,6 +77,7 @@ def test_cycles_converge_where_one_pass_cannot_ideal_imu_tz300():
     assert abs(yaw["full-cycle"]) < 1e-3
 
 
+@pytest.mark.slow
 def test_modes_agree_when_one_pass_converges_ideal_imu_tz100():
     """T_z = 100 s: a pass forgets its start (σ·230 s = 14.5, e^−14.5 ≈ 5e-7), so with an
     ideal IMU every mode ends at the truth (all within 1e-3°)."""
@@ -99,6 +101,7 @@ def test_modes_agree_within_the_noise_at_tz100():
     assert abs(med["conventional"] - med["full-cycle"]) < 2 * np.sqrt(2) * se
 
 
+@pytest.mark.slow
 def test_analytic_coarse_starts_on_the_steady_state_so_no_mode_differs():
     """The seed's §5.3 as stated (biases only, ideal speed reference, analytic coarse
     alignment on 10 s of static data) at T_z = 300 s: the analytic coarse alignment has the
@@ -189,6 +192,7 @@ def test_linear_heading_transient_two_routes():
 # ------------------------------------------------------------- §5.2 and §6.2
 
 
+@pytest.mark.slow
 def test_swing_compensation_section_5_2():
     errors = {}
     for comp in ("none", "one_off", "continued"):

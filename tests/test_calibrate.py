@@ -50,6 +50,7 @@ def designed_cov():
 # --------------------------------------------------------------------------- ideal data
 
 
+@pytest.mark.slow
 def test_ideal_data_estimates_stay_at_zero():
     """Must-show 3: no sensor errors, no noise, no initial errors: the estimates stay 0.
     What is left is the strapdown's own error in fast turns (25 Hz: 9°/s at 26 m/s²),
@@ -66,6 +67,7 @@ def test_ideal_data_estimates_stay_at_zero():
     assert np.abs(r.estimate / r.sigma).max() < 1e-2
 
 
+@pytest.mark.slow
 def test_noise_free_dgnss_converges_to_the_injected_errors():
     """Must-show 3: the spec's injected errors, exact DGNSS and no sensor noise on the 590 s
     designed take-off: every state stays within 3σ at every epoch, and every sensor error
@@ -123,6 +125,7 @@ def test_monte_carlo_consistency():
 # --------------------------------------------------------------------------- covariance
 
 
+@pytest.mark.slow
 def test_more_measurements_never_increase_sigma(designed_cov):
     """Must-show 3, spec §6 item 11: along the same trajectory P(both) ≤ P(velocity) and
     ≤ P(position) for every state at every epoch (Riccati monotonicity)."""
@@ -131,6 +134,7 @@ def test_more_measurements_never_increase_sigma(designed_cov):
         assert np.all(both <= designed_cov[other].sigma * (1 + 1e-9))
 
 
+@pytest.mark.slow
 def test_filter_sigma_ranks_the_same(designed_cov):
     """The filter's own σ (linearised on its estimate, not on the truth) keeps the order to
     1e-3 and equals the truth-linearised covariance run to 1 %."""
@@ -258,6 +262,7 @@ def test_seed_findings_in_direction(designed_cov):
         assert d_end[ie.IDX[k]] < 0.2 * conv[0, ie.IDX[k]]
 
 
+@pytest.mark.slow
 def test_calibration_time_590_s():
     """Must-show 6: one 590 s calibration (25 Hz navigation, 1 Hz filter, NEES against the
     truth) within 0.5 s warm; asserted here as at most 1 s of this process's CPU time, best

@@ -88,6 +88,7 @@ def test_builtin_json_contract(builtin):
     assert st["dKgz"]["sigma"] < 0.1 * st["dKgz"]["sigma0"]
 
 
+@pytest.mark.slow
 def test_results_file_show_and_plot(builtin, tmp_path):
     s, out = builtin
     with h5py.File(out) as f:
@@ -163,6 +164,7 @@ def test_measure_option_and_smoother(tmp_path):
             g["sigma"][-1, 9:], g["smoothed/sigma"][:, 9:].shape), rtol=1e-6)
 
 
+@pytest.mark.slow
 def test_compare_designed_and_conventional(tmp_path):
     """Must-show 4 on the real flights (the seed's Table 3): --compare runs velocity,
     position and both on the designed take-off and its first 6 stages on the same data.
@@ -191,6 +193,7 @@ def test_compare_designed_and_conventional(tmp_path):
     assert res.exit_code == 0, res.output
 
 
+@pytest.mark.slow
 def test_zero_velocity_alignment_on_lasergyro(tmp_path):
     """Must-show 5: the same filter as a zero-velocity fine alignment on the parked vehicle
     (configs/lasergyro_calibrate.yaml: inertial-frame coarse alignment over 60 s, then
@@ -216,6 +219,7 @@ def test_zero_velocity_alignment_on_lasergyro(tmp_path):
     assert "attitude" in names and "trajectory" not in names
 
 
+@pytest.mark.slow
 def test_batch_monte_carlo_matches_single_runs(tmp_path):
     """Batch over calibrate (truth drawn from P0 per seed, 2 workers): every run's metrics
     equal the single run of the same seed, and the default metrics are NEES and the

@@ -40,6 +40,7 @@ def write(tmp_path: Path, data, name="s.yaml") -> Path:
     return p
 
 
+@pytest.mark.slow
 def test_simulate_navigate_show_roundtrip(tmp_path):
     sim = tmp_path / "sim.h5"
     res = runner.invoke(app, ["simulate", str(write(tmp_path, SCENARIO)), "-o", str(sim), "--json"])
@@ -161,6 +162,7 @@ def test_pole_latitude_rejected(tmp_path):
 REAL = ROOT / "tests/data/lasergyro.imu.xz"  # what configs/lasergyro_align.yaml reads
 
 
+@pytest.mark.slow
 def test_navigate_from_an_alignment_of_the_real_file(tmp_path):
     """Align lasergyro.imu (gyrocompass, T3 = 400 s), then navigate 600 s of the same data
     from its attitude at T3 with the height held: the table and the plot show the drift."""
@@ -194,6 +196,7 @@ def test_navigate_from_an_alignment_of_the_real_file(tmp_path):
     assert res.exit_code == 2 and "align the same data" in res.output
 
 
+@pytest.mark.slow
 def test_long_runs_are_stored_at_the_output_rate_and_summed_increments_are_refused(tmp_path):
     """Beyond an hour the series are stored at 1 Hz: truth decimated, increments summed over
     each second (exact sums, row by row: noise makes every second differ), which navigation
@@ -228,7 +231,7 @@ def test_long_runs_are_stored_at_the_output_rate_and_summed_increments_are_refus
         for n, inc in every.items():
             np.testing.assert_allclose(f[f"imu/{n}"][()], inc.reshape(7200, 20, 3).sum(1),
                                        rtol=1e-12, atol=1e-16)
-    res = runner.invoke(app, ["navigate", str(full), "--json"])
+    res = runner.invoke(app, ["navigate", str(full), "-o", str(tmp_path / "nav.h5"), "--json"])
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout)["vertical"] == "hold"
 

@@ -191,6 +191,7 @@ def unstyled(text: str) -> str:
     return re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", text)
 
 
+@pytest.mark.slow
 def test_progress_bar_when_a_terminal_is_forced(tmp_path, monkeypatch):
     sc = {"name": "static", "site": {"lat_deg": 45, "lon_deg": 126},
           "motion": {"kind": "static", "duration_s": 60}}

@@ -48,6 +48,7 @@ def test_builtin_equals_configs_copy():
     assert BASE["imu"]["rate_hz"] == 100 and BASE["earth"] == "seed004"
 
 
+@pytest.mark.slow
 def test_builtin_run_json_contract_show_and_plot(tmp_path):
     """The built-in case for 1 h at the seed's 100 Hz: the JSON holds every scheme with its
     cycle, cycle mean, horizontal error at 1 h and maximum; the file holds the series, the
@@ -92,6 +93,7 @@ def test_builtin_run_json_contract_show_and_plot(tmp_path):
                      "modulate_mechanism.png"}
 
 
+@pytest.mark.slow
 def test_72h_json_has_every_report_hour(tmp_path):
     """At 10 Hz (the physics allows it, tests/test_modulate_navigation.py) the 72 h run:
     horizontal_error_m holds 1, 4, 12, 24 and 72 h, and the spec's table holds (10 %)."""
@@ -121,6 +123,7 @@ def test_scheme_option_runs_one_scheme_and_dwell_sets_its_timing(tmp_path):
         assert "mechanism:\n  scheme: dual-16" in f.attrs["scenario_yaml"]
 
 
+@pytest.mark.slow
 def test_a_user_table_that_returns_runs(tmp_path):
     """A single-axis table of rows, its own name in the comparison beside a built-in."""
     row = {"axis": "z", "profile": "trapezoid", "accel_s": 2, "const_s": 8, "decel_s": 2,
@@ -192,6 +195,7 @@ def test_dwell_sweep_config_validates():
     assert sweep.command == "modulate" and len(sweep.variants) >= 5
 
 
+@pytest.mark.slow
 def test_batch_over_modulate_scenarios(tmp_path):
     """A dwell sweep (dual-16 around the Schuler period, 0.5 h at 10 Hz): every run ok, the
     metrics read from the modulate summary, the batch equal to the single runs."""

@@ -66,6 +66,7 @@ def test_json_contract(builtin):
     assert s["cumulative"][-1]["t0_s"] == 0.0
 
 
+@pytest.mark.slow
 def test_results_file_show_and_heat_maps(builtin, tmp_path):
     s, out = builtin
     with h5py.File(out) as f:
@@ -81,6 +82,7 @@ def test_results_file_show_and_heat_maps(builtin, tmp_path):
                      "covariance_degree"}
 
 
+@pytest.mark.slow
 def test_position_observes_longitude_and_scaling_changes_degrees(builtin, tmp_path):
     """--measure position: δλ observable (η > 0 once the flight moves), cumulative rank 21;
     --scaling p0 changes the degrees but not the ranks of velocity matching."""
@@ -109,6 +111,7 @@ def test_conventional_is_the_designed_flights_first_six_segments(builtin, tmp_pa
             assert a["degree"][n] == pytest.approx(b["degree"][n], rel=1e-6, abs=1e-300)
 
 
+@pytest.mark.slow
 def test_batch_over_scaling(tmp_path):
     """A sweep over observability.scaling (no randomness: one seed)."""
     base = yaml.safe_load(CONVENTIONAL.read_text())

@@ -74,6 +74,7 @@ def test_builtin_equals_configs_copy():
     assert builtin_scenario_text() == (ROOT / "configs/seed003_table1.yaml").read_text()
 
 
+@pytest.mark.slow
 def test_builtin_json_contract(builtin):
     s, out, _ = builtin
     assert s["output"] == str(out) and out.is_file()
@@ -152,6 +153,7 @@ def test_builtin_lags_and_the_asynchronous_case(builtin):
     assert a["after_max_arcsec"]["kalman-ls"] < 0.5
 
 
+@pytest.mark.slow
 def test_builtin_show_file_and_plot(builtin, tmp_path):
     s, out, output = builtin
     assert "275″" in output and "async" in output  # the table, on stderr under --json
@@ -188,6 +190,7 @@ def test_builtin_show_file_and_plot(builtin, tmp_path):
                            + ["realtime_filter", "realtime_lag"])
 
 
+@pytest.mark.slow
 def test_figures_carry_the_data(builtin):
     """The case figure's before panel is the latched error; the filter figure's magnitude
     is 0 dB at DC; the lag figure's first line is the first case's measured lag."""
@@ -270,6 +273,7 @@ def test_batch_metric_and_run_task(tmp_path):
     assert 0 < rec["metrics"][metric] < 1.0
 
 
+@pytest.mark.slow
 def test_validate_does_not_load_scipy_or_numba():
     """`gcalign validate` reads the realtime section without importing scipy or numba."""
     cfg = str(ROOT / "configs/seed003_table1.yaml")
@@ -367,6 +371,7 @@ def test_bad_predictor_option_exits_2(tmp_path):
          "got 'foo'")
 
 
+@pytest.mark.slow
 def test_show_and_plot_do_not_load_scipy_or_numba(builtin, tmp_path):
     """`gcalign show` and `gcalign plot` of a realtime file read it without the kernels."""
     _, out, _ = builtin

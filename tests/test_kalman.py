@@ -53,6 +53,7 @@ def test_joseph_update_equals_the_textbook_form_for_the_optimal_gain():
     assert u.nis == pytest.approx((z - H @ x) @ np.linalg.solve(H @ P @ H.T + R, z - H @ x))
 
 
+@pytest.mark.slow
 def test_filter_on_its_own_model_is_consistent():
     """A random walk plus drift observed in noise: NEES and NIS averages inside χ² bands."""
     rng = np.random.default_rng(7)

@@ -90,6 +90,7 @@ def violations() -> list[str]:
     return bad
 
 
+@pytest.mark.slow
 def test_imports_go_one_way():
     bad = violations()
     assert not bad, "\n".join(bad)
@@ -130,6 +131,7 @@ def test_the_layers_allow_a_downward_import():
         f.unlink()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [["validate", "configs/seed000_moving_full_cycle.yaml"],
                                   ["--help"]])
 def test_commands_without_kernels_do_not_import_numba(argv):
@@ -147,6 +149,7 @@ def test_commands_without_kernels_do_not_import_numba(argv):
     assert code_ == 0 and not numba and not scipy
 
 
+@pytest.mark.slow
 def test_show_does_not_import_numba(tmp_path):
     root = PKG.parent
     out = tmp_path / "a.h5"

@@ -46,6 +46,7 @@ ALL_TERMS = {"gyro_scale": np.array([1e-4, -2e-4, 3e-4]), "gyro_misalignment": M
              "accel_asym": np.array([1e-5, 2e-5, -3e-5]), "lever": np.array([0.03, -0.05, 0.02])}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("terms, rtol", [(ALL_TERMS, 1e-7),
                                          ({"gyro_asym": np.array([2e-5, -1e-5, 3e-5])}, 2e-6)],
                          ids=["all-but-gyro-asym", "gyro-asym"])
@@ -202,6 +203,7 @@ def test_literal_scheme_is_an_unrotated_ins_with_a_third_of_the_biases():
     assert lit.at(72)[0] < 0.4 * full.at(72)[0]  # ≈ one third of the unrotated error
 
 
+@pytest.mark.slow
 def test_four_position_scheme_cancels():
     """Must-show 3: with four-position-12 the 72 h error is ≥ 50× smaller than without
     rotation, and the attitude excursion from the gyro bias stays ≤ 15″."""
@@ -215,6 +217,7 @@ def test_four_position_scheme_cancels():
     assert np.abs(unrot.phi[:, 2]).max() / ARCSEC > 300  # the heading error it removes
 
 
+@pytest.mark.slow
 def test_dual16_near_schuler_resonance():
     """Spec §3: dual-16 improved with the seed's timing (83.2 min ≈ Schuler) resonates
     (≈ 4.9 km and 6.3 m/s); with Ts = 200 s the 72 h error of dual-16 is below 500 m."""
@@ -242,6 +245,7 @@ def test_continuous_rotation_turns_the_scale_factor_into_a_drift():
     assert np.abs(s.phi).max() < 60 * ARCSEC and s.at(72)[0] < 1000
 
 
+@pytest.mark.slow
 def test_random_walk_prediction():
     """ARW N = 0.001 °/√h, isotropic. Impulse responses of the north error to a gyro-noise
     impulse on E, N, U: −R(cos Ωt − cos ω_s t), −R sin L sin Ωt, R cos L sin Ωt; their mean
@@ -258,6 +262,7 @@ def test_random_walk_prediction():
         np.testing.assert_array_equal(r.x, 0.0)
 
 
+@pytest.mark.slow
 def test_noisy_modulated_error_grows_as_the_random_walk():
     """Four-position-12 with the seed's biases and ARW 0.001 °/√h: sample paths scatter
     about the bias response as the covariance says (120 paths: the sample σ within 20 %),
@@ -300,6 +305,7 @@ def test_output_grid_and_bad_arguments():
     assert np.all(np.isfinite(r.x))
 
 
+@pytest.mark.slow
 def test_increment_response_equals_the_bias_response():
     """gyro_increment_response with the increments of a constant bias (ε T each) is the
     model's bias response: four-position-12, 24 h at 1 Hz, windows of 10 s, within 0.5 % of

@@ -84,6 +84,7 @@ def test_ideal_imu_on_every_scheme_navigates_to_round_off(name):
     assert max(r["max_attitude_error_arcsec"]) < 1e-3
 
 
+@pytest.mark.slow
 def test_body_attitude_has_no_steps_at_the_turns():
     """Spec §5 (e): with the seed's errors the body misalignment (the sensor attitude through
     the mechanism angles) is the sensor-frame φ of the linear model, which has no steps:
@@ -132,6 +133,7 @@ def test_third_order_velocity_terms_of_a_turn():
     assert np.abs(dv[:, 0]).max() < 1e-5  # east: Coriolis of the vertical error, 2Ω_N δv_U t
 
 
+@pytest.mark.slow
 def test_ten_hertz_reproduces_one_hundred_hertz():
     """4 h of seed-12 and four-position-12 with the seed's biases: 10 Hz against the seed's
     100 Hz within 0.2 m and 0.01″ (the third-order term is vertical, see above)."""
@@ -168,6 +170,7 @@ def test_every_scheme_sees_the_same_noise():
 # ------------------------------------------------------------------ must-show 2 and 3
 
 
+@pytest.mark.slow
 def test_literal_scheme_is_an_unrotated_ins_with_a_third_of_the_biases(seed_case):
     """Must-show 2: seed-12 with the seed's biases behaves like the IMU fixed to the body with
     biases diag(−1, 1, 1)/3 × the seed's: horizontal error within 5 % at 24 h and 72 h."""
@@ -181,6 +184,7 @@ def test_literal_scheme_is_an_unrotated_ins_with_a_third_of_the_biases(seed_case
     np.testing.assert_allclose(np.array(lit["cycle_mean"]), PARITY / 3, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_unrotated_navigation_follows_the_closed_forms():
     """Must-show 3, spec §5 (a)–(c), IMU fixed to the body (ENU, sensor x = east), each
     within 5 %: (a) ∇_E alone: east error peak 1272 m at 42.2 min, δv_E amplitude
@@ -224,6 +228,7 @@ def test_unrotated_navigation_follows_the_closed_forms():
         assert (pos[k72, 0] - pos[k24, 0]) / 48 == pytest.approx(slope, rel=0.05)
 
 
+@pytest.mark.slow
 def test_spec_table_and_the_four_position_gain(seed_case):
     """Must-show 3: the spec's reference table (§5) within 10 % for fixed and seed-12 at every
     hour; four-position-12 at 72 h ≥ 50× below the unrotated run; its attitude excursion
@@ -254,6 +259,7 @@ def test_navigation_agrees_with_the_linear_model(seed_case):
 # ------------------------------------------------------------------ must-show 4 and 5
 
 
+@pytest.mark.slow
 def test_scale_factor_excites_the_schuler_and_earth_rate_loops():
     """Must-show 4: δk = 10 ppm on every gyro, no biases. The open-loop attitude term of
     seed-12 returns to zero each cycle and peaks at 2π·δk = 13″, but the navigation sees the
@@ -273,6 +279,7 @@ def test_scale_factor_excites_the_schuler_and_earth_rate_loops():
         np.testing.assert_allclose(horizontal(r), linear_horizontal(r), rtol=0.01, atol=1.0)
 
 
+@pytest.mark.slow
 def test_asymmetric_scale_factor_becomes_a_drift_in_the_literal_scheme():
     """An asymmetric gyro scale factor of 10 ppm: its sign does not follow the turn's sense,
     so seed-12's ccw and cw halves add, 4π·diag(−1, 1, 1)·δk per cycle: a drift of
@@ -293,6 +300,7 @@ def test_asymmetric_scale_factor_becomes_a_drift_in_the_literal_scheme():
         np.testing.assert_allclose(horizontal(r), linear_horizontal(r), rtol=0.01, atol=1.0)
 
 
+@pytest.mark.slow
 def test_lever_arm_moves_the_sensor_point_only():
     """Accelerometers 5 cm from the rotation centre on each axis: they sense ω̇ × r +
     ω × (ω × r) (788 µg centripetal at 22.5 °/s for the 5 cm normal to the turn), but that
@@ -342,6 +350,7 @@ def test_lever_arm_increments_closed_form():
     np.testing.assert_array_equal(d[130:140], 0.0)
 
 
+@pytest.mark.slow
 def test_dual16_needs_a_cycle_away_from_the_schuler_period(seed_case):
     """Must-show 5 and spec §3: with the seed's timing dual-16's cycle (83.2 min) is next to
     the Schuler period (84.46 min) and the improved ordering resonates (≥ 4 km at 72 h, with

@@ -30,6 +30,7 @@ def _flight_scenario(rate_hz=100.0):
     return parse_scenario(data, "flight")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rate_hz", [100.0, 130.0])
 def test_sampled_truth_equals_truth_at_those_times(rate_hz):
     """Streamed blocks (sampled at 100 Hz, and at 130 Hz where segment boundaries fall

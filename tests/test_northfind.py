@@ -321,6 +321,7 @@ def test_index_error_effect():
     np.testing.assert_allclose(res_half.error("coordinate"), err / 2, rtol=1e-3, atol=1e-3 * closed)
 
 
+@pytest.mark.slow
 def test_samples_path_agrees_with_averaged_path():
     common = dict(
         azimuths=np.radians([10.0, 100.0, 250.0, 300.0]),

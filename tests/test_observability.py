@@ -270,6 +270,7 @@ def test_bad_table_input(flight):
         assert str(exc.value).startswith(field) and "\n" not in str(exc.value)
 
 
+@pytest.mark.slow
 def test_table_time_on_the_590_s_trajectory(flight):
     """Must-show 6: the observability table of the 590 s designed trajectory (21 segments,
     590 pieces, SOM/TOM/null space, covariance degree) within 0.5 s warm; asserted here as

@@ -228,6 +228,7 @@ def sweep_file(tmp_path_factory):
                   metrics=["error_t3_deg.2", "error_t3_deg"])
 
 
+@pytest.mark.slow
 def test_batch_figures_box_per_variant_and_component(batch_file):
     figs = plots.figures_for(batch_file)
     assert set(figs) == {"batch_error_t3_deg", "batch_equivalent_s"}
@@ -247,6 +248,7 @@ def test_batch_figures_box_per_variant_and_component(batch_file):
     assert scalar.axes[0].get_ylabel() == "equivalent_s (s)"
 
 
+@pytest.mark.slow
 def test_sweep_figure_median_against_the_numeric_key(sweep_file):
     """A numeric grid key gives lines instead of boxes: x = its values (sorted), y = the
     median over seeds of |metric| of each variant, read back from /batch/runs; one line
@@ -307,6 +309,7 @@ def test_sweep_figure_cases_are_lines_when_nothing_else_is():
     np.testing.assert_allclose(data_series(ax)[1].get_ydata(), [0.5, 1.0])
 
 
+@pytest.mark.slow
 def test_plot_command_writes_pngs_next_to_the_file(align_files, batch_file, tmp_path):
     for path, n in ((align_files["full-cycle"], 2), (batch_file, 2)):
         res = runner.invoke(app, ["plot", str(path), "--json"])
@@ -420,6 +423,7 @@ def test_simulate_figures_truth_and_imu_output(sim_and_nav):
     np.testing.assert_allclose(accel_y.get_ydata(), (dv[:n, 1] / ts).reshape(-1, k).mean(1))
 
 
+@pytest.mark.slow
 def test_plot_of_a_recorded_data_file_draws_its_imu_output(tmp_path):
     """`gcalign plot` of the compressed recording itself: its IMU output (°/s, the vehicle
     is disturbed), the file's own axes and rate."""
@@ -449,6 +453,7 @@ def test_a_results_file_without_figures_says_so(tmp_path):
 # ------------------------------------------------------------ navigate on recorded data
 
 
+@pytest.mark.slow
 def test_navigate_figure_of_recorded_data_is_the_solution_and_its_drift(tmp_path):
     """No truth: pitch/roll, yaw (unwrapped), velocity and the displacement from the start
     (east, north, horizontal norm) read back from the file; minutes for a 30 min run."""
@@ -503,6 +508,7 @@ def calibrate_file(tmp_path_factory):
     return run_each(("calibrate", "observability"), sc, folder)
 
 
+@pytest.mark.slow
 def test_calibrate_figures_estimates_sigma_errors_innovations(calibrate_file):
     """Each panel draws the file's series in the display unit of its state (°/h, µg, ppm,
     ″/′, m/s): the estimate, its ±3σ band and the injected truth; σ/σ0 from 1 at the start;

@@ -84,6 +84,7 @@ def attitude_difference_deg(ours, theirs):
     return np.degrees(np.linalg.norm(phi, axis=-1))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["swing", "moving"])
 def test_same_data_same_navigation(kind):
     ours, theirs, truth = both(kind)

@@ -282,6 +282,7 @@ def test_moving_trajectory_from_pyins_simulator():
     assert np.abs(wrap_pi(r["att"] - native_att)).max() < 1e-12
 
 
+@pytest.mark.slow
 def test_speed_reports_rates():
     out = pr.pyins_speed(n=2000, repeat=1)
     assert out["n"] == 2000

@@ -151,6 +151,7 @@ def test_tracker_model_is_the_van_loan_closed_form():
     np.testing.assert_allclose(m.Qd, Q, rtol=1e-9)
 
 
+@pytest.mark.slow
 def test_numba_tracker_equals_the_slow_route():
     """Kernel against gcalign.estimation.kalman.predict/update to 1e-12; a deliberate change
     of one term (Q_d's α entry by 1e-6) is seen."""

@@ -28,6 +28,7 @@ def default_rows():
     return [summarise(r) for r in table1(Settings(), np.random.default_rng(2027))]
 
 
+@pytest.mark.slow
 def test_table_has_the_seed_cases(default_rows):
     assert [r.name for r in default_rows] == [c.name for c in TABLE1]
     assert [r.kind for r in default_rows] == ["rate"] * 4 + ["accel"] * 4 + ["swing"] * 4
@@ -54,6 +55,7 @@ def test_after_kalman_ls_within_the_requirements(default_rows):
         assert r.stats["kalman-ls"].max["truth"] < 0.01 * r.stats["none"].max["truth"]
 
 
+@pytest.mark.slow
 def test_seed_semi_physical_claims_on_its_own_metric():
     """T = 4 ms, Δt = 0, reference = the INS's output 4 ms later: < 0.3″ / < 0.4″ / < 1″."""
     rows = [summarise(r) for r in table1(seed_semi_physical(), np.random.default_rng(2027))]

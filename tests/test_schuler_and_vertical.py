@@ -83,6 +83,7 @@ def test_east_accelerometer_bias_schuler_period_and_peak():
     assert pos[:, 0].max() == pytest.approx(1272.0, rel=0.02)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("axis, slope", [(1, 542.4), (2, 557.4)])
 def test_72h_east_error_grows_with_the_drift_along_the_earth_axis(axis, slope):
     """Only the drift component along the earth's axis grows without bound: 542.4 m/h of

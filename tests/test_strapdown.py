@@ -292,6 +292,7 @@ KERNEL_BLOCKS = [("moving", 500, 4500), ("climb", 1000, 4000), ("swing", 0, 3000
                  ("static", 0, 3000)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("direction", ["forward", "reverse"])
 @pytest.mark.parametrize("kind, k0, k1", KERNEL_BLOCKS)
 def test_kernel_matches_numpy_reference(kind, k0, k1, direction):
@@ -310,6 +311,7 @@ def test_kernel_matches_numpy_reference(kind, k0, k1, direction):
         np.testing.assert_array_equal(sol.pos, kernel[2])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("direction", ["forward", "reverse"])
 @pytest.mark.parametrize("kind, k0, k1", KERNEL_BLOCKS[:3])
 def test_kernel_step_matches_reference_step(kind, k0, k1, direction):

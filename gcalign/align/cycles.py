@@ -1,7 +1,8 @@
 """Fine-alignment passes: conventional, full-cycle and half-cycle modes (seed 000 §3-4, §6).
 
 A *pass* runs the gyrocompass kernel over the stored block [T1, T2] forward or in reverse
-(reverse = the data transform of :mod:`gcalign.nav.strapdown`). At each change of direction
+(reverse = the data transform of :mod:`gcalign.nav.strapdown`, applied by the kernel as it
+reads the block backwards). At each change of direction
 the loop states that are velocities or rates change sign with the data; the attitude is
 kept. Full-cycle alternates forward/reverse compass passes; half-cycle alternates forward
 compass passes with reverse attitude-only passes; conventional is one forward pass.
@@ -80,44 +81,54 @@ def loop_gains(stage: Stage, lat: float, h: float, azimuth_poles: str,
     )
 
 
-def run_block(state, block: Block, lo: int, hi: int, reverse: bool, gains, mode, q_out,
+def run_block(state: np.ndarray, block: Block, lo: int, hi: int, reverse: bool,
+              gains: np.ndarray, mode: int, q_out: np.ndarray,
               earth: EarthModel = WGS84) -> None:
-    """Kernel over increments lo..hi-1 of the block (forward) or hi-1..lo (reverse)."""
-    dth, dv, vref = block.dtheta[lo:hi], block.dv[lo:hi], block.vref[lo : hi + 1]
-    sign = 1.0
-    if reverse:
-        dth, dv, vref, sign = -dth[::-1], dv[::-1], -vref[::-1], -1.0
-    K.gyrocompass_block(state, np.ascontiguousarray(dth), np.ascontiguousarray(dv),
-                        np.ascontiguousarray(vref), block.vref_body, block.ts, sign,
-                        earth.params(), gains, mode, q_out)
+    """Kernel over increments lo..hi-1 of the block (forward) or hi-1..lo (reverse), the
+    attitude after every step into `q_out` ((hi - lo + 1, 4), row 0 the start)."""
+    idx = np.empty(hi - lo + 1, np.int64)
+    _range(state, block, lo, hi, reverse, gains, mode, 1, idx, q_out, earth)
 
 
-CHUNK = 1 << 16  #: steps per kernel call of a pass (bounds the full-rate attitude buffer)
+def _range(state: np.ndarray, block: Block, lo: int, hi: int, reverse: bool,
+           gains: np.ndarray, mode: int, stride: int, idx: np.ndarray, q: np.ndarray,
+           earth: EarthModel) -> int:
+    """:func:`gcalign.align.kernel.gyrocompass_range` on the block: a reverse pass reads it
+    backwards with the signs of the data transform applied as it reads (no copy)."""
+    sign = -1.0 if reverse else 1.0
+    return K.gyrocompass_range(
+        state, np.ascontiguousarray(block.dtheta), np.ascontiguousarray(block.dv),
+        np.ascontiguousarray(block.vref), block.vref_body, block.ts, int(lo), int(hi),
+        reverse, sign, sign, earth.params(), gains, int(mode), int(stride), idx, q)
 
 
-def run_stored(state, block: Block, lo: int, hi: int, reverse: bool, gains, mode,
-               stride: int, earth: EarthModel = WGS84):
-    """:func:`run_block` in chunks, keeping the attitude at the block samples that are
-    multiples of `stride` from the block's start, and at both ends of the range.
+#: Steps per kernel call of a pass. Each call starts its loops' control rates afresh from
+#: the state (with the radii at its first sample; within a call they carry the radii of the
+#: step before), so the call boundaries are part of the results, which are kept to the bit.
+CHUNK = 1 << 16
+
+
+def run_stored(state: np.ndarray, block: Block, lo: int, hi: int, reverse: bool,
+               gains: np.ndarray, mode: int, stride: int,
+               earth: EarthModel = WGS84) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`run_block` in calls of :data:`CHUNK` steps, keeping only the attitude at the
+    block samples that are multiples of `stride` from the block's start, at both ends of
+    the range and at the end of each call (only those rows are written).
 
     Returns (block sample indices in processing order, q_nb there (m, 4)).
     """
-    idx, qs = [], []
+    idx: list[np.ndarray] = []
+    qs: list[np.ndarray] = []
     order = range(hi, lo, -CHUNK) if reverse else range(lo, hi, CHUNK)
-    first = True
-    for a in order:
+    for a in order if hi > lo else [lo]:
         c_lo, c_hi = (max(a - CHUNK, lo), a) if reverse else (a, min(a + CHUNK, hi))
-        q = np.empty((c_hi - c_lo + 1, 4))
-        run_block(state, block, c_lo, c_hi, reverse, gains, mode, q, earth)
-        samples = np.arange(c_hi, c_lo - 1, -1) if reverse else np.arange(c_lo, c_hi + 1)
-        keep = samples % stride == 0
-        keep[-1] = True  # the end of the chunk: the next chunk's start, or the range's end
-        keep[0] = first  # a chunk's start is the previous chunk's end
-        first = False
-        idx.append(samples[keep])
-        qs.append(q[keep])
-    if not idx:  # an empty range: the state as it is
-        return np.array([hi if reverse else lo]), state[K.ATT][None].copy()
+        m = K.stored_rows(c_lo, c_hi, stride)
+        i, q = np.empty(m, np.int64), np.empty((m, 4))
+        rows = _range(state, block, c_lo, c_hi, reverse, gains, mode, stride, i, q, earth)
+        assert rows == m
+        start = 1 if idx else 0  # a call's first row is the previous call's last
+        idx.append(i[start:])
+        qs.append(q[start:])
     return np.concatenate(idx), np.concatenate(qs)
 
 

@@ -4,8 +4,9 @@ The loop state is one float64 vector so that passes can hand it on (indices belo
 
     q_nb (0:4) | v_E, v_N (4:6) | ∫δv_E, ∫δv_N (6:8) | ω_cU (8) | lat, lon, h (9:12)
 
-Per step (data already transformed for a reverse pass: gyro negated, velocity negated,
-``earth_sign = -1``, so Ω = earth_sign·ω_ie·cos L changes sign with the data):
+Per step (data transformed for a reverse pass: gyro negated, velocity negated,
+``earth_sign = -1``, so Ω = earth_sign·ω_ie·cos L changes sign with the data; the kernel
+reads the stored block backwards and applies the signs as it reads):
 
 - attitude ``q ← q(−ω_in T) ⊗ q ⊗ q(Δθ)`` with ``ω_in = ω_ie + ω_en(v_R) + ω_c``;
 - position along v_R by the trapezoid rule, radii at mid-interval (the strapdown step's);
@@ -52,17 +53,22 @@ GAINS_SIZE = 10
 
 
 @njit(cache=True)
-def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, E, gains, mode,
-                      q_out):
-    """Run the loops over N increments, updating `state` (12,) in place.
+def gyrocompass_range(state: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, vref: np.ndarray,
+                      vref_body: bool, ts: float, lo: int, hi: int, reverse: bool,
+                      data_sign: float, earth_sign: float, E: np.ndarray, gains: np.ndarray,
+                      mode: int, stride: int, idx_out: np.ndarray, q_out: np.ndarray) -> int:
+    """Run the loops over increments lo … hi−1 of a stored block, updating `state` (12,) in
+    place, and write the attitude at the samples kept; returns the number of rows written.
 
-    dtheta, dv : (N, 3) body increments (rad, m/s), in processing order.
-    vref : (N+1, 3) reference velocity at the start (row 0) and at the end of each step
-        (m/s); ENU, or body frame (odometer) if `vref_body`, then resolved with the
-        computed attitude.
-    E : earth model vector (:meth:`gcalign.nav.earth.EarthModel.params`).
-    gains : (10,) loop gains; mode : ATTITUDE, LEVEL or COMPASS.
-    q_out : (N+1, 4) attitude after each step, row 0 = start (preallocated).
+    dtheta, dv : (N, 3) body increments (rad, m/s) in forward time order; vref : (N+1, 3)
+        the reference velocity at the samples (ENU, or body frame if `vref_body`).
+    reverse : process hi−1 … lo (sample hi first) instead of lo … hi−1.
+    data_sign : multiplies the gyro increments and the reference velocity as they are read
+        (−1 in a reverse pass: the data transform of DESIGN.md, applied on reading, so no
+        reversed and negated copy of the block is made); earth_sign : that of the earth rate.
+    Kept: the first and the last sample of the range and every sample that is a multiple of
+    `stride` (block indices), in processing order, into `idx_out` (their block indices) and
+    `q_out` (q_nb), both preallocated for :func:`stored_rows` rows.
     """
     ke1, ke2, ke3 = gains[0], gains[1], gains[2]
     kn1, kn2, kn3 = gains[3], gains[4], gains[5]
@@ -72,9 +78,18 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, E, gai
     ie, inn = state[6], state[7]
     wcu = state[8]
     lat, lon, h = state[9], state[10], state[11]
+    n = hi - lo
+    # sample j of the range in processing order: forward lo + j, reverse hi − j
+    first = hi if reverse else lo
+    step = -1 if reverse else 1
+    idx_out[0] = first
     q_out[0, 0], q_out[0, 1], q_out[0, 2], q_out[0, 3] = q0, q1, q2, q3
+    row = 1
+    # the next multiple of the stride after the first sample, in processing order
+    keep = (first - 1) // stride * stride if reverse else (first // stride + 1) * stride
     # Reference velocity at the start of the first step.
-    re, rn, ru = vref[0, 0], vref[0, 1], vref[0, 2]
+    sg = data_sign
+    re, rn, ru = sg * vref[first, 0], sg * vref[first, 1], sg * vref[first, 2]
     if vref_body:
         re, rn, ru = qrot(q0, q1, q2, q3, re, rn, ru)
     wce = wcn = 0.0
@@ -87,7 +102,10 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, E, gai
             wce = -dvn * (1.0 + kn2) / (r_m + h) - kn3 * inn
         else:
             wce = -dvn * (1.0 + ku2) / (r_m + h)
-    for k in range(dtheta.shape[0]):
+    for k in range(n):
+        j = hi - 1 - k if reverse else lo + k  # the increment
+        nxt = first + step * (k + 1)  # the sample at the end of the step
+        bx, by, bz = sg * dtheta[j, 0], sg * dtheta[j, 1], sg * dtheta[j, 2]
         r_m, r_n, g, sl, cl = earth_at(E, lat, h)
         rmh, rnh = r_m + h, r_n + h  # radii at the start of the step
         wie = earth_sign * E[3]
@@ -101,15 +119,12 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, E, gai
         # Specific-force increment at mid-interval, and the attitude update with the
         # platform rate including the control rates: the pieces of the strapdown step.
         fx, fy, fz = specific_force_increment(
-            q0, q1, q2, q3, dtheta[k, 0], dtheta[k, 1], dtheta[k, 2], dv[k, 0], dv[k, 1],
-            dv[k, 2], wx, wy, wz,
+            q0, q1, q2, q3, bx, by, bz, dv[j, 0], dv[j, 1], dv[j, 2], wx, wy, wz,
         )
-        q0, q1, q2, q3 = attitude_update(
-            q0, q1, q2, q3, dtheta[k, 0], dtheta[k, 1], dtheta[k, 2], wx, wy, wz
-        )
+        q0, q1, q2, q3 = attitude_update(q0, q1, q2, q3, bx, by, bz, wx, wy, wz)
 
         # Reference velocity at the end of the step, and position along it.
-        ne, nn, nu = vref[k + 1, 0], vref[k + 1, 1], vref[k + 1, 2]
+        ne, nn, nu = sg * vref[nxt, 0], sg * vref[nxt, 1], sg * vref[nxt, 2]
         if vref_body:
             ne, nn, nu = qrot(q0, q1, q2, q3, ne, nn, nu)
         lat_new, lon, h_new = position_update(
@@ -146,14 +161,48 @@ def gyrocompass_block(state, dtheta, dv, vref, vref_body, ts, earth_sign, E, gai
             ve, vn = ne, nn
         lat, h = lat_new, h_new
         re, rn, ru = ne, nn, nu
-        q_out[k + 1, 0], q_out[k + 1, 1], q_out[k + 1, 2], q_out[k + 1, 3] = q0, q1, q2, q3
+        if nxt == keep or k == n - 1:
+            if nxt == keep:
+                keep += step * stride
+            idx_out[row] = nxt
+            q_out[row, 0], q_out[row, 1], q_out[row, 2], q_out[row, 3] = q0, q1, q2, q3
+            row += 1
 
     state[0], state[1], state[2], state[3] = q0, q1, q2, q3
     state[4], state[5], state[6], state[7], state[8] = ve, vn, ie, inn, wcu
     state[9], state[10], state[11] = lat, lon, h
+    return row
 
 
-def new_state(q_nb, v_n, pos) -> np.ndarray:
+def stored_rows(lo: int, hi: int, stride: int) -> int:
+    """Rows :func:`gyrocompass_range` writes over samples lo … hi: both ends and the
+    multiples of `stride` between them."""
+    if hi == lo:
+        return 1
+    return 2 + (hi - 1) // stride - lo // stride  # the ends, the multiples in (lo, hi)
+
+
+@njit(cache=True)
+def gyrocompass_block(state: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, vref: np.ndarray,
+                      vref_body: bool, ts: float, earth_sign: float, E: np.ndarray,
+                      gains: np.ndarray, mode: int, q_out: np.ndarray) -> None:
+    """Run the loops over N increments, updating `state` (12,) in place.
+
+    dtheta, dv : (N, 3) body increments (rad, m/s), in processing order.
+    vref : (N+1, 3) reference velocity at the start (row 0) and at the end of each step
+        (m/s); ENU, or body frame (odometer) if `vref_body`, then resolved with the
+        computed attitude.
+    E : earth model vector (:meth:`gcalign.nav.earth.EarthModel.params`).
+    gains : (10,) loop gains; mode : ATTITUDE, LEVEL or COMPASS.
+    q_out : (N+1, 4) attitude after each step, row 0 = start (preallocated).
+    (:func:`gyrocompass_range` with every sample kept, on data already in processing order.)
+    """
+    n = dtheta.shape[0]
+    gyrocompass_range(state, dtheta, dv, vref, vref_body, ts, 0, n, False, 1.0, earth_sign,
+                      E, gains, mode, 1, np.empty(n + 1, np.int64), q_out)
+
+
+def new_state(q_nb: np.ndarray, v_n: np.ndarray, pos: np.ndarray) -> np.ndarray:
     """Loop state vector from attitude, horizontal velocity and position; loop states zero."""
     s = np.zeros(STATE_SIZE)
     s[ATT] = q_nb

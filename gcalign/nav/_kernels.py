@@ -25,10 +25,49 @@ time constant √(R/2g) ≈ 570 s); ``HOLD`` keeps h at the reference height and
 
 from __future__ import annotations
 
+import importlib.machinery
+import importlib.util
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 from numba import njit
+
+
+def _numba_targets_without_scipy() -> None:
+    """Initialise numba's array functions without importing scipy.linalg.
+
+    On its first kernel call (cached or compiled) numba imports ``numba.np.arraymath``,
+    whose module-level BLAS probe imports ``scipy.linalg.cython_blas`` and with it all of
+    scipy.linalg: a quarter of a second of every command's start-up, for a probe whose
+    answer only says whether the BLAS extension is there. The probe is given that answer
+    (the extension file in scipy's install) while the module loads; the linear algebra
+    inside kernels, if any, still imports and checks scipy's BLAS when it is compiled.
+    """
+    import numba.np.linalg as nb_linalg
+
+    if "numba.np.arraymath" in sys.modules:
+        return
+    spec = importlib.util.find_spec("scipy")
+    linalg = Path(spec.origin).parent / "linalg" if spec and spec.origin else None
+    has_blas = linalg is not None and any(
+        (linalg / f"cython_blas{suffix}").is_file()
+        for suffix in importlib.machinery.EXTENSION_SUFFIXES)
+
+    def probe() -> None:
+        if not has_blas:
+            raise ImportError("scipy.linalg.cython_blas")
+
+    real = nb_linalg.ensure_blas
+    nb_linalg.ensure_blas = probe
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        nb_linalg.ensure_blas = real
+
+
+_numba_targets_without_scipy()
 
 Q = slice(0, 4)  #: q_nb in the state vector
 V = slice(4, 7)  #: v_n, ENU, m/s
@@ -58,7 +97,7 @@ def vertical_gains(tau: float, gravity_gradient: float) -> np.ndarray:
 
 
 @njit(cache=True, inline="always")
-def earth_at(E, lat, h):
+def earth_at(E: np.ndarray, lat: float, h: float) -> tuple[float, float, float, float, float]:
     """R_M, R_N (m), normal gravity g (m/s²), sin L, cos L of earth model `E` at (lat, h)."""
     sl = math.sin(lat)
     cl = math.cos(lat)
@@ -77,7 +116,7 @@ def earth_at(E, lat, h):
 
 
 @njit(cache=True, inline="always")
-def rv2q(rx, ry, rz):
+def rv2q(rx: float, ry: float, rz: float) -> tuple[float, float, float, float]:
     """Quaternion of a rotation vector. Below 0.05 rad the series of cos(θ/2) and
     sin(θ/2)/θ to θ⁸ are exact in float64 (the next terms are below 1e-22) and cost no
     transcendental function: every IMU increment takes this branch."""
@@ -95,7 +134,8 @@ def rv2q(rx, ry, rz):
 
 
 @njit(cache=True, inline="always")
-def qmul(aw, ax, ay, az, bw, bx, by, bz):
+def qmul(aw: float, ax: float, ay: float, az: float, bw: float, bx: float, by: float,
+         bz: float) -> tuple[float, float, float, float]:
     """Hamilton product a ⊗ b."""
     return (
         aw * bw - ax * bx - ay * by - az * bz,
@@ -106,7 +146,8 @@ def qmul(aw, ax, ay, az, bw, bx, by, bz):
 
 
 @njit(cache=True, inline="always")
-def qrot(qw, qx, qy, qz, vx, vy, vz):
+def qrot(qw: float, qx: float, qy: float, qz: float, vx: float, vy: float,
+         vz: float) -> tuple[float, float, float]:
     """Rotate v by unit quaternion q: q ⊗ v ⊗ q* (as C(q) @ v)."""
     # t = 2 q_v × v;  v' = v + w t + q_v × t
     tx = 2.0 * (qy * vz - qz * vy)
@@ -120,7 +161,8 @@ def qrot(qw, qx, qy, qz, vx, vy, vz):
 
 
 @njit(cache=True, inline="always")
-def rotate_small(rx, ry, rz, vx, vy, vz):
+def rotate_small(rx: float, ry: float, rz: float, vx: float, vy: float,
+                 vz: float) -> tuple[float, float, float]:
     """R(r) v for a small rotation vector r (Rodrigues, series to 4th order: |r| < 0.05)."""
     t2 = rx * rx + ry * ry + rz * rz
     a = 1.0 - t2 / 6.0 + t2 * t2 / 120.0  # sin t / t
@@ -136,13 +178,16 @@ def rotate_small(rx, ry, rz, vx, vy, vz):
 
 
 @njit(cache=True, inline="always")
-def transport_rate(ve, vn, r_m, r_n, h, sl, cl):
+def transport_rate(ve: float, vn: float, r_m: float, r_n: float, h: float, sl: float,
+                   cl: float) -> tuple[float, float, float]:
     """ω_en^n = [-v_N/(R_M+h), v_E/(R_N+h), v_E tan L/(R_N+h)]."""
     return -vn / (r_m + h), ve / (r_n + h), ve * sl / (cl * (r_n + h))
 
 
 @njit(cache=True, inline="always")
-def specific_force_increment(q0, q1, q2, q3, bx, by, bz, dx, dy, dz, wx, wy, wz):
+def specific_force_increment(q0: float, q1: float, q2: float, q3: float, bx: float, by: float,
+                             bz: float, dx: float, dy: float, dz: float, wx: float, wy: float,
+                             wz: float) -> tuple[float, float, float]:
     """Specific-force increment resolved at mid-interval: ``R(-ω_in T/2) C_nb R(Δθ/2) Δv``.
 
     (bx, by, bz) = Δθ, (dx, dy, dz) = Δv (body), (wx, wy, wz) = ω_in^n T.
@@ -153,7 +198,8 @@ def specific_force_increment(q0, q1, q2, q3, bx, by, bz, dx, dy, dz, wx, wy, wz)
 
 
 @njit(cache=True, inline="always")
-def attitude_update(q0, q1, q2, q3, bx, by, bz, wx, wy, wz):
+def attitude_update(q0: float, q1: float, q2: float, q3: float, bx: float, by: float, bz: float,
+                    wx: float, wy: float, wz: float) -> tuple[float, float, float, float]:
     """``q ← q(−ω_in T) ⊗ q ⊗ q(Δθ)``, renormalised: body rotation on the right,
     navigation-frame rotation (wx, wy, wz) = ω_in^n T on the left."""
     aw, ax, ay, az = rv2q(bx, by, bz)
@@ -167,7 +213,7 @@ def attitude_update(q0, q1, q2, q3, bx, by, bz, wx, wy, wz):
 
 
 @njit(cache=True, inline="always")
-def radii_at(E, sl):
+def radii_at(E: np.ndarray, sl: float) -> tuple[float, float]:
     """R_M, R_N of earth model `E` where sin L = sl."""
     s2 = sl * sl
     if E[0] == 0.0:
@@ -180,7 +226,9 @@ def radii_at(E, sl):
 
 
 @njit(cache=True, inline="always")
-def position_update(E, lat, lon, h, ue, un, uu, ts, r_m, sl, cl):
+def position_update(E: np.ndarray, lat: float, lon: float, h: float, ue: float, un: float,
+                    uu: float, ts: float, r_m: float, sl: float,
+                    cl: float) -> tuple[float, float, float]:
     """Position after `ts` at mean ENU velocity (ue, un, uu) (trapezoid rule); radii at the
     mid-interval latitude and height. r_m, sl, cl: R_M and sin, cos of the start latitude;
     the mid latitude's sine and cosine follow to second order in the half step d
@@ -194,9 +242,17 @@ def position_update(E, lat, lon, h, ue, un, uu, ts, r_m, sl, cl):
     return lat + un * ts / (r_m + h_mid), lon + ue * ts / ((r_n + h_mid) * c_mid), h + uu * ts
 
 
+#: The navigation state as the block kernels carry it from step to step, in local variables
+#: (registers): the 11 floats of the state vector, in its order.
+NavTuple = tuple[float, float, float, float, float, float, float, float, float, float, float]
+
+
 @njit(cache=True, inline="always")
-def strapdown_step(s, dth, dvb, ts, earth_sign, E, vertical, h_ref):
-    """One strapdown update of the state vector `s` in place (see the module docstring).
+def strapdown_step(x: NavTuple, dtheta: np.ndarray, dv: np.ndarray, k: int, ts: float,
+                   earth_sign: float, E: np.ndarray, vertical: np.ndarray,
+                   h_ref: float) -> NavTuple:
+    """One strapdown update of the state `x` (the state vector's floats, in its order) by
+    increment `k` of `dtheta`, `dv`; returns the new state (see the module docstring).
 
     Velocity:  v_k = v_{k-1} + R(-ω_in T/2) C_nb(k-1) R(Δθ/2) Δv + (g_n - (2ω_ie + ω_en) × v_mid) T
                (the specific-force increment resolved at mid-interval; Coriolis at a
@@ -206,18 +262,18 @@ def strapdown_step(s, dth, dvb, ts, earth_sign, E, vertical, h_ref):
     Vertical:  HOLD: h = h_ref, v_U = 0; DAMPED: v_U −= (k2 δh + a) T, h −= k1 δh T,
                a += k3 δh T with δh = h − h_ref at the start of the step.
     """
-    lat, lon, h = s[7], s[8], s[9]
+    q0, q1, q2, q3, ve, vn, vu, lat, lon, h, da = x
+    bx, by, bz = dtheta[k, 0], dtheta[k, 1], dtheta[k, 2]
     r_m, r_n, g, sl, cl = earth_at(E, lat, h)
     wie = earth_sign * E[3]
     wie_n, wie_u = wie * cl, wie * sl
-    ve, vn, vu = s[4], s[5], s[6]
     mode = vertical[0]
 
     inv_m, inv_n = 1.0 / (r_m + h), 1.0 / (r_n + h)  # the transport rate, twice below
     tan_l = sl / cl
     tx, ty, tz = -vn * inv_m, ve * inv_n, ve * tan_l * inv_n
     fx, fy, fz = specific_force_increment(
-        s[0], s[1], s[2], s[3], dth[0], dth[1], dth[2], dvb[0], dvb[1], dvb[2],
+        q0, q1, q2, q3, bx, by, bz, dv[k, 0], dv[k, 1], dv[k, 2],
         tx * ts, (wie_n + ty) * ts, (wie_u + tz) * ts,
     )
 
@@ -233,17 +289,16 @@ def strapdown_step(s, dth, dvb, ts, earth_sign, E, vertical, h_ref):
     # at v_U would leave a bias of ½ g3 v_U T in the vertical velocity
     vu1 = vu + fz - ((cx * mn - cy * me) + g - E[7] * 0.5 * mu * ts) * ts
 
-    s[0], s[1], s[2], s[3] = attitude_update(
-        s[0], s[1], s[2], s[3], dth[0], dth[1], dth[2], tx * ts, (wie_n + ty) * ts,
-        (wie_u + tz) * ts,
+    q0, q1, q2, q3 = attitude_update(
+        q0, q1, q2, q3, bx, by, bz, tx * ts, (wie_n + ty) * ts, (wie_u + tz) * ts,
     )
 
     dh = h - h_ref
     if mode == HOLD:
         vu, vu1 = 0.0, 0.0
     elif mode == DAMPED:
-        vu1 -= (vertical[2] * dh + s[DA]) * ts
-        s[DA] += vertical[3] * dh * ts
+        vu1 -= (vertical[2] * dh + da) * ts
+        da += vertical[3] * dh * ts
     lat1, lon1, h1 = position_update(
         E, lat, lon, h, 0.5 * (ve + ve1), 0.5 * (vn + vn1), 0.5 * (vu + vu1), ts, r_m, sl, cl
     )
@@ -251,29 +306,60 @@ def strapdown_step(s, dth, dvb, ts, earth_sign, E, vertical, h_ref):
         h1 = h_ref
     elif mode == DAMPED:
         h1 -= vertical[1] * dh * ts
-    s[4], s[5], s[6] = ve1, vn1, vu1
-    s[7], s[8], s[9] = lat1, lon1, h1
+    return q0, q1, q2, q3, ve1, vn1, vu1, lat1, lon1, h1, da
 
 
 @njit(cache=True)
-def strapdown_block(s, dtheta, dv, ts, earth_sign, E, vertical, h_ref, stride, out):
+def strapdown_block(s: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, ts: float,
+                    earth_sign: float, E: np.ndarray, vertical: np.ndarray, h_ref: np.ndarray,
+                    stride: int, out: np.ndarray) -> None:
     """Integrate N increments from the state `s` (updated in place); after every `stride`
     steps write the state into the next row of `out` ((N // stride, NAV_STATE)).
 
     h_ref : (N,) reference height at the start of each step, or (1,) for a constant one.
+    The state lives in local variables from the first step to the last (read from `s` once,
+    written back once); the steps run in groups of `stride`, each followed by its row.
     """
-    nref = h_ref.shape[0]
-    row = 0
-    for k in range(dtheta.shape[0]):
-        strapdown_step(s, dtheta[k], dv[k], ts, earth_sign, E, vertical,
-                       h_ref[k if k < nref else nref - 1])
-        if (k + 1) % stride == 0:
-            out[row, :] = s
-            row += 1
+    n = dtheta.shape[0]
+    last = h_ref.shape[0] - 1
+    x = (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8], s[9], s[10])
+    k = 0
+    for row in range(n // stride):
+        for _ in range(stride):
+            x = strapdown_step(x, dtheta, dv, k, ts, earth_sign, E, vertical,
+                               h_ref[k if k < last else last])
+            k += 1
+        (out[row, 0], out[row, 1], out[row, 2], out[row, 3], out[row, 4], out[row, 5],
+         out[row, 6], out[row, 7], out[row, 8], out[row, 9], out[row, 10]) = x
+    for _ in range(n - k):  # the steps after the last full group
+        x = strapdown_step(x, dtheta, dv, k, ts, earth_sign, E, vertical,
+                           h_ref[k if k < last else last])
+        k += 1
+    s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8], s[9], s[10] = x
+
+
+@njit(cache=True, inline="always")
+def coned_rotation(dtheta: np.ndarray, i0: int, n: int) -> tuple[float, float, float]:
+    """Coning-corrected rotation vector of increments i0 … i0+n−1:
+    ``φ = Σθ_i + (Σ_{i<n} c_i θ_i) × θ_n`` (:data:`CONE`)."""
+    sx = sy = sz = 0.0
+    cxs = cys = czs = 0.0
+    for i in range(n):
+        sx += dtheta[i0 + i, 0]
+        sy += dtheta[i0 + i, 1]
+        sz += dtheta[i0 + i, 2]
+        if i < n - 1:
+            c = CONE[n, i]
+            cxs += c * dtheta[i0 + i, 0]
+            cys += c * dtheta[i0 + i, 1]
+            czs += c * dtheta[i0 + i, 2]
+    lx, ly, lz = dtheta[i0 + n - 1, 0], dtheta[i0 + n - 1, 1], dtheta[i0 + n - 1, 2]
+    return sx + cys * lz - czs * ly, sy + czs * lx - cxs * lz, sz + cxs * ly - cys * lx
 
 
 @njit(cache=True)
-def attitude_block(q, dtheta, ts, w_in, subsamples, stride, out):
+def attitude_block(q: np.ndarray, dtheta: np.ndarray, ts: float, w_in: np.ndarray,
+                   subsamples: int, stride: int, out: np.ndarray) -> None:
     """Attitude-only strapdown over N increments in groups of `subsamples` (N a multiple):
     each group is one update over ``subsamples·ts`` with the coning-corrected rotation
     vector ``φ = Σθ_i + (Σ_{i<n} c_i θ_i) × θ_n`` (:data:`CONE`), and
@@ -284,33 +370,24 @@ def attitude_block(q, dtheta, ts, w_in, subsamples, stride, out):
     n = subsamples
     T = n * ts
     wx, wy, wz = w_in[0] * T, w_in[1] * T, w_in[2] * T
-    row = 0
-    for k in range(dtheta.shape[0] // n):
-        i0 = k * n
-        sx = sy = sz = 0.0
-        cxs = cys = czs = 0.0
-        for i in range(n):
-            sx += dtheta[i0 + i, 0]
-            sy += dtheta[i0 + i, 1]
-            sz += dtheta[i0 + i, 2]
-            if i < n - 1:
-                c = CONE[n, i]
-                cxs += c * dtheta[i0 + i, 0]
-                cys += c * dtheta[i0 + i, 1]
-                czs += c * dtheta[i0 + i, 2]
-        lx, ly, lz = dtheta[i0 + n - 1, 0], dtheta[i0 + n - 1, 1], dtheta[i0 + n - 1, 2]
-        px = sx + cys * lz - czs * ly
-        py = sy + czs * lx - cxs * lz
-        pz = sz + cxs * ly - cys * lx
-        q[0], q[1], q[2], q[3] = attitude_update(q[0], q[1], q[2], q[3], px, py, pz,
-                                                 wx, wy, wz)
-        if (k + 1) % stride == 0:
-            out[row, 0], out[row, 1], out[row, 2], out[row, 3] = q[0], q[1], q[2], q[3]
-            row += 1
+    updates = dtheta.shape[0] // n
+    q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
+    k = 0
+    for row in range(updates // stride):
+        for _ in range(stride):
+            px, py, pz = coned_rotation(dtheta, k * n, n)
+            q0, q1, q2, q3 = attitude_update(q0, q1, q2, q3, px, py, pz, wx, wy, wz)
+            k += 1
+        out[row, 0], out[row, 1], out[row, 2], out[row, 3] = q0, q1, q2, q3
+    for _ in range(updates - k):
+        px, py, pz = coned_rotation(dtheta, k * n, n)
+        q0, q1, q2, q3 = attitude_update(q0, q1, q2, q3, px, py, pz, wx, wy, wz)
+        k += 1
+    q[0], q[1], q[2], q[3] = q0, q1, q2, q3
 
 
 @njit(cache=True, inline="always")
-def euler_of(q0, q1, q2, q3):
+def euler_of(q0: float, q1: float, q2: float, q3: float) -> tuple[float, float, float]:
     """[pitch, roll, yaw] of q_nb (C_nb = Rz(yaw) Rx(pitch) Ry(roll)), as rotation.quat_to_euler."""
     c21 = 2.0 * (q2 * q3 + q0 * q1)
     c20 = 2.0 * (q1 * q3 - q0 * q2)
@@ -321,7 +398,7 @@ def euler_of(q0, q1, q2, q3):
 
 
 @njit(cache=True, inline="always")
-def wrapped(d):
+def wrapped(d: float) -> float:
     """A difference of two angles in [−π, π] wrapped to [−π, π), as rotation.wrap_pi (one
     turn at most, so a branch does it: a floating-point modulo costs ~15 ns more)."""
     if d >= math.pi:
@@ -332,8 +409,10 @@ def wrapped(d):
 
 
 @njit(cache=True)
-def error_block(states, q_bs, has_qbs, att_t, q_t, v_t, pos_t, has_truth, E, pos0, k_first,
-                stride, acc, out):
+def error_block(states: np.ndarray, q_bs: np.ndarray, has_qbs: bool, att_t: np.ndarray,
+                q_t: np.ndarray, v_t: np.ndarray, pos_t: np.ndarray, has_truth: bool,
+                E: np.ndarray, pos0: np.ndarray, k_first: int, stride: int, acc: np.ndarray,
+                out: np.ndarray) -> int:
     """Errors of a block of navigation states against the truth at every sample, folded
     into `acc`, and every `stride`-th sample written as a row of `out`.
 
