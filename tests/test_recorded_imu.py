@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 import scipy.io
 from cli_checks import assert_bad_input
-from conftest import LASERGYRO_XZ, ROOT
 from typer.testing import CliRunner
 
+from conftest import LASERGYRO_XZ, ROOT
 from gcalign.cli import app
 from gcalign.errors import ScenarioError
 from gcalign.io.imu_files import read_imu_file, read_psins_imu

@@ -12,13 +12,19 @@ of the demo's lines). The covariance step is :func:`gcalign.estimation.kalman.pr
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 
 from gcalign.nav._kernels import attitude_update, specific_force_increment
 
+Array = NDArray[np.float64]
+
 
 @njit(cache=True)
-def propagate(q, v, x, P, dtheta, dv, k_from, k_to, fed, w_in, g_cc, ts, Phi, Qd, C_nb):
+def propagate(q: Array, v: Array, x: Array, P: Array, dtheta: Array, dv: Array, k_from: int,
+              k_to: int, fed: Array, w_in: Array, g_cc: Array, ts: float, Phi: Array,
+              Qd: Array, C_nb: Array) -> None:
     """Steps k_from … k_to − 1, in place on q (4,), v (3,), x (n,), P (n, n) and Phi (n, n)
     (its flexure block and identity set by the caller). On return C_nb (3, 3) holds the
     slave attitude at the start of the last step (the demo's ``Cnbs`` of its update)."""

@@ -40,9 +40,11 @@ feedback optional (the demo's commented line ``qnbs = qdelphi(qnbs, x(φ)); x(φ
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from gcalign.errors import ScenarioError
 from gcalign.estimation.kalman import update, van_loan
@@ -201,7 +203,7 @@ class TransferResult:
 
 
 def convergence_times(t: np.ndarray, x: np.ndarray, sigma: np.ndarray,
-                      names) -> dict[str, float]:
+                      names: Sequence[str]) -> dict[str, float]:
     """First time after which ``|x_k − x_final| ≤ 2 σ_k`` for every later k, per state."""
     out = {}
     for i, n in enumerate(names):
@@ -210,7 +212,8 @@ def convergence_times(t: np.ndarray, x: np.ndarray, sigma: np.ndarray,
     return out
 
 
-def markov2_block(beta, sigma, dt: float):
+def markov2_block(beta: ArrayLike, sigma: ArrayLike,
+                  dt: float) -> tuple[np.ndarray, np.ndarray]:
     """Φ, Q_d (6, 6) of θ (3), ω (3) over `dt`: per axis ``θ̇ = ω``,
     ``ω̇ = −β² θ − 2β ω + w``, ``E[w w] = 4β³σ²`` (PSINS markov2; var θ → σ²)."""
     b, s = np.asarray(beta, dtype=float), np.asarray(sigma, dtype=float)
@@ -223,7 +226,8 @@ def markov2_block(beta, sigma, dt: float):
     return van_loan(F, G, np.diag(4.0 * b ** 3 * s * s), dt)
 
 
-def _slerp_master(master: MasterSeries, t: np.ndarray):
+def _slerp_master(master: MasterSeries, t: np.ndarray
+                  ) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
     """The master at times `t` (inside its span): v, pos linear, attitude along the
     rotation between the bracketing epochs. Returns (q_nb (N, 4) or None, v_n, pos)."""
     tm = np.asarray(master.t, dtype=float)
@@ -238,7 +242,7 @@ def _slerp_master(master: MasterSeries, t: np.ndarray):
     return quat_mult(q[j], rotvec_to_quat(quat_to_rotvec(dq) * a)), v, pos
 
 
-def _epochs(t_imu: np.ndarray, master: MasterSeries):
+def _epochs(t_imu: np.ndarray, master: MasterSeries) -> tuple[int, np.ndarray, np.ndarray]:
     """Start sample and measurement samples: the slave starts at the first master epoch
     inside the IMU run (at the IMU sample nearest to it); a measurement is taken at the
     IMU sample nearest to each later master epoch, the master interpolated to it."""
@@ -300,7 +304,8 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
     earth, n, rows = s.earth, s.n, s.rows
     lever = np.asarray(s.lever_arm_b, dtype=float)
 
-    def earth_terms(pos, v):  # PSINS eth = earth(pos, vn): ω_in^n and g_cc
+    # PSINS eth = earth(pos, vn): ω_in^n and g_cc
+    def earth_terms(pos: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         w_ie = earth.omega_ie_n(pos[0])
         w_in = w_ie + earth.omega_en_n(pos[0], pos[2], v)
         g = earth.gravity(pos[0], pos[2]) if s.gravity == "normal" else G0

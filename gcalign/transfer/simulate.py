@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from gcalign.nav.rotation import (
     euler_to_dcm,
@@ -26,7 +27,7 @@ from gcalign.nav.rotation import (
     quat_to_euler,
     rotvec_to_quat,
 )
-from gcalign.sim.imu import ideal_imu
+from gcalign.sim.imu import ImuData, ideal_imu
 from gcalign.sim.motions import Moving, Segment, Truth
 from gcalign.transfer.filter import EB, MU, PHI, MasterSeries, TransferResult, TransferSettings
 from gcalign.units import ARCMIN, DEG, DPH, DPSH, UG, UGPSHZ
@@ -71,7 +72,7 @@ def wing_rock(duration: float, speed: float = 12.0, yaw: float = 30 * DEG,
 
 
 @lru_cache(maxsize=4)
-def _ideal(duration: float, ts: float):
+def _ideal(duration: float, ts: float) -> tuple[Truth, ImuData]:
     return ideal_imu(wing_rock(duration), SITE, ts)
 
 
@@ -80,7 +81,7 @@ def transfer_case(rng: np.random.Generator, duration: float = 20.0, ts: float = 
                   eb_sigma: float = 500 * DPH, db_sigma: float = 1000 * UG,
                   arw: float = 0.1 * DPSH, vrw: float = 10 * UGPSHZ,
                   master_att_sigma: float = 1 * ARCMIN, master_v_sigma: float = 0.02,
-                  phi0_sigma: float = 0.1 * DEG, lever_arm_b=(0.0, 0.0, 0.0),
+                  phi0_sigma: float = 0.1 * DEG, lever_arm_b: ArrayLike = (0.0, 0.0, 0.0),
                   settings: TransferSettings | None = None) -> TransferCase:
     """One seeded case: μ, ε, ∇ and the slave's initial attitude error φ0 drawn from
     N(0, σ²) per axis (the filter's P0), then the slave's noise and the master's, in that
