@@ -149,6 +149,10 @@ class Imu(Model):
         return ImuErrors(gyro=self.gyro.to_si(), accel=self.accel.to_si())
 
 
+#: The commands that use the recorded-data keys ``reference`` and ``initial``.
+USED_BY: dict[str, tuple[str, ...]] = {"reference": ("navigation",), "initial": ("navigation",)}
+
+
 class Scenario(Model):
     """A whole scenario file. Either `motion` (simulated data) or `imu_file` (recorded data)."""
 
@@ -242,7 +246,7 @@ class Scenario(Model):
                 out.append(f"{', '.join(keys)}: cannot matter with recorded data (imu_file): "
                            "the recording carries its own rate and sensor errors")
         for key in ("reference", "initial"):
-            if getattr(self, key) is not None and section is not None:
+            if getattr(self, key) is not None and section not in (None, *USED_BY[key]):
                 out.append(f"{key}: read and checked (gcalign validate shows it), but "
                            f"{section} does not use it yet")
         model = getattr(self, section, None) if section else None
