@@ -81,10 +81,10 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
     every block (the simulation, if it is one, is most of an alignment's time)."""
     source = aiding.source
     has_truth = stream.truth0 is not None
-    if source != "none" and not has_truth:  # the reference is simulated from the truth
+    if source in ("odometer", "nav") and not has_truth:  # simulated from the truth
         raise ScenarioError(
             f"align.aiding.source: {source!r} needs a simulated motion (truth); "
-            "recorded data supports 'none'"
+            "recorded data take 'file' (a velocity, odometer or reference file) or 'none'"
         )
     body = source == "odometer"
     rng = np.random.default_rng([0 if stream.seed is None else stream.seed, 1])
@@ -92,6 +92,12 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
     m = hi - lo
     dtheta, dv = np.empty((m, 3)), np.empty((m, 3))
     vref = np.zeros((m + 1, 3))
+    if source == "file":  # the file's velocity at the samples lo .. hi
+        from gcalign.io.recorded.aiding import velocity_at
+
+        t_samples = stream.t0 + np.arange(lo, hi + 1) * stream.ts
+        vref, _ = velocity_at(aiding.read(), t_samples, "align.aiding")
+        source = "none"  # nothing more to take from the truth
     truth_att = np.empty((m + 1, 3)) if has_truth else None
     pos_t1 = stream.site.copy()
 
@@ -208,7 +214,7 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
                                             stream.earth)
         run = align(data.dtheta, data.dv, ts, stream.site, settings, earth=stream.earth,
                     position_t1=data.pos_t1, vref=data.vref,
-                    vref_body=cfg.aiding.source == "odometer", truth_att=data.truth_att,
+                    vref_body=cfg.aiding.body, truth_att=data.truth_att,
                     t0=stream.t0, stride=stride, first_sample=tl.lo, samples=stream.samples)
     except InputError as err:
         raise _scenario_error(err) from None
