@@ -178,6 +178,21 @@ def still_base_warnings(dtheta: np.ndarray, dv: np.ndarray, ts: float, lat: floa
     return []
 
 
+def _at_rest_warnings(sc: Scenario, stream: Stream, tl: Timeline, data: Window) -> list[str]:
+    """A recording aligned without aiding is taken to stand still over [0, T2]; say so
+    when its reference or its IMU show that it moves (:mod:`gcalign.app.at_rest`)."""
+    from gcalign.app.at_rest import evidence
+
+    k = slice(tl.i0 - tl.lo, tl.i2 - tl.lo)
+    why = evidence(sc, data.dtheta[k], data.dv[k], stream.ts, stream.site, stream.earth,
+                   stream.t0 + tl.i0 * stream.ts, stream.t0 + tl.i2 * stream.ts)
+    if why is None:
+        return []
+    return [f"align.aiding.source: 'none' takes the base to be at rest, but {why}; expect "
+            "a wrong heading and tilt: give the vehicle's velocity (align.aiding: {source: "
+            "file, path, format})"]
+
+
 def _scenario_error(err: InputError) -> ScenarioError:
     """The core's refusal, naming the scenario field it comes from."""
     names = {"site": "site.lat_deg", "coarse": "align.coarse.method", "passes": "align.stages"}
@@ -212,6 +227,8 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
             k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
             warnings += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
                                             stream.earth)
+        if cfg.aiding.source == "none" and stream.truth0 is None:  # recorded: at rest?
+            warnings += _at_rest_warnings(sc, stream, tl, data)
         run = align(data.dtheta, data.dv, ts, stream.site, settings, earth=stream.earth,
                     position_t1=data.pos_t1, vref=data.vref,
                     vref_body=cfg.aiding.body, truth_att=data.truth_att,

@@ -321,5 +321,7 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     runs = (compare_runs(case, config_of(sc).conventional_segments, progress) if compare
             else [run_filter(case)])
     out = summary(sc, case, runs, compare)
+    from gcalign.app.at_rest import zero_velocity_warnings  # a moving recording under ZUPT
+
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),
-                   case.seed)
+                   case.seed, tuple(zero_velocity_warnings(sc, case, out)))

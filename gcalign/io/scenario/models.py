@@ -150,7 +150,9 @@ class Imu(Model):
 
 
 #: The commands that use the recorded-data keys ``reference`` and ``initial``.
-USED_BY: dict[str, tuple[str, ...]] = {"reference": ("navigation",), "initial": ("navigation",)}
+#: (align and calibrate: the site when the file has none, and whether the base is at rest.)
+USED_BY: dict[str, tuple[str, ...]] = {"reference": ("navigation", "align", "calibrate"),
+                                       "initial": ("navigation",)}
 
 
 class Scenario(Model):
