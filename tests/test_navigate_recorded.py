@@ -179,3 +179,20 @@ def test_mems_against_fog_two_routes(mems, remove_biases):
         # φ_E ≈ −ε_x t (cos roll ≈ 0.9 of it, the roll swinging ±33°)
         assert np.degrees(phi_ours[at[-1], 0]) == pytest.approx(
             -np.degrees(mems[2]["eb0"][0] * 99.9), rel=0.15)
+
+
+def test_command_route_is_the_arrays_route(tmp_path, mems):
+    """`gcalign navigate configs/mems_fog.yaml` (height free, started from the FOG solution
+    at 0.1 s) and :func:`gcalign.nav.navigate.navigate` from the same state: the same
+    final horizontal error against the reference."""
+    res = runner.invoke(app, ["navigate", str(ROOT / "configs/mems_fog.yaml"), "-o",
+                              str(tmp_path / "c.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout.strip().splitlines()[-1])
+    imu, ref, _ = mems
+    att0, v0, pos0 = (a[0] for a in reference_at(ref, [imu.t[K0]]))
+    nav = navigate(imu.dtheta[K0 + 1:], imu.dv[K0 + 1:], imu.ts,
+                   NavState.from_euler(att0, v0, pos0), vertical=Vertical("free"), t0=imu.t[K0])
+    e = position_error_enu(nav.final.pos[None], reference_at(ref, [100.0])[2])[0]
+    assert s["vertical"] == "free"
+    np.testing.assert_allclose(s["final_error"]["position_m"], e, atol=1e-6)

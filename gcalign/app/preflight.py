@@ -54,9 +54,10 @@ def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
                 raise ScenarioError(f"imu_file: {sc.imu_file}: file not found")
             return None
         imu, truth = read_data_file(sc.imu_file, sc.recording_layout())
-        if sc.site is None and imu.site is None:
+        if sc.site is None and imu.site is None and sc.reference is None:
             raise ScenarioError(f"site: missing; {sc.imu_file} does not give the site, so "
-                                "the scenario must (site: {lat_deg, lon_deg, height_m})")
+                                "the scenario must (site: {lat_deg, lon_deg, height_m}, "
+                                "or a reference)")
         return Extent(len(imu), float(imu.ts), True, truth is not None)
     if sc.motion is None:
         return None
@@ -137,9 +138,9 @@ def _align(sc: Scenario, ext: Extent) -> None:
         raise ScenarioError(f"site.lat_deg: gyrocompassing needs |latitude| < 85°, got "
                             f"{sc.site.lat_deg:.4f}° (the horizontal earth rate vanishes)")
     if not ext.has_truth:
-        if cfg.aiding.source != "none":
+        if cfg.aiding.source in ("odometer", "nav"):
             raise ScenarioError(f"align.aiding.source: {cfg.aiding.source!r} needs a simulated "
-                                "motion (truth); recorded data supports 'none'")
+                                "motion (truth); recorded data take 'file' or 'none'")
         if cfg.coarse.method == "given":
             raise ScenarioError("align.coarse.method: 'given' needs truth; use 'analytic' or "
                                 "'inertial' for recorded data")

@@ -280,7 +280,9 @@ class AlignConfig(Model):
                 "(unused: real-time conventional)" if realtime else "",
             ),
             ("align.azimuth_poles", self.poles_for(kind), ""),
-            ("align.aiding", f"{self.aiding.source}, {self.aiding.noise_mps} m/s", ""),
+            ("align.aiding", f"file {self.aiding.path} ({self.aiding.format})"
+             if self.aiding.source == "file" else
+             f"{self.aiding.source}, {self.aiding.noise_mps} m/s", ""),
             ("align.level_s", f"{self.level_phase_s} s", ""),
         ]
         stages = self.stage_list()

@@ -251,7 +251,9 @@ class Scenario(Model):
                 out.append(f"{', '.join(keys)}: cannot matter with recorded data (imu_file): "
                            "the recording carries its own rate and sensor errors")
         for key in ("reference", "initial"):
-            if getattr(self, key) is not None and section not in (None, *USED_BY[key]):
+            if getattr(self, key) is not None and section is not None \
+                    and section not in USED_BY[key] \
+                    and getattr(self, section, None) is not None:  # a section of the file
                 out.append(f"{key}: read and checked (gcalign validate shows it), but "
                            f"{section} does not use it yet")
         model = getattr(self, section, None) if section else None
