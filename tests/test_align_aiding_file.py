@@ -158,3 +158,39 @@ def test_aiding_file_refusals(tmp_path):
         "source": "none", "path": short})], "path", "applies to source 'file' only")
     assert_bad_run(run, tmp_path, [_mems_scenario(tmp_path, MAT, {
         "source": "file", "path": short})], "format", "missing")
+
+
+def test_align_errors_against_the_reference(tmp_path):
+    """configs/mems_fog.yaml: the errors at T2, T3 and per pass are against the FOG
+    solution (error_source "reference"), equal to the estimate minus the reference
+    interpolated here; the file keeps it under /reference (no /truth), the table and the
+    figures say "reference"; a reference that does not cover the window is refused."""
+    import h5py
+    from rich.console import Console
+
+    from gcalign.app.align.plots import figures
+    from gcalign.app.align.tables import align_table
+
+    s = _align_json(tmp_path, str(ROOT / "configs/mems_fog.yaml"))
+    assert s["error_source"] == "reference"
+    r_att = reference_at(read_reference(MAT), [0.1 + s["t3_s"]])[0][0]
+    want = np.subtract(s["attitude_t3_deg"], np.degrees(r_att))
+    want[1:] = (want[1:] + 180) % 360 - 180
+    np.testing.assert_allclose(s["error_t3_deg"], want, atol=1e-9)
+    with h5py.File(tmp_path / "a.h5") as f:
+        assert "reference" in f and "truth" not in f
+        figs = figures(f, "mems")
+    assert "vs reference" in figs["align_attitude"].texts[0].get_text()
+    console = Console(width=200, record=True)
+    console.print(align_table(s))
+    text = console.export_text()
+    assert "reference at T3" in text and "estimate − reference" in text
+
+    sc = yaml.safe_load((ROOT / "configs/mems_fog.yaml").read_text())
+    sc["align"]["start_s"] = 0.0
+    sc["imu_file"] = sc["reference"]["path"] = sc["align"]["aiding"]["path"] = str(MAT)
+    sc["align"]["aiding"] = {"source": "none"}
+    path = tmp_path / "early.yaml"
+    path.write_text(yaml.safe_dump(sc))
+    assert_bad_run(lambda *a: runner.invoke(app, ["align", *map(str, a)]), tmp_path,
+                   [path], "reference:", "covers 0.100 .. 100.000 s", "align.start_s")

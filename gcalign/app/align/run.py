@@ -75,10 +75,12 @@ def _reference(aiding: Aiding, att, v_n, rng: np.random.Generator, body: bool):
 
 
 def collect(stream: Stream, tl: Timeline, aiding: Aiding,
-            progress: Progress | None = None) -> Window:
+            progress: Progress | None = None, reference=None) -> Window:
     """One pass over the stream for the samples tl.lo .. tl.hi; the rest of the run is
     never held (nor, simulated, generated). `progress(done_s, total_s, what)` hears of
-    every block (the simulation, if it is one, is most of an alignment's time)."""
+    every block (the simulation, if it is one, is most of an alignment's time). A
+    `reference` (:class:`gcalign.io.recorded.Reference`, recorded data) stands for the
+    truth attitude, for the errors only."""
     source = aiding.source
     has_truth = stream.truth0 is not None
     if source in ("odometer", "nav") and not has_truth:  # simulated from the truth
@@ -100,6 +102,8 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
         source = "none"  # nothing more to take from the truth
     truth_att = np.empty((m + 1, 3)) if has_truth else None
     pos_t1 = stream.site.copy()
+    if reference is not None and not has_truth:
+        truth_att = _reference_attitude(reference, stream, lo, hi)
 
     def take(k0: int, att, v_n, pos) -> None:
         """Truth rows of samples k0 .. k0+len-1: reference velocity, attitude, pos at T1."""
@@ -130,6 +134,21 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
         if b.k0 + n >= hi:
             break  # everything needed is in; the rest of the run is never generated
     return Window(dtheta, dv, vref, truth_att, pos_t1)
+
+
+def _reference_attitude(reference, stream: Stream, lo: int, hi: int) -> np.ndarray:
+    """The reference's attitude at samples lo .. hi (slerp); ScenarioError naming
+    align.start_s when it does not cover them."""
+    from gcalign.io.recorded import reference_at
+
+    t = stream.t0 + np.arange(lo, hi + 1) * stream.ts
+    lo_t, hi_t = float(reference.t[0]), float(reference.t[-1])
+    if t[0] < lo_t - 1e-6 * stream.ts or t[-1] > hi_t + 1e-6 * stream.ts:
+        raise ScenarioError(
+            f"reference: {reference.record.get('path', 'the reference')} covers {lo_t:.3f} .. "
+            f"{hi_t:.3f} s, the alignment reads {t[0]:.3f} .. {t[-1]:.3f} s (data time): "
+            "move align.start_s or shorten align.t2_s / t3_s, or remove the reference")
+    return reference_at(reference, t, tol=1e-6)[0]
 
 
 #: The share of the signal an excursion of the base may reach before the analytic coarse
@@ -222,7 +241,8 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
     try:
         settings = settings_of(cfg, kind)
         tl = timeline(settings, ts, stream.samples)
-        data = collect(stream, tl, cfg.aiding, progress)
+        reference = sc.reference.read() if sc.reference is not None else None
+        data = collect(stream, tl, cfg.aiding, progress, reference)
         if settings.coarse == "analytic":
             k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
             warnings += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
@@ -262,6 +282,8 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
         "scenario": name,
         "seed": stream.seed,
         "source": stream.source,
+        "error_source": None if run.truth_t3 is None else (
+            "truth" if stream.truth0 is not None else "reference"),
         "mode": s.mode,
         "compensation": "real time" if realtime else s.compensation,
         "azimuth_poles": run.azimuth_poles,
@@ -310,6 +332,7 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     else:
         stream = scenario_stream(sc, seed)
     run = run_alignment(sc, stream, progress)
-    return Outcome(alignment_summary(run, stream, sc.name),
-                   lambda f: write_alignment(f, run, stream), None, stream.seed, run.warnings,
-                   result=run)
+    summary = alignment_summary(run, stream, sc.name)
+    against = summary["error_source"] or "truth"
+    return Outcome(summary, lambda f: write_alignment(f, run, stream, against), None,
+                   stream.seed, run.warnings, result=run)
