@@ -157,8 +157,16 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
         raise ScenarioError(f"calibrate.coarse.duration_s: {err}") from None
     dth, dv = combine_increments(imu.dtheta[i1:i2], imu.dv[i1:i2], n)
     t = coarse_end + np.arange(len(dth) + 1) * n * ts
-    data = zero_velocity_data(t, dth, dv, NavState.from_euler(att, np.zeros(3), site), earth)
-    return Case(data, cfg.settings(site, earth), imu.source, "zero-velocity", n, rate, None,
+    aiding = cfg.aiding_for(sc)
+    if aiding == "file":  # measured velocity / position (gcalign.app.calibration_files)
+        from gcalign.app.calibration_files import file_data
+
+        data, att, _ = file_data(sc, cfg, t, dth, dv, att, site, earth, float(imu.t[0] - ts),
+                                 imu.att0)
+    else:
+        data = zero_velocity_data(t, dth, dv, NavState.from_euler(att, np.zeros(3), site),
+                                  earth)
+    return Case(data, cfg.settings(site, earth), imu.source, aiding, n, rate, None,
                 None, att, (start, coarse_end, end))
 
 
