@@ -194,3 +194,19 @@ def test_align_errors_against_the_reference(tmp_path):
     path.write_text(yaml.safe_dump(sc))
     assert_bad_run(lambda *a: runner.invoke(app, ["align", *map(str, a)]), tmp_path,
                    [path], "reference:", "covers 0.100 .. 100.000 s", "align.start_s")
+
+
+def test_aiding_paths_are_taken_from_the_scenario_folder(tmp_path, truth, monkeypatch):
+    """align.aiding.path relative to the scenario file, run from another folder; and a
+    batch's absolute paths (gcalign.io.scenario.recording.absolute_paths)."""
+    from gcalign.io.scenario.recording import absolute_paths
+
+    _write(tmp_path / "v.csv", "t,ve,vn,vu", truth.t, truth.v_n.T)
+    sc = small("conventional", "continued")
+    sc["align"]["aiding"] = {"source": "file", "path": "v.csv", "format": "velocity-enu"}
+    (tmp_path / "sc.yaml").write_text(yaml.safe_dump(sc))
+    monkeypatch.chdir(ROOT)
+    res = runner.invoke(app, ["align", str(tmp_path / "sc.yaml"), "-o", str(tmp_path / "a.h5")])
+    assert res.exit_code == 0, res.output
+    absolute_paths(sc, tmp_path)
+    assert sc["align"]["aiding"]["path"] == str(tmp_path / "v.csv")

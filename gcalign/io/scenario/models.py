@@ -199,15 +199,18 @@ class Scenario(Model):
         return out
 
     def resolve_paths(self, folder) -> None:
-        """Relative file paths (imu_file, reference.path, align.aiding.path) taken from
-        `folder` (the scenario file's)."""
+        """Relative file paths (imu_file, reference.path, align.aiding.path,
+        calibrate.files.*.path) taken from `folder` (the scenario file's)."""
         if self.imu_file is not None and not self.imu_file.is_absolute():
             self.imu_file = (Path(folder) / self.imu_file).resolve()
         if self.reference is not None and not self.reference.path.is_absolute():
             self.reference.path = (Path(folder) / self.reference.path).resolve()
-        aiding = self.align.aiding if self.align is not None else None
-        if aiding is not None and aiding.path is not None and not aiding.path.is_absolute():
-            aiding.path = (Path(folder) / aiding.path).resolve()
+        files: list = [self.align.aiding] if self.align is not None else []
+        if self.calibrate is not None and self.calibrate.files is not None:
+            files += [self.calibrate.files.velocity, self.calibrate.files.position]
+        for f in files:  # the aiding files
+            if f is not None and f.path is not None and not f.path.is_absolute():
+                f.path = (Path(folder) / f.path).resolve()
 
     def recording_layout(self):
         """How to read `imu_file` (:class:`gcalign.io.recorded.Layout`)."""
