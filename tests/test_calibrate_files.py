@@ -101,3 +101,15 @@ def test_calibrate_files_refusals(tmp_path):
                                              gnss_noise=True)], "calibrate.gnss_noise")
     assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel}, measure="velocity",
                                              aiding="zero-velocity")], "calibrate.files")
+
+
+def test_validate_shows_the_files(tmp_path):
+    """validate: the files beside calibrate.aiding; the reference (from 0.1 s) is not held
+    to the navigation window of a scenario that only calibrates."""
+    fog = scipy.io.loadmat(MAT)["fogavp"]
+    files = {"velocity": {"path": str(MAT), "format": "psins-mat"},
+             "position": {"path": _gnss_csv(tmp_path / "fog.csv", fog), "format": "csv"}}
+    res = runner.invoke(app, ["validate", _scenario(tmp_path, files)], env={"COLUMNS": "200"})
+    assert res.exit_code == 0, res.output
+    assert "velocity transfer_align_fog_mems.mat (psins-mat); position fog.csv (csv)" in \
+        res.stdout

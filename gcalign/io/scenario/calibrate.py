@@ -312,7 +312,10 @@ class CalibrateConfig(Model):
              f"{self.q.arw_dprh * u.DPSH:.6g} rad/√s, {self.q.vrw_ugrhz * u.UGPSHZ:.6g} m/s/√s"),
             ("calibrate.truth", self.truth, "imu biases, scale factors + initial_error"
              if self.truth == "scenario" else "all 21 errors ~ N(0, P0), the run's seed"),
-            ("calibrate.aiding", self.aiding_for(sc), ""),
+            ("calibrate.aiding", self.aiding_for(sc), "" if self.files is None else "; ".join(
+                f"{k} {f.path.name} ({f.format})" for k, f in (
+                    ("velocity", self.files.velocity), ("position", self.files.position))
+                if f is not None)),
             ("calibrate.feedback", str(self.feedback), "closed loop" if self.feedback
              else "feed-forward"),
             ("calibrate.discretization", self.discretization, ""),
