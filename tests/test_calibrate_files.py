@@ -93,6 +93,11 @@ def test_calibrate_files_refusals(tmp_path):
                    "calibrate.files.position:", "no common time")
     assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel})],
                    "calibrate.files.position:", "measure 'both' needs it")
+    for name, fmt in (("gnss_rtk_kfgins.txt", "i2nav-gnss"), ("rtklib_sample.pos",
+                                                               "rtklib-pos")):
+        real = {"path": str(ROOT / "tests/data" / name), "format": fmt}  # seconds of week
+        assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel, "position": real})],
+                       "calibrate.files.position:", "no common time", "seconds of week")
     near = _gnss_csv(tmp_path / "near.csv", fog)
     assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel, "position": {
         "path": near, "format": "csv", "lever_arm_m": [0, 1.2, 0.8]}})], "lever_arm_m",
