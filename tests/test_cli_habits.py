@@ -388,7 +388,8 @@ def test_a_csv_without_a_site_asks_for_lat_lon_height(tmp_path, lasergyro):
     res = runner.invoke(app, ["navigate", str(csv), "--lat", "34.246048", "--lon",
                               "108.909664", "--height", "380", "-o", str(tmp_path / "n.h5"),
                               "--json"])
-    assert res.exit_code == 2 and "--init: header" in res.stderr  # a CSV has no attitude
+    assert res.exit_code == 2 and "initial: " in res.stderr  # a CSV has no attitude:
+    assert "--reference" in res.stderr and "initial: {att_deg" in res.stderr  # the 3 ways
     al = tmp_path / "al.yaml"
     al.write_text(yaml.safe_dump({"name": "cut", "imu_file": str(csv), "align": {
         "coarse": {"method": "inertial"}, "mode": "conventional", "t1_s": 60, "t2_s": 150,

@@ -245,3 +245,31 @@ def inertial_frame_coarse(dtheta: ArrayLike, dv: ArrayLike, ts: float, lat: floa
     C_in0_n = rotation.quat_to_dcm(rotation.rotvec_to_quat(earth.omega_ie_n(lat) * t[-1]))
     C_nb = C_in0_n.T @ C_in0_ib0 @ rotation.quat_to_dcm(q_ib0_b[-1])
     return rotation.dcm_to_euler(C_nb)
+
+
+def unexplained_velocity(dtheta: ArrayLike, dv: ArrayLike, ts: float, lat: float,
+                         h: float = 0.0, earth: EarthModel = WGS84) -> float:
+    """The largest velocity change (m/s) over a block that a base at rest on the earth
+    cannot produce: how far the specific force integrated in ib0 (steps 1-2 of
+    :func:`inertial_frame_coarse`) stays from gravity's own integral in in0 (step 3) after
+    the best rotation and scale between them (step 4, with a scale so that an accelerometer
+    scale error or a gravity model a few 1e-4 off is not counted).
+
+    A still or swinging base leaves centimetres per second (lasergyro.imu: 0.02 m/s over
+    300 s); a vehicle that speeds up, brakes or turns leaves its velocity changes, less
+    what a tilt can absorb: a constant acceleration is indistinguishable from a tilt, and a
+    constant velocity from rest, by any accelerometer. Gyro drift far beyond ω_ie
+    (hundreds of °/h) also shows here: it mis-rotates gravity.
+    """
+    dtheta, dv, ts, lat = _check_inputs(dtheta, dv, ts, lat, min_samples=2)
+    q_ib0_b = _cumulative_quat(rotation.rotvec_to_quat(dtheta))
+    C_prev = np.concatenate([np.eye(3)[None], rotation.quat_to_dcm(q_ib0_b[:-1])])
+    v_ib0 = np.cumsum(np.einsum("kij,kj->ki", C_prev, dv + 0.5 * np.cross(dtheta, dv)), axis=0)
+    t = ts * np.arange(1, len(dtheta) + 1)
+    v_in0 = _gravity_velocity_in0(t, lat, float(earth.gravity(lat, h)), earth.omega_ie)
+    from scipy.spatial.transform import Rotation
+
+    rot, _ = Rotation.align_vectors(v_in0, v_ib0)
+    fit = rot.apply(v_ib0)
+    scale = float((v_in0 * fit).sum() / (fit * fit).sum())
+    return float(np.linalg.norm(v_in0 - scale * fit, axis=1).max())

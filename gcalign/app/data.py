@@ -157,10 +157,13 @@ def _recorded(scenario: Scenario) -> RunData:
         site = scenario.site.to_si()
     elif imu.site is not None:
         site = np.asarray(imu.site, float)
+    elif scenario.reference is not None:  # where the reference solution starts
+        site = np.asarray(scenario.reference.read().pos[0], float)
     else:
         raise ScenarioError(
             f"site: missing: {scenario.imu_file} does not give the site (a CSV file has no "
-            "header); give --lat/--lon/--height, or a site section in the scenario"
+            "header); give --lat/--lon/--height, a site section in the scenario, or a "
+            "reference (--reference)"
         )
     return RunData(imu=imu, truth=truth, site=site, seed=None, earth=scenario.earth_model)
 

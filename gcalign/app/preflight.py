@@ -41,10 +41,11 @@ def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
                 raise ScenarioError(f"imu_file: {sc.imu_file}: file not found")
             return None
         ext = _recorded_extent(Path(sc.imu_file), sc.recording_layout())
-        if sc.site is None and ext.lat is None:
+        if sc.site is None and ext.lat is None and sc.reference is None:
             raise ScenarioError(
                 f"site: missing: {sc.imu_file} does not give the site (a CSV file has no "
-                "header); give --lat/--lon/--height, or a site section in the scenario")
+                "header); give --lat/--lon/--height, a site section in the scenario, or a "
+                "reference)")
         return ext
     if sc.motion is None:
         return None

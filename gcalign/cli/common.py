@@ -55,6 +55,9 @@ IMU_FILE_HELP = ("Recorded IMU data (PSINS .imu, CSV/text, gcalign HDF5; .gz/.xz
                  "header or --lat/--lon/--height.")
 FORMAT_HELP = ("Layout of the --imu-file (or the scenario's imu_file): psins | psins-mat | "
                "i2nav | csv | auto (from the suffix); see README 'Your own recording'.")
+REFERENCE_HELP = ("Reference solution of the recording (a master INS, a post-processed "
+                  "trajectory): .mat psins-mat avp, .csv csv, else i2nav-nav (KF-GINS); "
+                  "errors against it, and the initial state when the data have none.")
 AXES_HELP = ("Body axes of the recording, the file's x, y, z: three of F/B, R/L, U/D, e.g. "
              "RFU (ours), FRD (KF-GINS), FLU (ROS).")
 
@@ -66,6 +69,7 @@ class Invocation:
     sets: list[str] = field(default_factory=list)
     imu_file: Path | None = None
     imu_layout: dict = field(default_factory=dict)  # --format, --axes
+    reference: Path | None = None  # --reference
     site: dict = field(default_factory=dict)  # lat_deg, lon_deg, height_m given as options
     applied: list[tuple[str, object]] = field(default_factory=list)  # (key, value), in order
     notes: list[str] = field(default_factory=list)  # warnings found while loading
@@ -87,6 +91,7 @@ def recorded_parameters(recorded: bool) -> list[inspect.Parameter]:
             _option("imu_file", Path | None, "FILE", "--imu-file", help=IMU_FILE_HELP),
             _option("imu_format", str | None, "FORMAT", "--format", help=FORMAT_HELP),
             _option("imu_axes", str | None, "AXES", "--axes", help=AXES_HELP),
+            _option("reference", Path | None, "FILE", "--reference", help=REFERENCE_HELP),
             _option("lat", float | None, "DEG", "--lat", help="Site latitude (deg); with "
                     "--lon (and --height) replaces the site of the scenario or of the data "
                     "file's header."),
@@ -110,7 +115,8 @@ def with_common_options(fn: Callable, recorded: bool) -> Callable:
         inv = Invocation(imu_file=given.get("imu_file"),
                          site={k: v for k, v in site.items() if v is not None},
                          imu_layout={k: given[o] for k, o in (("format", "imu_format"),
-                                     ("axes", "imu_axes")) if given.get(o) is not None})
+                                     ("axes", "imu_axes")) if given.get(o) is not None},
+                         reference=given.get("reference"))
         token = _INVOCATION.set(inv)
         try:
             return fn(*args, **kwargs)
@@ -182,6 +188,14 @@ def _apply_recorded(data: dict, inv: Invocation, applied: list) -> None:
 
         data["imu_file"] = with_layout(data.get("imu_file"), inv.imu_layout)
         applied.extend((f"imu_file.{k}", v) for k, v in inv.imu_layout.items())
+    if inv.reference is not None:  # --reference: a reference solution, format from its suffix
+        from gcalign.io.recorded.reference import reference_format_of
+
+        if not Path(inv.reference).is_file():
+            raise ScenarioError(f"--reference: {inv.reference}: file not found")
+        data["reference"] = {"path": str(Path(inv.reference).resolve()),
+                             "format": reference_format_of(inv.reference)}
+        applied.append(("reference", inv.reference))
     if inv.site:
         site = dict(data.get("site") or {}) if isinstance(data.get("site"), dict) else {}
         site.update(inv.site)

@@ -19,7 +19,7 @@ from gcalign.io import results
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario.resolve import resolved_rows
 
-DATA_SUFFIXES = {".imu", ".csv", ".txt"}
+DATA_SUFFIXES = {".imu", ".csv", ".txt", ".mat"}
 COMPRESSED = (".gz", ".xz")
 
 

@@ -195,7 +195,8 @@ def navigate_blocks(blocks: Iterable[ImuBlock], ts: float, start: NavState, *, k
                     vertical: Vertical = HOLD, stride: int = 1,
                     q_bs0: ArrayLike | None = None, t0: float = 0.0,
                     on_rows: Callable[[NavRows], None] | None = None,
-                    progress: Callable[[float, float, str], None] | None = None) -> Navigation:
+                    progress: Callable[[float, float, str], None] | None = None,
+                    truth_height: bool = True) -> Navigation:
     """Navigate from `start` (the state at sample `k_start`, time ``t0 + k_start·ts``) over
     increments k_start .. k_end-1 of the blocks (in order; blocks outside are skipped).
 
@@ -204,7 +205,8 @@ def navigate_blocks(blocks: Iterable[ImuBlock], ts: float, start: NavState, *, k
     the start row) and not kept: what bounds the memory of a long run. `q_bs0` (4,): the
     mechanism angles at the start, when the blocks carry q_bs. `progress(done_s, total_s,
     what)` hears of every block. The reference height of ``hold``/``damped`` is the true
-    height where the blocks carry truth, else the start height.
+    height where the blocks carry truth and `truth_height` is True, else the start height
+    (False: the blocks' "truth" is a reference solution, for the errors only).
     """
     if not (np.isfinite(ts) and ts > 0):
         raise InputError("ts", f"must be a finite interval > 0 s, got {ts}")
@@ -233,6 +235,8 @@ def navigate_blocks(blocks: Iterable[ImuBlock], ts: float, start: NavState, *, k
             continue
         has_truth = b.truth is not None
         truth_rows, h_ref, h_last = _block_truth(b.truth, lo, hi, h_last)
+        if not truth_height:
+            h_ref = None
         c0 = time.perf_counter()
         states = nav.run(b.dtheta[lo:hi], b.dv[lo:hi], h_ref)
         compute += time.perf_counter() - c0

@@ -81,9 +81,10 @@ class Align(Command):
         if ext is None:
             return
         if not ext.has_truth:
-            if cfg.aiding.source != "none":
+            if cfg.aiding.source in ("odometer", "nav"):
                 raise ScenarioError(f"align.aiding.source: {cfg.aiding.source!r} needs a "
-                                    "simulated motion (truth); recorded data supports 'none'")
+                                    "simulated motion (truth); recorded data take 'file' (a "
+                                    "velocity, odometer or reference file) or 'none'")
             if cfg.coarse.method == "given":
                 raise ScenarioError("align.coarse.method: 'given' needs truth; use 'analytic' "
                                     "or 'inertial' for recorded data")

@@ -10,19 +10,21 @@ from gcalign.io.results import ATT_FRAME, PHI_FRAME, put
 GAIN_NAMES = "K_E1, K_E2, K_E3, K_N1, K_N2, K_N3, K_U1, K_U2, K_U3, K_U4"
 
 
-def write_alignment(f: h5py.File, run, stream=None) -> None:
+def write_alignment(f: h5py.File, run, stream=None, error_source: str = "truth") -> None:
     """/align/pass_NN (attitude and error per pass, NN = 01, 02, …), /align/result,
-    /align/gains, and the true attitude at the stored samples under /truth (t, att)."""
+    /align/gains, and the true attitude at the stored samples under /truth (t, att), or
+    the reference's under /reference (`error_source` "reference": recorded data)."""
     if run.pass_truth is not None:
         rows = {}
         for rec, tr in zip(run.passes, run.pass_truth, strict=True):
             for t, a in zip(rec.t, tr, strict=True):
                 rows[float(t)] = a
         t = np.array(sorted(rows))
-        tg = f.create_group("truth")
+        tg = f.create_group(error_source)
         put(tg, "t", t, "s", description="the samples the passes stored (output rate)")
         put(tg, "att", np.array([rows[x] for x in t]), "rad", ATT_FRAME)
     g = f.create_group("align")
+    g.attrs["error_source"] = error_source
     g.attrs["mode"] = run.settings.mode
     g.attrs["azimuth_poles"] = run.azimuth_poles
     g.attrs["t1_s"], g.attrs["t2_s"], g.attrs["t3_s"] = run.t1, run.t2, run.t3

@@ -125,9 +125,9 @@ def align_error_figure(passes: list[PassSeries], title: str = "alignment error")
 
 def align_attitude_figure(passes: list[PassSeries], truth_t: np.ndarray | None = None,
                           truth_att: np.ndarray | None = None,
-                          title: str = "attitude estimate") -> Figure:
-    """Attitude estimate (deg) of every pass and, if known, the truth at the same data
-    times, against equivalent time; one subplot per angle."""
+                          title: str = "attitude estimate", label: str = "truth") -> Figure:
+    """Attitude estimate (deg) of every pass and, if known, the truth (or the reference:
+    `label`) at the same data times, against equivalent time; one subplot per angle."""
     xs, bounds = equivalent_time(passes)
     fig, axes = new_figure(3)
     for j, (ax, name) in enumerate(zip(axes, ANGLES, strict=True)):
@@ -140,7 +140,7 @@ def align_attitude_figure(passes: list[PassSeries], truth_t: np.ndarray | None =
             ty = np.concatenate([np.append(np.interp(p.t, truth_t, ref), np.nan)
                                  for p in passes])
             ax.plot(tx, np.degrees(ty), color="black", linestyle="--", linewidth=1.0,
-                    label="truth")
+                    label=label)
         _mark_boundaries(ax, bounds)
         ax.set_ylabel(f"{name} (deg)")
         ax.grid(True, alpha=0.3)
@@ -179,12 +179,15 @@ def figures(f, name: str) -> dict[str, Figure]:
     passes = read_passes(f)
     mode = _s(f["align"].attrs.get("mode", ""))
     head = f"{name}: {mode}, {len(passes)} pass(es)"
-    has_truth = "truth" in f and any(p.error is not None for p in passes)
+    against = _s(f["align"].attrs.get("error_source", "truth"))
+    has_truth = against in f and any(p.error is not None for p in passes)
     figs["align_attitude"] = align_attitude_figure(
-        passes, truth_t=f["truth/t"][()] if has_truth else None,
-        truth_att=f["truth/att"][()] if has_truth else None,
+        passes, truth_t=f[f"{against}/t"][()] if has_truth else None,
+        truth_att=f[f"{against}/att"][()] if has_truth else None,
         title=f"{head} — attitude estimate" + (
-            " vs truth" if has_truth else " (recorded data: no truth)"))
+            f" vs {against}" if has_truth else " (recorded data: no truth)"), label=against)
     if has_truth:
-        figs["align_error"] = align_error_figure(passes, title=f"{head} — attitude error per pass")
+        figs["align_error"] = align_error_figure(
+            passes, title=f"{head} — attitude error per pass" + (
+                "" if against == "truth" else " (against the reference)"))
     return figs

@@ -80,25 +80,30 @@ def _reference(aiding: Aiding, att, v_n, rng: np.random.Generator, body: bool):
 
 
 def collect(stream: Stream, tl: Timeline, aiding: Aiding,
-            progress: Progress | None = None) -> Window:
+            progress: Progress | None = None, reference=None) -> Window:
     """One pass over the stream for the samples tl.lo .. tl.hi; the rest of the run is
     never held (nor, simulated, generated). `progress(done_s, total_s, what)` hears of
-    every block (the simulation, if it is one, is most of an alignment's time)."""
-    source = aiding.source
+    every block (the simulation, if it is one, is most of an alignment's time). A
+    `reference` (:class:`gcalign.io.recorded.Reference`, recorded data) stands for the
+    truth attitude, for the errors only."""
+    source = aiding.source  # simulated aiding on recorded data is refused by Align.check
     has_truth = stream.truth0 is not None
-    if source != "none" and not has_truth:  # the reference is simulated from the truth
-        raise ScenarioError(
-            f"align.aiding.source: {source!r} needs a simulated motion (truth); "
-            "recorded data supports 'none'"
-        )
     body = source == "odometer"
     rng = np.random.default_rng([0 if stream.seed is None else stream.seed, 1])
     lo, hi, i1 = tl.lo, tl.hi, tl.i1
     m = hi - lo
     dtheta, dv = np.empty((m, 3)), np.empty((m, 3))
     vref = np.zeros((m + 1, 3))
+    if source == "file":  # the file's velocity at the samples lo .. hi
+        from gcalign.io.recorded.aiding import velocity_at
+
+        t_samples = stream.t0 + np.arange(lo, hi + 1) * stream.ts
+        vref, _ = velocity_at(aiding.read(), t_samples, "align.aiding")
+        source = "none"  # nothing more to take from the truth
     truth_att = np.empty((m + 1, 3)) if has_truth else None
     pos_t1 = stream.site.copy()
+    if reference is not None and not has_truth:
+        truth_att = _reference_attitude(reference, stream, lo, hi)
 
     def take(k0: int, att, v_n, pos) -> None:
         """Truth rows of samples k0 .. k0+len-1: reference velocity, attitude, pos at T1."""
@@ -129,6 +134,21 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
         if b.k0 + n >= hi:
             break  # everything needed is in; the rest of the run is never generated
     return Window(dtheta, dv, vref, truth_att, pos_t1)
+
+
+def _reference_attitude(reference, stream: Stream, lo: int, hi: int) -> np.ndarray:
+    """The reference's attitude at samples lo .. hi (slerp); ScenarioError naming
+    align.start_s when it does not cover them."""
+    from gcalign.io.recorded import reference_at
+
+    t = stream.t0 + np.arange(lo, hi + 1) * stream.ts
+    lo_t, hi_t = float(reference.t[0]), float(reference.t[-1])
+    if t[0] < lo_t - 1e-6 * stream.ts or t[-1] > hi_t + 1e-6 * stream.ts:
+        raise ScenarioError(
+            f"reference: {reference.record.get('path', 'the reference')} covers {lo_t:.3f} .. "
+            f"{hi_t:.3f} s, the alignment reads {t[0]:.3f} .. {t[-1]:.3f} s (data time): "
+            "move align.start_s or shorten align.t2_s / t3_s, or remove the reference")
+    return reference_at(reference, t, tol=1e-6)[0]
 
 
 #: The share of the signal an excursion of the base may reach before the analytic coarse
@@ -172,6 +192,21 @@ def still_base_warnings(dtheta: np.ndarray, dv: np.ndarray, ts: float, lat: floa
     return []
 
 
+def _at_rest_warnings(sc: Scenario, stream: Stream, tl: Timeline, data: Window) -> list[str]:
+    """A recording aligned without aiding is taken to stand still over [0, T2]; say so
+    when its reference or its IMU show that it moves (:mod:`gcalign.app.at_rest`)."""
+    from gcalign.app.at_rest import evidence
+
+    k = slice(tl.i0 - tl.lo, tl.i2 - tl.lo)
+    why = evidence(sc, data.dtheta[k], data.dv[k], stream.ts, stream.site, stream.earth,
+                   stream.t0 + tl.i0 * stream.ts, stream.t0 + tl.i2 * stream.ts)
+    if why is None:
+        return []
+    return [f"align.aiding.source: 'none' takes the base to be at rest, but {why}; expect "
+            "a wrong heading and tilt: give the vehicle's velocity (align.aiding: {source: "
+            "file, path, format})"]
+
+
 def _scenario_error(err: InputError) -> ScenarioError:
     """The core's refusal, naming the scenario field it comes from."""
     names = {"site": "site.lat_deg", "coarse": "align.coarse.method", "passes": "align.stages"}
@@ -201,14 +236,17 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
     try:
         settings = settings_of(cfg, kind)
         tl = timeline(settings, ts, stream.samples)
-        data = collect(stream, tl, cfg.aiding, progress)
+        reference = sc.reference.read() if sc.reference is not None else None
+        data = collect(stream, tl, cfg.aiding, progress, reference)
         if settings.coarse == "analytic":
             k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
             warnings += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
                                             stream.earth)
+        if cfg.aiding.source == "none" and stream.truth0 is None:  # recorded: at rest?
+            warnings += _at_rest_warnings(sc, stream, tl, data)
         run = align(data.dtheta, data.dv, ts, stream.site, settings, earth=stream.earth,
                     position_t1=data.pos_t1, vref=data.vref,
-                    vref_body=cfg.aiding.source == "odometer", truth_att=data.truth_att,
+                    vref_body=cfg.aiding.body, truth_att=data.truth_att,
                     t0=stream.t0, stride=stride, first_sample=tl.lo, samples=stream.samples)
     except InputError as err:
         raise _scenario_error(err) from None
@@ -239,6 +277,8 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
         "scenario": name,
         "seed": stream.seed,
         "source": stream.source,
+        "error_source": None if run.truth_t3 is None else (
+            "truth" if stream.truth0 is not None else "reference"),
         "mode": s.mode,
         "compensation": "real time" if realtime else s.compensation,
         "azimuth_poles": run.azimuth_poles,
@@ -290,6 +330,7 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     else:
         stream = scenario_stream(sc, seed)
     run = run_alignment(sc, stream, progress)
-    return Outcome(alignment_summary(run, stream, sc.name),
-                   lambda f: write_alignment(f, run, stream), None, stream.seed, run.warnings,
-                   result=run)
+    summary = alignment_summary(run, stream, sc.name)
+    against = summary["error_source"] or "truth"
+    return Outcome(summary, lambda f: write_alignment(f, run, stream, against), None,
+                   stream.seed, run.warnings, result=run)

@@ -40,6 +40,7 @@ def align_table(s: dict) -> Table:
     for name in ("", "t (s)", "pitch", "roll", "yaw"):
         table.add_column(name, justify="left" if not name else "right")
     has_truth = s.get("truth_t3_deg") is not None
+    against = s.get("error_source") or "truth"  # or "reference" (recorded data)
 
     def row(label, t, values, unit, end=False):
         t_text = t if isinstance(t, str) else number(t, 2)
@@ -49,7 +50,7 @@ def align_table(s: dict) -> Table:
     for when in ("t2", "t3"):
         t = s[f"{when}_s"]
         if has_truth:
-            row(f"truth at T{when[1]} (deg)", t, s[f"truth_{when}_deg"], "deg")
+            row(f"{against} at T{when[1]} (deg)", t, s[f"truth_{when}_deg"], "deg")
         row(f"estimate at T{when[1]} (deg)", t, s[f"attitude_{when}_deg"], "deg",
             end=when == "t3")
 
@@ -88,7 +89,7 @@ def align_table(s: dict) -> Table:
                  "attitude-only strapdown), stage of the loop parameters (align.stages); t: "
                  "alignment time (a reverse pass ends at T1)")
     if has_truth:
-        notes.append("error: estimate − truth as Euler angles (yaw wrapped)"
+        notes.append(f"error: estimate − {against} as Euler angles (yaw wrapped)"
                      + ("" if last is None else
                         f"; last pass, 2nd half: its {last['rows']} stored rows, std ddof 0"))
     else:

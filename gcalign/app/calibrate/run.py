@@ -27,6 +27,7 @@ from gcalign.calibrate import (
     FlightData,
     Settings,
     calibrate,
+    combine_increments,
     draw_truth,
     flight_from_ideal,
     motion_spans,
@@ -148,9 +149,18 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
                                                    earth=earth)
     except ValueError as err:
         raise ScenarioError(f"calibrate.coarse.duration_s: {err}") from None
-    data = parked_data(imu.dtheta[i1:i2], imu.dv[i1:i2], ts, att, site, t0=coarse_end,
-                       subsamples=n, earth=earth)
-    return Case(data, cfg.settings(site, earth), imu.source, "zero-velocity", n, rate, None,
+    aiding = cfg.aiding_for(sc)
+    if aiding == "file":  # measured velocity / position (gcalign.app.calibration_files)
+        from gcalign.app.calibration_files import file_data
+
+        dth, dv = combine_increments(imu.dtheta[i1:i2], imu.dv[i1:i2], n)
+        t = coarse_end + np.arange(len(dth) + 1) * n * ts
+        data, att, _ = file_data(sc, cfg, t, dth, dv, att, site, earth, float(imu.t[0] - ts),
+                                 imu.att0)
+    else:
+        data = parked_data(imu.dtheta[i1:i2], imu.dv[i1:i2], ts, att, site, t0=coarse_end,
+                           subsamples=n, earth=earth)
+    return Case(data, cfg.settings(site, earth), imu.source, aiding, n, rate, None,
                 None, att, (start, coarse_end, end))
 
 
@@ -315,6 +325,8 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     runs = (compare_runs(case, config_of(sc).conventional_segments, progress) if compare
             else [run_filter(case)])
     out = summary(sc, case, runs, compare)
+    from gcalign.app.at_rest import zero_velocity_warnings  # a moving recording under ZUPT
+
     result = tuple(r.result for r in runs) if compare else runs[0].result
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),
-                   case.seed, result=result)
+                   case.seed, tuple(zero_velocity_warnings(sc, case, out)), result=result)

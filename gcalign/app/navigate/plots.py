@@ -1,7 +1,7 @@
-"""Navigation figures: errors against truth (attitude as the misalignment φ, velocity,
-position with the horizontal norm), or, for recorded data, the solution and its drift
-from the start. Time in s, min or h and attitude in deg, ′ or ″ as the run's size needs;
-legends beside the panels."""
+"""Navigation figures: errors against truth or a reference solution, labelled which
+(attitude as the misalignment φ, velocity, position with the horizontal norm), or, for
+recorded data without a reference, the solution and its drift from the start. Time in s,
+min or h and attitude in deg, ′ or ″ as the run's size needs; legends beside the panels."""
 
 from __future__ import annotations
 
@@ -64,8 +64,10 @@ def figures(f, name: str) -> dict:
     if "error" in g:
         e = g["error"]
         phi = e["phi"][()] if "phi" in e else e["att"][()]
+        against = g.attrs.get("error_source", "truth")
+        against = against.decode() if isinstance(against, bytes) else str(against)
         return {"navigate_error": navigate_error_figure(
-            t, phi, e["v_n"][()], e["pos"][()], title=f"{head} — error against truth")}
+            t, phi, e["v_n"][()], e["pos"][()], title=f"{head} — error against {against}")}
     from gcalign.nav.navigate import position_error_enu
 
     pos = g["pos"][()]

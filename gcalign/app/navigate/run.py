@@ -1,29 +1,40 @@
-"""Strapdown navigation of a scenario's data, streamed block by block, with errors against truth.
+"""Strapdown navigation of a scenario's data, streamed block by block, with errors against
+the truth (simulated data) or a reference solution (recorded data with ``reference``).
 
 The data come as a :class:`gcalign.app.data.Stream` (simulated on the fly, or recorded);
-:func:`gcalign.nav.navigate.navigate_blocks` navigates its blocks (errors against the truth
-at every sample, rows decimated to the output rate), and the rows are appended to the
-results file as they come, so memory does not grow with a run's duration.
+:func:`gcalign.nav.navigate.navigate_blocks` navigates its blocks (errors at every sample,
+rows decimated to the output rate), and the rows are appended to the results file as they
+come, so memory does not grow with a run's duration.
 
-Where navigation starts (``--init``): the truth (simulated data), the file header (recorded
-data), or an alignment results file, whose attitude at T3 is taken at T3's data time.
+Where navigation starts (``--init``): the truth (simulated data); on recorded data the keys
+``initial``, else the reference at the start time, else the file's header
+(:func:`gcalign.io.recorded.initial_state`); or an alignment results file, whose attitude
+at T3 is taken at T3's data time.
+
+A reference is used for the errors only: interpolated to every increment's end time
+(attitude on the rotation group), it never enters the navigation (the vertical channel
+holds the start height, not the reference's), so a run with and without it navigates the
+same numbers.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from gcalign.app.data import Stream, scenario_stream
+from gcalign.app.data import DataBlock, Stream, scenario_stream
 from gcalign.app.registry import Outcome
 from gcalign.errors import InputError, ScenarioError
+from gcalign.io.recorded.reference import Reference, initial_state, reference_at
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.navigation import NavigationConfig
-from gcalign.nav.navigate import Navigation, NavRows, navigate_blocks
+from gcalign.nav.navigate import Navigation, NavRows, NavTruth, navigate_blocks
 from gcalign.nav.navigate import position_error_enu as position_error_enu  # its old home
+from gcalign.nav.rotation import attitude_error, misalignment_q
 from gcalign.nav.strapdown import NavState, Vertical
 
 
@@ -34,7 +45,7 @@ class Start:
 
     k: int
     state: NavState
-    source: str  # "truth" | "header" | "alignment FILE"
+    source: str  # "truth" | "header" | "keys ..." | "reference ..." | "alignment FILE"
 
 
 def alignment_start(path: Path, stream: Stream) -> Start:
@@ -69,6 +80,43 @@ def vertical_of(cfg: NavigationConfig, sc: Scenario, motion_kind: str | None = N
     return Vertical(mode, cfg.tau_s)
 
 
+def reference_window(ref: Reference, stream: Stream, k_start: int, k_end: int) -> tuple:
+    """The data times of samples `k_start` and `k_end`; ScenarioError (one line, naming the
+    keys that move them) when the reference does not cover them."""
+    t_a, t_b = stream.t0 + k_start * stream.ts, stream.t0 + k_end * stream.ts
+    lo, hi = float(ref.t[0]), float(ref.t[-1])
+    tol = 1e-6 * stream.ts
+    if t_a < lo - tol or t_b > hi + tol:
+        first = max(lo - stream.t0, 0.0)
+        raise ScenarioError(
+            f"reference: {ref.record.get('path', 'the reference')} covers {lo:.3f} .. {hi:.3f} s"
+            f", navigation needs {t_a:.3f} .. {t_b:.3f} s (data time): start at or after "
+            f"navigation.start_s {math.ceil(first / stream.ts) * stream.ts:.6g} s (--start) "
+            "and end by the reference's last epoch (navigation.duration_s, --duration)")
+    return t_a, t_b
+
+
+def against_reference(blocks: Iterator[DataBlock], ref: Reference, t_a: float, t_b: float
+                      ) -> Iterator[DataBlock]:
+    """The blocks with the reference at their end times as their 'truth' (times outside
+    [t_a, t_b], which the navigation skips, take the nearest end)."""
+    for b in blocks:
+        if b.t[0] > t_b:
+            return
+        att, v, pos = reference_at(ref, np.clip(b.t, t_a, t_b), tol=1e-6)
+        yield replace(b, truth=NavTruth(att, v, pos))  # type: ignore[arg-type]
+
+
+def _start_error(state: NavState, ref: Reference, t: float, earth) -> dict[str, np.ndarray]:
+    """The errors of the start row against the reference at data time `t`."""
+    att, v, pos = (a[0] for a in reference_at(ref, [t], tol=1e-6))
+    tr = NavState.from_euler(att, v, pos)
+    return {"error/att": attitude_error(state.att, att)[None],
+            "error/v_n": (np.asarray(state.v_n) - v)[None],
+            "error/pos": position_error_enu(np.asarray(state.pos)[None], pos[None], earth),
+            "error/phi": misalignment_q(state.q_nb, tr.q_nb)[None]}
+
+
 def _as_dict(rows: NavRows) -> dict[str, np.ndarray]:
     """Stored rows by the names of the results file's series."""
     data = {"t": rows.t, "att": rows.att, "v_n": rows.v_n, "pos": rows.pos}
@@ -80,34 +128,45 @@ def _as_dict(rows: NavRows) -> dict[str, np.ndarray]:
 
 def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
                     duration_s: float | None = None, sink=None, on_rows=None,
-                    progress=None) -> dict:
+                    progress=None, reference: Reference | None = None) -> dict:
     """Navigate from `start` to the end of the data (or for `duration_s`) by
     :func:`gcalign.nav.navigate.navigate_blocks`, write every `stride`-th row to `sink` (an
     h5py group) and hand it to `on_rows` (called with the dict of arrays appended to the
     series, block by block), and return the plain-number pieces of the summary (SI,
     radians) with the core's result under ``result``. `progress(done_s, total_s, what)`,
-    if given, hears of every block (seconds of data navigated)."""
+    if given, hears of every block (seconds of data navigated). With `reference` (recorded
+    data) the errors are against it (see the module docstring)."""
     from gcalign.io.results import ATT_FRAME, PHI_FRAME, Series
 
     ts = stream.ts
     k_end = stream.samples if duration_s is None else min(
         stream.samples, start.k + int(round(duration_s / ts)))
-    has_truth = stream.truth0 is not None
+    blocks = stream.blocks()
+    if reference is not None:
+        t_a, t_b = reference_window(reference, stream, start.k, k_end)
+        blocks = against_reference(blocks, reference, t_a, t_b)
+    has_truth = stream.truth0 is not None or reference is not None
+    against = "reference" if reference is not None else "true"
     series = None
     if sink is not None:
         spec = {"t": (None, "s", None), "att": (3, "rad", ATT_FRAME), "v_n": (3, "m/s", "ENU"),
                 "pos": (3, "rad, rad, m", "[latitude, longitude, height]")}
         if has_truth:
-            spec |= {"error/att": (3, "rad", "Euler differences est - true, roll and yaw "
-                                              "wrapped"),
+            spec |= {"error/att": (3, "rad", f"Euler differences est - {against}, roll and "
+                                              "yaw wrapped"),
                      "error/v_n": (3, "m/s", "ENU"),
                      "error/pos": (3, "m", "ENU (east, north, up)"),
                      "error/phi": (3, "rad", PHI_FRAME)}
         series = Series(sink, spec, stride=stride, rate_hz=1.0 / (stride * ts),
                         vertical=vertical.mode)
-        row0 = {"t": [start.k * ts + stream.t0], "att": [start.state.att],
-                "v_n": [start.state.v_n], "pos": [start.state.pos]}
-        if has_truth:
+        if reference is not None:
+            sink.attrs["error_source"] = "reference"
+        t_start = start.k * ts + stream.t0
+        row0: dict = {"t": [t_start], "att": [start.state.att], "v_n": [start.state.v_n],
+                      "pos": [start.state.pos]}
+        if reference is not None:
+            row0 |= _start_error(start.state, reference, t_start, stream.earth)
+        elif has_truth:
             row0 |= {f"error/{n}": np.zeros((1, 3)) for n in ("att", "v_n", "pos", "phi")}
         series.append(**row0)
 
@@ -119,10 +178,10 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
             on_rows(data)
 
     try:
-        nav = navigate_blocks(stream.blocks(), ts, start.state, k_start=start.k, k_end=k_end,
+        nav = navigate_blocks(blocks, ts, start.state, k_start=start.k, k_end=k_end,
                               earth=stream.earth, vertical=vertical, stride=stride,
                               q_bs0=stream.q_bs_at(start.k), t0=stream.t0, on_rows=rows_out,
-                              progress=progress)
+                              progress=progress, truth_height=reference is None)
     except InputError as err:
         raise ScenarioError(f"navigation: {err.message}") from None
     if series is not None:
@@ -156,6 +215,7 @@ def _run(sc: Scenario, seed: int | None, init: str | Path | None, sink, on_rows,
     """:func:`run_navigation` with the core's result."""
     cfg = sc.navigation or NavigationConfig()
     stream = scenario_stream(sc, seed)
+    ref = sc.reference.read() if sc.reference is not None else None
     kind = None if stream.header is None else stream.header.meta.get("motion_kind")
     vertical = vertical_of(cfg, sc, kind)
     stride = _stride(sc, stream)
@@ -178,19 +238,39 @@ def _run(sc: Scenario, seed: int | None, init: str | Path | None, sink, on_rows,
                                     "or an alignment results file")
             state = NavState.from_euler(tr[0], tr[1], tr[2])
         else:
-            hd = stream.header
-            if hd is None or hd.att0 is None:
-                raise ScenarioError(f"--init: header: {stream.source} gives no initial "
-                                    "attitude; use an alignment results file")
-            if k:
-                raise ScenarioError("navigation.start_s: the file header's state is at the "
-                                    "first sample; start_s must be 0 with --init header")
-            v0 = hd.v0_n if hd.v0_n is not None else np.zeros(3)
-            state = NavState.from_euler(hd.att0, v0, stream.site)
+            state, source = _recorded_start(sc, stream, k, ref, init == "header")
         start = Start(k, state, source)
     part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink, on_rows,
-                           progress)
+                           progress, ref)
     return _summary(sc, stream, start, vertical, stride, part), stream, part["result"]
+
+
+def _recorded_start(sc: Scenario, stream: Stream, k: int, ref: Reference | None,
+                    header_only: bool) -> tuple[NavState, str]:
+    """The state at sample k of recorded data and where it came from: the keys
+    ``initial``, else the reference at that time (its position too), else the file's
+    header (at the first sample only); `header_only` (``--init header``) takes the header."""
+    hd = stream.header
+    header_att = None if hd is None else hd.att0
+    if header_att is not None and k:
+        if header_only or (sc.initial is None and ref is None):
+            raise ScenarioError("navigation.start_s: the file header's state is at the "
+                                "first sample; start_s must be 0 with --init header")
+        header_att = None
+    t = stream.t0 + k * stream.ts
+    keys = {} if header_only or sc.initial is None else {
+        "att_deg": sc.initial.att_deg, "v_enu_mps": sc.initial.v_enu_mps}
+    if ref is not None and not header_only:
+        reference_window(ref, stream, k, k)  # the start inside the reference (one line)
+    att, v, source = initial_state(
+        stream.source, t, reference=None if header_only else ref, header_att=header_att,
+        header_v=None if hd is None else hd.v0_n, **keys)
+    pos = stream.site
+    if ref is not None and not header_only:  # the reference knows where the start is
+        pos = reference_at(ref, [t], tol=1e-6)[2][0]
+        if not source.startswith("reference"):
+            source += f"; position: the reference at {t:g} s"
+    return NavState.from_euler(att, v, pos), source
 
 
 def _stride(sc: Scenario, stream: Stream) -> int:
@@ -212,6 +292,10 @@ def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, str
         "start_s": part["start_s"],
         "duration_s": part["duration_s"],
         "init": start.source,
+        "error_source": None if part["peak"] is None else (
+            "reference" if sc.reference is not None else "truth"),
+        "reference": None if sc.reference is None else {
+            "path": str(sc.reference.path), "format": sc.reference.format},
         "vertical": vertical.mode,
         "vertical_tau_s": vertical.tau if vertical.mode == "damped" else None,
         "mechanism": stream.has_mechanism,

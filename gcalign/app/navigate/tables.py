@@ -1,5 +1,6 @@
-"""The `gcalign navigate` table: final and largest errors against truth, or (recorded data)
-the final state and its drift from the start. One row per quantity and instant, one
+"""The `gcalign navigate` table: final and largest errors against truth or a reference
+solution (labelled so), or (recorded data without one) the final state and its drift from
+the start. One row per quantity and instant, one
 column per component; each quantity's final and largest values share a unit and format."""
 
 from __future__ import annotations
@@ -73,8 +74,14 @@ def navigate_table(s: dict) -> Table:
         notes.append("recorded data, no truth: the displacement from the start is the drift "
                      "if the vehicle stood still")
     else:
-        notes.append("errors: estimate − truth at every sample (attitude as Euler angles, "
-                     "roll and yaw wrapped; φ: C_nb,est C_nb,true^T = exp(−[φ×]))")
+        if s.get("error_source") == "reference":
+            notes.append(f"errors: estimate − reference ({s['reference']['path']}, interpolated "
+                         "to every sample, attitude on the rotation group; it is not truth: "
+                         "its own errors are in these numbers; φ: C_nb,est C_nb,ref^T = "
+                         "exp(−[φ×]))")
+        else:
+            notes.append("errors: estimate − truth at every sample (attitude as Euler angles, "
+                         "roll and yaw wrapped; φ: C_nb,est C_nb,true^T = exp(−[φ×]))")
     notes.append(f"series stored at {s['output_rate_hz']:g} Hz; "
                  + run_line(s, "compute (the strapdown kernel)"))
     table.caption = "\n".join(notes)

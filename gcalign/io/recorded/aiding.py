@@ -36,9 +36,15 @@ from gcalign.io.recorded.imu import _table, _text_lines
 from gcalign.units import DEG
 
 __all__ = ["PositionFixes", "Velocities", "read_gnss", "read_velocity", "read_odometer",
-           "overlap", "GNSS_FORMATS"]
+           "overlap", "GNSS_FORMATS", "VELOCITY_FORMATS", "read_velocity_aiding",
+           "velocity_at"]
 
 GNSS_FORMATS = ("i2nav-gnss", "rtklib-pos", "csv")
+#: Velocity aiding files: a velocity CSV (ENU or NED), an odometer's speed, or the velocity
+#: of a reference solution (:mod:`gcalign.io.recorded.reference`; ``reference-csv`` is its
+#: ``csv``).
+VELOCITY_FORMATS = ("velocity-enu", "velocity-ned", "odometer", "psins-mat", "i2nav-nav",
+                    "reference-csv")
 _GNSS_COLUMNS = ("t", "lat", "lon", "h", "sn", "se", "sd")
 _WEEK_S = 604800.0
 _GPS_EPOCH = datetime(1980, 1, 6, tzinfo=timezone.utc)
@@ -246,3 +252,45 @@ def overlap(t_aid: np.ndarray, t_imu: np.ndarray, name: str, what: str = "aiding
             f"{start:.3f} .. {end:.3f} s: no common time; both must count the same seconds "
             "(GNSS seconds of week, or seconds of the recording)")
     return inside
+
+
+def read_velocity_aiding(path, format: str, columns=None, variable: str | None = None,
+                         axis: str = "F") -> Velocities:
+    """Velocity aiding from `path` in one of :data:`VELOCITY_FORMATS`: ENU m/s in ``v_n``,
+    or an odometer's speed along ``axis_b``."""
+    if format == "velocity-enu" or format == "velocity-ned":
+        return read_velocity(path, format.removeprefix("velocity-"), columns)
+    if format == "odometer":
+        return read_odometer(path, axis, columns)
+    if format not in VELOCITY_FORMATS:
+        raise ScenarioError(f"align.aiding.format: {format!r}; allowed: "
+                            f"{', '.join(VELOCITY_FORMATS)}")
+    from gcalign.io.recorded.reference import read_reference
+
+    ref = read_reference(path, "csv" if format == "reference-csv" else format, variable,
+                         columns)
+    return Velocities(ref.t, v_n=ref.v_n,
+                      record={**ref.record, "format": f"{format} (the reference's velocity)"})
+
+
+def velocity_at(vel: Velocities, t, what: str = "aiding") -> tuple[np.ndarray, bool]:
+    """The aiding velocity at times `t` (M,), linearly interpolated between its epochs:
+    ``(v (M, 3), body)``, ENU m/s, or (``body`` True) the odometer's speed times its body
+    axis. ScenarioError (one line) when the file shares no time with `t`
+    (:func:`overlap`) or does not cover all of it, naming both spans."""
+    t = np.asarray(t, dtype=float)
+    name = vel.record.get("path", "the aiding file")
+    overlap(vel.t, t, name, what)
+    lo, hi = float(vel.t[0]), float(vel.t[-1])
+    tol = 1e-6 * (float(t[1] - t[0]) if len(t) > 1 else 1.0)
+    if t[0] < lo - tol or t[-1] > hi + tol:
+        raise ScenarioError(
+            f"{what}: {name} covers {lo:.3f} .. {hi:.3f} s, the alignment needs "
+            f"{float(t[0]):.3f} .. {float(t[-1]):.3f} s (data time): every sample it aids "
+            "must lie inside the file (move align.start_s, shorten align.t2_s / t3_s)")
+    tq = np.clip(t, lo, hi)
+    if vel.speed is not None:
+        assert vel.axis_b is not None
+        return np.interp(tq, vel.t, vel.speed)[:, None] * vel.axis_b[None, :], True
+    assert vel.v_n is not None
+    return np.column_stack([np.interp(tq, vel.t, vel.v_n[:, i]) for i in range(3)]), False

@@ -34,7 +34,8 @@ from gcalign.io.recorded.imu import _table, _text_lines
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
 from gcalign.units import DEG
 
-__all__ = ["Reference", "read_reference", "reference_at", "initial_state", "REFERENCE_FORMATS"]
+__all__ = ["Reference", "read_reference", "reference_at", "initial_state", "REFERENCE_FORMATS",
+           "reference_format_of"]
 
 REFERENCE_FORMATS = ("psins-mat", "i2nav-nav", "csv")
 _CSV_COLUMNS = ("t", "pitch", "roll", "yaw", "ve", "vn", "vu", "lat", "lon", "h")
@@ -52,6 +53,15 @@ class Reference:
     v_n: np.ndarray
     pos: np.ndarray
     record: dict = field(default_factory=dict)
+
+
+def reference_format_of(path) -> str:
+    """The reference format a file's suffix implies (``--reference FILE``): ``.mat``
+    psins-mat, ``.csv`` csv, anything else (``.nav``, ``.txt``) i2nav-nav."""
+    suffixes = [x.lower() for x in os.path.basename(os.fspath(path)).split(".")[1:]]
+    suffixes = [x for x in suffixes if x not in ("gz", "xz")]
+    last = suffixes[-1] if suffixes else ""
+    return {"mat": "psins-mat", "csv": "csv"}.get(last, "i2nav-nav")
 
 
 def read_reference(path, format: str = "psins-mat", variable: str | None = None,

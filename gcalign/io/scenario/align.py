@@ -15,12 +15,14 @@ count is the sum of the stages' ``passes``. Two kinds of keys that cannot matter
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
 
 from gcalign.align.stages import Stage
+from gcalign.io.recorded.aiding import VELOCITY_FORMATS
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario import transfer as transfer_section
 from gcalign.io.scenario.base import Model, Vec3
@@ -71,9 +73,47 @@ class Coarse(Model):
 
 
 class Aiding(Model):
-    source: Literal["none", "odometer", "nav"] = "none"
+    """The reference velocity of the loops: none (a still or swinging base), simulated from
+    the truth (``odometer``, ``nav``), or read from a ``file`` (``path``, ``format``: a
+    velocity CSV ENU/NED, an odometer's speed, or a reference solution's velocity;
+    :func:`gcalign.io.recorded.aiding.read_velocity_aiding`)."""
+
+    source: Literal["none", "odometer", "nav", "file"] = "none"
     noise_mps: Annotated[float, B.NOISE_MPS] = Field(
         0.0, ge=0, description=f"white noise std of each reference sample, {B.NOISE_MPS.range()}")
+    path: Path | None = Field(None, description="source file: the aiding file")
+    format: Literal[VELOCITY_FORMATS] | None = Field(  # type: ignore[valid-type]
+        None, description=f"source file: one of {', '.join(VELOCITY_FORMATS)}")
+    columns: list[str] | None = None
+    variable: str | None = Field(None, description="psins-mat: the avp array to read")
+    axis: str = Field("F", description="odometer: the body axis of its speed (F, B, R, L, U, D)")
+
+    @model_validator(mode="after")
+    def _file_keys(self):
+        keys = [k for k in ("path", "format", "columns", "variable") if getattr(self, k)
+                is not None]
+        if self.source == "file":
+            missing = [k for k in ("path", "format") if getattr(self, k) is None]
+            if missing:
+                raise ValueError(f"{missing[0]}: missing; source 'file' needs path and format "
+                                 f"({', '.join(VELOCITY_FORMATS)})")
+        elif keys:
+            raise ValueError(f"{keys[0]}: applies to source 'file' only, got source "
+                             f"{self.source!r}")
+        return self
+
+    @property
+    def body(self) -> bool:
+        """The reference velocity is in the body frame (an odometer)."""
+        return self.source == "odometer" or (self.source == "file" and self.format == "odometer")
+
+    def read(self):
+        """The aiding file (:class:`gcalign.io.recorded.aiding.Velocities`)."""
+        from gcalign.io.recorded.aiding import read_velocity_aiding
+
+        assert self.path is not None and self.format is not None
+        return read_velocity_aiding(self.path, self.format, self.columns, self.variable,
+                                    self.axis)
 
 
 class StageModel(Model):
@@ -204,9 +244,10 @@ class AlignConfig(Model):
             elif counts[0] not in (None, 1):
                 out.append(f"align.stages.0.passes: {counts[0]} cannot matter in conventional "
                            "mode (one forward pass)")
-        if self.aiding.source == "none" and "noise_mps" in self.aiding.model_fields_set \
-                and self.aiding.noise_mps:
-            out.append("align.aiding.noise_mps: cannot matter with aiding source 'none'")
+        if self.aiding.source in ("none", "file") and "noise_mps" in \
+                self.aiding.model_fields_set and self.aiding.noise_mps:
+            out.append(f"align.aiding.noise_mps: cannot matter with aiding source "
+                       f"{self.aiding.source!r} (it adds noise to a simulated reference)")
         return out
 
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
@@ -243,7 +284,9 @@ class AlignConfig(Model):
                 "(unused: real-time conventional)" if realtime else "",
             ),
             ("align.azimuth_poles", self.poles_for(kind), ""),
-            ("align.aiding", f"{self.aiding.source}, {self.aiding.noise_mps} m/s", ""),
+            ("align.aiding", f"file {self.aiding.path} ({self.aiding.format})"
+             if self.aiding.source == "file" else
+             f"{self.aiding.source}, {self.aiding.noise_mps} m/s", ""),
             ("align.level_s", f"{self.level_phase_s} s", ""),
         ]
         stages = self.stage_list()

@@ -19,6 +19,7 @@
       initial_error: {attitude_arcsec: [20, -20, 1800]}  # φ ENU; velocity_enu_mps, position_enu_m
       gnss_noise: true           # add DGNSS noise of σ to the simulated measurements
       aiding: auto               # dgnss (simulated truth) | zero-velocity (a parked vehicle)
+                                 # | file (recorded: files: {velocity: {path, format}, position})
       coarse: {method: none}     # none (start from truth + initial_error) | analytic | inertial
       start_s: 0                 # data time at which the calibration (or coarse) window opens
       # duration_s: 400          # default: to the end of the data
@@ -38,10 +39,11 @@ converts them once to the SI :class:`gcalign.calibrate.Settings`.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BeforeValidator, Field
+from pydantic import BeforeValidator, Field, model_validator
 
 from gcalign import units as u
 from gcalign.errors import ScenarioError
@@ -126,6 +128,41 @@ class Coarse(Model):
     duration_s: float = Field(60.0, gt=0, description="coarse window at the start")
 
 
+class VelocityFile(Model):
+    """A measured velocity: a velocity CSV (ENU/NED) or a reference solution's velocity."""
+
+    path: Path
+    format: Literal["velocity-enu", "velocity-ned", "psins-mat", "i2nav-nav",
+                    "reference-csv"]
+    columns: list[str] | None = None
+    variable: str | None = None
+
+
+class PositionFile(Model):
+    """Measured positions: GNSS fixes (KF-GINS text, RTKLIB .pos, CSV)."""
+
+    path: Path
+    format: Literal["i2nav-gnss", "rtklib-pos", "csv"] = "i2nav-gnss"
+    columns: list[str] | None = None
+    lever_arm_m: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], description=(
+        "antenna in body axes (x right, y forward, z up), m; the filter has no lever-arm "
+        "term, so only 0 is accepted: give the positions of the IMU"))
+
+    @model_validator(mode="after")
+    def _no_lever_arm(self):
+        if any(self.lever_arm_m):
+            raise ValueError(f"lever_arm_m: {self.lever_arm_m} cannot be applied (the "
+                             "filter has no lever-arm term); give the IMU's positions and 0")
+        return self
+
+
+class AidingFiles(Model):
+    """``calibrate.files`` (``aiding: file``): what the filter measures on recorded data."""
+
+    velocity: VelocityFile | None = None
+    position: PositionFile | None = None
+
+
 def _divides(rate: float, sub: float) -> int | None:
     """The whole number `rate / sub`, or None."""
     k = rate / sub
@@ -150,7 +187,9 @@ class CalibrateConfig(Model):
     truth: Literal["scenario", "draw"] = "scenario"
     initial_error: InitialError = Field(default_factory=InitialError)
     gnss_noise: bool = True
-    aiding: Literal["auto", "dgnss", "zero-velocity"] = "auto"
+    aiding: Literal["auto", "dgnss", "zero-velocity", "file"] = "auto"
+    files: AidingFiles | None = Field(None, description="aiding file: the measured velocity "
+                                      "and/or position files")
     coarse: Coarse = Field(default_factory=Coarse)
     start_s: float = Field(0.0, ge=0)
     duration_s: float | None = Field(None, gt=0)
@@ -193,10 +232,33 @@ class CalibrateConfig(Model):
 
     def check(self, sc) -> None:
         """Checks that need the rest of the scenario; ScenarioError naming the field."""
+        if (self.aiding == "file") != (self.files is not None):
+            raise ScenarioError("calibrate.files: goes with aiding 'file' (and it needs them); "
+                                f"got aiding {self.aiding!r}"
+                                + ("" if self.files is not None else " without files"))
+        if self.aiding == "file":
+            need = {"velocity": ["velocity"], "position": ["position"],
+                    "both": ["velocity", "position"]}[self.measure]
+            assert self.files is not None
+            for key in need:
+                if getattr(self.files, key) is None:
+                    raise ScenarioError(f"calibrate.files.{key}: missing; measure "
+                                        f"{self.measure!r} needs it")
+            for key in ("velocity", "position"):
+                if key not in need and getattr(self.files, key) is not None:
+                    raise ScenarioError(f"calibrate.files.{key}: cannot matter with measure "
+                                        f"{self.measure!r}; remove it or measure both")
+            if not self.recorded(sc):
+                raise ScenarioError("calibrate.aiding: 'file' measures recorded data "
+                                    "(imu_file); a simulation takes 'dgnss'")
+            if self.gnss_noise:
+                raise ScenarioError("calibrate.gnss_noise: adds simulated noise to measured "
+                                    "files; set it false with aiding 'file'")
         if self.recorded(sc):
             if self.aiding == "dgnss":
                 raise ScenarioError("calibrate.aiding: 'dgnss' compares with the simulated "
-                                    "truth; recorded data support 'zero-velocity' (or auto)")
+                                    "truth; recorded data support 'zero-velocity' or 'file' "
+                                    "(or auto)")
             if self.coarse.method == "none":
                 raise ScenarioError("calibrate.coarse.method: recorded data have no truth to "
                                     "start from; use analytic or inertial, got 'none'")
@@ -250,7 +312,10 @@ class CalibrateConfig(Model):
              f"{self.q.arw_dprh * u.DPSH:.6g} rad/√s, {self.q.vrw_ugrhz * u.UGPSHZ:.6g} m/s/√s"),
             ("calibrate.truth", self.truth, "imu biases, scale factors + initial_error"
              if self.truth == "scenario" else "all 21 errors ~ N(0, P0), the run's seed"),
-            ("calibrate.aiding", self.aiding_for(sc), ""),
+            ("calibrate.aiding", self.aiding_for(sc), "" if self.files is None else "; ".join(
+                f"{k} {f.path.name} ({f.format})" for k, f in (
+                    ("velocity", self.files.velocity), ("position", self.files.position))
+                if f is not None)),
             ("calibrate.feedback", str(self.feedback), "closed loop" if self.feedback
              else "feed-forward"),
             ("calibrate.discretization", self.discretization, ""),

@@ -149,6 +149,12 @@ class Imu(Model):
         return ImuErrors(gyro=self.gyro.to_si(), accel=self.accel.to_si())
 
 
+#: The commands that use the recorded-data keys ``reference`` and ``initial``.
+#: (align and calibrate: the site when the file has none, and whether the base is at rest.)
+USED_BY: dict[str, tuple[str, ...]] = {"reference": ("navigation", "align", "calibrate"),
+                                       "initial": ("navigation",)}
+
+
 class Scenario(Model):
     """A whole scenario file. Either `motion` (simulated data) or `imu_file` (recorded data)."""
 
@@ -193,12 +199,18 @@ class Scenario(Model):
         return out
 
     def resolve_paths(self, folder) -> None:
-        """Relative file paths (imu_file, reference.path) taken from `folder` (the
-        scenario file's)."""
+        """Relative file paths (imu_file, reference.path, align.aiding.path,
+        calibrate.files.*.path) taken from `folder` (the scenario file's)."""
         if self.imu_file is not None and not self.imu_file.is_absolute():
             self.imu_file = (Path(folder) / self.imu_file).resolve()
         if self.reference is not None and not self.reference.path.is_absolute():
             self.reference.path = (Path(folder) / self.reference.path).resolve()
+        files: list = [self.align.aiding] if self.align is not None else []
+        if self.calibrate is not None and self.calibrate.files is not None:
+            files += [self.calibrate.files.velocity, self.calibrate.files.position]
+        for f in files:  # the aiding files
+            if f is not None and f.path is not None and not f.path.is_absolute():
+                f.path = (Path(folder) / f.path).resolve()
 
     def recording_layout(self):
         """How to read `imu_file` (:class:`gcalign.io.recorded.Layout`)."""
@@ -242,7 +254,9 @@ class Scenario(Model):
                 out.append(f"{', '.join(keys)}: cannot matter with recorded data (imu_file): "
                            "the recording carries its own rate and sensor errors")
         for key in ("reference", "initial"):
-            if getattr(self, key) is not None and section is not None:
+            if getattr(self, key) is not None and section is not None \
+                    and section not in USED_BY[key] \
+                    and getattr(self, section, None) is not None:  # a section of the file
                 out.append(f"{key}: read and checked (gcalign validate shows it), but "
                            f"{section} does not use it yet")
         model = getattr(self, section, None) if section else None

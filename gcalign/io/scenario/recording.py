@@ -171,13 +171,21 @@ def recorded_scenario(section: str, imu_file) -> dict:
 
 def absolute_paths(data: Any, folder) -> None:
     """In a scenario mapping (before validation), the relative file paths -- ``imu_file``
-    (a path or its ``path``) and ``reference.path`` -- made absolute from `folder`, in place
-    (batch workers may run elsewhere)."""
+    (a path or its ``path``), ``reference.path``, ``align.aiding.path`` and
+    ``calibrate.files.*.path`` -- made absolute from `folder`, in place (batch workers may
+    run elsewhere)."""
     if not isinstance(data, dict):
         return
-    for key in ("imu_file", "reference"):
-        node = data.get(key)
-        holder, field = (data, key) if isinstance(node, str) else (node, "path")
+    align, calibrate = data.get("align"), data.get("calibrate")
+    files = calibrate.get("files") if isinstance(calibrate, dict) else None
+    nodes = [(data, "imu_file"), (data, "reference"),
+             (align if isinstance(align, dict) else {}, "aiding"),
+             *(((files, k) for k in ("velocity", "position")) if isinstance(files, dict)
+               else ())]
+    for parent, key in nodes:
+        node = parent.get(key)
+        holder, field = (parent, key) if isinstance(node, str) and key != "aiding" else (
+            node, "path")
         if isinstance(holder, dict) and isinstance(holder.get(field), str):
             p = Path(holder[field])
             holder[field] = str(p if p.is_absolute() else (Path(folder) / p).resolve())

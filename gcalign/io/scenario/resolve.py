@@ -134,7 +134,9 @@ def recording_rows(sc: Scenario) -> list[tuple[str, str, str]]:
 def reference_rows(sc: Scenario) -> list[tuple[str, str, str]]:
     """The reference file and initial keys, read and checked: the reference must cover the
     navigation window (``navigation.start_s``, ``duration_s``; the whole recording by
-    default) of the recorded data (ScenarioError naming both spans otherwise)."""
+    default) of the recorded data (ScenarioError naming both spans otherwise) when the
+    scenario navigates: it has a navigation section, or no align or calibrate section
+    (those check their own windows when they run)."""
     from gcalign.io.recorded import read_recording
     from gcalign.io.recorded.reference import reference_at
 
@@ -152,10 +154,15 @@ def reference_rows(sc: Scenario) -> list[tuple[str, str, str]]:
     start = float(imu.t[0] - imu.ts) + (nav.start_s if nav is not None else 0.0)
     end = float(imu.t[-1]) if nav is None or nav.duration_s is None else min(
         float(imu.t[-1]), start + nav.duration_s)
-    reference_at(ref, [start, end])  # refuses a reference that does not cover the run
+    # navigate needs the whole window; align and calibrate check their own windows
+    navigates = nav is not None or (sc.align is None and sc.calibrate is None)
+    if navigates:
+        reference_at(ref, [start, end])  # refuses a reference that does not cover the run
     rows.append(("reference", f"{r['path']} ({r['format']}"
                  + (f", {r['variable']}" if "variable" in r else "") + ")",
                  f"{r['epochs']} epochs at {r['rate_hz']:.4g} Hz, t {r['t_first_s']:.3f} .. "
                  f"{r['t_last_s']:.3f} s ({r['time_origin']})"))
-    rows.append(("reference covers", f"{start:.3f} .. {end:.3f} s", "the navigation window"))
+    if navigates:
+        rows.append(("reference covers", f"{start:.3f} .. {end:.3f} s",
+                     "the navigation window"))
     return rows

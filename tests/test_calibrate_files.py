@@ -1,0 +1,120 @@
+"""Calibration of a recording with measured velocity and position from files
+(``calibrate.aiding: file``): the MEMS vehicle of transfer_align_fog_mems.mat aided by its
+FOG solution (velocity from the MAT file, positions as a GNSS CSV) estimates the MEMS gyro
+biases that PSINS's own transfer-alignment demo found (eb0, stored in the file): a second,
+independent route to the same numbers. One-line refusals of the files' keys."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import scipy.io
+import yaml
+from cli_checks import assert_bad_run
+from typer.testing import CliRunner
+
+from conftest import ROOT
+from gcalign.cli import app
+from gcalign.units import DPH, UG
+
+runner = CliRunner()
+MAT = ROOT / "tests/data/transfer_align_fog_mems.mat"
+#: The filter's prior for a MEMS IMU (the defaults are the seed's navigation grade): biases
+#: up to hundreds of °/h and 10 mg, the scale factors taken as known.
+MEMS_P0 = {"attitude_arcsec": [600, 600, 1800], "velocity_enu_mps": [0.1, 0.1, 0.1],
+           "position_enu_m": [0.5, 0.5, 1], "gyro_bias_dph": [300, 300, 300],
+           "accel_bias_ug": [10000, 10000, 10000], "gyro_scale_ppm": [1, 1, 1],
+           "accel_scale_ppm": [1, 1, 1]}
+
+
+def _gnss_csv(path, fog: np.ndarray, t_shift: float = 0.0) -> str:
+    rows = np.column_stack([fog[:, 9] + t_shift, np.degrees(fog[:, 6]), np.degrees(fog[:, 7]),
+                            fog[:, 8], *np.tile([[0.1], [0.1], [0.2]], len(fog))])
+    path.write_text("t,lat,lon,h,sn,se,sd\n" + "\n".join(
+        ",".join(repr(float(x)) for x in r) for r in rows) + "\n")
+    return str(path)
+
+
+def _scenario(tmp_path, files: dict, **calibrate) -> str:
+    sc = {"name": "mems-files", "imu_file": str(MAT), "reference": {"path": str(MAT)},
+          "calibrate": {"aiding": "file", "files": files, "measure": "both",
+                        "sigma_v_mps": 0.1, "sigma_p_m": 0.5,
+                        "coarse": {"method": "inertial", "duration_s": 1}, "start_s": 0.11,
+                        "gnss_noise": False, "filter_rate_hz": 10, "p0_scale": 1,
+                        "p0": MEMS_P0, "q": {"arw_dprh": 0.5, "vrw_ugrhz": 300}, **calibrate}}
+    path = tmp_path / "cal.yaml"
+    path.write_text(yaml.safe_dump(sc))
+    return str(path)
+
+
+def test_mems_gyro_biases_from_the_fog_solution(tmp_path):
+    """Velocity and position of the FOG solution, the start from it at 1.1 s: the gyro
+    bias estimates lie within 3σ (the filter's own) of the stored eb0 on every axis, the
+    accelerometer biases within 3σ on x and y (z, weakly observable in 100 s, is not
+    asserted), and the NIS is inside its band: the filter's model fits the data."""
+    m = scipy.io.loadmat(MAT)
+    eb0, db0 = m["eb0"].ravel(), m["db0"].ravel()
+    files = {"velocity": {"path": str(MAT), "format": "psins-mat"},
+             "position": {"path": _gnss_csv(tmp_path / "fog.csv", m["fogavp"]),
+                          "format": "csv"}}
+    res = runner.invoke(app, ["calibrate", _scenario(tmp_path, files), "-o",
+                              str(tmp_path / "c.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout.strip().splitlines()[-1])
+    assert s["aiding"] == "file" and not s["warnings"]
+    est = {k: (v["estimate"], v["sigma"]) for k, v in s["states"].items()}
+    eb = np.array([est[k][0] for k in ("ebx", "eby", "ebz")])
+    sb = np.array([est[k][1] for k in ("ebx", "eby", "ebz")])
+    db = np.array([est[k][0] for k in ("dbx", "dby", "dbz")])
+    sd = np.array([est[k][1] for k in ("dbx", "dby", "dbz")])
+    print(f"eb {np.round(eb / DPH, 1).tolist()} ± {np.round(sb / DPH, 1).tolist()} °/h "
+          f"(eb0 {np.round(eb0 / DPH, 1).tolist()}); db {np.round(db / UG).tolist()} ± "
+          f"{np.round(sd / UG).tolist()} µg (db0 {np.round(db0 / UG).tolist()}); "
+          f"NIS {s['nis']['mean']:.3g}")
+    assert (np.abs(eb - eb0) < 3 * sb).all()
+    assert (np.abs(db - db0)[:2] < 3 * sd[:2]).all()
+    # and sharp: σ 2 % of eb0 on the horizontal axes, 20 % on z (the up gyro is seen only
+    # through the heading, weakly in 100 s)
+    assert (sb[:2] < np.abs(eb0[:2]) / 20).all() and sb[2] < np.abs(eb0[2]) / 3
+    lo, hi = s["nis"]["band_95"]
+    assert s["nis"]["mean"] < hi
+
+
+def test_calibrate_files_refusals(tmp_path):
+    fog = scipy.io.loadmat(MAT)["fogavp"]
+    vel = {"path": str(MAT), "format": "psins-mat"}
+
+    def run(*args):
+        return runner.invoke(app, ["calibrate", *map(str, args)])
+
+    far = {"path": _gnss_csv(tmp_path / "far.csv", fog, 5000.0), "format": "csv"}
+    assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel, "position": far})],
+                   "calibrate.files.position:", "no common time")
+    assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel})],
+                   "calibrate.files.position:", "measure 'both' needs it")
+    for name, fmt in (("gnss_rtk_kfgins.txt", "i2nav-gnss"), ("rtklib_sample.pos",
+                                                               "rtklib-pos")):
+        real = {"path": str(ROOT / "tests/data" / name), "format": fmt}  # seconds of week
+        assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel, "position": real})],
+                       "calibrate.files.position:", "no common time", "seconds of week")
+    near = _gnss_csv(tmp_path / "near.csv", fog)
+    assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel, "position": {
+        "path": near, "format": "csv", "lever_arm_m": [0, 1.2, 0.8]}})], "lever_arm_m",
+        "no lever-arm term")
+    assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel}, measure="velocity",
+                                             gnss_noise=True)], "calibrate.gnss_noise")
+    assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel}, measure="velocity",
+                                             aiding="zero-velocity")], "calibrate.files")
+
+
+def test_validate_shows_the_files(tmp_path):
+    """validate: the files beside calibrate.aiding; the reference (from 0.1 s) is not held
+    to the navigation window of a scenario that only calibrates."""
+    fog = scipy.io.loadmat(MAT)["fogavp"]
+    files = {"velocity": {"path": str(MAT), "format": "psins-mat"},
+             "position": {"path": _gnss_csv(tmp_path / "fog.csv", fog), "format": "csv"}}
+    res = runner.invoke(app, ["validate", _scenario(tmp_path, files)], env={"COLUMNS": "200"})
+    assert res.exit_code == 0, res.output
+    assert "velocity transfer_align_fog_mems.mat (psins-mat); position fog.csv (csv)" in \
+        res.stdout
