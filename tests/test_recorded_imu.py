@@ -77,6 +77,19 @@ def test_the_psins_file_alone_aligns_with_the_recorded_data_defaults(psins_yaw):
     assert coarse == pytest.approx(-90.6, abs=1.0)
 
 
+@pytest.mark.slow
+def test_the_psins_file_alone_calibrates_with_the_recorded_data_defaults(tmp_path):
+    """`calibrate --imu-file lasergyro.imu.xz` alone: the recording taken as parked
+    (inertial coarse over 60 s, zero-velocity updates), named after the file; the INS yaw
+    at the end lands on the known −90.6°."""
+    res = runner.invoke(app, ["calibrate", "--imu-file", str(LASERGYRO_XZ), "--json", "-o",
+                              str(tmp_path / "c.h5")])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["scenario"] == "lasergyro"
+    assert s["attitude_deg"][2] == pytest.approx(-90.6, abs=0.03)
+
+
 @pytest.mark.parametrize("case, options", [
     ("i2nav", ["--format", "i2nav", "--axes", "FRD"]),
     ("rates", ["--format", "csv", "--axes", "FRD"]),

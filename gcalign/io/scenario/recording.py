@@ -152,6 +152,10 @@ def with_layout(imu_file: Any, layout: dict) -> dict:
 RECORDED_DEFAULTS: dict[str, dict] = {
     "align": {"coarse": {"method": "inertial"}, "mode": "conventional", "t1_s": 60,
               "t2_s": 300, "t3_s": 300, "stages": [{"t_xy_s": 20, "t_z_s": 100, "xi": 0.707}]},
+    # a recording alone is taken as parked: zero-velocity updates after an inertial-frame
+    # coarse alignment (a driving one is warned about, with the evidence)
+    "calibrate": {"aiding": "zero-velocity", "coarse": {"method": "inertial", "duration_s": 60},
+                  "measure": "velocity", "gnss_noise": False},
 }
 
 
