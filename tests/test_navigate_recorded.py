@@ -141,6 +141,7 @@ def _mems_run(mems, remove_biases: bool, vertical: str):
     return nav.rows, py, ref, C_mu
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("remove_biases", [False, True])
 def test_mems_against_fog_two_routes(mems, remove_biases):
     """MEMS vs FOG, height free: horizontal error at 10, 30, 60, 100 s and the attitude

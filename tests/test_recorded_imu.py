@@ -121,6 +121,7 @@ def test_foreign_layouts_align_as_the_psins_file(case, options, foreign, psins_y
         assert record["time_origin"] == "GNSS seconds of week"
 
 
+@pytest.mark.slow
 def test_i2nav_through_the_installed_command_line(foreign, psins_yaw, tmp_path):
     """The same through `python -m gcalign` (a fresh process, as a user runs it)."""
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
