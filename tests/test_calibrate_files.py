@@ -8,14 +8,17 @@ from __future__ import annotations
 
 import json
 
+import h5py
 import numpy as np
 import scipy.io
 import yaml
 from cli_checks import assert_bad_run
+from scipy.spatial.transform import Rotation, Slerp
 from typer.testing import CliRunner
 
 from conftest import ROOT
 from gcalign.cli import app
+from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
 from gcalign.units import DPH, UG
 
 runner = CliRunner()
@@ -79,6 +82,28 @@ def test_mems_gyro_biases_from_the_fog_solution(tmp_path):
     assert (sb[:2] < np.abs(eb0[:2]) / 20).all() and sb[2] < np.abs(eb0[2]) / 3
     lo, hi = s["nis"]["band_95"]
     assert s["nis"]["mean"] < hi
+    # against the FOG reference at the last epoch it covers, recomputed here from the FOG
+    # array (its two neighbouring epochs, the attitude interpolated by scipy's slerp)
+    e = s["final_error"]
+    assert s["error_source"] == "reference" and "against the reference at" in res.stderr
+    fog = m["fogavp"]
+    rot = Rotation.from_matrix(euler_to_dcm(fog[:, :3]))
+    t = e["t_s"]
+    assert fog[0, 9] <= t <= fog[-1, 9]
+    with h5py.File(tmp_path / "c.h5") as f:  # the INS solution at that epoch
+        g = f["calibrate/runs/00"]
+        k = int(np.argmin(np.abs(g["t"][()] - t)))
+        att, v_n = g["att"][k], g["v_n"][k]
+    ref_att = dcm_to_euler(Slerp(fog[:, 9], rot)([t]).as_matrix())[0]
+    err = (att - ref_att + np.pi) % (2 * np.pi) - np.pi
+    np.testing.assert_allclose(e["attitude_deg"], np.degrees(err), atol=1e-9)
+    ref_v = [np.interp(t, fog[:, 9], fog[:, 3 + i]) for i in range(3)]
+    np.testing.assert_allclose(e["velocity_mps"], v_n - ref_v, atol=1e-9)
+    # the aiding holds the horizontal position and velocity to the FOG's; the attitude
+    # stays within the filter's prior of the FOG's (the mounting mu0, 18′ at most, is not
+    # separated in 100 s)
+    assert np.hypot(*e["position_m"][:2]) < 2.0 and np.hypot(*e["velocity_mps"][:2]) < 0.3
+    assert np.all(np.abs(e["attitude_deg"]) < 0.5)
 
 
 def test_calibrate_files_refusals(tmp_path):

@@ -307,11 +307,35 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
         "compare": compare,
     }
     if compare:
-        out["runs"] = [run_summary(r) for r in runs]
+        out["runs"] = [run_summary(r) | reference_errors(sc, r) for r in runs]
         out["compute_s"] = float(sum(r.compute_s for r in runs))
     else:
-        out |= run_summary(runs[0])
+        out |= run_summary(runs[0]) | reference_errors(sc, runs[0])
     return out
+
+
+def reference_errors(sc: Scenario, run: Run) -> dict:
+    """A recording's INS solution at the filter's last epoch inside the scenario's
+    reference, against it (attitude by slerp, Euler differences with roll and yaw wrapped; velocity;
+    position in m ENU), in the fields navigate gives against truth: ``final_error`` and
+    ``error_source: "reference"``; nothing without a reference or with truth."""
+    r = run.result
+    if sc.reference is None or r.truth is not None:
+        return {}
+    from gcalign.io.recorded.reference import reference_at
+    from gcalign.nav.navigate import position_error_enu
+    from gcalign.nav.rotation import attitude_error
+
+    ref = sc.reference.read()
+    k = int(np.searchsorted(r.t, ref.t[-1] + 1e-9, side="right")) - 1  # last epoch it covers
+    if k < 0 or r.t[k] < ref.t[0]:
+        return {}
+    att, v_n, pos = reference_at(ref, [float(r.t[k])], tol=1e-6)
+    return {"error_source": "reference", "final_error": {
+        "t_s": float(r.t[k]),
+        "attitude_deg": np.degrees(attitude_error(r.att[k], att[0])).tolist(),
+        "velocity_mps": (r.v_n[k] - v_n[0]).tolist(),
+        "position_m": position_error_enu(r.pos[k:k + 1], pos, run.data.earth)[0].tolist()}}
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,

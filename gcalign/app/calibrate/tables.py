@@ -12,6 +12,7 @@ from rich.text import Text
 
 from gcalign.app.calibrate import UNIT_TEXT
 from gcalign.app.report import number, numbers, run_line
+from gcalign.units import angle_text
 
 GROUP_ENDS = ("phiU", "dvU", "dh", "ebz", "dbz", "dKgz", "dKaz")
 SHORT = {"velocity": "v", "position": "p", "both": "v+p"}
@@ -94,6 +95,12 @@ def run_table(s: dict) -> Table:
                      f"filtered → {sm['phiU']['sigma'] * k:.3g}′ smoothed (the sensor errors, "
                      "constants without process noise, gain nothing: their smoothed σ is the "
                      "final filtered σ)")
+    e = s.get("final_error") if s.get("error_source") == "reference" else None
+    if e:
+        a = [angle_text(math.radians(x)) for x in e["attitude_deg"]]
+        notes.append(f"against the reference at {e['t_s']:.2f} s: attitude (pitch, roll, yaw) "
+                     f"{', '.join(a)}; velocity {'  '.join(numbers(e['velocity_mps'], most=3))}"
+                     f" m/s; position {'  '.join(numbers(e['position_m'], most=3))} m ENU")
     notes.append("navigation states at the end: estimate = estimated error of the INS before "
                  "the last correction; error = what the correction leaves; injected at t = 0")
     notes.append(f"truth {s['truth_source'] or 'unknown (recorded data)'}; "
