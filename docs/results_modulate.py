@@ -451,7 +451,7 @@ def error_term_table() -> str:
             r = s["schemes"][n]
             lin = r["linear"]["horizontal_error_m"]
             ol = (max(r["scale_factor_peak_arcsec"]) if "scale" in str(gyro) else
-                  max(abs(x) for x in r["asym_drift_dph"]) * r["cycle_s"] * DPH / ARCSEC
+                  max(abs(x) for x in r["asym_drift_dph"]) * (r["cycle_s"] or 0.0) * DPH / ARCSEC
                   if "asym" in str(gyro) else 0.0)
             rows.append(
                 f"| {label} | `{n}` | {r['horizontal_error_m']['24h']:,.1f} ({lin['24h']:,.1f}) "
