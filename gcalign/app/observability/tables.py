@@ -54,7 +54,7 @@ def observability_table(s: dict) -> Table:
               str(last["rank"]), str(last["tom_rank"]), str(last["rank"]),
               *(_exp(last["degree"][n]) for n in nav))
     b.add_row("all", *(_exp(last["degree"][n]) for n in rest))
-    margins = "  ".join(f"{i + 1}\u00a0{margin(seg.get('rank_margin'))}"  # a pair never split
+    margins = " ".join(f"{i + 1}:{margin(seg.get('rank_margin'))}"  # a pair never split
                         for i, (seg, _) in enumerate(rows))
     outer = Table(
         title=f"gcalign observability: {s['scenario']} — {s['measure']} matching, scaling "
