@@ -346,7 +346,7 @@ def main() -> None:
               + monte_carlo(args.runs, 1 + 2 * args.runs)[2:])
         for title, lines in ((f"Monte Carlo, {args.runs} runs per seed set", mc),
                              ("Per-state NEES", per_state_nees(args.runs)),
-                             ("Vertical channel sweep", vertical_sweep(40))):
+                             ("Vertical channel sweep", vertical_sweep(min(40, args.runs)))):
             print(f"### {title}\n\n" + "\n".join(lines) + "\n")
         return
     data = simulated_case(scenario()).data
