@@ -52,9 +52,11 @@ def _errors_line(e: dict) -> str:
 
 
 def _net_peak_mean(r: dict, term: str) -> str:
-    """A rate term's net over the cycle / peak in it / cycle mean (the standing offset)."""
-    return " / ".join(_triple(r.get(f"{term}_{part}_arcsec"), "{:.2g}")
-                      for part in ("net", "peak", "offset"))
+    """A rate term's net over the cycle / peak in it / cycle mean (the standing offset);
+    one "0" when all three are."""
+    parts = [_triple(r.get(f"{term}_{part}_arcsec"), "{:.2g}") for part in ("net", "peak",
+                                                                            "offset")]
+    return "0" if all(x == "0" for x in parts) else " / ".join(parts)
 
 
 def _ratios(r: dict) -> str:
@@ -62,7 +64,7 @@ def _ratios(r: dict) -> str:
     q = r.get("ratio_to_fixed")
     if not q:
         return "—"
-    return " / ".join("—" if q[k] is None else f"{q[k]:.3g}" for k in ("last_hour", "max", "rms"))
+    return "/".join("—" if q[k] is None else f"{q[k]:.3g}" for k in ("last_hour", "max", "rms"))
 
 
 def _terms_table(rows: list[list[str]]) -> Table:
@@ -70,8 +72,7 @@ def _terms_table(rows: list[list[str]]) -> Table:
     headers wrap instead)."""
     t = Table(title="invariants over one cycle, for these errors", title_justify="left",
               header_style="bold", box=box.SIMPLE_HEAD)
-    heads = ("scheme", "peak ∫C dt (s)", "ε excursion (″)", "δk net / peak / mean (″)",
-             "M net / peak / mean (″)")
+    heads = ("scheme", "peak ∫C dt (s)", "ε excursion (″)", "δk term (″)", "M term (″)")
     for k, col in enumerate(heads):
         t.add_column(col, justify="left" if k == 0 else "right",
                      min_width=max(len(r[k]) for r in rows))
@@ -100,8 +101,7 @@ def modulate_table(s: dict) -> Group:
     pos.add_column(f"lin. {hours[-1]:g} h" if hours else "linear", justify="right")
     ratios = any(s["schemes"][n].get("ratio_to_fixed") for n in s["compare"])
     if ratios:
-        pos.add_column(f"fixed ÷ ({hours[-1]:g} h / max / rms)" if hours else "fixed ÷",
-                       justify="right")
+        pos.add_column("fixed ÷", justify="right", no_wrap=True)
     inv = Table(title="attitude error and invariants", title_justify="left",
                 header_style="bold", box=box.SIMPLE_HEAD)
     inv.add_column("scheme", no_wrap=True, min_width=width)
@@ -133,14 +133,14 @@ def modulate_table(s: dict) -> Group:
     notes = [
         "navigation against truth at each hour (the last: the run's end); max: over every "
         "sample; lin.: the linear error model (static base) for the same errors; fixed ÷: the "
-        "unrotated run's error over this scheme's, at the last hour (one instant of an "
-        "oscillating curve), of the whole-run maxima and of the RMS over the stored rows; "
+        "unrotated run's error over this scheme's: at the last hour (one instant of an "
+        "oscillating curve) / of the whole-run maxima / of the RMS over the stored rows; "
         "φ max: largest misalignment, E N U; "
         "T: cycle; diag C̄: mean of C_s^r over the cycle (* off-diagonal terms too); "
         "invariants, open loop: peak of |∫C e_j dt| per sensor axis, attitude excursion "
-        "from the gyro bias, scale-factor and gyro misalignment M × rate terms (net over the "
-        "cycle / peak in it / cycle mean: the standing attitude offset the navigation sees as "
-        "an initial attitude error, which a net 0 does not cancel), E N U",
+        "from the gyro bias, scale-factor δk and gyro misalignment M × rate terms (net over "
+        "the cycle / peak in it / cycle mean: the standing attitude offset the navigation "
+        "sees as an initial attitude error, which a net 0 does not cancel), E N U",
         _errors_line(s["errors"]),
     ]
     for name in s["compare"]:
