@@ -128,7 +128,7 @@ class HourProbe:
 
     @property
     def rms(self) -> float:
-        return math.sqrt(self._sum_sq / self._n) if self._n else math.nan
+        return math.sqrt(self._sum_sq / self._n)
 
 
 def error_terms(sc: Scenario, entry: Entry) -> ErrorTerms:
