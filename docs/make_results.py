@@ -28,6 +28,8 @@ SECTIONS = (
     "results_calibrate.md",
     "results_realtime.md",
     "results_modulate.md",
+    "results_transfer.md",
+    "results_recorded.md",
 )
 
 

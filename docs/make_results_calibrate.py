@@ -63,14 +63,15 @@ def fmt(v: float) -> str:
 
 def table1(data, scaling: str) -> list[str]:
     tab = observability_table(data.truth, data.segments, "velocity", scaling, covariance=False)
-    out = ["| # | segment | " + " | ".join(NAMES) + " | rank | TOM | rank cum. |",
-           "|---" * (len(NAMES) + 5) + "|"]
+    out = ["| # | segment | " + " | ".join(NAMES) + " | rank | margin | TOM | rank cum. |",
+           "|---" * (len(NAMES) + 6) + "|"]
     for i, seg in enumerate(tab.segments):
         cells = " | ".join(fmt(v) for v in tab.eta[i])
-        out.append(f"| {i + 1} | {seg} | {cells} | {tab.rank[i]} | {tab.tom_rank[i]} | "
-                   f"{tab.rank_cum[i]} |")
+        out.append(f"| {i + 1} | {seg} | {cells} | {tab.rank[i]} | ×{tab.margin[i]:.2g} | "
+                   f"{tab.tom_rank[i]} | {tab.rank_cum[i]} |")
     cells = " | ".join(fmt(v) for v in tab.eta_cum[-1])
-    out.append(f"| | whole run | {cells} | {tab.rank_cum[-1]} | {tab.tom_rank_cum[-1]} | |")
+    out.append(f"| | whole run | {cells} | {tab.rank_cum[-1]} | ×{tab.margin_cum[-1]:.2g} | "
+               f"{tab.tom_rank_cum[-1]} | |")
     res = tab.null_residual
     out.append("")
     out.append(f"eq. 12 residual ‖F N‖/‖F‖ per segment: {res.min():.0e} … {res.max():.0e}; "
@@ -155,19 +156,32 @@ def noise_free() -> list[str]:
     return out
 
 
+PER_STATE: dict[tuple[int, str], np.ndarray] = {}  # (first seed, measure) -> (runs, K+1, 21)
+DRAWS: dict[int, np.ndarray] = {}  # first seed -> (runs, 21) the draws in units of σ(0)
+
+
 def monte_carlo(runs: int, first: int = 1) -> list[str]:
     """Truth from P0 at p0_scale 1 (calibrate.truth: draw), sensor noise and DGNSS noise,
-    seeds first … first + runs − 1, the three measurements on the same data."""
+    seeds first … first + runs − 1, the three measurements on the same data. Keeps every
+    run's (error/σ)² per state for :func:`per_state_nees`."""
     sc = scenario(truth="draw", p0_scale=1)
     out = ["| seeds | measure | ANEES min…max (χ²₂₁ 95 % band) | epochs inside | mean NIS/m | "
            "whitened innovation mean, variance |", "|---|---|---|---|---|---|"]
     store: dict[str, tuple[list, list, list]] = {m: ([], [], []) for m in ie.MEASUREMENTS}
+    draws = []
     for seed in range(first, first + runs):
         case = simulated_case(sc, seed, cache_key="mc")
+        assert case.data.x_true is not None
+        draws.append(case.data.x_true / np.sqrt(np.diag(case.settings.covariances(
+            case.data.start.pos, case.data.earth)[0])))
         for m in ie.MEASUREMENTS:
             r = run_filter(case, m).result
+            assert r.truth is not None
+            PER_STATE.setdefault((first, m), []).append(  # type: ignore[arg-type]
+                ((r.estimate - r.truth) / r.sigma) ** 2)
             for lst, v in zip(store[m], (r.nees, r.nis, r.standardized), strict=True):
                 lst.append(v)
+    DRAWS[first] = np.array(draws)
     for m, (nees, nis, white) in store.items():
         a = np.mean(nees, 0)
         lo, hi = chi2.ppf([0.025, 0.975], 21 * runs) / runs
@@ -176,6 +190,86 @@ def monte_carlo(runs: int, first: int = 1) -> list[str]:
                    f"({lo:.2f}…{hi:.2f}) | "
                    f"{np.mean((a > lo) & (a < hi)):.0%} | {np.mean(nis) / w.shape[1]:.3f} | "
                    f"{np.abs(w.mean(0)).max():.3f}, {w.var(0).min():.3f}…{w.var(0).max():.3f} |")
+    return out
+
+
+STATIC_END_S = 60.0  # the designed flight's static stage
+
+
+def per_state_nees(runs: int, states: tuple[str, ...] = ("dvU", "dh", "dbz", "dKaz", "phiU",
+                                                          "dvE", "ebx")) -> list[str]:
+    """Mean (error/σ)² over the runs of each seed set, per state: at t = 0 (the draws
+    themselves), at the end of the static stage, its range over the flight and at the end,
+    against the χ²_N/N band of N runs; "out" where an epoch leaves the band. Needs
+    :func:`monte_carlo` first. The overall ANEES averages 21 states and can hide one."""
+    lo, hi = chi2.ppf([0.025, 0.975], runs) / runs
+    out = [f"| seeds | measure | state | t = 0 (draws) | after {STATIC_END_S:g} s static | "
+           f"flight min…max | end | epochs outside {lo:.2f}…{hi:.2f} |", "|---" * 8 + "|"]
+    t = np.arange(next(iter(PER_STATE.values()))[0].shape[0], dtype=float)  # 1 Hz epochs
+    k60 = int(np.argmin(np.abs(t - STATIC_END_S)))
+    for (first, m), acc in PER_STATE.items():
+        a = np.mean(acc, 0)
+        z0 = np.mean(DRAWS[first] ** 2, 0)
+        for n in states:
+            i = ie.IDX[n]
+            outside = np.mean((a[:, i] < lo) | (a[:, i] > hi))
+            out.append(f"| {first}…{first + runs - 1} | {m} | {n} | {z0[i]:.2f} | "
+                       f"{a[k60, i]:.2f} | {a[k60:, i].min():.2f}…{a[k60:, i].max():.2f} | "
+                       f"{a[-1, i]:.2f} | {outside:.0%} |")
+    every = np.concatenate([np.asarray(v) for (f, m), v in PER_STATE.items()
+                            if m == "velocity"])
+    a = every.mean(0)
+    lo3, hi3 = chi2.ppf([0.025, 0.975], len(every)) / len(every)
+    bad = [n for n in NAMES if np.mean((a[:, ie.IDX[n]] < lo3) | (a[:, ie.IDX[n]] > hi3)) > 0.5]
+    out += ["", f"velocity, all {len(every)} runs together (band {lo3:.2f}…{hi3:.2f}): dvU "
+            f"{a[k60:, ie.IDX['dvU']].min():.2f}…{a[k60:, ie.IDX['dvU']].max():.2f}, dh "
+            f"{a[k60:, ie.IDX['dh']].min():.2f}…{a[k60:, ie.IDX['dh']].max():.2f} over the "
+            f"flight; states outside the band at most epochs: {', '.join(bad) or 'none'}"]
+    return out
+
+
+def vertical_sweep(runs: int) -> list[str]:
+    """What moves the vertical states' per-state NEES (velocity matching, seeds 1 … runs):
+    the filter's process noise, the DGNSS noise (simulation and filter together), the
+    filter's P0 of δvU and δh against the draw's; the simulation's sensor noise."""
+    from dataclasses import replace
+
+    def scaled_p0(k: float):
+        def f(s: Settings) -> Settings:
+            assert s.p0_sigma is not None
+            p = np.array(s.p0_sigma)
+            p[[ie.IDX["dvU"], ie.IDX["dh"]]] *= k
+            return replace(s, p0_sigma=tuple(p))
+        return f
+
+    variants = [
+        ("as simulated", {}, lambda s: s),
+        ("filter Q × 0.01", {}, lambda s: replace(s, arw=s.arw * 0.01, vrw=s.vrw * 0.01)),
+        ("filter Q × 10", {}, lambda s: replace(s, arw=s.arw * 10, vrw=s.vrw * 10)),
+        ("no sensor noise in the simulation", {"noise": False}, lambda s: s),
+        ("no DGNSS noise (simulation and filter)", {"gnss_noise": False}, lambda s: s),
+        ("filter P0 of δvU, δh × 0.5", {}, scaled_p0(0.5)),
+        ("filter P0 of δvU, δh × 2", {}, scaled_p0(2.0)),
+    ]
+    out = ["| variant | δvU: static end / flight mean / end | δh: static end / flight mean / end "
+           "| δvE end |", "|---|---|---|---|"]
+    for label, kw, change in variants:
+        noise = kw.pop("noise", True)
+        sc = scenario(noise=noise, truth="draw", p0_scale=1, **kw)
+        acc = []
+        for seed in range(1, runs + 1):
+            case = simulated_case(sc, seed, cache_key=f"sweep-{noise}")
+            s = change(replace(case.settings, measure="velocity"))
+            r = calibrate(case.data, s, np.random.default_rng([seed, 3]))
+            assert r.truth is not None
+            acc.append(((r.estimate - r.truth) / r.sigma) ** 2)
+        a = np.mean(acc, 0)
+        k60 = int(np.argmin(np.abs(r.t - STATIC_END_S)))
+        cells = [" / ".join(f"{v:.2f}" for v in (a[k60, i], a[k60:, i].mean(), a[-1, i]))
+                 for i in (ie.IDX["dvU"], ie.IDX["dh"])]
+        out.append(f"| {label} | {cells[0]} | {cells[1]} | {a[-1, ie.IDX['dvE']]:.2f} |")
+    lo, hi = chi2.ppf([0.025, 0.975], runs) / runs
+    out += ["", f"{runs} runs: band {lo:.2f}…{hi:.2f}"]
     return out
 
 
@@ -244,12 +338,23 @@ def f_check() -> list[str]:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=100)
+    ap.add_argument("--only", choices=["nees"], help="only the Monte Carlo, the per-state "
+                    "NEES and the vertical sweep")
     args = ap.parse_args()
+    if args.only == "nees":
+        mc = (monte_carlo(args.runs) + monte_carlo(args.runs, 1 + args.runs)[2:]
+              + monte_carlo(args.runs, 1 + 2 * args.runs)[2:])
+        for title, lines in ((f"Monte Carlo, {args.runs} runs per seed set", mc),
+                             ("Per-state NEES", per_state_nees(args.runs)),
+                             ("Vertical channel sweep", vertical_sweep(min(40, args.runs)))):
+            print(f"### {title}\n\n" + "\n".join(lines) + "\n")
+        return
     data = simulated_case(scenario()).data
     sections = [
-        ("Table 1 analogue, designed flight, velocity matching, unscaled (the paper's η)",
-         table1(data, "none")),
-        ("Table 1 analogue, scaled by the initial σ (--scaling p0)", table1(data, "p0")),
+        ("Table 1 analogue, scaled by the initial σ (the default, --scaling p0)",
+         table1(data, "p0")),
+        ("Table 1 analogue, designed flight, velocity matching, unscaled (the paper's η, "
+         "--scaling none)", table1(data, "none")),
         ("Covariance degree σ(0)/σ(t), velocity (PSINS kfstat)", covariance_degree_table(data)),
         ("Final σ in multiples of the listed value (P0 = 10)", final_sigma_table(data)),
         ("Position vs velocity as the position noise grows (designed)", crossover_table(data)),
@@ -260,6 +365,8 @@ def main() -> None:
         (f"Monte Carlo, designed flight, {args.runs} runs per seed set",
          monte_carlo(args.runs) + monte_carlo(args.runs, 1 + args.runs)[2:]
          + monte_carlo(args.runs, 1 + 2 * args.runs)[2:]),
+        ("Per-state NEES (the Monte Carlo above)", per_state_nees(args.runs)),
+        ("Vertical channel sweep (velocity, 40 runs)", vertical_sweep(40)),
         ("lasergyro.imu: zero-velocity KF vs gyrocompass", lasergyro()),
     ]
     for title, lines in sections:

@@ -53,7 +53,7 @@ def _small(angle: float) -> str:
 def invariant_table() -> str:
     rows = ["| scheme | ref. | period (min) | diag C̄ | residual ε (°/h) | residual ∇ (µg) "
             "| peak ∫C dt (s) | gyro-bias excursion (″) | δk term: net / peak / mean (″) "
-            "| misalignment net (″) | Schuler |",
+            "| misalignment term: net / peak / mean (″) | Schuler |",
             "| --- " * 11 + "|"]
     for name in BUILTIN_NAMES:
         s = builtin_scheme(name)
@@ -65,8 +65,14 @@ def invariant_table() -> str:
                   for j in range(3) if i != j)
         sch = (f"**warn**: {r.harmonics[0].period / 60:.1f} min, ×{r.harmonics[0].attenuation:.3g}"
                if r.schuler_warning else "–")
+        singles = [invariant_report(s, ErrorTerms(gyro_misalignment=MIS * np.eye(3)[:, [i]]
+                                                  @ np.eye(3)[[j], :]))
+                   for i in range(3) for j in range(3) if i != j]
+        mis_peak = max(np.abs(x.misalignment_peak).max() for x in singles)
+        mis_mean = max(np.abs(x.misalignment_offset).max() for x in singles)
         rows.append(
-            f"| `{name}` | {s.reference} | {s.period / 60:.1f} | {diag} "
+            f"| `{name}` | {s.reference} | {'—' if name == 'fixed' else f'{s.period / 60:.1f}'} "
+            f"| {diag} "
             f"| {_vec(r.residual_gyro_bias, DPH, '{:.4f}')} "
             f"| {_vec(r.residual_accel_bias, UG, '{:.1f}')} "
             f"| {_vec(r.peak_integral_C, 1.0, '{:.0f}')} "
@@ -74,7 +80,7 @@ def invariant_table() -> str:
             f"| {_small(np.abs(r.scale_factor_net).max())} / "
             f"{_vec(r.scale_factor_peak, ARCSEC, '{:.2f}')} / "
             f"{_vec(r.scale_factor_offset, ARCSEC, '{:.2f}')} "
-            f"| {_small(mis)} | {sch} |")
+            f"| {_small(mis)} / {mis_peak / ARCSEC:.2f} / {mis_mean / ARCSEC:.2f} | {sch} |")
     return "\n".join(rows)
 
 
@@ -182,11 +188,13 @@ Computed from the schedule itself (`gcalign.modulate.invariant_report`; Gauss–
 the schedule's pieces, exact to round-off). Residual biases for the seed's errors (0.01 °/h
 and 1e-4·g0 on each sensor axis), resolved in the reference frame. Peak ∫C dt: per sensor
 axis, the largest |∫_0^t C e_j dt| in a cycle. Gyro-bias excursion: per reference axis, the
-largest open-loop attitude excursion ∫_0^t (C − C̄) ε dt (for `fixed` the period is
-just the length of its one dwell). δk term for 10 ppm on each axis:
+largest open-loop attitude excursion ∫_0^t (C − C̄) ε dt (`fixed` has no cycle: its
+columns are over one hour). δk term for 10 ppm on each axis:
 net over the cycle / peak within it / cycle mean (the last is a standing attitude offset
-that the navigation loops see like an initial attitude error). Misalignment: the net term
-for a 10″ misalignment, worst single entry. Schuler: the modulation period within ±20 % of
+that the navigation loops see like an initial attitude error). Misalignment: the same
+three for a 10″ misalignment, worst single entry — a net of 0 is not a cancellation: the
+peak (2·10″ for one 180° turn about the rate axis, closed form) and the mean remain, and the
+navigation sees them (the error-term table below). Schuler: the modulation period within ±20 % of
 the Schuler period (84.46 min), with the attenuation ω_s²/|ω_m² − ω_s²| (> 1 amplifies).
 
 {invariants}
@@ -267,7 +275,10 @@ def claim_table(lit72: float, fix72: float, fp72: float, nav72: dict) -> str:
          "net 0 per cycle (ccw and cw halves), peak 2π·δk on each axis (12.96″ at 10 ppm), "
          "cycle mean π·δk·(−1, 1, 1)"),
         ("gyro misalignment × mechanism rate", "not discussed",
-         "net 0 per cycle (each edge is run both ways)"),
+         "net 0 per cycle (each edge is run both ways) but not cancelled: within the cycle it "
+         "tilts the computed attitude, its cycle mean stands like an initial attitude error, "
+         "and a cycle near the Schuler period amplifies it (the navigation's numbers: the "
+         "error-term table below)"),
         ("asymmetric gyro scale factor × mechanism rate", "not discussed",
          "does not cancel: the ccw and cw halves add, 4π·δk·diag(−1, 1, 1) per cycle, a drift "
          "of 0.0069 °/h for 10 ppm (55 km at 72 h); `four-position-12` cancels it"),
@@ -436,9 +447,14 @@ def rate_rows(main: dict) -> str:
 
 
 def error_term_table() -> str:
-    """Scale factor, asymmetric scale factor and lever arm, navigation (linear), 10 Hz."""
+    """Scale factor, asymmetric scale factor, gyro misalignment and lever arm, navigation
+    (linear), 10 Hz. Open-loop term: the peak of the rate term within a cycle (scale factor,
+    misalignment) or the asymmetric term per cycle."""
+    mis = [[0, 10, 10], [10, 0, 10], [10, 10, 0]]  # 10″ in every off-diagonal entry
     cases = [("δk 10 ppm", {"scale_ppm": [10, 10, 10]}, None),
              ("δk_asym 10 ppm", {"asym_ppm": [10, 10, 10]}, None),
+             ("gyro misalignment 10″ (every off-diagonal entry)",
+              {"misalignment_arcsec": mis}, None),
              ("lever arm 5 cm on each axis", {}, [5.0, 5.0, 5.0])]
     names = ["fixed", "seed-12", "four-position-12", "four-position-24", "dual-16-improved"]
     rows = ["| error | scheme | 24 h | 72 h | max | φ max (″) | open-loop term (″) |",
@@ -451,8 +467,9 @@ def error_term_table() -> str:
             r = s["schemes"][n]
             lin = r["linear"]["horizontal_error_m"]
             ol = (max(r["scale_factor_peak_arcsec"]) if "scale" in str(gyro) else
-                  max(abs(x) for x in r["asym_drift_dph"]) * r["cycle_s"] * DPH / ARCSEC
-                  if "asym" in str(gyro) else 0.0)
+                  max(abs(x) for x in r["asym_drift_dph"]) * (r["cycle_s"] or 0.0) * DPH / ARCSEC
+                  if "asym" in str(gyro) else
+                  max(r["misalignment_peak_arcsec"]) if "misalignment" in str(gyro) else 0.0)
             rows.append(
                 f"| {label} | `{n}` | {r['horizontal_error_m']['24h']:,.1f} ({lin['24h']:,.1f}) "
                 f"| {r['horizontal_error_m']['72h']:,.1f} ({lin['72h']:,.1f}) "
@@ -563,8 +580,11 @@ of spec §5: east error peak {a_peak:,.0f} m at {a_time:.1f} min (1272 m at 42.2
 δv_E amplitude {a_v:.3f} m/s (0.789), north error {b_1h:,.0f} m at 1 h (−1353), φ_E
 amplitude {b_phi:.2f}″ (8.1″), east growth {c_n:.1f} m/h from ε_N (542.4) and {c_u:.1f}
 m/h from ε_U (557.4), latitude amplitude {c_amp:,.0f} m (4234), heading {c_head:.2f}′ at
-12 h (6.55′). `four-position-12` ends {gain:.0f}× below the unrotated run at 72 h, and
-with the gyro bias alone its attitude excursion stays at {fp_phi:.1f}″.
+12 h (6.55′). `four-position-12` ends {gain:.0f}× below the unrotated run at 72 h — one
+instant of an oscillating curve (its error swings through tens to hundreds of metres in the
+last hours); over the whole run the maxima are {gain_max:.0f}× apart and the RMS errors
+{gain_rms:.0f}× (`ratio_to_fixed` in the JSON, the table's last column). With the gyro bias
+alone its attitude excursion stays at {fp_phi:.1f}″.
 
 **Rate.** On a static base the increments are exact at any rate and the attitude update
 is exact for a constant navigation-frame rate; what a lower rate changes is the velocity
@@ -582,6 +602,11 @@ or the asymmetric term accumulated over one cycle.
 
 {error_terms}
 
+- A **gyro misalignment** nets to 0 per cycle too, and no scheme cancels it: it enters
+  through every turn's rate, its in-cycle peak and standing mean act like attitude errors,
+  and `four-position-12` ends only a few times below the unrotated run at 72 h, its
+  maximum on the way above the unrotated one; `dual-16-improved`, whose cycle sits next to the Schuler period, multiplies it — the
+  Schuler warning holds for every error the mechanism modulates, not for biases only.
 - The scale factor returns to zero every cycle in open loop (peak 2π·δk = 13″ for
   `seed-12`), but the navigation sees the in-cycle tilts and their standing mean like an
   initial attitude error: the misalignment and the position error are set by the Schuler
@@ -754,7 +779,9 @@ def navigation_section(main: dict, wall: float) -> str:
         d24=100 * abs(lit["24h"] / eq["horizontal_error_m"]["24h"] - 1),
         d72=100 * abs(lit["72h"] / eq["horizontal_error_m"]["72h"] - 1),
         gain=sch["fixed"]["horizontal_error_m"]["72h"]
-        / sch["four-position-12"]["horizontal_error_m"]["72h"], fp_phi=fp_phi)
+        / sch["four-position-12"]["horizontal_error_m"]["72h"], fp_phi=fp_phi,
+        gain_max=sch["four-position-12"]["ratio_to_fixed"]["max"],
+        gain_rms=sch["four-position-12"]["ratio_to_fixed"]["rms"])
     must = must_show(dict(
         values, **invariant_checks(), slope=noise["slope"], bench=BENCHMARK,
         cf_dev=max(100 * abs(cf[k] / v - 1) for k, v in SPEC_CLOSED.items()),

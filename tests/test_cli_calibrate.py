@@ -23,7 +23,7 @@ from typer.testing import CliRunner
 
 from gcalign.cli import app
 from gcalign.estimation import ins_error as ie
-from gcalign.units import DPH, PPM, UG
+from gcalign.units import ARCSEC, DPH, PPM, UG
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()
@@ -70,6 +70,13 @@ def test_builtin_json_contract(builtin):
     assert list(s["units"]) == list(ie.STATE_NAMES) == list(s["states"])
     assert s["units"]["ebx"] == "rad/s" and s["units"]["dbx"] == "m/s^2"
     assert s["units"]["dKgx"] == "1" and s["units"]["dL"] == "rad"
+    # display_scale keyed by state like units and display_units: SI × scale = display unit
+    assert list(s["display_scale"]) == list(s["display_units"]) == list(s["units"])
+    assert s["display_scale"]["ebx"] == pytest.approx(1 / DPH)
+    assert s["display_scale"]["dbx"] == pytest.approx(1 / UG)
+    assert s["display_scale"]["dKgx"] == pytest.approx(1 / PPM)
+    assert s["display_scale"]["phiE"] == pytest.approx(1 / ARCSEC)
+    assert s["display_scale"]["dvU"] == 1.0 and s["display_units"]["dvU"] == "m/s"
     st = s["states"]
     for name in ie.STATE_NAMES:
         assert {"truth", "estimate", "sigma", "sigma0"} <= set(st[name])

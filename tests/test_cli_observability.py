@@ -48,12 +48,13 @@ def test_json_contract(builtin):
     and the cumulative rank ends at 20; η of the measured states is 1 (σ_0 is theirs)."""
     s, _ = builtin
     assert s["states"] == list(ie.STATE_NAMES)
-    assert s["measure"] == "velocity" and s["scaling"] == "none"
+    assert s["measure"] == "velocity" and s["scaling"] == "p0"  # the default
     for key in ("segments", "cumulative"):
         rows = s[key]
         assert len(rows) == 21
         for r in rows:
-            assert {"name", "t0_s", "t1_s", "rank", "degree"} <= set(r)
+            assert {"name", "t0_s", "t1_s", "rank", "rank_margin", "degree"} <= set(r)
+            assert r["rank_margin"] is None or r["rank_margin"] > 1.0
             assert list(r["degree"]) == list(ie.STATE_NAMES)
             assert r["degree"]["dlam"] == 0.0
             assert max(r["degree"]["dvE"], r["degree"]["dvN"]) == pytest.approx(1.0)
@@ -85,16 +86,17 @@ def test_results_file_show_and_heat_maps(builtin, tmp_path):
 @pytest.mark.slow
 def test_position_observes_longitude_and_scaling_changes_degrees(builtin, tmp_path):
     """--measure position: δλ observable (η > 0 once the flight moves), cumulative rank 21;
-    --scaling p0 changes the degrees but not the ranks of velocity matching."""
+    --scaling none (the paper's unscaled table) changes the degrees but not the final rank
+    of velocity matching."""
     res = _obs("--measure", "position", "--json", "-o", tmp_path / "p.h5")
     assert res.exit_code == 0, res.output
     s = json.loads(res.stdout)
     assert s["rank_final"] == 21
     assert all(r["degree"]["dlam"] > 0 for r in s["cumulative"])
-    res = _obs("--scaling", "p0", "--json", "-o", tmp_path / "s.h5")
+    res = _obs("--scaling", "none", "--json", "-o", tmp_path / "s.h5")
     assert res.exit_code == 0, res.output
-    scaled, plain = json.loads(res.stdout), builtin[0]
-    assert scaled["scaling"] == "p0" and scaled["rank_final"] == 20
+    plain, scaled = json.loads(res.stdout), builtin[0]
+    assert plain["scaling"] == "none" and plain["rank_final"] == 20
     assert scaled["degree_final"] != plain["degree_final"]
 
 

@@ -383,3 +383,42 @@ def test_show_and_plot_do_not_load_scipy_or_numba(builtin, tmp_path):
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert json.loads(res.stdout.strip().splitlines()[-1]) == [0, 0, False, False]
+
+
+def test_ramp_corners_are_rows_of_the_headline_table(tmp_path):
+    """A ramp's corner maxima (±corner_ms around the steps in α, excluded from the after
+    columns) appear on their own row under the ramp, with the JSON's numbers, and the
+    corner error exceeds the scored one (a step in α is not quadratic motion)."""
+    ramp = {"name": "accel 20°/s²", "steps": [
+        {"profile": "rest", "duration_s": 1},
+        {"axis": "z", "profile": "ramp", "accel_dps2": 20, "rate_dps": 15,
+         "duration_s": 2}]}
+    res = _run(str(_small(tmp_path, cases=[ramp])), "--json", "-o", str(tmp_path / "r.h5"))
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    c = s["cases"][0]
+    cm = c["corner_max_arcsec"]
+    assert cm["kalman-ls"] > c["after_max_arcsec"]["kalman-ls"]
+    shown = runner.invoke(app, ["show", str(tmp_path / "r.h5")])
+    assert shown.exit_code == 0, shown.output
+    row = next(x for x in shown.output.splitlines() if "corners ±50 ms" in x)
+    assert f"{cm['kalman-ls']:.3f}" in row and f"{cm['taylor']:.3f}" in row
+
+
+def test_beyond_seed_config_runs_a_2hz_swing_and_a_rate_step(tmp_path):
+    """configs/realtime_beyond_seed.yaml, shortened to 2 s per case: the 2 Hz swing before
+    prediction is the closed form 2A·sin(π f T) (1 %), and the rate step's scored maximum
+    holds its transient, above ω·T·(1/2) where the latched attitude lags by ω·T."""
+    d = yaml.safe_load((ROOT / "configs/realtime_beyond_seed.yaml").read_text())
+    d["realtime"]["cases"][0]["steps"][0]["duration_s"] = 2
+    d["realtime"]["cases"][1]["steps"][1]["duration_s"] = 1
+    p = tmp_path / "beyond.yaml"
+    p.write_text(yaml.safe_dump(d, sort_keys=False, allow_unicode=True))
+    res = _run(str(p), "--json", "-o", str(tmp_path / "b.h5"))
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    swing, step = s["cases"]
+    assert swing["motion"] == "swing" and step["motion"] == "rate"
+    assert swing["before_max_arcsec"] == pytest.approx(swing["before_theory_arcsec"], rel=0.01)
+    lag = 15 * 3600 * s["filter_delay_ms"] * 1e-3  # ω·T, ″
+    assert step["after_max_arcsec"]["kalman-ls"] > 0.5 * lag

@@ -261,6 +261,25 @@ def test_degree_definition_on_a_closed_form():
     assert d.rank == 3 and d.eta[2] == pytest.approx(0.05)
 
 
+def test_rank_margin_on_a_closed_form():
+    """The margin is the smaller of σ_rank/cut and cut/σ_rank+1 (cut = rtol·σ_max): on
+    diag(2, 0.5, 1e-14, 0) with rtol 1e-12 the cut is 2e-12, the last kept value 0.5 (×2.5e11
+    above) and the first dropped 1e-14 (×200 below); a full-rank matrix has only the first."""
+    d = ob.degree(np.diag([2.0, 0.5, 1e-14, 0.0]), measured=[0], rtol=1e-12)
+    assert d.margin == pytest.approx(200.0)
+    d = ob.degree(np.diag([2.0, 0.5, 1e-11]), measured=[0], rtol=1e-12)
+    assert d.rank == 3 and d.margin == pytest.approx(1e-11 / 2e-12)
+    d = ob.degree(np.diag([2.0, 0.0]), measured=[0], rtol=1e-12)
+    assert d.margin == pytest.approx(1.0 / 1e-12)
+
+
+def test_table_carries_the_rank_margins(table):
+    """Each segment's and each cumulative rank has its margin (> 1: the rank is above the
+    cut-off and the next value below it)."""
+    assert table.margin.shape == table.rank.shape == table.margin_cum.shape
+    assert np.all(table.margin > 1.0) and np.all(table.margin_cum > 1.0)
+
+
 def test_bad_table_input(flight):
     data = flight
     for kwargs, field in (({"scaling": "sigma"}, "scaling"), ({"rtol": 0.0}, "rtol"),

@@ -34,6 +34,8 @@ class ObservabilityTable:
     null_residual : (S,) the largest ``‖F_j N_j‖/‖F_j‖`` over the segment's pieces
         (N_j = null(O_j)); condition : (S,) whether it is ≤ null_tol.
     eta_cum, rank_cum, tom_rank_cum : the same from the start of the run to each segment end.
+    margin, margin_cum : (S,) the SOM rank's distance from the cut-off, per segment and
+        cumulative (:attr:`gcalign.estimation.observability.Degree.margin`).
     cov_degree : (S, 21) σ_k(0)/σ_k(t_end); cov_degree_segment : σ_k(t_start)/σ_k(t_end);
         None without the covariance run.
     """
@@ -54,6 +56,8 @@ class ObservabilityTable:
     tom_rank_cum: np.ndarray
     cov_degree: np.ndarray | None
     cov_degree_segment: np.ndarray | None
+    margin: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    margin_cum: np.ndarray = field(default_factory=lambda: np.zeros(0))
     names: tuple[str, ...] = field(default=ie.STATE_NAMES)
 
 
@@ -98,7 +102,7 @@ class ObservabilitySettings:
     """Settings of :func:`observability` (see :func:`observability_table` for each)."""
 
     measure: str = "velocity"
-    scaling: str = "none"
+    scaling: str = "p0"  # docs/decisions/013: the unscaled ranks depend on the units
     rtol: float = ob.RANK_RTOL_DEFAULT
     piece_s: float = 1.0
     null_tol: float = 1e-9
@@ -117,7 +121,7 @@ def observability(truth: Trajectory, segments: tuple[Span, ...],
 
 
 def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: str = "velocity",
-                        scaling: str = "none", rtol: float = ob.RANK_RTOL_DEFAULT,
+                        scaling: str = "p0", rtol: float = ob.RANK_RTOL_DEFAULT,
                         piece_s: float = 1.0, null_tol: float = 1e-9,
                         settings: Settings | None = None,
                         covariance: bool = True) -> ObservabilityTable:
@@ -125,7 +129,8 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
 
     measure : "velocity" | "position" | "both"; σ_0 is the largest σ of the directly
         measured states (the non-zero columns of H).
-    scaling : "none" (the paper) or "p0" (columns scaled by the initial σ of `settings`).
+    scaling : "p0" (columns scaled by the initial σ of `settings`: ranks and degrees that do
+        not depend on the units) or "none" (the paper's literal table).
     rtol : relative rank tolerance (singular values ≤ rtol·σ_max are zero).
     null_tol : the null-space condition holds where the residual is at most this.
     settings : filter settings for P0 (scaling p0) and the covariance degree (its measure
@@ -154,7 +159,7 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
     eta, sig = np.zeros((n_seg, ie.N_STATES)), np.zeros((n_seg, ie.N_STATES))
     eta_c = np.zeros((n_seg, ie.N_STATES))
     rank, tom_rank, rank_c, tom_c = (np.zeros(n_seg, int) for _ in range(4))
-    resid = np.zeros(n_seg)
+    resid, margin, margin_c = np.zeros(n_seg), np.zeros(n_seg), np.zeros(n_seg)
     R_cum: np.ndarray | None = None
     R_tom_cum: np.ndarray | None = None
     M_cum = np.eye(ie.N_STATES)
@@ -162,7 +167,7 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
         js = np.flatnonzero(pc.segment == i)
         R_seg = _stack_r(None, ob.som(Rp[js]))
         d = ob.degree(R_seg, measured, scale, rtol)
-        eta[i], sig[i], rank[i] = d.eta, d.sigma_state, d.rank
+        eta[i], sig[i], rank[i], margin[i] = d.eta, d.sigma_state, d.rank, d.margin
         # TOM of the segment alone (from its first piece) and from the start of the run
         M = np.eye(ie.N_STATES)
         rows, rows_cum = [], []
@@ -175,7 +180,7 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
         tom_c[i] = ob.degree(R_tom_cum, measured, scale, rtol).rank
         R_cum = _stack_r(R_cum, R_seg)
         dc = ob.degree(R_cum, measured, scale, rtol)
-        eta_c[i], rank_c[i] = dc.eta, dc.rank
+        eta_c[i], rank_c[i], margin_c[i] = dc.eta, dc.rank, dc.margin
         resid[i] = resid_piece[js].max()
 
     cov = cov_seg = None
@@ -190,4 +195,5 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
         segments=tuple(sp.name for sp in segments), measure=measure, scaling=scaling, rtol=rtol,
         piece_s=piece_s, eta=eta, sigma_state=sig, rank=rank, tom_rank=tom_rank,
         null_residual=resid, condition=resid <= null_tol, eta_cum=eta_c, rank_cum=rank_c,
-        tom_rank_cum=tom_c, cov_degree=cov, cov_degree_segment=cov_seg)
+        tom_rank_cum=tom_c, cov_degree=cov, cov_degree_segment=cov_seg, margin=margin,
+        margin_cum=margin_c)

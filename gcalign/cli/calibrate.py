@@ -53,7 +53,8 @@ def observability(
     scenario: Path | None = typer.Argument(None, help=SCENARIO_HELP),
     measure: str | None = typer.Option(None, "--measure", help=MEASURE_HELP),
     scaling: str | None = typer.Option(
-        None, "--scaling", help="none (the paper: unscaled states) | p0 (columns × initial σ)."),
+        None, "--scaling",
+        help="p0 (default: columns × initial σ, unit-free ranks) | none (the paper: unscaled)."),
     output: Output = None,
     as_json: Json = False,
     set_: Sets = None,

@@ -31,6 +31,7 @@ The covariance-based degree σ_k(0)/σ_k(t) (PSINS ``kfstat``) is the cross-chec
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -143,6 +144,20 @@ class Degree:
     sigma_0: float
     rank: int
     rtol: float
+
+    @property
+    def margin(self) -> float:
+        """How far the rank is from the cut-off ``c = rtol·σ_max``: the smaller of
+        ``σ_rank / c`` (the last singular value kept) and ``c / σ_rank+1`` (the first one
+        dropped); the factor by which the tolerance may change before the rank does (inf
+        for full rank with nothing near the cut-off from below)."""
+        cut = self.rtol * float(self.sigma[0])
+        if cut <= 0:
+            return math.inf
+        above = float(self.sigma[self.rank - 1]) / cut if self.rank > 0 else math.inf
+        below = (cut / float(self.sigma[self.rank])
+                 if self.rank < len(self.sigma) and self.sigma[self.rank] > 0 else math.inf)
+        return min(above, below)
 
 
 def degree(Q: np.ndarray, measured: Iterable[int], scale: ArrayLike | None = None,

@@ -37,7 +37,10 @@ axis lies along ± one reference axis, so each diagonal entry of the mean is a s
 does not hold.
 
 Schuler resonance (spec §3): a bias modulated at ω_m drives the Schuler loop, attenuated
-only by ``ω_s² / |ω_m² − ω_s²|``. We warn when a harmonic k of C(t) with amplitude above
+only by ``ω_s² / |ω_m² − ω_s²|``; so does every other error the mechanism modulates — the
+scale-factor and misalignment × rate terms m(t) repeat with the cycle too, and a net of 0
+per cycle does not keep their harmonics out of the loop, nor their cycle mean (the
+``*_offset`` below) out of the navigation. We warn when a harmonic k of C(t) with amplitude above
 1 % has its period ``T/k`` within ±20 % of the Schuler period (k = 1: the cycle period
 itself; dual-16 with the seed's timing: 83.2 min against 84.46 min).
 
@@ -232,8 +235,10 @@ def invariant_report(scheme: Scheme | Schedule, errors: ErrorTerms | None = None
     harmonics = schuler_harmonics(schedule, omega_s)
     warnings = tuple(
         f"modulation period {h.period / 60:.1f} min (cycle/{h.k}) is within ±20 % of the "
-        f"Schuler period {2 * math.pi / omega_s / 60:.2f} min: a modulated bias is "
-        f"attenuated only ×{h.attenuation:.3g} (amplitude {h.amplitude:.3g} per unit bias)"
+        f"Schuler period {2 * math.pi / omega_s / 60:.2f} min: every error the mechanism "
+        f"modulates (biases, and the scale-factor and misalignment × rate terms, which "
+        f"repeat with the cycle) is attenuated only ×{h.attenuation:.3g} (bias amplitude "
+        f"{h.amplitude:.3g} per unit bias)"
         for h in harmonics if h.amplitude > HARMONIC_FLOOR)
     return InvariantReport(
         scheme=name, reference=reference, period=T, integral_C=integral_C, mean_C=mean_C,

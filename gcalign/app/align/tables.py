@@ -80,8 +80,9 @@ def align_table(s: dict) -> Table:
             row(_pass_label(p), p["t_end_s"], p["attitude_deg"], "deg")
 
     notes = [
-        f"T1 = {s['t1_s']:g} s; data used {s['data_used_s']:.1f} s, equivalent length "
-        f"{s['equivalent_s']:.1f} s (passes laid end to end)"
+        f"window T1–T2 = {s['t1_s']:g}–{s['t2_s']:g} s ({s['t2_s'] - s['t1_s']:g} s, each "
+        f"pass over it; the coarse alignment before T1); data used {s['data_used_s']:.1f} s, "
+        f"equivalent length {s['equivalent_s']:.1f} s (passes laid end to end)"
         + ("" if s.get("t3_source") != "measured" else
            f"; T3 measured: T2 + the passes' compute time = {s['t3_s']:.2f} s"),
     ]

@@ -299,8 +299,9 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
         "site_deg_m": [*np.degrees(d.start.pos[:2]).tolist(), float(d.start.pos[2])],
         "earth": d.earth.name,
         "units": dict(zip(ie.STATE_NAMES, ie.STATE_UNITS, strict=True)),
-        "display_scale": ie.display_scale(float(d.start.pos[0]), float(d.start.pos[2]),
-                                          d.earth).tolist(),
+        "display_scale": dict(zip(ie.STATE_NAMES,
+                                  ie.display_scale(float(d.start.pos[0]), float(d.start.pos[2]),
+                                                   d.earth).tolist(), strict=True)),
         "display_units": dict(zip(ie.STATE_NAMES, ie.DISPLAY_UNITS, strict=True)),
         "coarse_attitude_deg": None if case.coarse_att is None
         else np.degrees(case.coarse_att).tolist(),

@@ -28,9 +28,7 @@ def _g(x, unit: str) -> str:
 
 
 def _display(s: dict):
-    names = list(s["units"])
-    scale = dict(zip(names, s["display_scale"], strict=True))
-    return names, scale, s["display_units"]
+    return list(s["units"]), s["display_scale"], s["display_units"]
 
 
 def _captioned(table: Table, notes: list[str]) -> Table:

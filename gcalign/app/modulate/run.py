@@ -45,7 +45,9 @@ def hour_key(h: float) -> str:
 
 
 def report_hours(hours: float) -> list[float]:
-    return [h for h in REPORT_HOURS if h <= hours + 1e-9]
+    """The report hours within a run of `hours` h, and the run's last hour always."""
+    within = [h for h in REPORT_HOURS if h <= hours + 1e-9]
+    return within if within and abs(within[-1] - hours) <= 1e-9 else within + [hours]
 
 
 def seed_scenario(compare: Iterable[str], *, rate: float = 10.0,
@@ -106,19 +108,27 @@ def _stride_checked(v: Scenario, hours: list[float]) -> int:
 
 class HourProbe:
     """Collects, from the stored rows as they stream by, the horizontal position error at the
-    report hours (m)."""
+    report hours (m) and its RMS over the stored rows (m)."""
 
     def __init__(self, hours: list[float]):
         self.t = np.array([h * HOUR for h in hours])
         self.keys = [hour_key(h) for h in hours]
         self.value: dict[str, float] = {}
+        self._sum_sq, self._n = 0.0, 1  # the start row (zero error) is a stored row too
 
     def __call__(self, rows: dict) -> None:
         t, pos = rows["t"], rows["error/pos"]
+        horizontal = np.hypot(pos[:, 0], pos[:, 1])
+        self._sum_sq += float(np.sum(horizontal**2))
+        self._n += len(horizontal)
         k = np.searchsorted(t, self.t - 1e-6)
         for key, tk, i in zip(self.keys, self.t, k, strict=True):
             if i < len(t) and abs(t[i] - tk) < 1e-6:
-                self.value[key] = float(np.hypot(pos[i, 0], pos[i, 1]))
+                self.value[key] = float(horizontal[i])
+
+    @property
+    def rms(self) -> float:
+        return math.sqrt(self._sum_sq / self._n)
 
 
 def error_terms(sc: Scenario, entry: Entry) -> ErrorTerms:
@@ -137,10 +147,11 @@ def _clean(v: np.ndarray, scale: float) -> np.ndarray:
     return np.where(np.abs(v) <= 1e-12 * scale, 0.0, v)
 
 
-def invariants_summary(r: InvariantReport) -> dict:
+def invariants_summary(r: InvariantReport, rotated: bool = True) -> dict:
+    """The invariants in user units; an unrotated scheme has no cycle (``cycle_s`` None)."""
     e = r.errors
     return {
-        "cycle_s": r.period,
+        "cycle_s": r.period if rotated else None,
         "cycle_mean": _clean(r.mean_C, 1.0).tolist(),
         "residual_gyro_bias_dph": (_clean(r.residual_gyro_bias, np.abs(e.gyro_bias).sum())
                                    / DPH).tolist(),
@@ -152,15 +163,25 @@ def invariants_summary(r: InvariantReport) -> dict:
         "scale_factor_peak_arcsec": _arcsec(r.scale_factor_peak),
         "scale_factor_offset_arcsec": _arcsec(r.scale_factor_offset),
         "misalignment_net_arcsec": _arcsec(r.misalignment_net),
+        "misalignment_peak_arcsec": _arcsec(r.misalignment_peak),
+        "misalignment_offset_arcsec": _arcsec(r.misalignment_offset),
         "asym_drift_dph": (r.asym_net / r.period / DPH).tolist(),
         "schuler_period_s": r.schuler_period,
         "schuler_warnings": list(r.warnings),
     }
 
 
+def _linear_at(lin: LinearErrors, h: float) -> float | None:
+    """The linear model's horizontal error at `h` hours, None if that is not an output time."""
+    try:
+        return float(lin.at(h)[0])
+    except ValueError:
+        return None
+
+
 def linear_summary(lin: LinearErrors, hours: list[float]) -> dict:
     return {
-        "horizontal_error_m": {hour_key(h): float(lin.at(h)[0]) for h in hours},
+        "horizontal_error_m": {hour_key(h): _linear_at(lin, h) for h in hours},
         "max_horizontal_error_m": float(lin.horizontal.max()),
         "final_horizontal_error_m": float(lin.horizontal[-1]),
         "max_misalignment_arcsec": _arcsec(np.abs(lin.phi).max(0)),
@@ -177,7 +198,7 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group: 
 
     hours = report_hours(plan.hours)
     v = variant(sc, entry, plan)
-    _stride_checked(v, hours)
+    _stride_checked(v, [h for h in hours if h in REPORT_HOURS])  # the last: its final row
     probe = HourProbe(hours)
     nav, stream = run_navigation(v, seed, None, group, on_rows=probe)
     terms = error_terms(sc, entry)
@@ -189,15 +210,17 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group: 
                               duration=plan.duration_s, name=entry.name)
     report, lin = analysis.invariants, analysis.linear
     me, fe = nav["max_error"], nav["final_error"]
+    final = float(math.hypot(*fe["position_m"][:2]))  # the last hour if off the stored grid
     s = entry.scheme
     out = {
         "description": s.description,
         "reference": s.reference,
         "mechanism": entry.mechanism is not None,
-        **invariants_summary(report),
-        "horizontal_error_m": {k: probe.value[k] for k in probe.keys},
+        **invariants_summary(report, rotated=entry.mechanism is not None),
+        "horizontal_error_m": {k: probe.value.get(k, final) for k in probe.keys},
         "max_horizontal_error_m": nav["max_horizontal_error_m"],
-        "final_horizontal_error_m": float(math.hypot(*fe["position_m"][:2])),
+        "final_horizontal_error_m": final,
+        "rms_horizontal_error_m": probe.rms,
         "max_misalignment_arcsec": [3600.0 * x for x in me["misalignment_deg"]],
         "max_attitude_error_arcsec": [3600.0 * x for x in me["attitude_deg"]],
         "final_misalignment_arcsec": [3600.0 * x for x in fe["misalignment_deg"]],
@@ -208,6 +231,23 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group: 
     if group is not None:
         write_scheme(group, entry, analysis, stream.ts)
     return out, analysis
+
+
+def ratios_to_fixed(schemes: dict[str, dict], last: str) -> None:
+    """Beside each rotated scheme, how many times smaller its horizontal error is than the
+    unrotated run's (``fixed`` in the comparison): at the last report hour (one instant of an
+    oscillating curve), of the whole-run maxima and of the RMS over the stored rows."""
+    ref = schemes.get("fixed")
+    for name, r in schemes.items():
+        if ref is None or name == "fixed":
+            r["ratio_to_fixed"] = None
+            continue
+        pairs = {"last_hour": (ref["horizontal_error_m"].get(last),
+                               r["horizontal_error_m"].get(last)),
+                 "max": (ref["max_horizontal_error_m"], r["max_horizontal_error_m"]),
+                 "rms": (ref["rms_horizontal_error_m"], r["rms_horizontal_error_m"])}
+        r["ratio_to_fixed"] = {k: (a / b if a is not None and b else None)
+                               for k, (a, b) in pairs.items()}
 
 
 def errors_summary(sc: Scenario, lever_cm: Any) -> dict:
@@ -251,6 +291,7 @@ def run_modulate(sc: Scenario, seed: int | None = None, sink: Any = None,
     lever = next((e.mechanism.lever_arm_cm for e in plan.entries
                   if e.mechanism is not None and e.mechanism.lever_arm_cm is not None), None)
     names = [e.name for e in plan.entries]
+    ratios_to_fixed(schemes, hour_key(report_hours(plan.hours)[-1]))
     if root is not None:
         root.attrs["compare"] = names
         root.attrs["hours"] = plan.hours

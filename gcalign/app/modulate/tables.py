@@ -51,13 +51,28 @@ def _errors_line(e: dict) -> str:
     return "sensor errors (sensor frame): " + ("; ".join(parts) or "none")
 
 
+def _net_peak_mean(r: dict, term: str) -> str:
+    """A rate term's net over the cycle / peak in it / cycle mean (the standing offset);
+    one "0" when all three are."""
+    parts = [_triple(r.get(f"{term}_{part}_arcsec"), "{:.2g}") for part in ("net", "peak",
+                                                                            "offset")]
+    return "0" if all(x == "0" for x in parts) else " / ".join(parts)
+
+
+def _ratios(r: dict) -> str:
+    """The ratios to the unrotated run: last hour / whole-run maxima / RMS."""
+    q = r.get("ratio_to_fixed")
+    if not q:
+        return "—"
+    return "/".join("—" if q[k] is None else f"{q[k]:.3g}" for k in ("last_hour", "max", "rms"))
+
+
 def _terms_table(rows: list[list[str]]) -> Table:
     """The invariant terms per scheme; each column at least as wide as its numbers (the
     headers wrap instead)."""
     t = Table(title="invariants over one cycle, for these errors", title_justify="left",
               header_style="bold", box=box.SIMPLE_HEAD)
-    heads = ("scheme", "peak ∫C dt (s)", "ε excursion (″)", "δk net / peak (″)",
-             "M net (″)")
+    heads = ("scheme", "peak ∫C dt (s)", "ε excursion (″)", "δk term (″)", "M term (″)")
     for k, col in enumerate(heads):
         t.add_column(col, justify="left" if k == 0 else "right",
                      min_width=max(len(r[k]) for r in rows))
@@ -84,6 +99,9 @@ def modulate_table(s: dict) -> Group:
         pos.add_column(f"{h:g} h", justify="right")
     pos.add_column("max", justify="right")
     pos.add_column(f"lin. {hours[-1]:g} h" if hours else "linear", justify="right")
+    ratios = any(s["schemes"][n].get("ratio_to_fixed") for n in s["compare"])
+    if ratios:
+        pos.add_column("fixed ÷", justify="right", no_wrap=True)
     inv = Table(title="attitude error and invariants", title_justify="left",
                 header_style="bold", box=box.SIMPLE_HEAD)
     inv.add_column("scheme", no_wrap=True, min_width=width)
@@ -98,11 +116,12 @@ def modulate_table(s: dict) -> Group:
                                           lin["final_horizontal_error_m"])
         pos.add_row(*map(Text, [name] + [metres(r["horizontal_error_m"].get(f"{h:g}h"))
                                          for h in hours]
-                         + [metres(r["max_horizontal_error_m"]), metres(lin_v)]))
+                         + [metres(r["max_horizontal_error_m"]), metres(lin_v)]
+                         + ([_ratios(r)] if ratios else [])))
         inv.add_row(*map(Text, [
             name, {"navigation": "nav"}.get(r["reference"], r["reference"])
             if r["mechanism"] else "—",
-            f"{r['cycle_s'] / 60:.1f}" if r["mechanism"] else "—", _diag(r["cycle_mean"]),
+            "—" if r["cycle_s"] is None else f"{r['cycle_s'] / 60:.1f}", _diag(r["cycle_mean"]),
             " ".join(f"{x:.0f}" if x >= 10 else f"{x:.2g}"
                      for x in r["max_misalignment_arcsec"]),
             "warn" if r["schuler_warnings"] else "–"]))
@@ -110,16 +129,18 @@ def modulate_table(s: dict) -> Group:
             term_rows.append([
                 name, _triple(r.get("peak_integral_C_s"), "{:.0f}"),
                 _triple(r["gyro_bias_excursion_arcsec"], "{:.2g}"),
-                f"{_triple(r['scale_factor_net_arcsec'], '{:.2g}')} / "
-                f"{_triple(r['scale_factor_peak_arcsec'], '{:.2g}')}",
-                _triple(r["misalignment_net_arcsec"], "{:.2g}")])
+                _net_peak_mean(r, "scale_factor"), _net_peak_mean(r, "misalignment")])
     notes = [
-        "navigation against truth at each hour; max: over every sample; lin.: the linear "
-        "error model (static base) for the same errors; φ max: largest misalignment, E N U; "
+        "navigation against truth at each hour (the last: the run's end); max: over every "
+        "sample; lin.: the linear error model (static base) for the same errors; fixed ÷: the "
+        "unrotated run's error over this scheme's: at the last hour (one instant of an "
+        "oscillating curve) / of the whole-run maxima / of the RMS over the stored rows; "
+        "φ max: largest misalignment, E N U; "
         "T: cycle; diag C̄: mean of C_s^r over the cycle (* off-diagonal terms too); "
         "invariants, open loop: peak of |∫C e_j dt| per sensor axis, attitude excursion "
-        "from the gyro bias, scale-factor term (net over the cycle / peak in it) and gyro "
-        "misalignment M × rate term (net), E N U",
+        "from the gyro bias, scale-factor δk and gyro misalignment M × rate terms (net over "
+        "the cycle / peak in it / cycle mean: the standing attitude offset the navigation "
+        "sees as an initial attitude error, which a net 0 does not cancel), E N U",
         _errors_line(s["errors"]),
     ]
     for name in s["compare"]:

@@ -2,8 +2,10 @@
 
 The truth and ideal increments of the motion (once per batch variant), at the calibration's
 navigation rate; each manoeuvre cut into PWCS pieces; per segment and cumulative SOM
-degrees η = σ_(k)/σ_0 (states unscaled by default, as the paper), ranks, TOM ranks, the
-null-space condition of seed eq. (12), and the covariance degree σ(0)/σ(t) (PSINS kfstat).
+degrees η = σ_(k)/σ_0 (states scaled by their initial σ by default; ``scaling: none`` is the
+paper's literal, unit-dependent table), ranks with their margin from the cut-off, TOM
+ranks, the null-space condition of seed eq. (12), and the covariance degree σ(0)/σ(t)
+(PSINS kfstat).
 """
 
 from __future__ import annotations
@@ -70,16 +72,23 @@ def _degrees(values: np.ndarray) -> dict:
     return {n: float(v) for n, v in zip(ie.STATE_NAMES, values, strict=True)}
 
 
+def _finite(x: float) -> float | None:
+    """A margin for JSON: None when nothing is near the cut-off (inf)."""
+    return float(x) if np.isfinite(x) else None
+
+
 def summary(sc: Scenario, tab: ObservabilityTable, spans: tuple[Span, ...],
             compute_s: float) -> dict:
     """Plain numbers: the JSON contract of ``gcalign observability``."""
     segs, cum = [], []
     for i, sp in enumerate(spans):
         seg = {"name": sp.name, "t0_s": sp.start, "t1_s": sp.end, "rank": int(tab.rank[i]),
-               "tom_rank": int(tab.tom_rank[i]), "null_residual": float(tab.null_residual[i]),
+               "rank_margin": _finite(tab.margin[i]), "tom_rank": int(tab.tom_rank[i]),
+               "null_residual": float(tab.null_residual[i]),
                "condition": bool(tab.condition[i]), "degree": _degrees(tab.eta[i])}
         c = {"name": sp.name, "t0_s": spans[0].start, "t1_s": sp.end,
-             "rank": int(tab.rank_cum[i]), "tom_rank": int(tab.tom_rank_cum[i]),
+             "rank": int(tab.rank_cum[i]), "rank_margin": _finite(tab.margin_cum[i]),
+             "tom_rank": int(tab.tom_rank_cum[i]),
              "degree": _degrees(tab.eta_cum[i])}
         if tab.cov_degree is not None and tab.cov_degree_segment is not None:
             seg["covariance_degree"] = _degrees(tab.cov_degree_segment[i])

@@ -17,6 +17,13 @@ def _exp(eta: float) -> str:
     return "·" if eta <= 0 else f"{round(math.log10(eta)):d}"
 
 
+def margin(m: float | None) -> str:
+    """A rank's margin from the cut-off as ×factor ('—': nothing near it)."""
+    if m is None:
+        return "—"
+    return f"×{m:.2g}" if m < 100 else f"×{m:.0e}".replace("e+0", "e")
+
+
 def _block(title: str | None) -> Table:
     t = Table(title=title, title_justify="left", header_style="bold", box=box.SIMPLE_HEAD,
               pad_edge=False, padding=(0, 0), show_edge=False, collapse_padding=True)
@@ -47,6 +54,8 @@ def observability_table(s: dict) -> Table:
               str(last["rank"]), str(last["tom_rank"]), str(last["rank"]),
               *(_exp(last["degree"][n]) for n in nav))
     b.add_row("all", *(_exp(last["degree"][n]) for n in rest))
+    margins = " ".join(f"{i + 1}:{margin(seg.get('rank_margin'))}"  # a pair never split
+                        for i, (seg, _) in enumerate(rows))
     outer = Table(
         title=f"gcalign observability: {s['scenario']} — {s['measure']} matching, scaling "
         f"{s['scaling']}, {len(rows)} segments in {s['piece_s']:g} s pieces",
@@ -59,8 +68,11 @@ def observability_table(s: dict) -> Table:
         "largest singular value), rounded: −3 ≈ 1e-3; · = 0 (unobservable, or below the rank "
         f"tolerance {s['rank_rtol']:g}·σ_max). rank, TOM: the segment's SOM and TOM ranks; "
         "cum.: the SOM rank from the start; 'whole run'/'all': the cumulative degree at the "
-        "end. The values, eq. 12's null-space residual and the covariance degree σ(0)/σ(t) "
-        f"are in --json and the results file. Compute {s['compute_s']:.2f} s; output "
+        f"end.\nrank margin per segment (how far its rank is from the cut-off: the smaller "
+        f"of σ_rank/cut and cut/σ_rank+1; a margin of a few moves with small changes of F "
+        f"or of the units): {margins}; whole run {margin(last.get('rank_margin'))}.\n"
+        "The values, eq. 12's null-space residual and the covariance degree σ(0)/σ(t) are in "
+        f"--json and the results file. Compute {s['compute_s']:.2f} s; output "
         f"{s.get('output') or '—'}")
     outer.caption_justify = "left"
     return outer

@@ -61,6 +61,7 @@ def realtime_table(s: dict) -> Table:
     for p in after:
         later.add_column(p, justify="right")
     later.add_column(f"truth: max ({' / '.join(after)})", justify="right")
+
     for c in s["cases"]:
         before.add_row(Text(c["name"]), _tdelay(c, T), c["seed_before"] or "—", _before(c),
                        _theory(c))
@@ -69,6 +70,10 @@ def realtime_table(s: dict) -> Table:
             cells.append(f"{_a(c['after_max_arcsec'][p])} ({_a(c['after_rms_arcsec'][p])})")
         cells.append(" / ".join(_a(c["truth"]["after_max_arcsec"][p], 2) for p in after))
         later.add_row(*cells)
+        cm = c.get("corner_max_arcsec")
+        if cm:  # the ramp's corners, where the seed's bound does not hold: max only
+            later.add_row(Text(f"  corners ±{s['corner_ms']:g} ms", style="dim"), "",
+                          *(_a(cm[p]) for p in after), "")
     table = Table.grid(padding=(1, 0))
     table.title = (f"gcalign realtime: {s['scenario']} — {setting}; the designed chain's own "
                    f"delay {s['chain_delay_ms']:.4f} ms (FIR {s['fir_delay_ms']:.3f} ms + "
@@ -83,7 +88,8 @@ def realtime_table(s: dict) -> Table:
         f"″ of the turned Euler angle against {REFERENCE_TEXT[s['reference']]}"
         + (f" (truth: {truth} against the true attitude at the pulse time)"
            if s["reference"] != "truth" else "") + f", after "
-        f"{s['settle_s']:g} s, ±{s['corner_ms']:g} ms around the ramp corners excluded; "
+        f"{s['settle_s']:g} s, ±{s['corner_ms']:g} ms around the ramp corners excluded (their "
+        f"max on the rows 'corners', on the run's reference); "
         f"ramps: before = slope. Gyros (ours, the seed gives none): counts "
         f"{m['quantum_arcsec']:g}″, ARW {m['arw_dprh']:g} °/√h, dither "
         f"{m['dither_arcsec']:g}″ @ {m['dither_hz']:g} Hz; tracker Qc {m['qc_rad2ps5']:g} "

@@ -27,7 +27,7 @@
 
     observability:
       measure: velocity          # the seed's Table 1 is velocity matching
-      scaling: none              # none (the paper) | p0 (columns × initial σ)
+      scaling: p0                # p0 (columns × initial σ, the default) | none (the paper)
       piece_s: 1                 # PWCS piece length
       rank_rtol: 1.0e-12         # singular values ≤ rank_rtol · σ_max count as zero
       null_tol: 1.0e-9           # the null-space condition of seed eq. (12) holds below this
@@ -333,7 +333,7 @@ class CalibrateConfig(Model):
 
 class ObservabilityConfig(Model):
     measure: Literal["velocity", "position", "both"] = "velocity"
-    scaling: Literal["none", "p0"] = "none"
+    scaling: Literal["none", "p0"] = "p0"  # docs/decisions/013
     piece_s: float = Field(1.0, gt=0)
     rank_rtol: float = Field(1e-12, gt=0, lt=1)
     null_tol: float = Field(1e-9, gt=0)
