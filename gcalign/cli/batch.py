@@ -145,6 +145,7 @@ def batch(
         if bar is not None:
             bar.stop()
     summary = result.summary
+    sys.stderr.write(f"wrote {out}\n")
     consoles(as_json).print(engine.COMMAND.table(summary))
     if as_json:
         emit_json(summary)

@@ -311,9 +311,15 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     six, in the summary's order)."""
     from gcalign.app.calibrate.hdf5 import write_calibration
 
+    if progress is not None:
+        progress(0, 1, "simulating / reading the data")
     case = scenario_case(sc, seed, cache_key)
+    if progress is not None and not compare:
+        progress(0, 1, "filter run")
     runs = (compare_runs(case, config_of(sc).conventional_segments, progress) if compare
             else [run_filter(case)])
+    if progress is not None and not compare:
+        progress(1, 1, "filter run")
     out = summary(sc, case, runs, compare)
     result = tuple(r.result for r in runs) if compare else runs[0].result
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),
