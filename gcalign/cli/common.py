@@ -189,6 +189,11 @@ def _apply_recorded(data: dict, inv: Invocation, applied: list) -> None:
         applied.extend((f"site.{k}", v) for k, v in inv.site.items())
 
 
+def imu_file_given() -> bool:
+    """Was ``--imu-file`` given to the running command?"""
+    return (_INVOCATION.get() or Invocation()).imu_file is not None
+
+
 def load_with_overrides(
     path: Path | None,
     builtin: str,
@@ -474,10 +479,18 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
     with ProgressBar(name) as bar:  # the scenario's name heads the table
         summary = run_command(name, sc, text, seed, out, progress=bar, notes=notes,
                               before_write=bar.close, **options)
-    for line in summary["warnings"]:
-        sys.stderr.write(f"warning: {line}\n")
+    warn(summary["warnings"], as_json)
     sys.stderr.write(f"wrote {out}\n")  # where the file went, also under --json
     show(name, summary, as_json)
+
+
+def warn(warnings: Sequence[str], as_json: bool) -> None:
+    """The warnings on stderr, one line each, unless the table that lists them is shown on
+    the same screen (a terminal) or goes to stderr itself (--json): each is said once."""
+    if as_json or sys.stdout.isatty():
+        return
+    for line in warnings:
+        sys.stderr.write(f"warning: {line}\n")
 
 
 def show(kind: str, summary: dict, as_json: bool) -> None:
