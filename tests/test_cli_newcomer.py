@@ -124,3 +124,152 @@ def test_a_silent_stage_is_drawn_after_the_delay(monkeypatch):
     late.close()  # done before the delay: never drawn
     time.sleep(0.1)
     assert late.bar is None
+
+
+# ------------------------------------------------------------------ options that match
+
+REAL = __import__("pathlib").Path(__file__).resolve().parent / "data/lasergyro.imu.xz"
+
+
+def test_navigate_takes_a_recording_given_alone(tmp_path):
+    out = tmp_path / "n.h5"
+    res = runner.invoke(app, ["navigate", "--imu-file", str(REAL), "--duration", "2",
+                              "-o", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    s = __import__("json").loads(res.stdout)
+    assert s["duration_s"] == 2 and s["init"] == "header" and out.is_file()
+    none = runner.invoke(app, ["navigate"])
+    assert none.exit_code == 2
+    assert none.stderr.strip() == ("error: navigate: give a scenario or a data file "
+                                   "(SOURCE), or --imu-file FILE")
+
+
+def test_align_takes_t1_like_t2_and_t3(tmp_path):
+    import json
+
+    res = runner.invoke(app, ["align", str(small_align(tmp_path)), "--t1", "7",
+                              "-o", str(tmp_path / "a.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["t1_s"] == 7.0
+    assert "t1_7" in str(__import__("gcalign.cli.common", fromlist=["x"]).output_name(
+        "x", "align", 1, [("align.t1_s", 7.0)]))
+
+
+def test_a_duration_past_the_data_warns(tmp_path):
+    import json
+
+    p = _write(tmp_path, {**STATIC, "motion": {"kind": "static", "duration_s": 40}}, "mine")
+    res = runner.invoke(app, ["navigate", str(p), "--start", "10", "--duration", "1e9",
+                              "-o", str(tmp_path / "n.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["duration_s"] == 30
+    assert s["warnings"] == ["navigation.duration_s: 1e+09 s runs past the end of the data: "
+                             "ran 30 s (from 10 s)"]
+    ok = runner.invoke(app, ["navigate", str(p), "--start", "10", "--duration", "30",
+                             "-o", str(tmp_path / "m.h5"), "--json"])
+    assert json.loads(ok.stdout)["warnings"] == []  # exactly to the end: nothing to say
+
+
+def test_warnings_are_said_once(tmp_path):
+    """Under --json the table (with its warnings) is on stderr: no second copy there."""
+    p = _write(tmp_path, {**STATIC, "motion": {"kind": "static", "duration_s": 40}}, "mine")
+    res = runner.invoke(app, ["navigate", str(p), "--duration", "1e9", "-o",
+                              str(tmp_path / "n.h5"), "--json"])
+    assert ANSI.sub("", res.stderr).count("runs past the end of the data") == 1
+    plain = runner.invoke(app, ["navigate", str(p), "--duration", "1e9", "-o",
+                                str(tmp_path / "n.h5")])  # table on stdout, not a terminal
+    assert plain.stderr.count("warning: navigation.duration_s") == 1
+    assert plain.stdout.count("warning: navigation.duration_s") == 1
+    d = yaml.safe_load(small_align(tmp_path).read_text())
+    d["align"].update(mode="half-cycle", realtime=True)  # realtime: conventional mode only
+    v = _write(tmp_path, d, "v")
+    val = runner.invoke(app, ["validate", str(v), "--json"])
+    assert val.exit_code == 0, val.output
+    warnings = __import__("json").loads(val.stdout)["warnings"]
+    assert warnings and any("align.realtime" in w for w in warnings)
+    for w in warnings:
+        assert ANSI.sub("", val.stderr).replace("\n", " ").count(w[:30]) == 1
+
+
+def test_validate_shows_long_names_whole_at_80_columns(tmp_path, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "80")
+    name = "a-scenario-whose-name-is-long-as-users-name-them-seed002-designed-variant-b"
+    p = _write(tmp_path, {**STATIC, "name": name, "calibrate": {"navigation_rate_hz": 25}},
+               "long")
+    res = runner.invoke(app, ["validate", str(p)], terminal_width=80)
+    assert res.exit_code == 0, res.output
+    lines = res.stdout.splitlines()
+    assert all(len(x) <= 80 for x in lines)
+    cells = "".join(x.split("│")[2].strip() for x in lines if x.count("│") == 4
+                    and (x.split("│")[1].strip() in ("name", "")))
+    assert name in cells  # folded over lines, not cut
+    assert any("calibrate.navigation_rate_hz" in x for x in lines)  # a key on one line
+    assert "…" not in res.stdout
+
+
+def test_batch_set_and_seeds_on_a_sweep(tmp_path):
+    import json
+
+    base = yaml.safe_load(small_align(tmp_path).read_text())
+    sweep = {"name": "modes", "base": base, "grid": {"align.mode": ["conventional",
+                                                                     "half-cycle"]},
+             "seeds": 5, "metrics": ["error_t3_deg"]}
+    p = _write(tmp_path, sweep, "sweep")
+    res = runner.invoke(app, ["batch", str(p), "--seeds", "2", "--set", "align.t3_s=measured",
+                              "-w", "1", "-o", str(tmp_path / "b.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout)
+    assert s["runs"] == 4  # 2 variants × 2 seeds, not × 5
+    assert "note: --seeds 2 replaces the sweep's seeds (5)" in res.stderr
+    assert f"wrote {tmp_path / 'b.h5'}" in res.stderr
+    one = runner.invoke(app, ["align", str(small_align(tmp_path)), "--mode", "half-cycle",
+                              "--t3", "measured", "--seed", "2", "-o", str(tmp_path / "1.h5"),
+                              "--json"])
+    import h5py
+    import numpy as np
+
+    with h5py.File(tmp_path / "b.h5") as f:
+        r = f["batch/runs"]
+        sel = (r["variant"][()] == 1) & (r["seed"][()] == 2)
+        np.testing.assert_array_equal(r["metrics"]["error_t3_deg"][()][sel][0],
+                                      json.loads(one.stdout)["error_t3_deg"])
+    twice = runner.invoke(app, ["batch", str(p), "--set", "align.mode=conventional"])
+    assert twice.exit_code == 2
+    assert "--set align.mode: also set by the sweep's grid or cases" in twice.stderr
+    files = runner.invoke(app, ["batch", str(small_align(tmp_path)), "--set",
+                                "align.t3_s=measured", "-w", "1", "-o",
+                                str(tmp_path / "c.h5"), "--json"])
+    assert files.exit_code == 0, files.output
+
+
+def test_batch_bar_label_is_short():
+    from types import SimpleNamespace
+
+    from gcalign.app.batch.sweep import FILE_KEY
+    from gcalign.cli.batch import bar_label
+
+    files = SimpleNamespace(name="a+b+c", seeds=10, variants=(1, 2, 3),
+                            grid={FILE_KEY: ["a", "b", "c"]})
+    assert bar_label(files) == "3 scenarios × 10 seeds"
+    sweep = SimpleNamespace(name="seed000-two-stage-moving-variable-long", seeds=1,
+                            variants=(1,) * 12, grid={"align.mode": []})
+    label = bar_label(sweep)
+    assert len(label) <= 30 and label.endswith(" 12 variants × 1 seed")
+
+
+# ------------------------------------------------------------------ the Python API
+
+
+def test_result_truth_is_none_without_full_truth(tmp_path):
+    import gcalign
+
+    p = _write(tmp_path, STATIC, "static")
+    nav = gcalign.run("navigate", p, output=tmp_path / "n.h5")
+    assert nav.truth() is None  # its errors against truth are in its own series
+    al = gcalign.run("align", small_align(tmp_path), output=tmp_path / "a.h5")
+    assert al.truth() is None  # attitude truth only
+    assert "att" in al.series("truth")
+    sim = gcalign.run("simulate", p, output=tmp_path / "s.h5")
+    tr = sim.truth()
+    assert tr is not None and tr.v_n.shape == (len(tr.t), 3)

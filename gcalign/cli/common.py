@@ -486,18 +486,20 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
 
 def warn(warnings: Sequence[str], as_json: bool) -> None:
     """The warnings on stderr, one line each, unless the table that lists them is shown on
-    the same screen (a terminal) or goes to stderr itself (--json): each is said once."""
-    if as_json or sys.stdout.isatty():
+    the same screen (a terminal); under --json the table on stderr leaves them out
+    (:func:`show`): each is said once where it is read."""
+    if not as_json and sys.stdout.isatty():
         return
     for line in warnings:
         sys.stderr.write(f"warning: {line}\n")
 
 
 def show(kind: str, summary: dict, as_json: bool) -> None:
-    """Print a command's table (stderr under --json), its warnings under it, and, under
-    --json, the summary."""
+    """Print a command's table with its warnings under it and, under --json, the table on
+    stderr without the warnings (one line each beside it: :func:`warn`) and the summary."""
     from gcalign.app.report import summary_table
 
-    consoles(as_json).print(summary_table(kind, summary))
+    shown = {**summary, "warnings": []} if as_json else summary  # said above (warn)
+    consoles(as_json).print(summary_table(kind, shown))
     if as_json:
         emit_json(summary)

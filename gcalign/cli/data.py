@@ -136,7 +136,7 @@ def validate(
     for column in table.columns:  # a long name or value folds onto the next line, whole
         column.overflow = "fold"
     table.columns[0].no_wrap = True  # the keys whole, on one line
-    consoles(as_json).print(with_warnings(table, warnings))
+    consoles(as_json).print(table if as_json else with_warnings(table, warnings))
     if as_json:
         emit_json({"valid": True, "values": {k: {"value": v, "si": s} for k, v, s in rows},
                    "warnings": warnings})
