@@ -323,4 +323,12 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     out = summary(sc, case, runs, compare)
     result = tuple(r.result for r in runs) if compare else runs[0].result
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),
-                   case.seed, result=result)
+                   case.seed, filter_warnings(runs, compare), result=result)
+
+
+def filter_warnings(runs: list[Run], compare: bool) -> tuple[str, ...]:
+    """The core's consistency checks of each run (:mod:`gcalign.calibrate.health`)."""
+    from gcalign.calibrate.health import health_warnings
+
+    return tuple(w for r in runs for w in health_warnings(
+        r.result, f"{r.label} {r.result.settings.measure}: " if compare else ""))
