@@ -273,3 +273,37 @@ def test_result_truth_is_none_without_full_truth(tmp_path):
     sim = gcalign.run("simulate", p, output=tmp_path / "s.h5")
     tr = sim.truth()
     assert tr is not None and tr.v_n.shape == (len(tr.t), 3)
+
+
+# ------------------------------------------------------------------ batch figures
+
+
+def test_batch_figure_of_long_file_names_neither_overlaps_nor_clips():
+    """Box plot of a batch over three files with long names: the tick labels do not
+    overlap each other and the title stays inside the figure (drawn, then measured)."""
+    import numpy as np
+
+    from gcalign.app.batch.plots import batch_figure, wrap_words
+
+    names = ["scenario=seed000_moving_conventional.yaml",
+             "scenario=seed000_moving_full_cycle.yaml", "scenario=seed000_moving_half_cycle.yaml"]
+    variant = np.repeat(np.arange(3), 4)
+    values = np.random.default_rng(1).normal(size=(12, 3))
+    fig = batch_figure("error_t3_deg", values, variant, names, ["pitch", "roll", "yaw"],
+                       title="+".join(names) + ": error_t3_deg over 4 seed(s) per variant")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    boxes = [t.get_window_extent(renderer) for t in fig.axes[-1].get_xticklabels()]
+    assert len(boxes) == 3
+    for a, b in zip(boxes, boxes[1:], strict=False):
+        assert a.x1 < b.x0  # apart
+    title = fig._suptitle.get_window_extent(renderer)
+    assert title.x0 >= 0 and title.x1 <= fig.bbox.width and title.y1 <= fig.bbox.height
+    assert wrap_words("seed000_moving_full_cycle", 14) == "seed000_\nmoving_full_\ncycle"
+    from gcalign.app.batch.plots import _variant_label
+
+    assert _variant_label({"scenario": "seed000_moving_conventional.yaml"}, ["scenario"]) \
+        == "seed000_moving_conventional"
