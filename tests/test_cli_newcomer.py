@@ -61,14 +61,17 @@ def _args(tmp_path, command: str) -> list[str]:
     if command == "modulate":
         return [command, "--scheme", "seed-12", "--hours", "0.05", "--set", "imu.rate_hz=10",
                 "-o", out]
+    if command == "batch":
+        return [command, str(small_align(tmp_path)), "--seeds", "2", "-w", "1", "-o", out]
     raise KeyError(command)
 
 
-COMMANDS = ["simulate", "navigate", "align", "calibrate", "observability", "northfind",
-            "realtime", "modulate"]
+SLOW = {"calibrate", "batch"}  #: over 2 s (a simulated flight; a process pool)
+COMMANDS = [pytest.param(c, marks=pytest.mark.slow) if c in SLOW else c for c in (
+    "simulate", "navigate", "align", "calibrate", "observability", "northfind", "realtime",
+    "modulate", "batch")]
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("command", COMMANDS)
 def test_every_command_shows_a_bar_and_where_its_file_went(tmp_path, monkeypatch, command):
     monkeypatch.setenv("GCALIGN_PROGRESS", "always")
@@ -76,8 +79,9 @@ def test_every_command_shows_a_bar_and_where_its_file_went(tmp_path, monkeypatch
     res = runner.invoke(app, args)
     assert res.exit_code == 0, res.output
     bar = ANSI.sub("", res.stderr).replace("\r", "\n")
-    assert f"{command} running" in bar  # before the first kernel call (numba's compile)
-    assert "100%" in bar, bar
+    first = "1 scenario × 2 seeds" if command == "batch" else f"{command} running"
+    assert first in bar  # for a command, before the first kernel call (numba's compile)
+    assert ("2/2" if command == "batch" else "100%") in bar, bar
     assert all(len(x) <= 80 for x in bar.splitlines() if "━" in x), bar
     assert "running" not in res.stdout  # the table's stream holds no bar
     assert f"wrote {args[-1]}\n" in res.stderr
@@ -91,6 +95,7 @@ def test_modulate_bar_counts_data_seconds_of_its_scheme(tmp_path, monkeypatch):
     assert "modulate seed-12 (data s)" in bar and "180/180" in bar  # 0.05 h = 180 s
 
 
+@pytest.mark.slow
 def test_calibrate_single_run_reports_its_stages(tmp_path, monkeypatch):
     monkeypatch.setenv("GCALIGN_PROGRESS", "always")
     res = runner.invoke(app, _args(tmp_path, "calibrate"))

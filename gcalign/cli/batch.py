@@ -20,8 +20,13 @@ from gcalign.errors import ScenarioError
 
 
 def _progress_bar(total_hint: str):
-    """A rich progress bar with ETA on stderr, or None when stderr is not a terminal."""
-    if not sys.stderr.isatty():
+    """A rich progress bar with ETA on stderr, or None when stderr is not a terminal;
+    ``GCALIGN_PROGRESS=always`` forces it (into a pipe or a log too), ``never`` turns it
+    off, as for the other commands (:class:`gcalign.cli.common.ProgressBar`)."""
+    import os
+
+    mode = os.environ.get("GCALIGN_PROGRESS", "auto").lower()
+    if mode == "never" or (mode != "always" and not sys.stderr.isatty()):
         return None
     from rich.console import Console
     from rich.progress import (
@@ -41,7 +46,7 @@ def _progress_bar(total_hint: str):
         TimeElapsedColumn(),
         TextColumn("ETA"),
         TimeRemainingColumn(),
-        console=Console(stderr=True),
+        console=Console(stderr=True, force_terminal=mode == "always" or None),
         transient=False,
     )
 
