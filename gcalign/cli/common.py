@@ -376,7 +376,10 @@ class ProgressBar:
             BarColumn(bar_width=20), TaskProgressColumn(),
             TextColumn("{task.completed:.0f}/{task.total:.0f}"), _TimeColumn(),
             console=Console(stderr=True, force_terminal=self.force or None),
-            transient=not self.force)
+            transient=not self.force,
+            # sys.stdout and sys.stderr left as they are: a module imported during the run
+            # (colorama's init) must not keep rich's wrapper of them
+            redirect_stdout=False, redirect_stderr=False)
         self.bar.start()
 
     def __call__(self, done: float, total: float, what: str = "") -> None:
