@@ -374,7 +374,7 @@ class ProgressBar:
         self.bar = Progress(
             TextColumn(f"[bold]{self.title}[/bold] {{task.description}}"),
             BarColumn(bar_width=20), TaskProgressColumn(),
-            TextColumn("{task.completed:.0f}/{task.total:.0f}"), _TimeColumn(),
+            TextColumn("{task.completed:.0f}/{task.total:.0f}"), _time_column(),
             console=Console(stderr=True, force_terminal=self.force or None),
             transient=not self.force,
             # sys.stdout and sys.stderr left as they are: a module imported during the run
@@ -433,8 +433,9 @@ class ProgressBar:
         self.close()
 
 
-def _TimeColumn():  # noqa: N802 - a rich column class, made when a bar is drawn
-    """Time left, or, before any of the stage is done, the time it has run."""
+def _time_column():
+    """A rich column (made when a bar is drawn, so that rich loads only then): the time
+    left, or, before any of the stage is done, the time it has run."""
     from rich.progress import ProgressColumn
     from rich.text import Text
 
