@@ -95,6 +95,15 @@ def test_modulate_bar_counts_data_seconds_of_its_scheme(tmp_path, monkeypatch):
     assert "modulate seed-12 (data s)" in bar and "180/180" in bar  # 0.05 h = 180 s
 
 
+def test_observability_reports_its_stages(tmp_path, monkeypatch):
+    monkeypatch.setenv("GCALIGN_PROGRESS", "always")
+    res = runner.invoke(app, _args(tmp_path, "observability"))
+    assert res.exit_code == 0, res.output
+    bar = ANSI.sub("", res.stderr)
+    assert "observability simulating the flight" in bar
+    assert "observability PWCS + SVD table" in bar and "100% 1/1" in bar
+
+
 @pytest.mark.slow
 def test_calibrate_single_run_reports_its_stages(tmp_path, monkeypatch):
     monkeypatch.setenv("GCALIGN_PROGRESS", "always")
