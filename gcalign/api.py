@@ -75,9 +75,17 @@ class Result:
         return open_results(self.path)
 
     def truth(self):
-        """The truth stored in the file (:class:`gcalign.sim.motions.Truth`), or None."""
-        from gcalign.io.results import read_truth
+        """The full truth stored in the file (:class:`gcalign.sim.motions.Truth`: attitude,
+        velocity and position at every sample), or None when the file holds none: recorded
+        data, ``navigate`` and ``modulate`` (their errors against truth are in their own
+        series), and ``align``, which stores the true attitude only (``series("truth")``
+        reads it). ScenarioError when the full truth is there but damaged."""
+        from gcalign.io.results import open_results, read_truth
 
+        with open_results(self.path) as f:
+            g = f.get("truth")
+            if g is None or not all(k in g for k in ("t", "att", "v_n", "pos")):
+                return None
         return read_truth(self.path)
 
     def imu(self):

@@ -444,5 +444,5 @@ def test_batch_over_a_plain_list_of_scenario_files(tmp_path):
         sel = (r["variant"][()] == 1) & (r["seed"][()] == 2)
         np.testing.assert_array_equal(r["metrics"]["error_t3_deg"][()][sel][0], yaw)
     bad = runner.invoke(app, ["batch", str(ROOT / "configs/sweeps/seed000_modes.yaml"),
-                              "--seeds", "3"])
-    assert bad.exit_code == 2 and "--seeds: applies to a list of scenario files" in bad.stderr
+                              "--command", "calibrate"])  # a sweep says its command
+    assert bad.exit_code == 2 and "--command: applies to a list of scenario files" in bad.stderr

@@ -26,7 +26,8 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
 
     The summary gets ``warnings`` (`notes`, the scenario's keys that cannot matter, and the
     run's own), ``wall_s`` (the whole call) and ``output``. `progress(done, total, what)`
-    goes to a command whose ``execute`` takes it; `before_write` is called when the run is
+    goes to a command whose ``execute`` takes it, after a first stage ``running`` from the
+    start (a first run's kernel compile falls in it); `before_write` is called when the run is
     done, before the file is finished (the command line closes its progress bar there);
     `on_outcome` hears of the command's :class:`Outcome` (the Python API keeps its typed
     result).
@@ -36,12 +37,16 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
     cmd = command(name)
     kwargs = dict(options, progress=progress)
     t0 = time.perf_counter()
+    if progress is not None:  # a bar before the first kernel call (numba compiles it once)
+        progress(0.0, 1.0, "running")
     try:
         with results.atomic_h5(out) as f:
             # preflight checks, the seed's range, a finite summary
             if cmd.options.streams:
                 kwargs["sink"] = f
             outcome = checked_execute(name, sc, seed, **kwargs)
+            if progress is not None:
+                progress(1.0, 1.0, "running")
             if on_outcome is not None:
                 on_outcome(outcome)
             if before_write is not None:

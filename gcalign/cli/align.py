@@ -68,6 +68,8 @@ def align(
     passes: int | None = typer.Option(
         None, "--passes", help="Forward and reverse passes in all (sets the last stage's "
         "align.stages.N.passes)."),
+    t1: float | None = typer.Option(
+        None, "--t1", help="End of the coarse window T1 (s); the fine block starts there."),
     t2: float | None = typer.Option(None, "--t2", help="End of the stored data block T2 (s)."),
     t3: str | None = typer.Option(None, "--t3", help="Result time T3 (s) or 'measured'."),
     seed: Seed = None,
@@ -80,6 +82,7 @@ def align(
         "mode": mode,
         "compensation": compensation,
         "passes": passes,
+        "t1_s": t1,
         "t2_s": t2,
         "t3_s": _t3(t3),
     }

@@ -15,13 +15,18 @@ import typer
 from gcalign.app import batch as engine
 from gcalign.app.batch.sweep import sweep_from_files
 from gcalign.cli import app, consoles, default_output, emit_json, user_errors
-from gcalign.cli.options import Json
+from gcalign.cli.options import Json, Sets
 from gcalign.errors import ScenarioError
 
 
 def _progress_bar(total_hint: str):
-    """A rich progress bar with ETA on stderr, or None when stderr is not a terminal."""
-    if not sys.stderr.isatty():
+    """A rich progress bar with ETA on stderr, or None when stderr is not a terminal;
+    ``GCALIGN_PROGRESS=always`` forces it (into a pipe or a log too), ``never`` turns it
+    off, as for the other commands (:class:`gcalign.cli.common.ProgressBar`)."""
+    import os
+
+    mode = os.environ.get("GCALIGN_PROGRESS", "auto").lower()
+    if mode == "never" or (mode != "always" and not sys.stderr.isatty()):
         return None
     from rich.console import Console
     from rich.progress import (
@@ -41,29 +46,67 @@ def _progress_bar(total_hint: str):
         TimeElapsedColumn(),
         TextColumn("ETA"),
         TimeRemainingColumn(),
-        console=Console(stderr=True),
+        console=Console(stderr=True, force_terminal=mode == "always" or None),
         transient=False,
     )
 
 
 def load_batch(files: list[Path], command: str | None, seeds: int | None,
-               seed_start: int | None, metrics: list[str] | None):
-    """One sweep file, or a plain list of scenario files (each file a variant)."""
+               seed_start: int | None, metrics: list[str] | None,
+               sets: list[str] | None = None, notes: list[str] | None = None):
+    """One sweep file, or a plain list of scenario files (each file a variant). On a sweep
+    file, --seeds and --seed-start replace the file's (said in `notes`); --set changes the
+    base scenario of a sweep, or every file of a list."""
+    from gcalign.cli.common import parse_set
     from gcalign.io.scenario.loader import read_yaml
 
-    list_options = {"--command": command, "--seeds": seeds, "--seed-start": seed_start,
-                    "--metric": metrics or None}
+    pairs = [parse_set(item) for item in sets or []]
+    list_options = {"--command": command, "--metric": metrics or None}
     if len(files) == 1:
         data = read_yaml(files[0])
         if isinstance(data, dict) and "base" in data:
             given = [k for k, v in list_options.items() if v is not None]
             if given:
                 raise ScenarioError(f"{given[0]}: applies to a list of scenario files; the "
-                                    f"sweep file {files[0]} says it (command, seeds, "
-                                    "seed_start, metrics)")
-            return engine.load_sweep(files[0])
+                                    f"sweep file {files[0]} says it (command, metrics)")
+            text = files[0].read_text(encoding="utf-8")
+            for option, key, value in (("--seeds", "seeds", seeds),
+                                       ("--seed-start", "seed_start", seed_start)):
+                if value is not None:
+                    if notes is not None:
+                        notes.append(f"{option} {value} replaces the sweep's {key} "
+                                     f"({data.get(key, 1)})")
+                    data[key] = value
+                    text += f"\n# command line: {option} {value}\n"
+            return engine.sweep_from_mapping(data, str(files[0]), files[0].parent, text,
+                                             default_name=files[0].stem, sets=pairs)
     return sweep_from_files(files, command, 1 if seeds is None else seeds,
-                            1 if seed_start is None else seed_start, metrics or None)
+                            1 if seed_start is None else seed_start, metrics or None, pairs)
+
+
+def _named(sw, seeds: int | None, seed_start: int | None, sets: list[str] | None) -> list:
+    """The options that change a batch's results beside its sweep file, for its default
+    file name: --set, and --seeds/--seed-start on a sweep file."""
+    from gcalign.app.batch.sweep import FILE_KEY
+    from gcalign.cli.common import parse_set
+
+    sweep = FILE_KEY not in sw.grid
+    return [*((k, v) for k, v in (("seeds", seeds), ("seed_start", seed_start))
+              if sweep and v is not None), *(parse_set(x) for x in sets or [])]
+
+
+def bar_label(sw) -> str:
+    """The batch's short name for its progress bar (within 30 characters): a list of files
+    by its count, a sweep by its name and its variants."""
+    from gcalign.app.batch.sweep import FILE_KEY
+
+    seeds = f"{sw.seeds} seed{'s' if sw.seeds != 1 else ''}"
+    n = len(sw.variants)
+    if FILE_KEY in sw.grid:
+        return f"{n} scenario{'s' if n != 1 else ''} × {seeds}"
+    what = f" {n} variants × {seeds}"
+    name = sw.name if len(sw.name) + len(what) <= 30 else sw.name[:29 - len(what)] + "…"
+    return name + what
 
 
 @app.command()
@@ -86,9 +129,11 @@ def batch(
         None, "--command", help="Scenario files: the command to run (default: the one whose "
         "section the files have; align)."),
     seeds: int | None = typer.Option(
-        None, "--seeds", help="Scenario files: seeds per file (default 1)."),
+        None, "--seeds", help="Seeds per variant (scenario files: default 1; a sweep file: "
+        "replaces its seeds)."),
     seed_start: int | None = typer.Option(
-        None, "--seed-start", help="Scenario files: the first seed (default 1)."),
+        None, "--seed-start", help="The first seed (scenario files: default 1; a sweep "
+        "file: replaces its seed_start)."),
     metric: list[str] | None = typer.Option(
         None, "--metric", help="Scenario files: a metric, a dotted path into the run "
         "summary (repeatable; default: the command's)."),
@@ -103,6 +148,7 @@ def batch(
         False, "--resume", help="Run only what an earlier, interrupted batch did not finish."
     ),
     as_json: Json = False,
+    set_: Sets = None,
 ):
     """Run a sweep (variants × seeds), or the same seeds on several scenario files; aggregate
     each metric per variant into one HDF5 file. One batch starts Python once: far cheaper
@@ -114,11 +160,14 @@ def batch(
             "--workers: applies to the local process pool; with --scheduler "
             "the cluster's workers run the batch (give one or the other)"
         )
-    sw = load_batch(files, command, seeds, seed_start, metric)
-    out = output or default_output(sw.name, "batch", None)
+    notes: list[str] = []
+    sw = load_batch(files, command, seeds, seed_start, metric, set_, notes)
+    out = output or default_output(sw.name, "batch", None, _named(sw, seeds, seed_start, set_))
     err = consoles(True)  # notes always on stderr
+    for line in notes:
+        sys.stderr.write(f"note: {line}\n")
 
-    bar = _progress_bar(f"{sw.name}")
+    bar = _progress_bar(bar_label(sw))
     task = None
 
     def progress(done: int, total: int, failed: int) -> None:
@@ -145,6 +194,7 @@ def batch(
         if bar is not None:
             bar.stop()
     summary = result.summary
+    sys.stderr.write(f"wrote {out}\n")
     consoles(as_json).print(engine.COMMAND.table(summary))
     if as_json:
         emit_json(summary)

@@ -203,6 +203,11 @@ def _apply_recorded(data: dict, inv: Invocation, applied: list) -> None:
         applied.extend((f"site.{k}", v) for k, v in inv.site.items())
 
 
+def imu_file_given() -> bool:
+    """Was ``--imu-file`` given to the running command?"""
+    return (_INVOCATION.get() or Invocation()).imu_file is not None
+
+
 def load_with_overrides(
     path: Path | None,
     builtin: str,
@@ -356,10 +361,13 @@ def _replaced_other(out: Path, kind: str, text: str, seed: int | None) -> str | 
 class ProgressBar:
     """A transient rich progress bar on stderr for a run's ``progress(done, total, what)``
     reports. It appears only on a terminal and once a run has taken more than `delay_s`
-    (short runs stay quiet); ``GCALIGN_PROGRESS=always`` forces it at once (also into a
-    pipe or a log, where it stays), ``never`` turns it off."""
+    (short runs stay quiet), also while no report comes (a first run's numba compile): a
+    stage not yet begun shows the time since it started. ``GCALIGN_PROGRESS=always`` forces
+    it at once (also into a pipe or a log, where it stays), ``never`` turns it off."""
 
     def __init__(self, title: str, delay_s: float = 1.0):
+        import threading
+
         mode = os.environ.get("GCALIGN_PROGRESS", "auto").lower()
         self.enabled = mode == "always" or (mode == "auto" and sys.stderr.isatty())
         self.force = mode == "always"
@@ -367,34 +375,54 @@ class ProgressBar:
         self.t0 = time.perf_counter()
         self.bar = None
         self.tasks: dict[str, int] = {}
+        self.lock = threading.Lock()
+        self.pending: tuple[float, float, str] | None = None
+        self.timer: threading.Timer | None = None
+        self.closed = False
 
     def _start(self):
         from rich.console import Console
-        from rich.progress import (
-            BarColumn,
-            Progress,
-            TaskProgressColumn,
-            TextColumn,
-            TimeRemainingColumn,
-        )
+        from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn
 
         # one line of 80 columns (a pipe or a log has no width): what, how far, how long
         self.bar = Progress(
             TextColumn(f"[bold]{self.title}[/bold] {{task.description}}"),
             BarColumn(bar_width=20), TaskProgressColumn(),
-            TextColumn("{task.completed:.0f}/{task.total:.0f}"), TimeRemainingColumn(),
-            TextColumn("left"),
+            TextColumn("{task.completed:.0f}/{task.total:.0f}"), _time_column(),
             console=Console(stderr=True, force_terminal=self.force or None),
-            transient=not self.force)
+            transient=not self.force,
+            # sys.stdout and sys.stderr left as they are: a module imported during the run
+            # (colorama's init) must not keep rich's wrapper of them
+            redirect_stdout=False, redirect_stderr=False)
         self.bar.start()
 
     def __call__(self, done: float, total: float, what: str = "") -> None:
+        import threading
+
         if not self.enabled or total <= 0:
             return
-        if self.bar is None:
-            if time.perf_counter() - self.t0 < self.delay and done < total:
+        with self.lock:
+            if self.closed:
                 return
-            self._start()
+            if self.bar is None:
+                wait = self.delay - (time.perf_counter() - self.t0)
+                if wait > 0 and done < total:  # a report before the delay: shown after it
+                    self.pending = (done, total, what)
+                    if self.timer is None:
+                        self.timer = threading.Timer(wait, self._late_start)
+                        self.timer.daemon = True
+                        self.timer.start()
+                    return
+                self._start()
+            self._update(done, total, what)
+
+    def _late_start(self) -> None:
+        with self.lock:
+            if self.bar is None and not self.closed and self.pending is not None:
+                self._start()
+                self._update(*self.pending)
+
+    def _update(self, done: float, total: float, what: str) -> None:
         assert self.bar is not None
         if what not in self.tasks:
             for other in self.tasks.values():  # a new stage: the earlier ones are done
@@ -404,15 +432,40 @@ class ProgressBar:
         self.bar.update(self.tasks[what], completed=min(done, total), total=total)
 
     def close(self) -> None:
-        if self.bar is not None:
-            self.bar.stop()
-            self.bar = None
+        with self.lock:
+            self.closed = True
+            if self.timer is not None:
+                self.timer.cancel()
+            if self.bar is not None:
+                self.bar.stop()
+                self.bar = None
 
     def __enter__(self) -> ProgressBar:
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _time_column():
+    """A rich column (made when a bar is drawn, so that rich loads only then): the time
+    left, or, before any of the stage is done, the time it has run."""
+    from rich.progress import ProgressColumn
+    from rich.text import Text
+
+    class TimeColumn(ProgressColumn):
+        def render(self, task) -> Text:
+            def clock(s: float | None) -> str:
+                if s is None:
+                    return "-:--:--"
+                s = int(s)
+                return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
+
+            if task.completed <= 0 and not task.finished:
+                return Text(f"{clock(task.elapsed)} so far", style="progress.elapsed")
+            return Text(f"{clock(task.time_remaining)} left", style="progress.remaining")
+
+    return TimeColumn()
 
 
 # --------------------------------------------------------------------------- run and show
@@ -444,16 +497,27 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
     with ProgressBar(name) as bar:  # the scenario's name heads the table
         summary = run_command(name, sc, text, seed, out, progress=bar, notes=notes,
                               before_write=bar.close, **options)
-    for line in summary["warnings"]:
-        sys.stderr.write(f"warning: {line}\n")
+    warn(summary["warnings"], as_json)
+    sys.stderr.write(f"wrote {out}\n")  # where the file went, also under --json
     show(name, summary, as_json)
 
 
+def warn(warnings: Sequence[str], as_json: bool) -> None:
+    """The warnings on stderr, one line each, unless the table that lists them is shown on
+    the same screen (a terminal); under --json the table on stderr leaves them out
+    (:func:`show`): each is said once where it is read."""
+    if not as_json and sys.stdout.isatty():
+        return
+    for line in warnings:
+        sys.stderr.write(f"warning: {line}\n")
+
+
 def show(kind: str, summary: dict, as_json: bool) -> None:
-    """Print a command's table (stderr under --json), its warnings under it, and, under
-    --json, the summary."""
+    """Print a command's table with its warnings under it and, under --json, the table on
+    stderr without the warnings (one line each beside it: :func:`warn`) and the summary."""
     from gcalign.app.report import summary_table
 
-    consoles(as_json).print(summary_table(kind, summary))
+    shown = {**summary, "warnings": []} if as_json else summary  # said above (warn)
+    consoles(as_json).print(summary_table(kind, shown))
     if as_json:
         emit_json(summary)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-import sys
 from pathlib import Path
 
 import typer
@@ -13,8 +12,9 @@ from gcalign.app.preflight import preflight
 from gcalign.app.registry import COMMANDS
 from gcalign.app.report import kv_table, summary_table, with_warnings
 from gcalign.cli import app, consoles, emit_json, user_errors
-from gcalign.cli.common import load_with_overrides, run_and_show
+from gcalign.cli.common import imu_file_given, load_with_overrides, run_and_show, warn
 from gcalign.cli.options import Json, Output, Seed, Sets
+from gcalign.errors import ScenarioError
 from gcalign.io import results
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario.resolve import resolved_rows
@@ -50,9 +50,10 @@ def simulate(
 @app.command()
 @user_errors
 def navigate(
-    source: Path = typer.Argument(
-        ..., help="Scenario YAML, a results file with /imu, or a PSINS .imu / CSV data file "
-        "(.gz/.xz compressed too); a CSV has no site: give --lat/--lon/--height."
+    source: Path | None = typer.Argument(
+        None, help="Scenario YAML, a results file with /imu, or a PSINS .imu / CSV data file "
+        "(.gz/.xz compressed too); a CSV has no site: give --lat/--lon/--height. Or none, "
+        "with --imu-file FILE."
     ),
     init: str | None = typer.Option(
         None, "--init", help="Start from: truth | header | an alignment results file (its "
@@ -74,9 +75,12 @@ def navigate(
     start (`final_error` is null in the JSON).
     """
     overrides = {"vertical": vertical, "start_s": start, "duration_s": duration}
-    suffix = data_suffix(source)
+    suffix = "" if source is None else data_suffix(source)
     data = text = None
-    if suffix in DATA_SUFFIXES | HDF5_SUFFIXES:
+    if source is None and not imu_file_given():
+        raise ScenarioError("navigate: give a scenario or a data file (SOURCE), or "
+                            "--imu-file FILE")
+    if source is not None and suffix in DATA_SUFFIXES | HDF5_SUFFIXES:
         # A bare data file stands for the scenario `imu_file: SOURCE`; our own results
         # file keeps the name and text of the scenario that made it.
         text = results.read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
@@ -126,11 +130,13 @@ def validate(
     rows = resolved_rows(sc)
     sections = [c.section for c in COMMANDS.values() if c.section]
     warnings = list(dict.fromkeys(w for sec in sections for w in sc.unused(sec)))
-    for line in warnings:
-        sys.stderr.write(f"warning: {line}\n")
+    warn(warnings, as_json)
     table = kv_table(f"{scenario}: valid", rows, ("field", "value", "SI"),
                      ("left", "right", "left"))
-    consoles(as_json).print(with_warnings(table, warnings))
+    for column in table.columns:  # a long name or value folds onto the next line, whole
+        column.overflow = "fold"
+    table.columns[0].no_wrap = True  # the keys whole, on one line
+    consoles(as_json).print(table if as_json else with_warnings(table, warnings))
     if as_json:
         emit_json({"valid": True, "values": {k: {"value": v, "si": s} for k, v, s in rows},
                    "warnings": warnings})

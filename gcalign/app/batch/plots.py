@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.app.batch.aggregate import metric_label, metric_units
-from gcalign.app.batch.sweep import CASE_KEY
+from gcalign.app.batch.sweep import CASE_KEY, FILE_KEY
 from gcalign.app.plots import _s, angle_scale, legend_below, new_figure, suptitle
 
 
@@ -34,8 +34,32 @@ def _pairs(overrides: dict, keys: list[str], sep: str) -> str:
 
 
 def _variant_label(overrides: dict, grid_keys: list[str]) -> str:
+    if list(overrides) == [FILE_KEY]:  # a batch of scenario files: the file's name
+        return str(overrides[FILE_KEY]).rsplit("/", 1)[-1].removesuffix(".yaml")
     return _pairs(overrides, [*grid_keys, *(k for k in overrides if k not in grid_keys)],
                   "\n") or "base"
+
+
+TICK_CHARS_PER_INCH = 13.0  #: characters of a "small" tick label per inch of width
+TITLE_CHARS_PER_INCH = 9.0  #: characters of the title per inch of width
+
+
+def wrap_words(text: str, width: int) -> str:
+    """`text` on lines of at most `width` characters, broken after ``_ - + = , /`` or a
+    space (a file name has no spaces), each line of a multi-line text on its own."""
+    import re
+
+    out = []
+    for line in text.split("\n"):
+        pieces = re.findall(r"[^_\-+=,/ ]*[_\-+=,/ ]?", line)
+        row = ""
+        for piece in filter(None, pieces):
+            if row and len(row) + len(piece.rstrip()) > width:
+                out.append(row.rstrip())
+                row = ""
+            row += piece
+        out.append(row.rstrip())
+    return "\n".join(out)
 
 
 def _values_and_components(values, components: list[str] | None):
@@ -61,8 +85,10 @@ def batch_figure(metric: str, values: np.ndarray, variant: np.ndarray, labels: l
     """
     values, comps, pooled = _values_and_components(values, components)
     n_var = len(labels)
-    fig, axes = new_figure(len(comps), width=max(6.0, 1.1 * n_var + 3.0),
-                           height=2.8 * len(comps) + 1.4)
+    width = max(6.0, 1.1 * n_var + 3.0)
+    per_box = max(8, int((width - 1.5) / n_var * TICK_CHARS_PER_INCH))  # no overlap
+    labels = [wrap_words(x, per_box) for x in labels]
+    fig, axes = new_figure(len(comps), width=width, height=2.8 * len(comps) + 1.4)
     for j, (ax, comp) in enumerate(zip(axes, comps, strict=True)):
         data = []
         for vi in range(n_var):
@@ -81,7 +107,8 @@ def batch_figure(metric: str, values: np.ndarray, variant: np.ndarray, labels: l
         ax.set_ylabel(f"{name} ({unit})" if unit else name)
         ax.grid(True, axis="y", alpha=0.3)
     axes[-1].set_xlabel("variant (whiskers 5–95 %, box quartiles, line median)")
-    suptitle(fig, title or f"{metric}: distribution over seeds per variant")
+    suptitle(fig, wrap_words(title or f"{metric}: distribution over seeds per variant",
+                             int(width * TITLE_CHARS_PER_INCH)))
     return fig
 
 
@@ -215,7 +242,10 @@ def figures(f, name: str) -> dict[str, Figure]:
                 title=f"{summary['sweep']}: median |{name}| over {summary['seeds']} seed(s) "
                       f"against {short[x_key]} (band: 25-75 % of the seeds)", name=name)
         if not x_keys:
+            files = grid_keys == [FILE_KEY]
+            what = f"{len(labels)} scenario files" if files else summary["sweep"]
             figs[stem] = batch_figure(
                 m, metrics[m], variant, labels, st.get("components"), units,
-                title=f"{summary['sweep']}: {name} over {summary['seeds']} seed(s) per variant")
+                title=f"{what}: {name} over {summary['seeds']} seed(s) per "
+                      f"{'file' if files else 'variant'}")
     return figs

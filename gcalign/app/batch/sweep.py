@@ -19,6 +19,7 @@ import hashlib
 import itertools
 import json
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -292,9 +293,11 @@ def _command_of(spec: SweepFile, base_data: Any, source: str) -> str:
 
 
 def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None,
-                       text: str | None = None, default_name: str = "sweep") -> Sweep:
+                       text: str | None = None, default_name: str = "sweep",
+                       sets: Sequence[tuple[str, Any]] = ()) -> Sweep:
     """Validate a parsed sweep mapping (:class:`SweepFile`); every variant is parsed and
-    preflighted before anything runs.
+    preflighted before anything runs. `sets` (``--set KEY=VALUE`` of the command line, as
+    (key, value)) change the base scenario before the grid is applied.
 
     Raises ScenarioError with one line naming the key and the value that is wrong.
     """
@@ -311,6 +314,12 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     text = text if text is not None else yaml.safe_dump(data, sort_keys=False)
     base_data, base_source, base_text, _ = _read_base(spec, source, Path(base_dir or "."))
     base_model = parse_scenario(base_data, base_source)
+    if sets:
+        grid_keys = set(spec.grid) | {k for over in spec.cases.values() for k in over}
+        apply_sets(base_data, sets, base_model, grid_keys)
+        base_model = parse_scenario(base_data, base_source)
+        text += "\n# command-line overrides of the base:\n" + yaml.safe_dump(
+            dict(sets), sort_keys=False)
     command = _command_of(spec, base_data, source)
     metrics = spec.metrics or list(batchable()[command])
     axes, cases = dict(spec.grid), spec.cases
@@ -372,12 +381,28 @@ def _check_section(sc, command: str, where: str) -> None:
         raise ScenarioError(f"{where}: {err}") from None
 
 
+def apply_sets(data: dict, sets: Sequence[tuple[str, Any]], base_model: Any = None,
+               grid_keys: Iterable[str] = ()) -> None:
+    """The command line's ``--set KEY=VALUE`` items written into a scenario mapping, in
+    place; a key the grid (or a case) also sets is refused: it would be overridden."""
+    taken = set(grid_keys)
+    for key, value in sets:
+        if key in taken:
+            raise ScenarioError(f"--set {key}: also set by the sweep's grid or cases; "
+                                "give it once")
+        try:
+            apply_override(data, key, value, base_model)
+        except ScenarioError as err:
+            raise ScenarioError(f"--set {key}: {err}") from None
+
+
 #: The pseudo grid key of a batch over a list of scenario files: each file is a variant.
 FILE_KEY = "scenario"
 
 
 def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int = 1,
-                     seed_start: int = 1, metrics: list[str] | None = None) -> Sweep:
+                     seed_start: int = 1, metrics: list[str] | None = None,
+                     sets: Sequence[tuple[str, Any]] = ()) -> Sweep:
     """A batch over a plain list of scenario files (``gcalign batch a.yaml b.yaml …``):
     every file is a variant (labelled by its name under the pseudo key ``scenario``), run
     for the same seeds; each file is validated before anything runs.
@@ -400,7 +425,10 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
             raise ScenarioError(f"{path}: a sweep file (it has 'base'); a batch takes one "
                                 "sweep file, or a list of scenario files")
         absolute_paths(data, path.parent)  # workers may run elsewhere
-        parse_scenario(copy.deepcopy(data), str(path))
+        model = parse_scenario(copy.deepcopy(data), str(path))
+        if sets and isinstance(data, dict):
+            apply_sets(data, sets, model)
+            parse_scenario(copy.deepcopy(data), str(path))
         datas.append(data)
         texts.append(path.read_text(encoding="utf-8"))
     if command is None:
@@ -418,6 +446,8 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
         raise ScenarioError("batch: a scenario file is listed twice")
     spec = {"files": [str(p) for p in paths], "command": command, "seeds": seeds,
             "seed_start": seed_start, "metrics": list(metrics or batchable()[command])}
+    if sets:
+        spec["set"] = dict(sets)
     stems = [p.name.split(".")[0] for p in paths]
     name = "+".join(stems) if len(stems) <= 3 else f"{stems[0]}+{len(stems) - 1}-more"
     # The checks of seeds, seed_start and metrics are the sweep's (one variant: file 1).

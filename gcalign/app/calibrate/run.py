@@ -346,12 +346,27 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     six, in the summary's order)."""
     from gcalign.app.calibrate.hdf5 import write_calibration
 
+    if progress is not None:
+        progress(0, 1, "simulating / reading the data")
     case = scenario_case(sc, seed, cache_key)
+    if progress is not None and not compare:
+        progress(0, 1, "filter run")
     runs = (compare_runs(case, config_of(sc).conventional_segments, progress) if compare
             else [run_filter(case)])
+    if progress is not None and not compare:
+        progress(1, 1, "filter run")
     out = summary(sc, case, runs, compare)
     from gcalign.app.at_rest import zero_velocity_warnings  # a moving recording under ZUPT
 
     result = tuple(r.result for r in runs) if compare else runs[0].result
+    warnings = (*zero_velocity_warnings(sc, case, out), *filter_warnings(runs, compare))
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),
-                   case.seed, tuple(zero_velocity_warnings(sc, case, out)), result=result)
+                   case.seed, warnings, result=result)
+
+
+def filter_warnings(runs: list[Run], compare: bool) -> tuple[str, ...]:
+    """The core's consistency checks of each run (:mod:`gcalign.calibrate.health`)."""
+    from gcalign.calibrate.health import health_warnings
+
+    return tuple(w for r in runs for w in health_warnings(
+        r.result, f"{r.label} {r.result.settings.measure}: " if compare else ""))

@@ -37,7 +37,7 @@ from gcalign.modulate.linear import REPORT_HOURS, LinearErrors
 from gcalign.modulate.terms import ErrorTerms
 from gcalign.units import ARCSEC, DPH, DPSH, HOUR, PPM, UG, UGPSHZ
 
-Progress = Callable[[str, int, int], None]  # (scheme, index, count)
+Progress = Callable[[float, float, str], None]  # (done, total, what)
 
 
 def hour_key(h: float) -> str:
@@ -190,17 +190,19 @@ def linear_summary(lin: LinearErrors, hours: list[float]) -> dict:
 
 
 def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group: Any = None,
-               linear: bool = True) -> tuple[dict, SchemeAnalysis]:
+               linear: bool = True, progress: Progress | None = None
+               ) -> tuple[dict, SchemeAnalysis]:
     """Navigate one scheme and analyse it (:func:`gcalign.modulate.analyse_scheme`); its
     summary and the analysis. `group`: an h5py group for the series, the invariants, the
-    mechanism cycle and the linear model."""
+    mechanism cycle and the linear model; `progress(done_s, total_s, what)` hears of every
+    block navigated."""
     from gcalign.app.modulate.hdf5 import write_scheme
 
     hours = report_hours(plan.hours)
     v = variant(sc, entry, plan)
     _stride_checked(v, [h for h in hours if h in REPORT_HOURS])  # the last: its final row
     probe = HourProbe(hours)
-    nav, stream = run_navigation(v, seed, None, group, on_rows=probe)
+    nav, stream = run_navigation(v, seed, None, group, on_rows=probe, progress=progress)
     terms = error_terms(sc, entry)
     assert sc.site is not None and sc.motion is not None
     static = linear and sc.motion.kind == "static"
@@ -268,7 +270,8 @@ def run_modulate(sc: Scenario, seed: int | None = None, sink: Any = None,
                  progress: Progress | None = None
                  ) -> tuple[dict, tuple[str, ...], dict[str, SchemeAnalysis]]:
     """Every scheme of the plan; the summary (plain numbers), the warnings and the analysis
-    of each scheme by name."""
+    of each scheme by name. `progress(done_s, total_s, what)` hears of every block of every
+    scheme (one stage per scheme)."""
     t0 = time.perf_counter()
     plan = plan_of(sc)
     cfg = sc.modulate
@@ -277,11 +280,13 @@ def run_modulate(sc: Scenario, seed: int | None = None, sink: Any = None,
     schemes: dict[str, dict] = {}
     analyses: dict[str, SchemeAnalysis] = {}
     warnings: list[str] = []
+    n = len(plan.entries)
     for i, entry in enumerate(plan.entries):
-        if progress is not None:
-            progress(entry.name, i, len(plan.entries))
         group = None if root is None else root.create_group(entry.name)
-        r, analyses[entry.name] = run_scheme(sc, entry, plan, seed, group, linear)
+        what = f"{entry.name} ({i + 1}/{n}, data s)" if n > 1 else f"{entry.name} (data s)"
+        stage = None if progress is None else (
+            lambda done, total, _, p=progress, w=what: p(done, total, w))
+        r, analyses[entry.name] = run_scheme(sc, entry, plan, seed, group, linear, stage)
         schemes[entry.name] = r
         warnings += [f"{entry.name}: {w}" for w in r["schuler_warnings"]]
     assert sc.site is not None and sc.motion is not None

@@ -327,4 +327,15 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None, sink=None
     the decimated series go into its /navigate group as they are computed."""
     group = None if sink is None else sink.create_group("navigate")
     summary, stream, nav = _run(sc, seed, init, group, None, progress)
-    return Outcome(summary, lambda f: None, None, stream.seed, result=nav)
+    warnings = duration_warnings(sc, summary, stream.ts)
+    return Outcome(summary, lambda f: None, None, stream.seed, warnings, result=nav)
+
+
+def duration_warnings(sc: Scenario, summary: dict, ts: float) -> tuple[str, ...]:
+    """A requested ``navigation.duration_s`` the data cannot give: said, not cut quietly."""
+    asked = (sc.navigation or NavigationConfig()).duration_s
+    ran = summary["duration_s"]
+    if asked is None or asked <= ran + ts / 2:
+        return ()
+    return (f"navigation.duration_s: {asked:g} s runs past the end of the data: ran {ran:g} s "
+            f"(from {summary['start_s']:g} s)",)

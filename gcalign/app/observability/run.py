@@ -11,6 +11,7 @@ ranks, the null-space condition of seed eq. (12), and the covariance degree σ(0
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import numpy as np
 
@@ -51,13 +52,17 @@ def flight_truth(sc: Scenario,
     return traj, motion_spans(sc.motion.to_motion(), float(traj.t[-1]))
 
 
-def run_table(sc: Scenario, cache_key: str | None = None
+def run_table(sc: Scenario, cache_key: str | None = None, progress: Any = None
               ) -> tuple[ObservabilityTable, Trajectory, tuple[Span, ...], float]:
     """``(table, trajectory, spans, compute_s)``: the table's own time, without the
-    simulation."""
+    simulation. `progress(done, total, what)` hears of the two stages."""
     cfg = sc.observability or ObservabilityConfig()
     cfg.check(sc)
+    if progress is not None:
+        progress(0, 1, "simulating the flight")
     traj, spans = flight_truth(sc, cache_key)
+    if progress is not None:
+        progress(0, 1, "PWCS + SVD table")
     cal = sc.calibrate or CalibrateConfig()
     settings = cal.settings(traj.pos[0], traj.earth)
     warm_up()
@@ -65,6 +70,8 @@ def run_table(sc: Scenario, cache_key: str | None = None
     options = ObservabilitySettings(cfg.measure, cfg.scaling, cfg.rank_rtol, cfg.piece_s,
                                     cfg.null_tol, cfg.covariance)
     tab = observability(traj, spans, options, settings)
+    if progress is not None:
+        progress(1, 1, "PWCS + SVD table")
     return tab, traj, spans, time.perf_counter() - t0
 
 
@@ -110,12 +117,13 @@ def summary(sc: Scenario, tab: ObservabilityTable, spans: tuple[Span, ...],
     }
 
 
-def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Outcome:
+def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+            progress: Any = None) -> Outcome:
     """The table of the scenario's flight; the registry's entry point (no randomness: the
     seed only names the run)."""
     from gcalign.app.observability.hdf5 import write_observability
 
-    tab, traj, spans, compute_s = run_table(sc, cache_key)
+    tab, traj, spans, compute_s = run_table(sc, cache_key, progress)
     truth = sampled_truth(traj, spans)
     return Outcome(summary(sc, tab, spans, compute_s),
                    lambda f: write_observability(f, tab, truth, spans), truth, None, result=tab)
