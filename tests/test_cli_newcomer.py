@@ -151,7 +151,7 @@ def test_navigate_takes_a_recording_given_alone(tmp_path):
                               "-o", str(out), "--json"])
     assert res.exit_code == 0, res.output
     s = __import__("json").loads(res.stdout)
-    assert s["duration_s"] == 2 and s["init"] == "header" and out.is_file()
+    assert s["duration_s"] == 2 and s["init"] == "the file's header" and out.is_file()
     none = runner.invoke(app, ["navigate"])
     assert none.exit_code == 2
     assert none.stderr.strip() == ("error: navigate: give a scenario or a data file "
