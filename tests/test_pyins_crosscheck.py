@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from lazy import lazy_module
 from test_strapdown import (
     horizontal_error_m,

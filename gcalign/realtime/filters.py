@@ -27,6 +27,7 @@ pieces with the same numbers as in one piece (tested).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 
@@ -44,7 +45,7 @@ __all__ = [
 ]
 
 
-def _signal():
+def _signal() -> ModuleType:
     """scipy.signal, imported when a filter is designed or run (not at start-up)."""
     from scipy import signal
 
