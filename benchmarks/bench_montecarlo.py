@@ -34,9 +34,10 @@ def cpu() -> float:
 
 def main() -> None:
     from gcalign.align import kernel as AK
-    from gcalign.align.cycles import run_passes
+    from gcalign.align.cycles import Block, run_passes
+    from gcalign.align.gyrocompass import timeline
     from gcalign.app import batch as B
-    from gcalign.app.align.run import AlignConfig, _index, collect
+    from gcalign.app.align.run import AlignConfig, collect, settings_of
     from gcalign.app.data import scenario_data, stream_of
     from gcalign.nav.rotation import euler_to_quat
 
@@ -56,13 +57,16 @@ def main() -> None:
         sc = B.runs._scenario(task)
         cfg = sc.align or AlignConfig()
         stream = stream_of(scenario_data(sc, task["seed"], B.runs.noise_free_key(sc)))
-        i1, i2 = _index(stream, cfg, cfg.t1_s, "t1_s"), _index(stream, cfg, cfg.t2_s, "t2_s")
-        data = collect(stream, cfg, i1, i2, lambda k: k == i1)
-        block = data.block(i1, i2)
-        state0 = AK.new_state(euler_to_quat(data.att_at(i1)), np.zeros(2), data.pos_t1)
-        poles = cfg.poles_for(sc.motion.kind if sc.motion else None)
-        return lambda: run_passes(state0, block, cfg.mode, cfg.pass_count, cfg.stage_list(),
-                                  poles, cfg.level_phase_s, data.earth)
+        settings = settings_of(cfg, sc.motion.kind if sc.motion else None)
+        tl = timeline(settings, stream.ts, stream.samples)
+        w = collect(stream, tl, cfg.aiding)
+        i, j = tl.i1 - tl.lo, tl.i2 - tl.lo
+        block = Block(t=np.arange(tl.i1, tl.i2 + 1) * stream.ts, dtheta=w.dtheta[i:j],
+                      dv=w.dv[i:j], vref=w.vref[i:j + 1], vref_body=False, ts=stream.ts)
+        state0 = AK.new_state(euler_to_quat(w.truth_att[i]), w.vref[i], w.pos_t1)
+        return lambda: run_passes(state0, block, settings.mode, settings.pass_count,
+                                  list(settings.stages), settings.azimuth_poles,
+                                  settings.level_phase_s, stream.earth)
 
     rec = B.run_task(tasks[0])  # warm-up: JIT cache, imports, the noise-free simulation
     assert rec["status"] == "ok", rec

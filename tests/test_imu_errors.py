@@ -248,6 +248,35 @@ def test_gyro_noise_drawn_before_accel():
     np.testing.assert_allclose(a.dv, expected, rtol=0, atol=1e-16)
 
 
+@pytest.mark.parametrize("gyro_noisy", [True, False])
+def test_error_stream_same_bits_whole_run_blocks_or_private(gyro_noisy):
+    """One block or many, a private generator or the caller's: the same measured bits; a
+    caller's generator ends where the gyro's draws left it (3N normals on)."""
+    from gcalign.sim.errors import ErrorStream
+
+    ideal = constant_block(2500)
+    errs = ImuErrors(GYRO if gyro_noisy else SensorErrors(bias=GYRO.bias), ACCEL)
+    n = len(ideal)
+
+    def run(private: bool, block: int, rng: np.random.Generator):
+        s = ErrorStream(errs, TS, rng, n, private=private)
+        parts = [s.apply(ideal.dtheta[k:k + block], ideal.dv[k:k + block])
+                 for k in range(0, n, block)]
+        return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+    ref = run(False, n, np.random.default_rng(9))
+    for private, block in ((True, n), (True, 700), (False, 700)):
+        got = run(private, block, np.random.default_rng(9))
+        assert np.array_equal(got[0], ref[0]) and np.array_equal(got[1], ref[1])
+    caller, fresh = np.random.default_rng(9), np.random.default_rng(9)
+    run(False, n, caller)
+    if gyro_noisy:
+        fresh.standard_normal(3 * n)
+    else:  # the accelerometer skipped the gyro's 3N and drew its own 3N
+        fresh.standard_normal(6 * n)
+    assert caller.standard_normal() == fresh.standard_normal()
+
+
 # ---------------------------------------------------------------- units through the config
 
 

@@ -9,11 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from lazy import lazy_module
 from typer.testing import CliRunner
 
-from gcalign.app import plots
 from gcalign.cli import app
 from gcalign.io import results
+
+plots = lazy_module("gcalign.app.plots")  # matplotlib: imported when a test runs
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()

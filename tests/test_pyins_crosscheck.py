@@ -41,19 +41,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-pytest.importorskip("pyins")
-
-import pyins_ref as pr  # noqa: E402  (after the importorskip guard)
-from test_strapdown import (  # noqa: E402
+from lazy import lazy_module
+from test_strapdown import (
     horizontal_error_m,
     scenario,
     true_start,
 )
 
-from gcalign.nav import earth  # noqa: E402
-from gcalign.nav.rotation import euler_to_dcm, misalignment, quat_to_dcm  # noqa: E402
-from gcalign.nav.strapdown import navigate  # noqa: E402
+from gcalign.nav import earth
+from gcalign.nav.rotation import euler_to_dcm, misalignment, quat_to_dcm
+from gcalign.nav.strapdown import navigate
+
+lazy_module("pyins")  # skips this module if pyins is missing
+pr = lazy_module("pyins_ref")  # pyins, pandas, scipy: imported when a test runs
 
 _RUNS: dict = {}
 

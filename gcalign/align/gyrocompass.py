@@ -462,8 +462,11 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
     def block(a: int, b: int) -> Block:
         """Increments a .. b-1 and the reference at samples a .. b, as the passes take them."""
         i, j = a - lo, b - lo
-        return Block(t=t0 + np.arange(a, b + 1) * ts, dtheta=dth[i:j], dv=dvb[i:j],
-                     vref=ref[i:j + 1], vref_body=vref_body, ts=ts)
+        t = np.arange(a, b + 1, dtype=float)  # t0 + k·ts in place: one array of the window
+        t *= ts
+        t += t0
+        return Block(t=t, dtheta=dth[i:j], dv=dvb[i:j], vref=ref[i:j + 1],
+                     vref_body=vref_body, ts=ts)
 
     records, q2, q3, i3, compute = _passes(settings, K.new_state(q1, v1, pos1), tl, block,
                                            t0, ts, earth, stride)

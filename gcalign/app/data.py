@@ -21,7 +21,7 @@ from gcalign.errors import ScenarioError
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario import Scenario
 from gcalign.nav.earth import WGS84, EarthModel
-from gcalign.nav.rotation import dcm_to_quat, euler_to_quat
+from gcalign.nav.rotation import dcm_to_quat
 from gcalign.sim.errors import ErrorStream
 from gcalign.sim.imu import ImuData
 from gcalign.sim.motions import Moving, Truth, sample_count
@@ -40,11 +40,12 @@ class RunData:
 
 @dataclass(frozen=True)
 class BlockTruth:
-    """The truth at the end times of a block's increments: att (n, 3), q_nb (n, 4), v_n,
-    pos (n, 3) and the motion segment of each increment (n,)."""
+    """The truth at the end times of a block's increments: att (n, 3), q_nb (n, 4) or None
+    (then whoever needs it computes ``euler_to_quat(att)``), v_n, pos (n, 3) and the motion
+    segment of each increment (n,)."""
 
     att: np.ndarray
-    q_nb: np.ndarray
+    q_nb: np.ndarray | None
     v_n: np.ndarray
     pos: np.ndarray
     segment: np.ndarray
@@ -107,6 +108,8 @@ def check_finite_block(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray) -> Non
     from gcalign.io.imu_files import MAX_DTHETA_RAD, MAX_DV_MPS
 
     for name, a, bound in (("gyro", dtheta, MAX_DTHETA_RAD), ("accel", dv, MAX_DV_MPS)):
+        if np.abs(a).max(initial=0.0) <= bound:  # NaN propagates: False
+            continue
         ok = (np.abs(a) <= bound).all(1)  # False for NaN too
         if not ok.all():
             k = int(np.argmin(ok))
@@ -195,7 +198,7 @@ def scenario_stream(scenario: Scenario, seed: int | None = None,
     errors = scenario.imu.errors()
 
     def simulated_blocks() -> Iterator[DataBlock]:
-        stream = ErrorStream(errors, ts, np.random.default_rng(seed), n)
+        stream = ErrorStream(errors, ts, np.random.default_rng(seed), n, private=True)
         for b in ideal_blocks(motion, site, ts, earth, mech, block=block):
             dtheta, dv = stream.apply(b.dtheta, b.dv)
             check_finite_block(b.t, dtheta, dv)
@@ -234,8 +237,7 @@ def stream_of(data: RunData, earth: EarthModel | None = None,
             if truth is not None:
                 seg = (np.zeros(len(imu.t[sl]), np.int64) if truth.segment is None
                        else truth.segment[1:][sl])
-                att = truth.att[1:][sl]
-                tr = BlockTruth(att, euler_to_quat(att), truth.v_n[1:][sl], truth.pos[1:][sl],
+                tr = BlockTruth(truth.att[1:][sl], None, truth.v_n[1:][sl], truth.pos[1:][sl],
                                 seg)
             yield DataBlock(k0, imu.t[sl], imu.dtheta[sl], imu.dv[sl], tr,
                             None if imu.q_bs is None else imu.q_bs[sl])
@@ -322,7 +324,7 @@ def with_errors(scenario: Scenario, ideal: RunData, seed: int | None = None) -> 
     """The scenario's sensor errors applied to noise-free data; `seed` overrides imu.seed."""
     seed = scenario.imu.seed if seed is None else seed
     stream = ErrorStream(scenario.imu.errors(), ideal.imu.ts, np.random.default_rng(seed),
-                         len(ideal.imu))
+                         len(ideal.imu), private=True)
     dtheta, dv = stream.apply(ideal.imu.dtheta, ideal.imu.dv)
     check_finite_block(ideal.imu.t, dtheta, dv)
     return RunData(imu=replace(ideal.imu, dtheta=dtheta, dv=dv), truth=ideal.truth,

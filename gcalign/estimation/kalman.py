@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.linalg import expm
 
 
 def van_loan(F: np.ndarray, G: np.ndarray, Qc: np.ndarray,
@@ -27,6 +26,8 @@ def van_loan(F: np.ndarray, G: np.ndarray, Qc: np.ndarray,
     ``expm([[−F, G Qc Gᵀ], [0, Fᵀ]] dt) = [[·, Φ⁻¹ Q_d], [0, Φᵀ]]`` gives
     ``Φ = e^{F dt}`` and ``Q_d = ∫₀^dt e^{F s} G Qc Gᵀ e^{Fᵀ s} ds``. Returns ``(Φ, Q_d)``.
     """
+    from scipy.linalg import expm  # scipy.linalg only where used (start-up)
+
     F = np.asarray(F, dtype=float)
     n = F.shape[0]
     GQG = np.asarray(G, dtype=float) @ np.asarray(Qc, dtype=float) @ np.asarray(G, dtype=float).T

@@ -27,9 +27,9 @@ pieces with the same numbers as in one piece (tested).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
-from scipy import signal
 
 from gcalign.realtime.settings import FilterSettings
 
@@ -45,13 +45,20 @@ __all__ = [
 ]
 
 
+def _signal() -> ModuleType:
+    """scipy.signal, imported when a filter is designed or run (not at start-up)."""
+    from scipy import signal
+
+    return signal
+
+
 def design_fir(order: int, cutoff_hz: float, fs: float, window: str = "hamming") -> np.ndarray:
     """Linear-phase FIR low-pass of `order` N (N + 1 taps), unit DC gain (``Σh = 1``).
 
     ``scipy.signal.firwin(N + 1, cutoff, window, fs)`` (windowed sinc; scaled so the DC
     gain is 1, which a rate or an increment stream needs to keep its mean). Shape (N + 1,).
     """
-    h = signal.firwin(order + 1, cutoff_hz, window=window, fs=fs)
+    h = _signal().firwin(order + 1, cutoff_hz, window=window, fs=fs)
     return h / h.sum()
 
 
@@ -61,7 +68,7 @@ def design_notch(f0_hz: float, q: float, fs: float) -> tuple[np.ndarray, np.ndar
     Returns ``(b, a)``, each shape (3,); ``b = g [1, −2 cos w0, 1]``, ``a = [1, a1, a2]``,
     unit gain at DC.
     """
-    b, a = signal.iirnotch(f0_hz, q, fs=fs)
+    b, a = _signal().iirnotch(f0_hz, q, fs=fs)
     return np.asarray(b, dtype=float), np.asarray(a, dtype=float)
 
 
@@ -134,17 +141,17 @@ class FilterChain:
     def group_delay(self, freqs_hz: np.ndarray) -> np.ndarray:
         """Group delay of the chain (s) at `freqs_hz` (``scipy.signal.group_delay``), (F,)."""
         f = np.asarray(freqs_hz, dtype=float)
-        _, gd = signal.group_delay((self.h, [1.0]), w=f, fs=self.fs)
+        _, gd = _signal().group_delay((self.h, [1.0]), w=f, fs=self.fs)
         if self.notch_ba is not None:
-            gd = gd + signal.group_delay(self.notch_ba, w=f, fs=self.fs)[1]
+            gd = gd + _signal().group_delay(self.notch_ba, w=f, fs=self.fs)[1]
         return gd / self.fs
 
     def response(self, freqs_hz: np.ndarray) -> np.ndarray:
         """Complex frequency response of the chain at `freqs_hz`, (F,)."""
         f = np.asarray(freqs_hz, dtype=float)
-        H = signal.freqz(self.h, [1.0], worN=f, fs=self.fs)[1]
+        H = _signal().freqz(self.h, [1.0], worN=f, fs=self.fs)[1]
         if self.notch_ba is not None:
-            H = H * signal.freqz(*self.notch_ba, worN=f, fs=self.fs)[1]
+            H = H * _signal().freqz(*self.notch_ba, worN=f, fs=self.fs)[1]
         return H
 
     def initial_state(self, channels: int = 1, x0: float | np.ndarray = 0.0) -> ChainState:
@@ -156,7 +163,7 @@ class FilterChain:
         x0 = np.broadcast_to(np.asarray(x0, dtype=float), (channels,))
         notch = None
         if self.notch_ba is not None:
-            notch = signal.lfilter_zi(*self.notch_ba)[:, None] * x0[None, :]
+            notch = _signal().lfilter_zi(*self.notch_ba)[:, None] * x0[None, :]
         return ChainState(notch=notch, fir=np.tile(x0, (self.order, 1)))
 
     def apply(self, x: np.ndarray, state: ChainState) -> tuple[np.ndarray, ChainState]:
@@ -164,7 +171,7 @@ class FilterChain:
         x = np.asarray(x, dtype=float)
         zn = state.notch
         if self.notch_ba is not None:
-            x, zn = signal.lfilter(*self.notch_ba, x, axis=0, zi=zn)
+            x, zn = _signal().lfilter(*self.notch_ba, x, axis=0, zi=zn)
         # FIR y_i = Σ_k h_k x_{i−k} over the carried inputs and this chunk (direct
         # convolution per channel: lfilter's FIR path loops over channels in Python)
         buf = np.concatenate([state.fir, x])

@@ -43,7 +43,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import solve_discrete_are
 
 from gcalign.estimation.kalman import predict as kf_predict
 from gcalign.estimation.kalman import update as kf_update
@@ -158,6 +157,8 @@ def steady_state(model: TrackerModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
     by ``D = diag(1, τ, τ²)`` and the result polished by iterating the Riccati map (a
     contraction at the steady state) until it no longer changes.
     """
+    from scipy.linalg import solve_discrete_are  # scipy.linalg only where used (start-up)
+
     d = np.array([1.0, model.tau, model.tau**2]) / math.sqrt(model.R)
     D = np.diag(d)
     Phi_s, Q_s = D @ model.Phi @ np.linalg.inv(D), D @ model.Qd @ D

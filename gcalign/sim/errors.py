@@ -75,9 +75,9 @@ class _Channel:
         err = self.err
         out = ideal + self.bias_ts if self.unit else ideal @ self.M + self.bias_ts
         if self.asym is not None:
-            out = out + self.asym * np.abs(ideal)
+            out += self.asym * np.abs(ideal)
         if self.rng is not None:
-            out = out + self.rng.standard_normal(ideal.shape) * self.sigma
+            out += self.rng.standard_normal(ideal.shape) * self.sigma
         if err.quantum > 0:
             # Quantise the running sum, then difference it (the remainder is kept).
             run = np.cumsum(np.concatenate([self.running[None], out]), axis=0)[1:]
@@ -91,23 +91,41 @@ class ErrorStream:
     """Applies :class:`ImuErrors` to consecutive blocks of ideal increments.
 
     `samples` is the run's total length N: the accelerometer noise stream starts after
-    the 3N gyro normals of `rng` (see the module docstring).
+    the 3N gyro normals of `rng` (see the module docstring). It is positioned at the first
+    block. `private`: nothing else draws from `rng` afterwards, so if the gyro has drawn all
+    3N by then (the whole run in one block), the accelerometer continues the gyro's
+    generator instead of skipping 3N normals on a copy of it (same numbers; a caller's
+    generator otherwise ends where the gyro left it).
     """
 
-    def __init__(self, errors: ImuErrors, ts: float, rng: np.random.Generator, samples: int):
-        g_rng = a_rng = None
-        if errors.gyro.noisy:
-            g_rng = rng
-        if errors.accel.noisy:
-            a_rng = copy.deepcopy(rng) if g_rng is not None else rng
-            left = 3 * samples
-            while left > 0:  # skip the gyro part of the stream
-                k = min(left, _SKIP_BLOCK)
-                a_rng.standard_normal(k)
-                left -= k
+    def __init__(self, errors: ImuErrors, ts: float, rng: np.random.Generator, samples: int,
+                 private: bool = False):
+        g_rng = rng if errors.gyro.noisy else None
+        self._samples, self._private = samples, private
+        # the generator at the start of the run, for the accelerometer to skip from
+        self._a_start = None if not errors.accel.noisy else (
+            copy.deepcopy(rng) if g_rng is not None else rng)
+        self._g_drawn = 0  # gyro normals drawn so far
         self.gyro = _Channel(errors.gyro, ts, g_rng)
-        self.accel = _Channel(errors.accel, ts, a_rng)
+        self.accel = _Channel(errors.accel, ts, None)
+
+    def _accel_rng(self) -> np.random.Generator:
+        """The accelerometer's generator, 3N normals after the start of the run."""
+        assert self._a_start is not None
+        if self._private and self.gyro.rng is not None and self._g_drawn == 3 * self._samples:
+            return self.gyro.rng  # the gyro's draws were the skip; it draws no more
+        a_rng, left = self._a_start, 3 * self._samples
+        while left > 0:  # skip the gyro part of the stream
+            k = min(left, _SKIP_BLOCK)
+            a_rng.standard_normal(k)
+            left -= k
+        return a_rng
 
     def apply(self, dtheta: np.ndarray, dv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Measured (dtheta, dv) of the next block."""
-        return self.gyro.apply(dtheta), self.accel.apply(dv)
+        gyro = self.gyro.apply(dtheta)
+        if self.gyro.rng is not None:
+            self._g_drawn += dtheta.size
+        if self._a_start is not None:
+            self.accel.rng, self._a_start = self._accel_rng(), None
+        return gyro, self.accel.apply(dv)

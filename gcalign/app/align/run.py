@@ -27,7 +27,7 @@ from gcalign.errors import InputError, ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import Aiding, AlignConfig
 from gcalign.nav.earth import EarthModel
-from gcalign.nav.rotation import euler_to_dcm, quat_to_euler
+from gcalign.nav.rotation import quat_to_euler
 from gcalign.units import angle_text
 
 Progress = Callable[[float, float, str], None]
@@ -63,20 +63,26 @@ class Window:
     pos_t1: np.ndarray
 
 
-def _reference(aiding: Aiding, att, v_n, rng: np.random.Generator, body: bool):
-    """Reference velocity of samples with true attitude att and velocity v_n (n, 3).
+def _reference(aiding: Aiding, att, v_n, rng: np.random.Generator, body: bool,
+               rows: slice) -> np.ndarray:
+    """Reference velocity at `rows` of samples with true attitude att and velocity v_n
+    (n, 3): (m, 3) ENU, or for an odometer the forward speed (m,).
 
     nav: the true ENU velocity plus white noise. odometer: the body-frame forward speed
     plus white noise (seed §1: converted to the navigation frame with the computed attitude
-    inside the loop). The noise of successive blocks continues one stream.
+    inside the loop). The noise of successive blocks continues one stream: it is drawn for
+    all n samples, whichever rows are kept.
     """
     noise = aiding.noise_mps
     if not body:
-        return v_n + noise * rng.standard_normal(v_n.shape)
-    speed = np.einsum("kji,kj->ki", euler_to_dcm(att), v_n)[:, 1]
-    speed = speed + noise * rng.standard_normal(len(speed))
-    z = np.zeros_like(speed)
-    return np.stack([z, speed, z], -1)
+        return v_n[rows] + noise * rng.standard_normal(v_n.shape)[rows]
+    white = rng.standard_normal(len(att))[rows]
+    att, v_n = att[rows], v_n[rows]
+    # y of C_bn v_n: column y of C_nb (the terms of euler_to_dcm, summed in einsum's order)
+    sp, cp = np.sin(att[:, 0]), np.cos(att[:, 0])
+    sy, cy = np.sin(att[:, 2]), np.cos(att[:, 2])
+    speed = (-sy * cp) * v_n[:, 0] + (cy * cp) * v_n[:, 1] + sp * v_n[:, 2]
+    return speed + noise * white
 
 
 def collect(stream: Stream, tl: Timeline, aiding: Aiding,
@@ -108,14 +114,19 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
     def take(k0: int, att, v_n, pos) -> None:
         """Truth rows of samples k0 .. k0+len-1: reference velocity, attitude, pos at T1."""
         nonlocal pos_t1
-        k = k0 + np.arange(len(att))
-        sel = (k >= lo) & (k <= hi)
+        n = len(att)
+        a, c = max(lo - k0, 0), min(hi - k0 + 1, n)  # the block's rows of samples lo .. hi
+        rows, out = slice(a, max(a, c)), slice(k0 + a - lo, k0 + max(a, c) - lo)
         if source != "none":
-            vref[k[sel] - lo] = _reference(aiding, att, v_n, rng, body)[sel]
+            ref = _reference(aiding, att, v_n, rng, body, rows)
+            if body:
+                vref[out, 1] = ref  # an odometer measures along the body's y axis only
+            else:
+                vref[out] = ref
         assert truth_att is not None
-        truth_att[k[sel] - lo] = att[sel]
-        if k[0] <= i1 <= k[-1]:
-            pos_t1 = pos[i1 - k[0]].copy()
+        truth_att[out] = att[rows]
+        if k0 <= i1 <= k0 + n - 1:
+            pos_t1 = pos[i1 - k0].copy()
 
     if stream.truth0 is not None:
         tr0 = stream.truth0

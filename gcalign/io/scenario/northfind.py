@@ -49,7 +49,7 @@ Converted once to :class:`gcalign.northfind.NorthfindSetup` (SI, radians) by
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -58,7 +58,9 @@ from gcalign import limits
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.base import Model
-from gcalign.northfind import NorthfindSetup, tilt_from_pitch_roll
+
+if TYPE_CHECKING:  # the capability loads when a north-finding is set up, not at start-up
+    from gcalign.northfind import NorthfindSetup
 
 MethodName = Literal["coordinate", "vector", "naive", "none", "vector_literal"]
 DEFAULT_METHODS: list[MethodName] = ["coordinate", "vector", "naive", "none"]
@@ -194,6 +196,8 @@ class NorthfindConfig(Model):
     def tilt_rad(self) -> tuple[float, float]:
         """``(tilt ε, tilt direction ζ)`` in rad; ζ relative to `reference`."""
         if self.pitch_deg is not None or self.roll_deg is not None:
+            from gcalign.northfind import tilt_from_pitch_roll
+
             eps, zeta = tilt_from_pitch_roll((self.pitch_deg or 0.0) * u.DEG,
                                              (self.roll_deg or 0.0) * u.DEG)
             return float(eps), float(zeta)
@@ -262,6 +266,8 @@ class NorthfindConfig(Model):
 
     def to_setup(self, sc) -> NorthfindSetup:
         """The SI setup for :func:`gcalign.northfind.run_northfind` (runs :meth:`check`)."""
+        from gcalign.northfind import NorthfindSetup
+
         self.check(sc)
         g, a = sc.imu.gyro, sc.imu.accel
         tilt, direction = self.tilt_rad()

@@ -65,7 +65,7 @@ Converted once to :class:`gcalign.realtime.settings.Settings` and
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -76,7 +76,6 @@ from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, Vec3
 from gcalign.io.scenario.schedule import RowModel
-from gcalign.realtime.cases import Case, check_case
 from gcalign.realtime.settings import (
     FilterSettings,
     PulseSettings,
@@ -86,6 +85,9 @@ from gcalign.realtime.settings import (
     seed_semi_physical,
 )
 from gcalign.sim.schedule import Step
+
+if TYPE_CHECKING:  # the cases module builds seed 003's table at import: where it is used
+    from gcalign.realtime.cases import Case
 
 PredictorName = Literal["none", "taylor", "kalman-ls"]
 DEFAULT_PREDICTORS: list[PredictorName] = ["none", "taylor", "kalman-ls"]  # = core PREDICTORS
@@ -183,6 +185,8 @@ def case_of(name: str, rows: list[RowModel], attitude_deg, duration_s: float | N
             pulses: PulseSettings | None = None, seed_before: str = "",
             seed_after: str = "") -> Case:
     """A core :class:`Case` from validated rows (ValueError names the row)."""
+    from gcalign.realtime.cases import Case
+
     steps: list[Step] = []
     for i, r in enumerate(rows):
         try:
@@ -224,6 +228,8 @@ class RealtimeConfig(Model):
             raise ValueError("pulses: semi_physical: true puts the pulses on every solution "
                              "instant (Δt = 0); remove realtime.pulses (a case may still "
                              "bring its own) or set semi_physical: false")
+        from gcalign.realtime.cases import check_case
+
         settings = self.to_settings()  # the core's checks, one line naming the setting
         for i, c in enumerate(self.cases or ()):
             try:
@@ -287,6 +293,8 @@ class RealtimeConfig(Model):
             if mo.repeat:
                 raise ScenarioError("motion.repeat: a realtime case runs its rows once; "
                                     "allowed: false, got true")
+            from gcalign.realtime.cases import check_case
+
             try:
                 check_case(case_of(sc.name, mo.steps, mo.attitude_deg, mo.duration_s),
                            self.to_settings())
