@@ -104,3 +104,18 @@ def ideal(which: str = "designed"):
 
 def motion(which: str = "designed"):
     return scenario(which).motion.to_motion()
+
+
+def tiny_flight(**calibrate) -> dict:
+    """A 30-second flight scenario (hold, ground roll, a 90° turn, cruise) at 25 Hz, for
+    command-line and health checks that need a flight but not its statistics."""
+    return {
+        "name": "short-flight", "site": {"lat_deg": 38.0, "lon_deg": 121.0},
+        "imu": {"rate_hz": 25, "seed": 2},
+        "motion": {"kind": "flight", "segments": [
+            {"kind": "hold", "duration_s": 10, "name": "static"},
+            {"kind": "accelerate", "accel_mps2": 6.5, "speed_mps": 40, "name": "ground roll"},
+            {"kind": "turn", "rate_dps": 9, "angle_deg": -90, "name": "turn"},
+            {"kind": "hold", "duration_s": 5, "name": "cruise"}]},
+        "calibrate": {"navigation_rate_hz": 25, **calibrate},
+    }

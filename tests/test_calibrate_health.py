@@ -11,21 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from calibrate_cases import tiny_flight
 
 import gcalign
 from gcalign.calibrate.health import health_warnings, mean_nis_band
 
 ROOT = Path(__file__).resolve().parents[1]
-FLIGHT = {
-    "name": "short-flight", "site": {"lat_deg": 38.0, "lon_deg": 121.0},
-    "imu": {"rate_hz": 25, "seed": 2},
-    "motion": {"kind": "flight", "segments": [
-        {"kind": "hold", "duration_s": 10, "name": "static"},
-        {"kind": "accelerate", "accel_mps2": 6.5, "speed_mps": 40, "name": "ground roll"},
-        {"kind": "turn", "rate_dps": 9, "angle_deg": -90, "name": "turn"},
-        {"kind": "hold", "duration_s": 5, "name": "cruise"}]},
-    "calibrate": {"navigation_rate_hz": 25, "measure": "both"},
-}
+FLIGHT = tiny_flight(measure="both")
 
 
 def test_band_of_one_epoch_is_the_chi2_band():

@@ -11,6 +11,7 @@ import time
 import pytest
 import yaml
 from align_cases import small_align
+from calibrate_cases import tiny_flight
 from typer.testing import CliRunner
 
 from gcalign.cli import app
@@ -20,16 +21,7 @@ ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
 STATIC = {"name": "static", "site": {"lat_deg": 45, "lon_deg": 126},
           "motion": {"kind": "static", "duration_s": 20}}
-SHORT_FLIGHT = {
-    "name": "short-flight", "site": {"lat_deg": 38.0, "lon_deg": 121.0},
-    "imu": {"rate_hz": 25, "seed": 2},
-    "motion": {"kind": "flight", "segments": [
-        {"kind": "hold", "duration_s": 10, "name": "static"},
-        {"kind": "accelerate", "accel_mps2": 6.5, "speed_mps": 40, "name": "ground roll"},
-        {"kind": "turn", "rate_dps": 9, "angle_deg": -90, "name": "turn"},
-        {"kind": "hold", "duration_s": 5, "name": "cruise"}]},
-    "calibrate": {"navigation_rate_hz": 25, "conventional_segments": 2},
-}
+SHORT_FLIGHT = tiny_flight(conventional_segments=2)
 NORTHFIND = {"name": "nf", "site": {"lat_deg": 40, "lon_deg": 116, "height_m": 0},
              "imu": {"rate_hz": 100, "seed": 3},
              "northfind": {"positions": 4, "dwell_s": 1, "azimuth_deg": 30}}
