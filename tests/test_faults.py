@@ -516,3 +516,19 @@ def test_results_files_have_ordinary_permissions(tmp_path):
     finally:
         os.umask(mask)
     assert (tmp_path / "r.h5").stat().st_mode & 0o777 == 0o644
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("limit", [30_000, 120_000])
+def test_full_disk_during_modulate_is_exit_1_one_line_and_nothing_kept(tmp_path, limit):
+    """modulate streams its series into the results file as it navigates (its sink): a
+    write refused there (``ulimit -f``) goes through the same guard as every other
+    command's: exit 1, one line naming the file, neither the file nor its temporary."""
+    d = json.loads(json.dumps(F.MODULATE))
+    d["modulate"]["hours"] = 1.0
+    d["output"] = {"rate_hz": 10}
+    (tmp_path / "M.yaml").write_text(F.emit(d))
+    res = cli(["modulate", "M.yaml", "-o", "o.h5"], tmp_path, limit_fsize=limit)
+    assert res.returncode == 1, res.stderr[-2000:]
+    assert "cannot write o.h5: File too large" in one_error_line(res.stderr)
+    assert not (tmp_path / "o.h5").exists() and temps(tmp_path) == []

@@ -160,3 +160,52 @@ def test_messages_name_the_file_row_and_value(name, expected, fuzz_env):
     line = out.stderr.strip()
     assert re.search(expected, line), line
     assert "align.coarse" not in line
+
+
+def _one_line(res) -> str:
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), res.stderr
+    assert "internal error" not in lines[0] and "Traceback" not in res.stderr
+    return lines[0]
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["modulate", "M.yaml", "--dwell", "0"],
+     "modulate.compare: fixed with the mechanism's timing: mechanism.dwell_s: the fixed "
+     "scheme needs a dwell > 0 s"),
+    (["modulate", "M.yaml", "--dwell", "1e-300"],
+     "mechanism.dwell_s: the cycle of fixed lasts 1e-300 s, shorter than 10 IMU samples"),
+    (["realtime", "R.yaml", "--set", "realtime.filter.window=boxcar2"],
+     "realtime.filter.window: 'boxcar2' is not a scipy.signal window"),
+    (["realtime", "R.yaml", "--set", "realtime.filter.nav_cutoff_hz=1e9"],
+     "realtime.filter.nav_cutoff_hz: must lie within (0, fs_hz/2"),
+])
+def test_bad_settings_of_a_run_are_exit_2_naming_the_key_and_validate_agrees(
+        argv, expected, fuzz_env):
+    """Settings that the run's set-up (the scheme's timing, the filter design) would refuse
+    are refused as bad input naming the key, by the run and by validate alike; they were
+    'internal error' (a pydantic dump, NumPy's array limit, scipy's ValueError)."""
+    (fuzz_env / "M.yaml").write_text(F.emit(F.MODULATE))
+    (fuzz_env / "R.yaml").write_text(F.emit(F.REALTIME))
+    res = runner.invoke(app, [*argv, "-o", "out.h5"])
+    assert res.exit_code == 2 and expected in _one_line(res), res.stderr
+    assert not (fuzz_env / "out.h5").exists()
+    check = runner.invoke(app, ["validate", argv[1], *argv[2:]]
+                          if argv[2] == "--set" else ["validate", argv[1], "--set",
+                                                      f"mechanism.dwell_s={argv[3]}"])
+    assert check.exit_code == 2 and expected.split(":")[0] in _one_line(check)
+
+
+def test_a_value_error_of_a_check_is_exit_2_naming_the_section(fuzz_env, monkeypatch):
+    """A check or cost model that meets a value it cannot take (ValueError, TypeError) is bad
+    input of its section, exit 2, not an internal error."""
+    from gcalign.app.modulate import Modulate
+
+    def refuse(self, sc, ext):
+        raise ValueError("period: cannot be negative")
+
+    monkeypatch.setattr(Modulate, "check", refuse)
+    (fuzz_env / "M.yaml").write_text(F.emit(F.MODULATE))
+    res = runner.invoke(app, ["modulate", "M.yaml", "-o", "out.h5"])
+    assert res.exit_code == 2
+    assert _one_line(res) == "error: modulate: period: cannot be negative"

@@ -87,8 +87,24 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
                             "or 'imu_file' (recorded data)"
                             + ("" if name else ", or a northfind/realtime section"))
     for c in commands:
-        c.check(sc, ext)
-        budget(sc, c, ext)
+        try:
+            c.check(sc, ext)
+            budget(sc, c, ext)
+        except (ValueError, TypeError) as err:  # a settings object refused what it was given
+            raise setup_error(c.section or c.name, err) from None
+
+
+def setup_error(section: str, err: Exception) -> ScenarioError:
+    """A ValueError or TypeError raised while a run is set up from its scenario (settings
+    built, checked, costed; before any computation) as bad input naming the section: one
+    line, exit 2. Pydantic's errors become its one-line-per-field form."""
+    from pydantic import ValidationError
+
+    from gcalign.io.scenario.loader import scenario_errors
+
+    if isinstance(err, ValidationError):
+        return ScenarioError(scenario_errors(err, section))
+    return ScenarioError(f"{section}: {err}")
 
 
 def _commands_of(sc: Scenario) -> list[Command]:

@@ -108,7 +108,29 @@ class FilterConfig(Model):
     align_cutoff_hz: float = 100.0
     notch_hz: float | None = Field(400.0, description="IIR notch (null: none)")
     notch_q: float = Field(10.0, gt=0)
-    window: str = "hamming"
+    window: str = Field("hamming", description="FIR window: a scipy.signal window that takes "
+                        "no parameter (hamming, hann, blackman, boxcar, ...)")
+
+    @model_validator(mode="after")
+    def _designable(self):
+        """What the filter design (scipy.signal) would refuse, refused here by its key."""
+        from scipy import signal
+
+        try:
+            signal.get_window(self.window, 8)
+        except (ValueError, TypeError):
+            raise ValueError(f"window: {self.window!r} is not a scipy.signal window without "
+                             "parameters (hamming, hann, blackman, boxcar, ...)") from None
+        nyquist = self.fs_hz / 2
+        for key in ("nav_cutoff_hz", "align_cutoff_hz", "notch_hz"):
+            v = getattr(self, key)
+            if v is not None and not 0 < v < nyquist:
+                raise ValueError(f"{key}: must lie within (0, fs_hz/2 = {nyquist:g}) Hz, "
+                                 f"got {v:g}")
+        for key in ("nav_order", "align_order"):
+            if getattr(self, key) < 1:
+                raise ValueError(f"{key}: must be at least 1, got {getattr(self, key)}")
+        return self
 
     def to_settings(self) -> FilterSettings:
         return FilterSettings(fs_hz=self.fs_hz, align_order=self.align_order,
