@@ -209,3 +209,75 @@ def test_a_value_error_of_a_check_is_exit_2_naming_the_section(fuzz_env, monkeyp
     res = runner.invoke(app, ["modulate", "M.yaml", "-o", "out.h5"])
     assert res.exit_code == 2
     assert _one_line(res) == "error: modulate: period: cannot be negative"
+
+
+def test_latitude_is_reported_with_the_digits_given(fuzz_env):
+    res = runner.invoke(app, ["align", "--lat", "89.99999", "--lon", "1", "-o", "out.h5"])
+    assert res.exit_code == 2
+    assert "got 89.99999°" in _one_line(res)  # was "got 90.0000°"
+
+
+@pytest.mark.parametrize("given, missing", [("--lat", "--lon"), ("--lon", "--lat")])
+def test_lat_without_lon_is_refused(given, missing, fuzz_env):
+    res = runner.invoke(app, ["align", given, "45", "-o", "out.h5"])
+    assert res.exit_code == 2
+    assert _one_line(res) == (f"error: {missing}: missing beside {given}; give both (and "
+                              "--height if it matters) or neither")
+    assert not (fuzz_env / "out.h5").exists()
+
+
+def test_a_fifo_or_a_symlink_loop_is_named_for_what_it_is(fuzz_env):
+    os.mkfifo(fuzz_env / "pipe.imu")
+    (fuzz_env / "a.imu").symlink_to("b.imu")
+    (fuzz_env / "b.imu").symlink_to("a.imu")
+    for name, what in (("pipe.imu", "is a FIFO (named pipe), expected a regular file"),
+                       ("a.imu", "is a symbolic link loop, expected a file")):
+        for argv in (["navigate", name], ["calibrate", "--imu-file", name],
+                     ["show", name]):
+            res = runner.invoke(app, [*argv, "--lat", "45", "--lon", "126"]
+                                if argv[0] != "show" else argv)
+            assert res.exit_code == 2 and f"{name}: {what}" in _one_line(res), argv
+
+
+def test_navigate_refuses_to_write_over_its_own_input(fuzz_env):
+    (fuzz_env / "S.yaml").write_text(F.emit(F.S))
+    assert runner.invoke(app, ["align", "S.yaml", "-o", "a.h5"]).exit_code == 0
+    before = (fuzz_env / "a.h5").read_bytes()
+    res = runner.invoke(app, ["navigate", "S.yaml", "--init", "a.h5", "-o", "a.h5"])
+    assert res.exit_code == 2
+    assert _one_line(res).startswith("error: --output: a.h5 is --init of this run")
+    assert (fuzz_env / "a.h5").read_bytes() == before
+
+
+def test_numpy_warnings_do_not_print_before_the_error_line(fuzz_env, monkeypatch):
+    """A RuntimeWarning on the way to a refusal (an overflow in a cost estimate, say) would
+    print its lines before the one error line."""
+    import numpy as np
+
+    from gcalign.app.modulate import Modulate
+    from gcalign.errors import ScenarioError
+
+    def overflowing(self, sc, ext):
+        np.float64(1e200) * np.float64(1e200)  # RuntimeWarning: overflow
+        raise ScenarioError("modulate.hours: too long")
+
+    monkeypatch.setattr(Modulate, "check", overflowing)
+    (fuzz_env / "M.yaml").write_text(F.emit(F.MODULATE))
+    res = runner.invoke(app, ["modulate", "M.yaml", "-o", "out.h5"])
+    assert res.exit_code == 2 and _one_line(res) == "error: modulate.hours: too long"
+
+
+def test_the_python_api_refuses_bad_arguments_as_scenario_errors():
+    import gcalign
+    from gcalign.errors import ScenarioError
+
+    sc = gcalign.example("modulate")
+    for call, expected in (
+            (lambda: gcalign.run("calibrate", sc, measure="velocity"),
+             "run: calibrate takes no option 'measure'"),
+            (lambda: gcalign.example("calibrate", [1, 2]), "overrides: must map dotted keys"),
+            (lambda: gcalign.load(5), "load: the scenario must be a file name"),
+            (lambda: gcalign.run("navigate", sc, zz=1), "run: navigate takes no option 'zz'; "
+             "its options: init")):
+        with pytest.raises(ScenarioError, match=expected.replace("(", r"\(")):
+            call()

@@ -28,6 +28,7 @@ from matplotlib.figure import Figure
 
 from gcalign import units
 from gcalign.errors import ScenarioError
+from gcalign.io.paths import not_a_file
 
 ANGLES = ("pitch", "roll", "yaw")
 ENU = ("east", "north", "up")
@@ -226,7 +227,7 @@ def figures_for(path: Path) -> dict[str, Figure]:
 
 def _is_hdf5(path: Path) -> bool:
     if not path.is_file():
-        raise ScenarioError(f"{path}: file not found")
+        raise ScenarioError(f"{path}: {not_a_file(path)}")
     with open(path, "rb") as fh:
         return fh.read(8) == b"\x89HDF\r\n\x1a\n"
 

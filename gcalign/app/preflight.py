@@ -19,7 +19,8 @@ from typing import Any
 from gcalign import limits
 from gcalign.app.command import DOUBLE, Command, Cost, Extent
 from gcalign.app.registry import COMMANDS, Outcome, command
-from gcalign.errors import ScenarioError
+from gcalign.errors import GcalignError, ScenarioError
+from gcalign.io.paths import not_a_file
 from gcalign.io.scenario import Scenario
 
 __all__ = ["Extent", "budget", "check_seed", "checked_execute", "extent", "preflight",
@@ -38,7 +39,7 @@ def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
     if sc.imu_file is not None:
         if not read_recorded:
             if not sc.imu_file.is_file():
-                raise ScenarioError(f"imu_file: {sc.imu_file}: file not found")
+                raise ScenarioError(f"imu_file: {sc.imu_file}: {not_a_file(sc.imu_file)}")
             return None
         ext = _recorded_extent(Path(sc.imu_file), sc.recording_layout())
         if sc.site is None and ext.lat is None:
@@ -90,6 +91,8 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
         try:
             c.check(sc, ext)
             budget(sc, c, ext)
+        except GcalignError:
+            raise
         except (ValueError, TypeError) as err:  # a settings object refused what it was given
             raise setup_error(c.section or c.name, err) from None
 

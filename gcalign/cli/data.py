@@ -15,7 +15,9 @@ from gcalign.app.report import kv_table, summary_table, with_warnings
 from gcalign.cli import app, consoles, emit_json, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
+from gcalign.errors import ScenarioError
 from gcalign.io import results
+from gcalign.io.paths import not_a_file
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario.resolve import resolved_rows
 
@@ -74,6 +76,13 @@ def navigate(
     start (`final_error` is null in the JSON).
     """
     overrides = {"vertical": vertical, "start_s": start, "duration_s": duration}
+    for what, given in (("--init", init), ("the source", source)):
+        if output is not None and given not in (None, "truth", "header") and \
+                Path(given).resolve() == Path(output).resolve():
+            raise ScenarioError(f"--output: {output} is {what} of this run; write the result "
+                                "under another name (it would replace its own input)")
+    if not source.is_file():
+        raise ScenarioError(f"{source}: {not_a_file(source)}")
     suffix = data_suffix(source)
     data = text = None
     if suffix in DATA_SUFFIXES | HDF5_SUFFIXES:

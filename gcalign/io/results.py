@@ -26,6 +26,7 @@ import numpy as np
 
 from gcalign import __version__
 from gcalign.errors import GcalignError, ScenarioError
+from gcalign.io.paths import not_a_file
 from gcalign.limits import SEED_MAX
 from gcalign.sim.imu import ImuData
 from gcalign.sim.motions import Truth
@@ -408,7 +409,7 @@ def open_results(path: Path) -> h5py.File:
     """Open a gcalign results file for reading; ScenarioError if it is missing or not ours."""
     path = Path(path)
     if not path.is_file():
-        raise ScenarioError(f"{path}: file not found")
+        raise ScenarioError(f"{path}: {not_a_file(path)}")
     try:
         f = h5py.File(path, "r")
     except OSError:
