@@ -203,9 +203,9 @@ def run(command: str, scenario, seed: int | None = None, output: str | Path | No
     if command not in COMMANDS or command == "batch":
         raise ScenarioError(f"run: {command!r} is not a command that runs a scenario; "
                             f"commands: {', '.join(c for c in COMMANDS if c != 'batch')}")
-    from gcalign.io.scenario import Scenario
-
     import inspect
+
+    from gcalign.io.scenario import Scenario
 
     own = [p for p in inspect.signature(COMMANDS[command]._execute()).parameters
            if p not in _RUN_PARAMETERS]
