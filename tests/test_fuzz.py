@@ -281,3 +281,135 @@ def test_the_python_api_refuses_bad_arguments_as_scenario_errors():
              "its options: init")):
         with pytest.raises(ScenarioError, match=expected.replace("(", r"\(")):
             call()
+
+
+@pytest.fixture(scope="module")
+def results_of_kinds(tmp_path_factory):
+    """Small valid results files of the newer commands (and align)."""
+    folder = tmp_path_factory.mktemp("kinds")
+    bases = {"calibrate": F.CALIBRATE, "observability": F.CALIBRATE, "realtime": F.REALTIME,
+             "modulate": F.MODULATE, "align": F.S}
+    here = os.getcwd()
+    os.chdir(folder)
+    try:
+        for kind, data in bases.items():
+            (folder / f"{kind}.yaml").write_text(F.emit(data))
+            res = runner.invoke(app, [kind, f"{kind}.yaml", "-o", f"{kind}.h5"])
+            assert res.exit_code == 0, res.stderr
+    finally:
+        os.chdir(here)
+    return folder
+
+
+def _first_series(f, kind: str) -> str:
+    import h5py
+
+    names: list[str] = []
+    f[kind].visititems(lambda n, o: names.append(o.name) if isinstance(o, h5py.Dataset)
+                       and o.dtype.kind == "f" and o.size > 3 and not o.is_scale
+                       and o.name.rsplit("/", 1)[-1] not in ("t", "t0", "t1") else None)
+    return names[0]
+
+
+def _first_time(f, kind: str) -> str:
+    import h5py
+
+    names: list[str] = []
+    f[kind].visititems(lambda n, o: names.append(o.name) if isinstance(o, h5py.Dataset)
+                       and o.name.rsplit("/", 1)[-1] in ("t", "t0") and o.size > 2 else None)
+    return names[0]
+
+
+def _damage(kind: str, how: str):
+    import numpy as np
+
+    def zeros3(f):
+        name = _first_series(f, kind)
+        del f[name]
+        f[name] = np.zeros(3)
+        return name
+
+    def strings(f):
+        name = _first_series(f, kind)
+        units = f[name].attrs["units"]
+        del f[name]
+        f[name] = np.array([b"a", b"b"])
+        f[name].attrs["units"] = units
+        return name
+
+    def nan(f):
+        name = _first_series(f, kind)
+        a = f[name][()]
+        a.flat[1] = np.nan
+        f[name][...] = a
+        return name
+
+    def zeroed_time(f):
+        name = _first_time(f, kind)
+        a = f[name][()]
+        a[len(a) // 2:] = 0.0
+        f[name][...] = a
+        return name
+
+    def no_group(f):
+        del f[kind]
+        return f"/{kind} group"
+
+    def relabelled(f):
+        f.attrs["kind"] = "modulate" if kind != "modulate" else "calibrate"
+        return "/modulate group" if kind != "modulate" else "/calibrate group"
+
+    return {"zeros(3)": zeros3, "strings": strings, "NaN": nan, "zeroed time": zeroed_time,
+            "no group": no_group, "relabelled": relabelled}[how]
+
+
+@pytest.mark.parametrize("how", ["zeros(3)", "strings", "NaN", "zeroed time", "no group",
+                                 "relabelled"])
+@pytest.mark.parametrize("kind", ["calibrate", "observability", "realtime", "modulate",
+                                  "align"])
+def test_damaged_results_files_are_refused_by_plot_show_export_and_init(
+        kind, how, results_of_kinds, fuzz_env):
+    """Each results kind is read through its check (its command's groups present; numbers
+    with units, finite, time not going backwards): plot, show, export and navigate --init
+    refuse a damaged file with one line naming the dataset or the group, exit 2. They were
+    internal errors, or (a missing or relabelled group) exit 0 with only the trajectory."""
+    import shutil
+
+    import h5py
+
+    shutil.copy(results_of_kinds / f"{kind}.h5", fuzz_env / "d.h5")
+    with h5py.File(fuzz_env / "d.h5", "a") as f:
+        where = _damage(kind, how)(f)
+    for argv in (["plot", "d.h5", "-o", "figs"], ["show", "d.h5"], ["export", "d.h5", "--format", "csv"],
+                 ["navigate", "--init", "d.h5", str(results_of_kinds / "align.yaml"),
+                  "-o", "n.h5"]):
+        res = runner.invoke(app, argv)
+        assert res.exit_code == 2, (argv, res.stderr)
+        line = _one_line(res)
+        assert "d.h5" in line and where.split()[0] in line, (argv, line)
+    assert not (fuzz_env / "figs").exists() or not list((fuzz_env / "figs").iterdir())
+    assert not (fuzz_env / "n.h5").exists()
+
+
+def test_plot_interrupted_midway_leaves_no_figure_and_no_temporary_folder(
+        results_of_kinds, fuzz_env, monkeypatch):
+    """plot draws into a temporary folder and renames: a SIGTERM (here raised by the second
+    figure's save) leaves neither a truncated PNG under a figure's name nor the folder."""
+    from matplotlib.figure import Figure
+
+    from gcalign.app import plots
+
+    saved = []
+    real = Figure.savefig
+
+    def savefig(self, p, **kw):
+        if saved:
+            raise KeyboardInterrupt
+        saved.append(p)
+        real(self, p, **kw)
+
+    monkeypatch.setattr(Figure, "savefig", savefig)
+    with pytest.raises(KeyboardInterrupt):
+        plots.plot_file(results_of_kinds / "calibrate.h5", fuzz_env / "figs")
+    assert saved and list((fuzz_env / "figs").iterdir()) == []
+    assert [p.name for p in fuzz_env.iterdir() if p.name != "figs"] == []

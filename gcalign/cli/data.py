@@ -110,7 +110,9 @@ def show(
     as_json: Json = False,
 ):
     """Print the summary of a results file again, from the file alone."""
-    kind, summary, attrs = results.read_summary(file)
+    from gcalign.app.checked import read_checked
+
+    kind, summary, attrs = read_checked(file)
     console = consoles(as_json)
     console.print(summary_table(kind, summary))
     console.print(

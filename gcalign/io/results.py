@@ -468,6 +468,57 @@ def read_summary(path: Path) -> tuple[str, dict, dict]:
     return kind, summary, attrs
 
 
+def check_layout(path: Path, kind: str, groups: tuple[str, ...]) -> None:
+    """The reader check of a results file of `kind`: ScenarioError naming the file and the
+    dataset when a group the kind writes (`groups`, its command's ``layout``; ``/truth`` may
+    be absent) is missing, or a dataset under them is damaged: numbers without their
+    ``units`` attribute (every dataset gcalign writes has one; text has none), text or
+    other types where numbers were written, values that are not finite, a time ``t`` that
+    does not increase (a zeroed chunk)."""
+    with open_results(path) as f:
+        for name in groups:
+            g = f.get(name)
+            if not isinstance(g, h5py.Group):
+                if name == "truth" and g is None:
+                    continue
+                have = ", ".join(k for k in f if isinstance(f[k], h5py.Group)) or "none"
+                raise ScenarioError(f"{path}: a {kind!r} results file needs its /{name} group; "
+                                    f"it has {have}")
+            problem: list[str] = []
+
+            def visit(_: str, ds, problem=problem) -> None:
+                if problem or not isinstance(ds, h5py.Dataset):
+                    return
+                why = _damaged(ds)
+                if why:
+                    problem.append(f"{path}: dataset {ds.name} {why}")
+
+            g.visititems(visit)
+            if problem:
+                raise ScenarioError(problem[0])
+
+
+_TIMES = ("t", "t0", "t1")  #: datasets of times, strictly increasing
+
+
+def _damaged(ds: h5py.Dataset) -> str:
+    """What is wrong with one dataset of a results file ('' when nothing is)."""
+    text = h5py.check_string_dtype(ds.dtype) is not None
+    if "units" not in ds.attrs:
+        return "" if text else "has no 'units' attribute (not as gcalign wrote it)"
+    if ds.dtype.kind not in "fiub":
+        return f"must hold numbers, got {ds.dtype}"
+    if ds.dtype.kind == "f" and ds.size:
+        a = ds[()]
+        if not np.isfinite(a).all():
+            bad = np.argwhere(~np.isfinite(np.atleast_1d(a)))[0].tolist()
+            return f"holds a value that is not finite at {bad}"
+        if ds.name.rsplit("/", 1)[-1] in _TIMES and a.ndim == 1 and np.any(np.diff(a) <= 0):
+            i = int(np.argmax(np.diff(a) <= 0))
+            return f"(time) does not increase at row {i + 1}: {a[i]!r} then {a[i + 1]!r}"
+    return ""
+
+
 def _dataset(g, name: str, path: Path) -> np.ndarray:
     if name not in g or not isinstance(g[name], h5py.Dataset):
         raise ScenarioError(f"{path}: dataset {g.name}/{name} missing")
