@@ -32,6 +32,19 @@ runner = CliRunner()
 
 
 def run_case(case: F.Case, folder) -> F.Outcome:
+    saved = {k: os.environ.get(k) for k, _ in case.env}
+    os.environ.update(dict(case.env))
+    try:
+        return _run_case(case, folder)
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def _run_case(case: F.Case, folder) -> F.Outcome:
     argv = F.materialize(case, folder)
     before = F.snapshot(folder)
     t0 = time.perf_counter()
@@ -380,7 +393,8 @@ def test_damaged_results_files_are_refused_by_plot_show_export_and_init(
     shutil.copy(results_of_kinds / f"{kind}.h5", fuzz_env / "d.h5")
     with h5py.File(fuzz_env / "d.h5", "a") as f:
         where = _damage(kind, how)(f)
-    for argv in (["plot", "d.h5", "-o", "figs"], ["show", "d.h5"], ["export", "d.h5", "--format", "csv"],
+    for argv in (["plot", "d.h5", "-o", "figs"], ["show", "d.h5"],
+                 ["export", "d.h5", "--format", "csv"],
                  ["navigate", "--init", "d.h5", str(results_of_kinds / "align.yaml"),
                   "-o", "n.h5"]):
         res = runner.invoke(app, argv)

@@ -474,7 +474,7 @@ def check_layout(path: Path, kind: str, groups: tuple[str, ...]) -> None:
     be absent) is missing, or a dataset under them is damaged: numbers without their
     ``units`` attribute (every dataset gcalign writes has one; text has none), text or
     other types where numbers were written, values that are not finite, a time ``t`` that
-    does not increase (a zeroed chunk)."""
+    is not strictly monotonic (a zeroed chunk)."""
     with open_results(path) as f:
         for name in groups:
             g = f.get(name)
@@ -498,7 +498,7 @@ def check_layout(path: Path, kind: str, groups: tuple[str, ...]) -> None:
                 raise ScenarioError(problem[0])
 
 
-_TIMES = ("t", "t0", "t1")  #: datasets of times, strictly increasing
+_TIMES = ("t", "t0", "t1")  #: datasets of times, strictly monotonic
 
 
 def _damaged(ds: h5py.Dataset) -> str:
@@ -513,9 +513,12 @@ def _damaged(ds: h5py.Dataset) -> str:
         if not np.isfinite(a).all():
             bad = np.argwhere(~np.isfinite(np.atleast_1d(a)))[0].tolist()
             return f"holds a value that is not finite at {bad}"
-        if ds.name.rsplit("/", 1)[-1] in _TIMES and a.ndim == 1 and np.any(np.diff(a) <= 0):
-            i = int(np.argmax(np.diff(a) <= 0))
-            return f"(time) does not increase at row {i + 1}: {a[i]!r} then {a[i + 1]!r}"
+        step = np.sign(np.diff(a)) if a.ndim == 1 else None
+        if ds.name.rsplit("/", 1)[-1] in _TIMES and step is not None and len(step) and (
+                step[0] == 0 or np.any(step != step[0])):  # a reverse pass runs backwards
+            i = int(np.argmax(step != step[0])) if step[0] else 0
+            return (f"(time) is not strictly monotonic at row {i + 1}: {float(a[i])!r} then "
+                    f"{float(a[i + 1])!r}")
     return ""
 
 
