@@ -447,7 +447,7 @@ def test_a_results_file_without_figures_says_so(tmp_path):
         results.write_header(f, "align", "", 1, {"scenario": "x"})
     res = runner.invoke(app, ["plot", str(path)])
     assert res.exit_code == 2
-    assert "nothing to plot: this 'align' results file holds none of the groups" in res.output
+    assert "a 'align' results file needs its /align group; it has none" in res.output
 
 
 # ------------------------------------------------------------ navigate on recorded data

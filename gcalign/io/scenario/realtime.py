@@ -112,8 +112,9 @@ class FilterConfig(Model):
                         "no parameter (hamming, hann, blackman, boxcar, ...)")
 
     @model_validator(mode="after")
-    def _designable(self):
-        """What the filter design (scipy.signal) would refuse, refused here by its key."""
+    def _window(self):
+        """A window scipy.signal's design would refuse, refused here by its key (the
+        orders and frequencies are checked by FilterSettings)."""
         from scipy import signal
 
         try:
@@ -121,15 +122,6 @@ class FilterConfig(Model):
         except (ValueError, TypeError):
             raise ValueError(f"window: {self.window!r} is not a scipy.signal window without "
                              "parameters (hamming, hann, blackman, boxcar, ...)") from None
-        nyquist = self.fs_hz / 2
-        for key in ("nav_cutoff_hz", "align_cutoff_hz", "notch_hz"):
-            v = getattr(self, key)
-            if v is not None and not 0 < v < nyquist:
-                raise ValueError(f"{key}: must lie within (0, fs_hz/2 = {nyquist:g}) Hz, "
-                                 f"got {v:g}")
-        for key in ("nav_order", "align_order"):
-            if getattr(self, key) < 1:
-                raise ValueError(f"{key}: must be at least 1, got {getattr(self, key)}")
         return self
 
     def to_settings(self) -> FilterSettings:
