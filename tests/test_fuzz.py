@@ -190,6 +190,8 @@ def _one_line(res) -> str:
      "mechanism.dwell_s: the cycle of fixed lasts 1e-300 s, shorter than 10 IMU samples"),
     (["realtime", "R.yaml", "--set", "realtime.filter.window=boxcar2"],
      "realtime.filter.window: 'boxcar2' is not a scipy.signal window"),
+    (["modulate", "M.yaml", "--hours", "2e-7"],  # found by the limited generator
+     "modulate.hours: 2e-07 h holds fewer than 2 IMU samples at 10 Hz"),
     (["realtime", "R.yaml", "--set", "realtime.filter.nav_cutoff_hz=1e9"],
      "realtime.filter.nav_cutoff_hz: must be in (0, 2500) Hz"),
 ])
@@ -203,9 +205,9 @@ def test_bad_settings_of_a_run_are_exit_2_naming_the_key_and_validate_agrees(
     res = runner.invoke(app, [*argv, "-o", "out.h5"])
     assert res.exit_code == 2 and expected in _one_line(res), res.stderr
     assert not (fuzz_env / "out.h5").exists()
-    check = runner.invoke(app, ["validate", argv[1], *argv[2:]]
-                          if argv[2] == "--set" else ["validate", argv[1], "--set",
-                                                      f"mechanism.dwell_s={argv[3]}"])
+    key = {"--dwell": "mechanism.dwell_s", "--hours": "modulate.hours"}.get(argv[2])
+    check = runner.invoke(app, ["validate", argv[1], *argv[2:]] if key is None
+                          else ["validate", argv[1], "--set", f"{key}={argv[3]}"])
     assert check.exit_code == 2 and expected.split(":")[0] in _one_line(check)
 
 

@@ -165,6 +165,9 @@ def plan_of(sc) -> Plan:
         if sc.motion.kind != "static" and hours * 3600.0 > motion_s + 1e-9:
             raise ScenarioError(f"modulate.hours: {hours:g} h is longer than the motion "
                                 f"({motion_s / 3600:g} h); shorten it or lengthen the motion")
+    if not hours * 3600.0 * sc.imu.rate_hz >= 2:
+        raise ScenarioError(f"modulate.hours: {hours:g} h holds fewer than 2 IMU samples at "
+                            f"{sc.imu.rate_hz:g} Hz; navigate at least {2 / sc.imu.rate_hz:g} s")
     return Plan(tuple(entries), hours, hours * 3600.0)
 
 
