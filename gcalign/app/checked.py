@@ -8,9 +8,10 @@ from pathlib import Path
 from gcalign.app.registry import COMMANDS
 from gcalign.io import results
 
-#: kinds whose datasets are finite when written (north-finding stores NaN for a prediction
-#: it cannot make, a batch for a failed run's metrics, navigation for errors without truth)
-FINITE = frozenset({"align", "calibrate", "observability", "realtime", "modulate"})
+#: kinds whose every dataset has units and finite values when written (north-finding stores
+#: NaN for a prediction it cannot make, a batch for a failed run's metrics, navigation for
+#: errors without truth; /imu and /truth have readers of their own)
+STRICT = frozenset({"align", "calibrate", "observability", "realtime", "modulate"})
 
 
 def read_checked(path: Path) -> tuple[str, dict, dict]:
@@ -19,5 +20,5 @@ def read_checked(path: Path) -> tuple[str, dict, dict]:
     (:func:`gcalign.io.results.check_layout`); ScenarioError (one line) otherwise."""
     kind, summary, attrs = results.read_summary(path)
     if kind in COMMANDS:
-        results.check_layout(Path(path), kind, COMMANDS[kind].layout, kind in FINITE)
+        results.check_layout(Path(path), kind, COMMANDS[kind].layout, kind in STRICT)
     return kind, summary, attrs

@@ -468,14 +468,15 @@ def read_summary(path: Path) -> tuple[str, dict, dict]:
     return kind, summary, attrs
 
 
-def check_layout(path: Path, kind: str, groups: tuple[str, ...], finite: bool = True) -> None:
+def check_layout(path: Path, kind: str, groups: tuple[str, ...], strict: bool = True) -> None:
     """The reader check of a results file of `kind`: ScenarioError naming the file and the
     dataset when a group the kind writes (`groups`, its command's ``layout``; ``/truth`` may
     be absent) is missing, or a dataset under them is damaged: numbers without their
     ``units`` attribute (every dataset gcalign writes has one; text has none or ``none``),
-    text or other types where numbers were written, values that are not finite (with
-    `finite`: kinds that never store NaN), a time ``t`` that
-    is not strictly monotonic (a zeroed chunk)."""
+    text or other types where numbers were written, values that are not finite, a time
+    ``t`` that is not strictly monotonic (a zeroed chunk). Without `strict` (kinds that
+    store NaN, and whose groups have readers of their own: ``/imu``, ``/truth``), only the
+    groups and the types are checked."""
     with open_results(path) as f:
         for name in groups:
             g = f.get(name)
@@ -490,7 +491,7 @@ def check_layout(path: Path, kind: str, groups: tuple[str, ...], finite: bool = 
             def visit(_: str, ds, problem=problem) -> None:
                 if problem or not isinstance(ds, h5py.Dataset):
                     return
-                why = _damaged(ds, finite)
+                why = _damaged(ds, strict)
                 if why:
                     problem.append(f"{path}: dataset {ds.name} {why}")
 
@@ -502,19 +503,21 @@ def check_layout(path: Path, kind: str, groups: tuple[str, ...], finite: bool = 
 _TIMES = ("t", "t0", "t1")  #: datasets of times, strictly monotonic
 
 
-def _damaged(ds: h5py.Dataset, finite: bool) -> str:
+def _damaged(ds: h5py.Dataset, strict: bool) -> str:
     """What is wrong with one dataset of a results file ('' when nothing is)."""
     units = ds.attrs.get("units")
     if h5py.check_string_dtype(ds.dtype) is not None or ds.dtype.kind == "O":
         return "" if units in (None, "", "none", b"", b"none") else (
             f"must hold numbers (units {_short(units)}), got text")
-    if units is None:
-        return "has no 'units' attribute (not as gcalign wrote it)"
     if ds.dtype.kind not in "fiub":
         return f"must hold numbers, got {ds.dtype}"
+    if not strict:
+        return ""
+    if units is None:
+        return "has no 'units' attribute (not as gcalign wrote it)"
     if ds.dtype.kind == "f" and ds.size:
         a = ds[()]
-        if finite and not np.isfinite(a).all():
+        if not np.isfinite(a).all():
             bad = np.argwhere(~np.isfinite(np.atleast_1d(a)))[0].tolist()
             return f"holds a value that is not finite at {bad}"
         step = np.sign(np.diff(a)) if a.ndim == 1 else None
