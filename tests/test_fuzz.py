@@ -236,8 +236,9 @@ def test_latitude_is_reported_with_the_digits_given(fuzz_env):
 def test_lat_without_lon_is_refused(given, missing, fuzz_env):
     res = runner.invoke(app, ["align", given, "45", "-o", "out.h5"])
     assert res.exit_code == 2
-    assert _one_line(res) == (f"error: {missing}: missing beside {given}; give both (and "
-                              "--height if it matters) or neither")
+    assert _one_line(res) == (f"error: {missing}: missing beside {given} "
+                              f"(site.{missing[2:]}_deg); give both (and --height if it "
+                              "matters) or neither")
     assert not (fuzz_env / "out.h5").exists()
 
 

@@ -111,8 +111,9 @@ def with_common_options(fn: Callable, recorded: bool) -> Callable:
         if (site["lat_deg"] is None) != (site["lon_deg"] is None):
             given_, missing = ("--lat", "--lon") if site["lon_deg"] is None else ("--lon",
                                                                                   "--lat")
-            sys.stderr.write(f"error: {missing}: missing beside {given_}; give both (and "
-                             "--height if it matters) or neither\n")
+            sys.stderr.write(f"error: {missing}: missing beside {given_} "
+                             f"(site.{missing[2:]}_deg); give both (and --height if it "
+                             "matters) or neither\n")
             raise typer.Exit(2)
         inv = Invocation(imu_file=given.get("imu_file"),
                          site={k: v for k, v in site.items() if v is not None},
