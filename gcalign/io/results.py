@@ -211,17 +211,37 @@ class _GuardedFile:
         except OSError as err:
             self.error = self.error or err
 
+    # A buffered file flushes what it holds before it seeks, reads or tells, so a refused
+    # write can surface in any of them (seen with modulate's many small writes under
+    # ``ulimit -f``: HDF5 met the error in a seek and crashed): each records it too.
+
     def read(self, n=-1):
-        return b"" if self.raw.closed else self.raw.read(n)
+        try:
+            return b"" if self.raw.closed else self.raw.read(n)
+        except OSError as err:
+            self.error = self.error or err
+            return b""
 
     def readinto(self, b):
-        return 0 if self.raw.closed else self.raw.readinto(b)
+        try:
+            return 0 if self.raw.closed else self.raw.readinto(b)
+        except OSError as err:
+            self.error = self.error or err
+            return 0
 
     def seek(self, offset, whence=0):
-        return 0 if self.raw.closed else self.raw.seek(offset, whence)
+        try:
+            return 0 if self.raw.closed else self.raw.seek(offset, whence)
+        except OSError as err:
+            self.error = self.error or err
+            return offset if whence == 0 else 0
 
     def tell(self):
-        return 0 if self.raw.closed else self.raw.tell()
+        try:
+            return 0 if self.raw.closed else self.raw.tell()
+        except OSError as err:
+            self.error = self.error or err
+            return 0
 
 
 @contextmanager
