@@ -33,6 +33,7 @@ SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --
 def run(case: F.Case, src: str | None, timeout: float, mem_gb: float) -> F.Outcome:
     env = {k: v for k, v in os.environ.items() if not k.startswith("GCALIGN_")}
     env.update(F.FUZZ_ENV)
+    env.update(dict(case.env))
     if src:
         env["PYTHONPATH"] = src
     cmd = [sys.executable, "-c", "import sys; from gcalign.cli import main; "

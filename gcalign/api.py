@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import atexit
 import copy
+import os
 import shutil
 import tempfile
 from dataclasses import dataclass, field, replace
@@ -119,6 +120,9 @@ def _mapping(source) -> tuple[dict, str, Path | None]:
 
     if isinstance(source, dict):
         return copy.deepcopy(source), "scenario", None
+    if not isinstance(source, (str, os.PathLike)):
+        raise ScenarioError(f"load: the scenario must be a file name, a path or a mapping, "
+                            f"got {type(source).__name__}")
     path = Path(source)
     names = path.name.lower().split(".")
     if len(names) > 1 and ("." + names[-1] in DATA_SUFFIXES or (
@@ -137,6 +141,10 @@ def load(source, overrides: dict | None = None):
     from gcalign.io.scenario import parse_scenario
 
     data, name, folder = _mapping(source)
+    if overrides is not None and not (isinstance(overrides, dict)
+                                      and all(isinstance(k, str) for k in overrides)):
+        raise ScenarioError("overrides: must map dotted keys to values ({'align.mode': "
+                            f"'conventional'}}), got {type(overrides).__name__}")
     if overrides:
         base = parse_scenario(copy.deepcopy(data), name)
         for key, value in overrides.items():
@@ -203,8 +211,18 @@ def run(command: str, scenario, seed: int | None = None, output: str | Path | No
     if command not in COMMANDS or command == "batch":
         raise ScenarioError(f"run: {command!r} is not a command that runs a scenario; "
                             f"commands: {', '.join(c for c in COMMANDS if c != 'batch')}")
+    import inspect
+
     from gcalign.io.scenario import Scenario
 
+    own = [p for p in inspect.signature(COMMANDS[command]._execute()).parameters
+           if p not in _RUN_PARAMETERS]
+    unknown = [k for k in options if k not in own]
+    if unknown:
+        raise ScenarioError(f"run: {command} takes no option {unknown[0]!r}; "
+                            + (f"its options: {', '.join(own)}" if own else "it has none")
+                            + " (settings go into the scenario: load(..., {'"
+                            + f"{COMMANDS[command].section or command}.KEY': value}}))")
     sc = scenario if isinstance(scenario, Scenario) else load(scenario)
     out = Path(output) if output is not None else Path(tempfile.mkstemp(
         suffix=".h5", prefix=f"{sc.name}-{command}-", dir=_scratch())[1])
@@ -214,6 +232,10 @@ def run(command: str, scenario, seed: int | None = None, output: str | Path | No
     run_command(command, sc, scenario_text(sc), seed, out, progress=progress,
                 on_outcome=outcomes.append, **options)
     return replace(read(out), value=outcomes[0].result)
+
+
+#: parameters of a command's ``execute`` that run() fills itself
+_RUN_PARAMETERS = ("sc", "seed", "cache_key", "sink", "progress")
 
 
 def read(path: str | Path) -> Result:

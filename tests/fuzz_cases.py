@@ -58,6 +58,7 @@ class Case:
     validate: str | None = None  # scenario whose `gcalign validate` must agree on exit 2
     outputs: tuple[str, ...] = ("out.h5",)  # files a successful run may leave
     dirs: tuple[str, ...] = ()  # folders to create (read-only when named "ro*")
+    env: tuple[tuple[str, str], ...] = ()  # environment beside FUZZ_ENV (limits of the case)
 
     @property
     def id(self) -> str:
@@ -207,6 +208,20 @@ BASES: dict[str, tuple[dict, str]] = {
 #: mutations come last, from a generator of their own, so that the cases above stay the same
 LATE_BASES: dict[str, tuple[dict, str]] = {"modulate": (MODULATE, "modulate")}
 
+#: The newer commands' bases, mutated with small limits in play (:func:`limited_cases`)
+LIMITED_BASES: dict[str, tuple[dict, str]] = {
+    "calibrate": (CALIBRATE, "calibrate"), "observability": (CALIBRATE, "observability"),
+    "realtime": (REALTIME, "realtime"), "modulate": (MODULATE, "modulate")}
+#: Limits small enough that a mutation multiplying the work (a rate, a duration, an order,
+#: a piece length) meets them, well above what each base costs as given.
+SMALL_LIMITS = (("GCALIGN_MAX_WORK", "2e10"), ("GCALIGN_MAX_MEMORY_MB", "256"),
+                ("GCALIGN_MAX_OUTPUT_MB", "16"), ("GCALIGN_MAX_SAMPLES", "500000"),
+                ("GCALIGN_MAX_REALTIME_SAMPLES", "2000000"))
+#: Hostile values of a limit variable (each must be refused naming it, or honoured)
+LIMIT_VALUES = ("abc", "", "0", "-1", "1e-300", "1e-9", "nan", "inf", "1e400", " 5 ")
+#: Multipliers of numbers that cost: the limits, not the time bound, must stop them
+COSTLY = ("1e3", "1e4", "1e6", "0.001", "1e-6")
+
 # Hostile scalars and structures (YAML text).
 HOSTILE = [
     "true", "false", "yes", "no", "on", "null", "~", "-1", "0", "1e-9", "1e308", "-1e308",
@@ -310,6 +325,40 @@ def scenario_cases(rng: random.Random, n: int, bases=None) -> list[Case]:
         out.append(Case(cls, f"{base}/{command}: {label}",
                         (command, "case.yaml", "-o", "out.h5"),
                         (("case.yaml", text.encode()),), exits, validate="case.yaml"))
+    return out
+
+
+def limited_cases(rng: random.Random, n: int) -> list[Case]:
+    """`n` mutations of the newer commands' bases (:data:`LIMITED_BASES`) under
+    :data:`SMALL_LIMITS`: a key-by-key mutation (class 0), a number that costs scaled up or
+    down (class 1: a limit or a bound must refuse it, within the time bound), or a limit
+    variable set to a hostile value (class 1: refused naming the variable, or honoured)."""
+    out = []
+    names = list(LIMITED_BASES)
+    for i in range(n):
+        base = names[i % len(names)]
+        data, command = LIMITED_BASES[base]
+        env = SMALL_LIMITS
+        kind = rng.choice(["mutate", "costly", "limit"])
+        if kind == "mutate":
+            text, label, cls, exits = mutate(rng, data)
+        elif kind == "costly":
+            d = _copy(data)
+            paths = [p for p in list(_leaves(d))[1:] if _is_number(_get(d, p))]
+            path = rng.choice(paths)
+            factor = rng.choice(COSTLY)
+            _set(d, path, float(_get(d, path)) * float(factor))
+            text, label = emit(d), f"{'.'.join(map(str, path))} × {factor}"
+            cls, exits = 1, frozenset({0, 1, 2})
+        else:
+            var = rng.choice([k for k, _ in SMALL_LIMITS])
+            value = rng.choice(LIMIT_VALUES)
+            env = tuple((k, v) for k, v in SMALL_LIMITS if k != var) + ((var, value),)
+            text, label = emit(data), f"{var}={value!r}"
+            cls, exits = 1, frozenset({0, 2})
+        out.append(Case(cls, f"limited {base}/{command}: {label}",
+                        (command, "case.yaml", "-o", "out.h5"),
+                        (("case.yaml", text.encode()),), exits, validate="case.yaml", env=env))
     return out
 
 
@@ -882,13 +931,16 @@ def input_file_cases() -> list[Case]:
 
 
 def all_cases(seed: int, n_scenarios: int = 240, n_sweeps: int = 24,
-              n_options: int = 30, n_late: int = 30) -> list[Case]:
-    """Every case of one fuzz run, in a fixed order (the same seed gives the same cases)."""
+              n_options: int = 30, n_late: int = 30, n_limited: int = 60) -> list[Case]:
+    """Every case of one fuzz run, in a fixed order (the same seed gives the same cases);
+    generators added later come last, each with its own random stream, so that the cases
+    before them stay the same."""
     rng = random.Random(seed)
     return [*fixed_cases(), *scenario_cases(rng, n_scenarios), *sweep_cases(rng, n_sweeps),
             *recorded_cases(rng), *journal_cases(rng), *option_cases(rng, n_options),
             *input_file_cases(),
-            *scenario_cases(random.Random(f"{seed}-late"), n_late, LATE_BASES)]
+            *scenario_cases(random.Random(f"{seed}-late"), n_late, LATE_BASES),
+            *limited_cases(random.Random(f"{seed}-limited"), n_limited)]
 
 
 # --------------------------------------------------------------------------- contract

@@ -263,7 +263,7 @@ def test_window_of_a_longer_record_gives_the_same_result():
     ({"align.t2_s": 5000, "align.t3_s": 5000}, "align.t2_s: 5000.0 s (+ start_s 0.0 s) is past "
      "the end of the data"),
     ({"site": {"lat_deg": 86.0, "lon_deg": 116.0, "height_m": 0.0}},
-     "site.lat_deg: gyrocompassing needs |latitude| < 85°, got 86.0000°"),
+     "site.lat_deg: gyrocompassing needs |latitude| < 85°, got 86°"),
 ])
 def test_the_cores_refusals_name_the_scenario_field(tmp_path, overrides, message):
     """A recorded file's length and site are known only when it is read: the core refuses,

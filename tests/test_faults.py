@@ -516,3 +516,53 @@ def test_results_files_have_ordinary_permissions(tmp_path):
     finally:
         os.umask(mask)
     assert (tmp_path / "r.h5").stat().st_mode & 0o777 == 0o644
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("limit", [30_000, 51_200, 120_000])
+def test_full_disk_during_modulate_is_exit_1_one_line_and_nothing_kept(tmp_path, limit):
+    """modulate streams its series into the results file as it navigates (its sink): a
+    write refused there (``ulimit -f``) goes through the same guard as every other
+    command's: exit 1, one line naming the file, neither the file nor its temporary."""
+    d = json.loads(json.dumps(F.MODULATE))
+    d["modulate"]["hours"] = 1.0
+    d["output"] = {"rate_hz": 10}
+    (tmp_path / "M.yaml").write_text(F.emit(d))
+    res = cli(["modulate", "M.yaml", "-o", "o.h5"], tmp_path, limit_fsize=limit)
+    assert res.returncode == 1, res.stderr[-2000:]
+    assert "cannot write o.h5: File too large" in one_error_line(res.stderr)
+    assert not (tmp_path / "o.h5").exists() and temps(tmp_path) == []
+
+
+def test_stdout_that_refuses_writes_is_exit_1_one_line(tmp_path):
+    """``> /dev/full`` and a closed stdout: exit 1, "cannot write to stdout" (they were
+    internal errors)."""
+    with open("/dev/full", "w") as full:
+        res = subprocess.run(GCALIGN + ["example", "calibrate"], cwd=tmp_path, stdout=full,
+                             stderr=subprocess.PIPE, text=True, timeout=120)
+    assert res.returncode == 1
+    assert one_error_line(res.stderr) == ("error: cannot write to stdout: No space left on "
+                                          "device")
+    res = subprocess.run(["bash", "-c", 'exec "$@" >&-', "_", *GCALIGN, "example", "calibrate"],
+                         cwd=tmp_path, capture_output=False, stderr=subprocess.PIPE, text=True,
+                         timeout=120)
+    assert res.returncode == 1
+    assert one_error_line(res.stderr) == "error: cannot write to stdout: it is closed"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command, limit_mb", [("align", 300)])
+def test_address_space_limit_is_out_of_memory_not_a_bad_output(tmp_path, command, limit_mb):
+    """``ulimit -v``: a shared library that cannot be mapped (numba's llvmlite, OpenBLAS) or
+    a MemoryError is exit 1 "out of memory" (it was "--output: cannot write ...
+    libllvmlite.so", exit 2), and the temporary file is gone."""
+    lim = limit_mb * 2**20
+
+    def pre():
+        resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
+
+    res = subprocess.run(GCALIGN + [command, "-o", "o.h5"], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=300, preexec_fn=pre)
+    assert res.returncode == 1, res.stderr
+    assert one_error_line(res.stderr).startswith("error: out of memory")
+    assert not (tmp_path / "o.h5").exists() and temps(tmp_path) == []

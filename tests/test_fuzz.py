@@ -32,6 +32,19 @@ runner = CliRunner()
 
 
 def run_case(case: F.Case, folder) -> F.Outcome:
+    saved = {k: os.environ.get(k) for k, _ in case.env}
+    os.environ.update(dict(case.env))
+    try:
+        return _run_case(case, folder)
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def _run_case(case: F.Case, folder) -> F.Outcome:
     argv = F.materialize(case, folder)
     before = F.snapshot(folder)
     t0 = time.perf_counter()
@@ -160,3 +173,260 @@ def test_messages_name_the_file_row_and_value(name, expected, fuzz_env):
     line = out.stderr.strip()
     assert re.search(expected, line), line
     assert "align.coarse" not in line
+
+
+def _one_line(res) -> str:
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), res.stderr
+    assert "internal error" not in lines[0] and "Traceback" not in res.stderr
+    return lines[0]
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["modulate", "M.yaml", "--dwell", "0"],
+     "modulate.compare: fixed with the mechanism's timing: mechanism.dwell_s: the fixed "
+     "scheme needs a dwell > 0 s"),
+    (["modulate", "M.yaml", "--dwell", "1e-300"],
+     "mechanism.dwell_s: the cycle of fixed lasts 1e-300 s, shorter than 10 IMU samples"),
+    (["realtime", "R.yaml", "--set", "realtime.filter.window=boxcar2"],
+     "realtime.filter.window: 'boxcar2' is not a scipy.signal window"),
+    (["modulate", "M.yaml", "--hours", "2e-7"],  # found by the limited generator
+     "modulate.hours: 2e-07 h holds fewer than 2 IMU samples at 10 Hz"),
+    (["realtime", "R.yaml", "--set", "realtime.filter.nav_cutoff_hz=1e9"],
+     "realtime.filter.nav_cutoff_hz: must be in (0, 2500) Hz"),
+])
+def test_bad_settings_of_a_run_are_exit_2_naming_the_key_and_validate_agrees(
+        argv, expected, fuzz_env):
+    """Settings that the run's set-up (the scheme's timing, the filter design) would refuse
+    are refused as bad input naming the key, by the run and by validate alike; they were
+    'internal error' (a pydantic dump, NumPy's array limit, scipy's ValueError)."""
+    (fuzz_env / "M.yaml").write_text(F.emit(F.MODULATE))
+    (fuzz_env / "R.yaml").write_text(F.emit(F.REALTIME))
+    res = runner.invoke(app, [*argv, "-o", "out.h5"])
+    assert res.exit_code == 2 and expected in _one_line(res), res.stderr
+    assert not (fuzz_env / "out.h5").exists()
+    key = {"--dwell": "mechanism.dwell_s", "--hours": "modulate.hours"}.get(argv[2])
+    check = runner.invoke(app, ["validate", argv[1], *argv[2:]] if key is None
+                          else ["validate", argv[1], "--set", f"{key}={argv[3]}"])
+    assert check.exit_code == 2 and expected.split(":")[0] in _one_line(check)
+
+
+def test_a_value_error_of_a_check_is_exit_2_naming_the_section(fuzz_env, monkeypatch):
+    """A check or cost model that meets a value it cannot take (ValueError, TypeError) is bad
+    input of its section, exit 2, not an internal error."""
+    from gcalign.app.modulate import Modulate
+
+    def refuse(self, sc, ext):
+        raise ValueError("period: cannot be negative")
+
+    monkeypatch.setattr(Modulate, "check", refuse)
+    (fuzz_env / "M.yaml").write_text(F.emit(F.MODULATE))
+    res = runner.invoke(app, ["modulate", "M.yaml", "-o", "out.h5"])
+    assert res.exit_code == 2
+    assert _one_line(res) == "error: modulate: period: cannot be negative"
+
+
+def test_latitude_is_reported_with_the_digits_given(fuzz_env):
+    res = runner.invoke(app, ["align", "--lat", "89.99999", "--lon", "1", "-o", "out.h5"])
+    assert res.exit_code == 2
+    assert "got 89.99999°" in _one_line(res)  # was "got 90.0000°"
+
+
+@pytest.mark.parametrize("given, missing", [("--lat", "--lon"), ("--lon", "--lat")])
+def test_lat_without_lon_is_refused(given, missing, fuzz_env):
+    res = runner.invoke(app, ["align", given, "45", "-o", "out.h5"])
+    assert res.exit_code == 2
+    assert _one_line(res) == (f"error: {missing}: missing beside {given} "
+                              f"(site.{missing[2:]}_deg); give both (and --height if it "
+                              "matters) or neither")
+    assert not (fuzz_env / "out.h5").exists()
+
+
+def test_a_fifo_or_a_symlink_loop_is_named_for_what_it_is(fuzz_env):
+    os.mkfifo(fuzz_env / "pipe.imu")
+    (fuzz_env / "a.imu").symlink_to("b.imu")
+    (fuzz_env / "b.imu").symlink_to("a.imu")
+    for name, what in (("pipe.imu", "is a FIFO (named pipe), expected a regular file"),
+                       ("a.imu", "is a symbolic link loop, expected a file")):
+        for argv in (["navigate", name], ["calibrate", "--imu-file", name],
+                     ["show", name]):
+            res = runner.invoke(app, [*argv, "--lat", "45", "--lon", "126"]
+                                if argv[0] != "show" else argv)
+            assert res.exit_code == 2 and f"{name}: {what}" in _one_line(res), argv
+
+
+def test_navigate_refuses_to_write_over_its_own_input(fuzz_env):
+    (fuzz_env / "S.yaml").write_text(F.emit(F.S))
+    assert runner.invoke(app, ["align", "S.yaml", "-o", "a.h5"]).exit_code == 0
+    before = (fuzz_env / "a.h5").read_bytes()
+    res = runner.invoke(app, ["navigate", "S.yaml", "--init", "a.h5", "-o", "a.h5"])
+    assert res.exit_code == 2
+    assert _one_line(res).startswith("error: --output: a.h5 is --init of this run")
+    assert (fuzz_env / "a.h5").read_bytes() == before
+
+
+def test_numpy_warnings_do_not_print_before_the_error_line(fuzz_env, monkeypatch):
+    """A RuntimeWarning on the way to a refusal (an overflow in a cost estimate, say) would
+    print its lines before the one error line."""
+    import numpy as np
+
+    from gcalign.app.modulate import Modulate
+    from gcalign.errors import ScenarioError
+
+    def overflowing(self, sc, ext):
+        np.float64(1e200) * np.float64(1e200)  # RuntimeWarning: overflow
+        raise ScenarioError("modulate.hours: too long")
+
+    monkeypatch.setattr(Modulate, "check", overflowing)
+    (fuzz_env / "M.yaml").write_text(F.emit(F.MODULATE))
+    res = runner.invoke(app, ["modulate", "M.yaml", "-o", "out.h5"])
+    assert res.exit_code == 2 and _one_line(res) == "error: modulate.hours: too long"
+
+
+def test_the_python_api_refuses_bad_arguments_as_scenario_errors():
+    import gcalign
+    from gcalign.errors import ScenarioError
+
+    sc = gcalign.example("modulate")
+    for call, expected in (
+            (lambda: gcalign.run("calibrate", sc, measure="velocity"),
+             "run: calibrate takes no option 'measure'"),
+            (lambda: gcalign.example("calibrate", [1, 2]), "overrides: must map dotted keys"),
+            (lambda: gcalign.load(5), "load: the scenario must be a file name"),
+            (lambda: gcalign.run("navigate", sc, zz=1), "run: navigate takes no option 'zz'; "
+             "its options: init")):
+        with pytest.raises(ScenarioError, match=expected.replace("(", r"\(")):
+            call()
+
+
+@pytest.fixture(scope="module")
+def results_of_kinds(tmp_path_factory):
+    """Small valid results files of the newer commands (and align)."""
+    folder = tmp_path_factory.mktemp("kinds")
+    bases = {"calibrate": F.CALIBRATE, "observability": F.CALIBRATE, "realtime": F.REALTIME,
+             "modulate": F.MODULATE, "align": F.S}
+    here = os.getcwd()
+    os.chdir(folder)
+    try:
+        for kind, data in bases.items():
+            (folder / f"{kind}.yaml").write_text(F.emit(data))
+            res = runner.invoke(app, [kind, f"{kind}.yaml", "-o", f"{kind}.h5"])
+            assert res.exit_code == 0, res.stderr
+    finally:
+        os.chdir(here)
+    return folder
+
+
+def _first_series(f, kind: str) -> str:
+    import h5py
+
+    names: list[str] = []
+    f[kind].visititems(lambda n, o: names.append(o.name) if isinstance(o, h5py.Dataset)
+                       and o.dtype.kind == "f" and o.size > 3 and not o.is_scale
+                       and o.name.rsplit("/", 1)[-1] not in ("t", "t0", "t1") else None)
+    return names[0]
+
+
+def _first_time(f, kind: str) -> str:
+    import h5py
+
+    names: list[str] = []
+    f[kind].visititems(lambda n, o: names.append(o.name) if isinstance(o, h5py.Dataset)
+                       and o.name.rsplit("/", 1)[-1] in ("t", "t0") and o.size > 2 else None)
+    return names[0]
+
+
+def _damage(kind: str, how: str):
+    import numpy as np
+
+    def zeros3(f):
+        name = _first_series(f, kind)
+        del f[name]
+        f[name] = np.zeros(3)
+        return name
+
+    def strings(f):
+        name = _first_series(f, kind)
+        units = f[name].attrs["units"]
+        del f[name]
+        f[name] = np.array([b"a", b"b"])
+        f[name].attrs["units"] = units
+        return name
+
+    def nan(f):
+        name = _first_series(f, kind)
+        a = f[name][()]
+        a.flat[1] = np.nan
+        f[name][...] = a
+        return name
+
+    def zeroed_time(f):
+        name = _first_time(f, kind)
+        a = f[name][()]
+        a[len(a) // 2:] = 0.0
+        f[name][...] = a
+        return name
+
+    def no_group(f):
+        del f[kind]
+        return f"/{kind} group"
+
+    def relabelled(f):
+        f.attrs["kind"] = "modulate" if kind != "modulate" else "calibrate"
+        return "/modulate group" if kind != "modulate" else "/calibrate group"
+
+    return {"zeros(3)": zeros3, "strings": strings, "NaN": nan, "zeroed time": zeroed_time,
+            "no group": no_group, "relabelled": relabelled}[how]
+
+
+@pytest.mark.parametrize("how", ["zeros(3)", "strings", "NaN", "zeroed time", "no group",
+                                 "relabelled"])
+@pytest.mark.parametrize("kind", ["calibrate", "observability", "realtime", "modulate",
+                                  "align"])
+def test_damaged_results_files_are_refused_by_plot_show_export_and_init(
+        kind, how, results_of_kinds, fuzz_env):
+    """Each results kind is read through its check (its command's groups present; numbers
+    with units, finite, time not going backwards): plot, show, export and navigate --init
+    refuse a damaged file with one line naming the dataset or the group, exit 2. They were
+    internal errors, or (a missing or relabelled group) exit 0 with only the trajectory."""
+    import shutil
+
+    import h5py
+
+    shutil.copy(results_of_kinds / f"{kind}.h5", fuzz_env / "d.h5")
+    with h5py.File(fuzz_env / "d.h5", "a") as f:
+        where = _damage(kind, how)(f)
+    for argv in (["plot", "d.h5", "-o", "figs"], ["show", "d.h5"],
+                 ["export", "d.h5", "--format", "csv"],
+                 ["navigate", "--init", "d.h5", str(results_of_kinds / "align.yaml"),
+                  "-o", "n.h5"]):
+        res = runner.invoke(app, argv)
+        assert res.exit_code == 2, (argv, res.stderr)
+        line = _one_line(res)
+        assert "d.h5" in line and where.split()[0] in line, (argv, line)
+    assert not (fuzz_env / "figs").exists() or not list((fuzz_env / "figs").iterdir())
+    assert not (fuzz_env / "n.h5").exists()
+
+
+def test_plot_interrupted_midway_leaves_no_figure_and_no_temporary_folder(
+        results_of_kinds, fuzz_env, monkeypatch):
+    """plot draws into a temporary folder and renames: a SIGTERM (here raised by the second
+    figure's save) leaves neither a truncated PNG under a figure's name nor the folder."""
+    from matplotlib.figure import Figure
+
+    from gcalign.app import plots
+
+    saved = []
+    real = Figure.savefig
+
+    def savefig(self, p, **kw):
+        if saved:
+            raise KeyboardInterrupt
+        saved.append(p)
+        real(self, p, **kw)
+
+    monkeypatch.setattr(Figure, "savefig", savefig)
+    with pytest.raises(KeyboardInterrupt):
+        plots.plot_file(results_of_kinds / "calibrate.h5", fuzz_env / "figs")
+    assert saved and list((fuzz_env / "figs").iterdir()) == []
+    assert [p.name for p in fuzz_env.iterdir() if p.name != "figs"] == []

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from gcalign.errors import ScenarioError
+from gcalign.io.paths import not_a_file
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario import Scenario
 from gcalign.nav.earth import WGS84, EarthModel
@@ -127,7 +128,7 @@ def read_data_file(path: Path, layout=None) -> tuple[ImuData, Truth | None]:
 
     path = Path(path)
     if not path.is_file():
-        raise ScenarioError(f"imu_file: {path}: file not found")
+        raise ScenarioError(f"imu_file: {path}: {not_a_file(path)}")
     if path.suffix.lower() in HDF5_SUFFIXES:
         if layout is not None and layout.declared() | ({layout.format} - {"auto"}):
             raise ScenarioError(f"imu_file.format: {path} is a gcalign results file, which "

@@ -43,7 +43,9 @@ def default_group(path: Path) -> str:
     """The group of the command that wrote the file (``navigate``, ``simulate``'s
     ``truth``, ...); :func:`gcalign.io.results.series` says which groups hold series when
     it has none."""
-    kind = results.read_summary(path)[0]
+    from gcalign.app.checked import read_checked
+
+    kind = read_checked(path)[0]
     return {"simulate": "truth"}.get(kind, kind)
 
 
@@ -55,7 +57,8 @@ def export(path, fmt: str, out=None, group: str | None = None, week: int = 0) ->
     if fmt not in FORMATS:
         raise ScenarioError(f"--format: {fmt!r} is not an export format; allowed: "
                             f"{', '.join(FORMATS)}")
-    group = group or default_group(path)
+    own = default_group(path)  # reads the file through its kind's checks (app.checked)
+    group = group or own
     data = results.series(path, group)
     out = results.check_output(default_output(path, fmt) if out is None else out)
     if out.resolve() == path.resolve():

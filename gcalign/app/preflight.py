@@ -19,7 +19,8 @@ from typing import Any
 from gcalign import limits
 from gcalign.app.command import DOUBLE, Command, Cost, Extent
 from gcalign.app.registry import COMMANDS, Outcome, command
-from gcalign.errors import ScenarioError
+from gcalign.errors import GcalignError, ScenarioError
+from gcalign.io.paths import not_a_file
 from gcalign.io.scenario import Scenario
 
 __all__ = ["Extent", "budget", "check_seed", "checked_execute", "extent", "preflight",
@@ -38,7 +39,7 @@ def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
     if sc.imu_file is not None:
         if not read_recorded:
             if not sc.imu_file.is_file():
-                raise ScenarioError(f"imu_file: {sc.imu_file}: file not found")
+                raise ScenarioError(f"imu_file: {sc.imu_file}: {not_a_file(sc.imu_file)}")
             return None
         ext = _recorded_extent(Path(sc.imu_file), sc.recording_layout())
         if sc.site is None and ext.lat is None and sc.reference is None:
@@ -88,8 +89,26 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
                             "or 'imu_file' (recorded data)"
                             + ("" if name else ", or a northfind/realtime section"))
     for c in commands:
-        c.check(sc, ext)
-        budget(sc, c, ext)
+        try:
+            c.check(sc, ext)
+            budget(sc, c, ext)
+        except GcalignError:
+            raise
+        except (ValueError, TypeError) as err:  # a settings object refused what it was given
+            raise setup_error(c.section or c.name, err) from None
+
+
+def setup_error(section: str, err: Exception) -> ScenarioError:
+    """A ValueError or TypeError raised while a run is set up from its scenario (settings
+    built, checked, costed; before any computation) as bad input naming the section: one
+    line, exit 2. Pydantic's errors become its one-line-per-field form."""
+    from pydantic import ValidationError
+
+    from gcalign.io.scenario.loader import scenario_errors
+
+    if isinstance(err, ValidationError):
+        return ScenarioError(scenario_errors(err, section))
+    return ScenarioError(f"{section}: {err}")
 
 
 def _commands_of(sc: Scenario) -> list[Command]:

@@ -6,13 +6,14 @@ No typer, no rich: progress is a plain callable and warnings are strings.
 
 from __future__ import annotations
 
+import errno
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from gcalign.app.preflight import checked_execute
 from gcalign.app.registry import Outcome, command
-from gcalign.errors import ScenarioError
+from gcalign.errors import GcalignError, ScenarioError
 from gcalign.io import results
 from gcalign.io.scenario import Scenario
 
@@ -66,5 +67,19 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
             outcome.write(f)
             results.add_dimension_scales(f)
     except OSError as err:
+        if out_of_memory(err):
+            raise GcalignError(OUT_OF_MEMORY) from None
         raise ScenarioError(f"--output: cannot write {out}: {err.strerror or err}") from None
     return summary
+
+
+OUT_OF_MEMORY = ("out of memory; a smaller run, or lower GCALIGN_MAX_MEMORY_MB so that gcalign "
+                 "refuses it up front (README 'Limits')")
+
+
+def out_of_memory(err: BaseException) -> bool:
+    """Is `err` the address space running out (``ulimit -v``): MemoryError, ENOMEM, or a
+    shared library (numba's llvmlite, OpenBLAS) that could not be mapped?"""
+    text = str(err)
+    return (isinstance(err, MemoryError) or getattr(err, "errno", None) == errno.ENOMEM
+            or "shared object" in text or "cannot allocate memory" in text.lower())

@@ -9,6 +9,7 @@ traceback of an unexpected error, which is a bug).
 
 from __future__ import annotations
 
+import errno
 import functools
 import json
 import math
@@ -16,6 +17,7 @@ import os
 import signal
 import sys
 import threading
+import warnings
 from pathlib import Path
 
 import typer
@@ -148,7 +150,12 @@ def user_errors(fn):
         main_thread = threading.current_thread() is threading.main_thread()
         previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
         try:
-            return fn(*args, **kwargs)
+            with warnings.catch_warnings():
+                # NumPy's overflow/invalid-value warnings would print lines before the one
+                # error line; a result that is not finite is refused by name anyway
+                # (results.finite_summary)
+                warnings.simplefilter("ignore", RuntimeWarning)
+                return fn(*args, **kwargs)
         except GcalignError as err:
             sys.stderr.write(f"error: {error_line(str(err))}\n")
             raise typer.Exit(err.exit_code) from None
@@ -160,11 +167,14 @@ def user_errors(fn):
             raise typer.Exit(143) from None
         except (typer.Exit, typer.Abort, click_errors.ClickException):
             raise
-        except MemoryError:
-            sys.stderr.write("error: out of memory; a smaller run, or lower GCALIGN_MAX_MEMORY_MB "
-                             "so that gcalign refuses it up front (README 'Limits')\n")
-            raise typer.Exit(1) from None
         except Exception as err:
+            from gcalign.app.runner import OUT_OF_MEMORY, out_of_memory
+
+            if isinstance(err, StdoutError):
+                _stdout_failed(err)
+            if out_of_memory(err):
+                sys.stderr.write(f"error: {OUT_OF_MEMORY}\n")
+                raise typer.Exit(1) from None
             if os.environ.get("GCALIGN_TRACEBACK"):
                 raise
             sys.stderr.write(f"error: internal error, {type(err).__name__}: "
@@ -185,8 +195,65 @@ def default_output(name: str, kind: str, seed: int | None, overrides=()) -> Path
     return output_name(name, kind, seed, list(overrides))
 
 
+def _stdout_failed(err: OSError) -> None:
+    """A write to stdout refused (``> /dev/full``, a closed stdout, a reader that went
+    away): one line, exit 1; what is still buffered goes to /dev/null, so that Python's own
+    flush at exit cannot print a traceback."""
+    reason = (err.strerror or os.strerror(err.errno)) if err.errno else str(err)
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.close(devnull)
+    except OSError:
+        pass
+    sys.stderr.write(f"error: cannot write to stdout: {reason}\n")
+    sys.stderr.flush()
+    os._exit(1)  # the buffered text would only fail again
+
+
+class StdoutError(OSError):
+    """A write to stdout that was refused."""
+
+
+class _Stdout:
+    """stdout as the commands write it: a refused write (``> /dev/full``, a closed stdout, a
+    reader that went away) raises :class:`StdoutError`, which no other write raises, so that
+    it is told apart from a results file that cannot be written."""
+
+    def __init__(self, raw):
+        self._raw = raw
+
+    def write(self, s: str) -> int:
+        if self._raw is None:  # the process started with stdout closed (>&-)
+            raise StdoutError(errno.EBADF, "it is closed")
+        try:
+            return self._raw.write(s)  # type: ignore[no-any-return]
+        except OSError as err:
+            raise StdoutError(err.errno, err.strerror) from None
+
+    def flush(self) -> None:
+        if self._raw is not None:
+            try:
+                self._raw.flush()
+            except OSError as err:
+                raise StdoutError(err.errno, err.strerror) from None
+
+    def isatty(self) -> bool:
+        return self._raw is not None and self._raw.isatty()
+
+    def __getattr__(self, name: str):
+        return getattr(self._raw, name)
+
+
 def main() -> None:
-    app()
+    sys.stdout = _Stdout(sys.stdout)  # type: ignore[assignment]
+    try:
+        app()
+    finally:
+        try:
+            sys.stdout.flush()
+        except OSError as err:
+            _stdout_failed(err)
 
 
 # Commands register themselves on `app`.

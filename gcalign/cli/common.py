@@ -44,6 +44,7 @@ from gcalign.app.registry import COMMANDS, builtin_text
 from gcalign.cli import consoles, emit_json
 from gcalign.errors import ScenarioError
 from gcalign.io import results
+from gcalign.io.paths import not_a_file
 from gcalign.io.scenario import Scenario, parse_scenario
 from gcalign.io.scenario.loader import parse_override, read_yaml
 
@@ -112,6 +113,13 @@ def with_common_options(fn: Callable, recorded: bool) -> Callable:
         given = {p.name: kwargs.pop(p.name, None) for p in extra}
         site = {k: given.get(o) for k, o in (("lat_deg", "lat"), ("lon_deg", "lon"),
                                              ("height_m", "height"))}
+        if (site["lat_deg"] is None) != (site["lon_deg"] is None):
+            given_, missing = ("--lat", "--lon") if site["lon_deg"] is None else ("--lon",
+                                                                                  "--lat")
+            sys.stderr.write(f"error: {missing}: missing beside {given_} "
+                             f"(site.{missing[2:]}_deg); give both (and --height if it "
+                             "matters) or neither\n")
+            raise typer.Exit(2)
         inv = Invocation(imu_file=given.get("imu_file"),
                          site={k: v for k, v in site.items() if v is not None},
                          imu_layout={k: given[o] for k, o in (("format", "imu_format"),
@@ -178,7 +186,7 @@ def _apply_recorded(data: dict, inv: Invocation, applied: list) -> None:
     if inv.imu_file is not None:
         path = Path(inv.imu_file)
         if not path.is_file():
-            raise ScenarioError(f"--imu-file: {path}: file not found")
+            raise ScenarioError(f"--imu-file: {path}: {not_a_file(path)}")
         for key in ("motion", "mechanism", "site", "imu"):  # the simulation it replaces
             data.pop(key, None)
         data["imu_file"] = str(path.resolve())

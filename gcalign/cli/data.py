@@ -16,6 +16,7 @@ from gcalign.cli.common import imu_file_given, load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
 from gcalign.io import results
+from gcalign.io.paths import not_a_file
 from gcalign.io.results import HDF5_SUFFIXES
 from gcalign.io.scenario.resolve import resolved_rows
 
@@ -75,6 +76,13 @@ def navigate(
     start (`final_error` is null in the JSON).
     """
     overrides = {"vertical": vertical, "start_s": start, "duration_s": duration}
+    for what, given in (("--init", init), ("the source", source)):
+        if output is not None and given not in (None, "truth", "header") and \
+                Path(given).resolve() == Path(output).resolve():
+            raise ScenarioError(f"--output: {output} is {what} of this run; write the result "
+                                "under another name (it would replace its own input)")
+    if source is not None and not source.is_file():
+        raise ScenarioError(f"{source}: {not_a_file(source)}")
     suffix = "" if source is None else data_suffix(source)
     data = text = None
     if source is None and not imu_file_given():
@@ -105,7 +113,9 @@ def show(
     as_json: Json = False,
 ):
     """Print the summary of a results file again, from the file alone."""
-    kind, summary, attrs = results.read_summary(file)
+    from gcalign.app.checked import read_checked
+
+    kind, summary, attrs = read_checked(file)
     console = consoles(as_json)
     console.print(summary_table(kind, summary))
     console.print(

@@ -51,6 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from gcalign.errors import ScenarioError
+from gcalign.io.paths import not_a_file
 from gcalign.sim.imu import ImuData
 from gcalign.units import ARCSEC, DEG
 
@@ -104,8 +105,8 @@ def read_bytes(path) -> tuple[str, bytes]:
 
     name = os.fspath(path)
     p = Path(name)
-    if not p.exists():
-        raise ImuFileError(f"{name}: file not found")
+    if not p.is_file() and not p.is_dir():
+        raise ImuFileError(f"{name}: {not_a_file(p)}")
     if p.is_dir():
         raise ImuFileError(f"{name}: is a directory, expected an IMU data file")
     try:

@@ -26,6 +26,7 @@ import numpy as np
 
 from gcalign import __version__
 from gcalign.errors import GcalignError, ScenarioError
+from gcalign.io.paths import not_a_file
 from gcalign.limits import SEED_MAX
 from gcalign.sim.imu import ImuData
 from gcalign.sim.motions import Truth
@@ -210,17 +211,37 @@ class _GuardedFile:
         except OSError as err:
             self.error = self.error or err
 
+    # A buffered file flushes what it holds before it seeks, reads or tells, so a refused
+    # write can surface in any of them (seen with modulate's many small writes under
+    # ``ulimit -f``: HDF5 met the error in a seek and crashed): each records it too.
+
     def read(self, n=-1):
-        return b"" if self.raw.closed else self.raw.read(n)
+        try:
+            return b"" if self.raw.closed else self.raw.read(n)
+        except OSError as err:
+            self.error = self.error or err
+            return b""
 
     def readinto(self, b):
-        return 0 if self.raw.closed else self.raw.readinto(b)
+        try:
+            return 0 if self.raw.closed else self.raw.readinto(b)
+        except OSError as err:
+            self.error = self.error or err
+            return 0
 
     def seek(self, offset, whence=0):
-        return 0 if self.raw.closed else self.raw.seek(offset, whence)
+        try:
+            return 0 if self.raw.closed else self.raw.seek(offset, whence)
+        except OSError as err:
+            self.error = self.error or err
+            return offset if whence == 0 else 0
 
     def tell(self):
-        return 0 if self.raw.closed else self.raw.tell()
+        try:
+            return 0 if self.raw.closed else self.raw.tell()
+        except OSError as err:
+            self.error = self.error or err
+            return 0
 
 
 @contextmanager
@@ -408,7 +429,7 @@ def open_results(path: Path) -> h5py.File:
     """Open a gcalign results file for reading; ScenarioError if it is missing or not ours."""
     path = Path(path)
     if not path.is_file():
-        raise ScenarioError(f"{path}: file not found")
+        raise ScenarioError(f"{path}: {not_a_file(path)}")
     try:
         f = h5py.File(path, "r")
     except OSError:
@@ -465,6 +486,67 @@ def read_summary(path: Path) -> tuple[str, dict, dict]:
         raise ScenarioError(f"{path}: root attribute 'summary_json' must be a JSON object, got "
                             f"{type(summary).__name__}")
     return kind, summary, attrs
+
+
+def check_layout(path: Path, kind: str, groups: tuple[str, ...], strict: bool = True) -> None:
+    """The reader check of a results file of `kind`: ScenarioError naming the file and the
+    dataset when a group the kind writes (`groups`, its command's ``layout``; ``/truth`` may
+    be absent) is missing, or a dataset under them is damaged: numbers without their
+    ``units`` attribute (every dataset gcalign writes has one; text has none or ``none``),
+    text or other types where numbers were written, values that are not finite, a time
+    ``t`` that is not strictly monotonic (a zeroed chunk). Without `strict` (kinds that
+    store NaN, and whose groups have readers of their own: ``/imu``, ``/truth``), only the
+    groups and the types are checked."""
+    with open_results(path) as f:
+        for name in groups:
+            g = f.get(name)
+            if not isinstance(g, h5py.Group):
+                if name == "truth" and g is None:
+                    continue
+                have = ", ".join(k for k in f if isinstance(f[k], h5py.Group)) or "none"
+                raise ScenarioError(f"{path}: a {kind!r} results file needs its /{name} group; "
+                                    f"it has {have}")
+            problem: list[str] = []
+
+            def visit(_: str, ds, problem=problem) -> None:
+                if problem or not isinstance(ds, h5py.Dataset):
+                    return
+                why = _damaged(ds, strict)
+                if why:
+                    problem.append(f"{path}: dataset {ds.name} {why}")
+
+            g.visititems(visit)
+            if problem:
+                raise ScenarioError(problem[0])
+
+
+_TIMES = ("t", "t0", "t1")  #: datasets of times, strictly monotonic
+
+
+def _damaged(ds: h5py.Dataset, strict: bool) -> str:
+    """What is wrong with one dataset of a results file ('' when nothing is)."""
+    units = ds.attrs.get("units")
+    if h5py.check_string_dtype(ds.dtype) is not None or ds.dtype.kind == "O":
+        return "" if units in (None, "", "none", b"", b"none") else (
+            f"must hold numbers (units {_short(units)}), got text")
+    if ds.dtype.kind not in "fiub":
+        return f"must hold numbers, got {ds.dtype}"
+    if not strict:
+        return ""
+    if units is None:
+        return "has no 'units' attribute (not as gcalign wrote it)"
+    if ds.dtype.kind == "f" and ds.size:
+        a = ds[()]
+        if not np.isfinite(a).all():
+            bad = np.argwhere(~np.isfinite(np.atleast_1d(a)))[0].tolist()
+            return f"holds a value that is not finite at {bad}"
+        step = np.sign(np.diff(a)) if a.ndim == 1 else None
+        if ds.name.rsplit("/", 1)[-1] in _TIMES and step is not None and len(step) and (
+                step[0] == 0 or np.any(step != step[0])):  # a reverse pass runs backwards
+            i = int(np.argmax(step != step[0])) if step[0] else 0
+            return (f"(time) is not strictly monotonic at row {i + 1}: {float(a[i])!r} then "
+                    f"{float(a[i + 1])!r}")
+    return ""
 
 
 def _dataset(g, name: str, path: Path) -> np.ndarray:

@@ -76,7 +76,7 @@ class Align(Command):
             None if ext is None or ext.lat is None else math.degrees(ext.lat))
         if lat is not None and abs(lat) > MAX_LAT_DEG:
             raise ScenarioError(f"site.lat_deg: gyrocompassing needs |latitude| < "
-                                f"{MAX_LAT_DEG:g}°, got {lat:.4f}° (the horizontal earth "
+                                f"{MAX_LAT_DEG:g}°, got {lat:.10g}° (the horizontal earth "
                                 "rate vanishes)")
         if ext is None:
             return

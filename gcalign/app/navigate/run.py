@@ -50,18 +50,25 @@ class Start:
 
 def alignment_start(path: Path, stream: Stream) -> Start:
     """The attitude at T3 of an alignment results file, at T3's data time."""
-    from gcalign.io import results
+    from gcalign.app.checked import read_checked
 
-    kind, summary, _ = results.read_summary(path)
+    kind, summary, _ = read_checked(path)
     if kind != "align":
         raise ScenarioError(f"--init: {path} is a {kind!r} results file; it must come from "
                             "'gcalign align'")
     if summary.get("source") != stream.source:
         raise ScenarioError(f"--init: {path} aligned {summary.get('source')!r}, but this run "
                             f"navigates {stream.source!r}; align the same data")
-    t_data = float(summary.get("start_s", 0.0)) + float(summary["t3_s"])
+    try:
+        t_data = float(summary.get("start_s", 0.0)) + float(summary["t3_s"])
+        att = np.radians(np.asarray(summary["attitude_t3_deg"], dtype=float))
+    except (KeyError, TypeError, ValueError):
+        att = t_data = None
+    if t_data is None or att is None or att.shape != (3,) or not (
+            np.isfinite(att).all() and math.isfinite(t_data) and t_data >= 0):
+        raise ScenarioError(f"--init: {path}: root attribute 'summary_json' must hold a "
+                            "finite 't3_s' and 'attitude_t3_deg' (3 numbers)")
     k = int(round(t_data / stream.ts))
-    att = np.radians(summary["attitude_t3_deg"])
     tr = stream.truth_at(k)
     known = tr is not None and tr[0] is not None
     v = tr[1] if known else np.zeros(3)  # type: ignore[index]

@@ -19,6 +19,7 @@ from pydantic import ValidationError
 
 from gcalign import limits
 from gcalign.errors import ScenarioError
+from gcalign.io.paths import not_a_file
 from gcalign.io.scenario.models import Scenario
 from gcalign.io.scenario.motion import MOTION_KINDS
 
@@ -256,7 +257,7 @@ def read_yaml(path: Path) -> dict:
     if path.is_dir():
         raise ScenarioError(f"{path}: is a directory, expected a YAML file")
     if not path.is_file():
-        raise ScenarioError(f"{path}: file not found")
+        raise ScenarioError(f"{path}: {not_a_file(path)}")
     try:
         size = path.stat().st_size
         limits.MAX_YAML_MB.check(size / 2**20, str(path))

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
-from pydantic import BeforeValidator, Field, field_validator
+from pydantic import BeforeValidator, Field, ValidationError, field_validator
 
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.base import Model
@@ -37,6 +37,7 @@ if TYPE_CHECKING:
 
 CYCLE_TOL = 1e-9  # rad: a table's cycle rotation below this returns the IMU to its start
 MAX_HOURS = 1e6 / 3600.0  # the longest motion a scenario may have (1e6 s)
+MIN_CYCLE_SAMPLES = 10  # a cycle shorter than this many IMU samples is not sampled at all
 
 
 def default_rate_hz(duration_s: float, imu_rate_hz: float) -> float:
@@ -128,13 +129,25 @@ def plan_of(sc) -> Plan:
                 k: getattr(mech, k) for k in _TIMING if getattr(mech, k) is not None}
             if mech is not None and mech.lever_arm_cm is not None:
                 kept["lever_arm_cm"] = mech.lever_arm_cm
-            cfg_e = MechanismConfig(scheme=name, **kept)
+            try:
+                cfg_e = MechanismConfig(scheme=name, **kept)
+            except ValidationError as err:  # the mechanism's timing does not suit this scheme
+                from gcalign.io.scenario.loader import scenario_errors
+
+                raise ScenarioError(f"modulate.compare: {name} with the mechanism's timing: "
+                                    f"mechanism.{scenario_errors(err)}") from None
         else:
             allowed = ", ".join(BUILTIN_NAMES) + (f", {own}" if own and own not in
                                                   BUILTIN_NAMES else "")
             raise ScenarioError(f"modulate.compare: unknown scheme {name!r}; allowed: "
                                 f"{allowed}")
         schedule = cfg_e.schedule(att0)
+        if not schedule.period >= MIN_CYCLE_SAMPLES * sc.imu.ts:
+            key = "mechanism.steps" if cfg_e.steps is not None else "mechanism.dwell_s"
+            raise ScenarioError(f"{key}: the cycle of {name} lasts {schedule.period:.4g} s, "
+                                f"shorter than {MIN_CYCLE_SAMPLES} IMU samples "
+                                f"({MIN_CYCLE_SAMPLES * sc.imu.ts:g} s at {sc.imu.rate_hz:g} "
+                                "Hz): no mechanism turns that fast")
         if cfg_e.scheme is not None:
             base = cfg_e.scheme_of(cfg_e.scheme)
             scheme = Scheme(name, base.rows, schedule, cfg_e.resolved_reference,
@@ -152,6 +165,9 @@ def plan_of(sc) -> Plan:
         if sc.motion.kind != "static" and hours * 3600.0 > motion_s + 1e-9:
             raise ScenarioError(f"modulate.hours: {hours:g} h is longer than the motion "
                                 f"({motion_s / 3600:g} h); shorten it or lengthen the motion")
+    if not hours * 3600.0 * sc.imu.rate_hz >= 2:
+        raise ScenarioError(f"modulate.hours: {hours:g} h holds fewer than 2 IMU samples at "
+                            f"{sc.imu.rate_hz:g} Hz; navigate at least {2 / sc.imu.rate_hz:g} s")
     return Plan(tuple(entries), hours, hours * 3600.0)
 
 

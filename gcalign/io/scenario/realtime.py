@@ -110,7 +110,21 @@ class FilterConfig(Model):
     align_cutoff_hz: float = 100.0
     notch_hz: float | None = Field(400.0, description="IIR notch (null: none)")
     notch_q: float = Field(10.0, gt=0)
-    window: str = "hamming"
+    window: str = Field("hamming", description="FIR window: a scipy.signal window that takes "
+                        "no parameter (hamming, hann, blackman, boxcar, ...)")
+
+    @model_validator(mode="after")
+    def _window(self):
+        """A window scipy.signal's design would refuse, refused here by its key (the
+        orders and frequencies are checked by FilterSettings)."""
+        from scipy import signal
+
+        try:
+            signal.get_window(self.window, 8)
+        except (ValueError, TypeError):
+            raise ValueError(f"window: {self.window!r} is not a scipy.signal window without "
+                             "parameters (hamming, hann, blackman, boxcar, ...)") from None
+        return self
 
     def to_settings(self) -> FilterSettings:
         return FilterSettings(fs_hz=self.fs_hz, align_order=self.align_order,
