@@ -16,6 +16,7 @@ from cli_checks import assert_bad_run
 from scipy.spatial.transform import Rotation, Slerp
 from typer.testing import CliRunner
 
+import gcalign
 from conftest import ROOT
 from gcalign.cli import app
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
@@ -101,6 +102,11 @@ def test_mems_gyro_biases_from_the_fog_solution(tmp_path):
         g = f["calibrate/runs/00"]
         k = int(np.argmin(np.abs(g["t"][()] - t)))
         att, v_n = g["att"][k], g["v_n"][k]
+        series = {n: g["reference_error"][n][()] for n in ("t", "att", "v_n", "pos")}
+    # the stored series ends on the summary's numbers, and plot draws it
+    assert series["t"][-1] == t and np.degrees(series["att"][-1]).tolist() == e["attitude_deg"]
+    assert series["pos"][-1].tolist() == e["position_m"]
+    assert "reference_errors" in gcalign.read(tmp_path / "c.h5").figures()
     ref_att = dcm_to_euler(Slerp(fog[:, 9], rot)([t]).as_matrix())[0]
     err = (att - ref_att + np.pi) % (2 * np.pi) - np.pi
     np.testing.assert_allclose(e["attitude_deg"], np.degrees(err), atol=1e-9)

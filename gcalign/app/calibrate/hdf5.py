@@ -35,7 +35,9 @@ def write_segments(f: h5py.File, truth, segments) -> None:
                                                      dtype=h5py.string_dtype()))
 
 
-def write_calibration(f: h5py.File, case, runs, compare: bool) -> None:
+def write_calibration(f: h5py.File, case, runs, compare: bool, against=None) -> None:
+    """``/calibrate``; `against` (one per run, or None) the INS solution's errors against a
+    reference (:func:`gcalign.app.calibrate.run.reference_series`)."""
     d = case.data
     write_segments(f, case.truth(), d.segments)
     g = f.create_group("calibrate")
@@ -56,6 +58,15 @@ def write_calibration(f: h5py.File, case, runs, compare: bool) -> None:
     rg = g.create_group("runs")
     for i, run in enumerate(runs):
         _write_run(rg.create_group(f"{i:02d}"), run)
+        e = None if against is None else against[i]
+        if e is not None:
+            ref = rg[f"{i:02d}"].create_group("reference_error")
+            ref.attrs["description"] = "INS solution - reference, at the epochs it covers"
+            put(ref, "t", e["t"], "s")
+            put(ref, "att", e["att"], "rad", description="Euler differences, roll and yaw "
+                "wrapped: pitch, roll, yaw")
+            put(ref, "v_n", e["v_n"], "m/s", "ENU")
+            put(ref, "pos", e["pos"], "m", "ENU")
 
 
 def _write_run(g: h5py.Group, run) -> None:

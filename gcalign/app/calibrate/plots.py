@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 
 from gcalign.app.calibrate import UNIT_TEXT
 from gcalign.app.plots import _s, finish, legend_below, legend_right, new_figure, suptitle
+from gcalign.units import ANGLE_UNITS, angle_unit
 
 STYLE = {"both": dict(color="tab:red", linestyle="--"),
          "velocity": dict(color="tab:cyan", linestyle="-"),
@@ -36,6 +37,9 @@ def read_runs(f) -> tuple[list[dict], dict]:
                "measure_names": _s(r.attrs.get("measure_names", "")).split(",")}
         for name in ("t", "estimate", "sigma", "truth", "nees", "standardized", "nis", "att"):
             run[name] = r[name][()] if name in r else None
+        e = r.get("reference_error")
+        run["reference_error"] = None if e is None else {k: e[k][()] for k in
+                                                         ("t", "att", "v_n", "pos")}
         runs.append(run)
     seg = g["segments"]
     attrs["segments"] = [(_s(n), float(a), float(b)) for n, a, b in
@@ -62,6 +66,7 @@ def _ylim(est, sig, truth, t) -> float:
     return 1.15 * lim if lim > 0 else 1.0
 
 
+AIDED = {"velocity": "velocity", "position": "position", "both": "velocity and position"}
 UNIT_WORD = {"arcsec": "arcsec", "arcmin": "arcmin"}  # readable as a label, unlike ″ and ′
 
 
@@ -211,6 +216,21 @@ def attitude_figure(run, title: str) -> Figure:
     return finish(fig, axes, xlabel, title)
 
 
+def reference_figure(e: dict, title: str) -> Figure:
+    """Attitude (in the unit its size needs), velocity and position of the INS solution
+    minus the reference, per component, against time."""
+    fig, axes = new_figure(3, 1, width=10.0, height=8.0)
+    tx, xlabel = _time_axis(e["t"])
+    unit = angle_unit(float(np.max(np.abs(e["att"]))))
+    rows = ((e["att"] / ANGLE_UNITS[unit][0], ("pitch", "roll", "yaw")),
+            (e["v_n"], ("E", "N", "U")), (e["pos"], ("E", "N", "U")))
+    for ax, (values, names) in zip(axes, rows, strict=True):
+        for j, n in enumerate(names):
+            ax.plot(tx, values[:, j], linewidth=0.9, label=n)
+    return finish(fig, axes, xlabel, title, [f"attitude ({unit})", "velocity (m/s)",
+                                              "position (m)"])
+
+
 def enu_track(pos: np.ndarray) -> np.ndarray:
     """East, north, up (m) from the first point: angles times the radii at the start
     latitude and each point's own height (the horizontal distance flown at altitude, as
@@ -301,6 +321,10 @@ def figures(f, name: str) -> dict[str, Figure]:
     else:
         figs["attitude"] = attitude_figure(first, f"{name}: INS attitude with ±3σ "
                                                   "(zero-velocity updates)")
+    if first["reference_error"] is not None:
+        figs["reference_errors"] = reference_figure(
+            first["reference_error"], f"{name}: INS solution against the reference "
+            f"(est − reference; {AIDED[first['measure']]} aiding)")
     figs["innovations"] = innovations_figure(
         first, f"{name}: standardized innovations, NIS and NEES ({first['measure']})")
     return figs

@@ -315,28 +315,37 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
     return out
 
 
-def reference_errors(sc: Scenario, run: Run) -> dict:
-    """A recording's INS solution at the filter's last epoch inside the scenario's
-    reference, against it (attitude by slerp, Euler differences with roll and yaw wrapped; velocity;
-    position in m ENU), in the fields navigate gives against truth: ``final_error`` and
-    ``error_source: "reference"``; nothing without a reference or with truth."""
+def reference_series(sc: Scenario, run: Run) -> dict[str, np.ndarray] | None:
+    """A recording's INS solution against the scenario's reference at every filter epoch
+    the reference covers (SI): ``t``, ``att`` (Euler differences est − reference, roll and
+    yaw wrapped; the reference's attitude by slerp), ``v_n`` (ENU), ``pos`` (m ENU); None
+    without a reference, with truth, or with no epoch inside the reference."""
     r = run.result
     if sc.reference is None or r.truth is not None:
-        return {}
+        return None
     from gcalign.io.recorded.reference import reference_at
     from gcalign.nav.navigate import position_error_enu
     from gcalign.nav.rotation import attitude_error
 
     ref = sc.reference.read()
-    k = int(np.searchsorted(r.t, ref.t[-1] + 1e-9, side="right")) - 1  # last epoch it covers
-    if k < 0 or r.t[k] < ref.t[0]:
+    inside = (r.t >= ref.t[0] - 1e-6) & (r.t <= ref.t[-1] + 1e-6)
+    if not inside.any():
+        return None
+    t = r.t[inside]
+    att, v_n, pos = reference_at(ref, t, tol=1e-6)
+    return {"t": t, "att": attitude_error(r.att[inside], att), "v_n": r.v_n[inside] - v_n,
+            "pos": position_error_enu(r.pos[inside], pos, run.data.earth)}
+
+
+def reference_errors(sc: Scenario, run: Run) -> dict:
+    """The summary's errors against a reference at the last epoch it covers, in the fields
+    navigate gives against truth: ``final_error`` and ``error_source: "reference"``."""
+    e = reference_series(sc, run)
+    if e is None:
         return {}
-    att, v_n, pos = reference_at(ref, [float(r.t[k])], tol=1e-6)
     return {"error_source": "reference", "final_error": {
-        "t_s": float(r.t[k]),
-        "attitude_deg": np.degrees(attitude_error(r.att[k], att[0])).tolist(),
-        "velocity_mps": (r.v_n[k] - v_n[0]).tolist(),
-        "position_m": position_error_enu(r.pos[k:k + 1], pos, run.data.earth)[0].tolist()}}
+        "t_s": float(e["t"][-1]), "attitude_deg": np.degrees(e["att"][-1]).tolist(),
+        "velocity_mps": e["v_n"][-1].tolist(), "position_m": e["pos"][-1].tolist()}}
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
@@ -360,8 +369,9 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
 
     result = tuple(r.result for r in runs) if compare else runs[0].result
     warnings = (*zero_velocity_warnings(sc, case, out), *filter_warnings(runs, compare))
-    return Outcome(out, lambda f: write_calibration(f, case, runs, compare), case.truth(),
-                   case.seed, warnings, result=result)
+    against = [reference_series(sc, r) for r in runs]
+    return Outcome(out, lambda f: write_calibration(f, case, runs, compare, against),
+                   case.truth(), case.seed, warnings, result=result)
 
 
 def filter_warnings(runs: list[Run], compare: bool) -> tuple[str, ...]:
