@@ -605,8 +605,9 @@ or the asymmetric term accumulated over one cycle.
 - A **gyro misalignment** nets to 0 per cycle too, and no scheme cancels it: it enters
   through every turn's rate, its in-cycle peak and standing mean act like attitude errors,
   and `four-position-12` ends only a few times below the unrotated run at 72 h, its
-  maximum on the way above the unrotated one; `dual-16-improved`, whose cycle sits next to the Schuler period, multiplies it — the
-  Schuler warning holds for every error the mechanism modulates, not for biases only.
+  maximum on the way above the unrotated one; `dual-16-improved`, whose cycle sits next to
+  the Schuler period, multiplies it — the Schuler warning holds for every error the
+  mechanism modulates, not for biases only.
 - The scale factor returns to zero every cycle in open loop (peak 2π·δk = 13″ for
   `seed-12`), but the navigation sees the in-cycle tilts and their standing mean like an
   initial attitude error: the misalignment and the position error are set by the Schuler

@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import yaml
-from conftest import ROOT
 from typer.testing import CliRunner
 
+from conftest import ROOT
 from gcalign.cli import app
 from gcalign.errors import ScenarioError
 from gcalign.io.recorded import read_recording
