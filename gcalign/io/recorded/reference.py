@@ -29,8 +29,8 @@ import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.io.imu_files import ImuFileError, read_bytes
-from gcalign.io.recorded.aiding import _check_rows, _columns, _finite
 from gcalign.io.recorded.imu import _table, _text_lines
+from gcalign.io.recorded.rows import _check_rows, _columns, _finite
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
 from gcalign.units import DEG
 
