@@ -76,3 +76,16 @@ def test_defaults_are_the_spec_proposals():
     assert (s.filter.align_cutoff_hz, s.filter.nav_cutoff_hz) == (100.0, 200.0)
     assert s.tracker.qc == 1.0
     assert s.delay_s is None  # T from the chain
+
+
+def test_the_fir_window_names_are_scipys_windows_without_parameters():
+    """The scenario checks the window by name (validate must not import scipy): every name
+    it allows is a window scipy.signal designs without a parameter, and one that needs a
+    parameter is not allowed."""
+    from scipy import signal
+
+    from gcalign.io.scenario.realtime import FIR_WINDOWS
+
+    for name in FIR_WINDOWS:
+        assert len(signal.get_window(name, 8)) == 8
+    assert "kaiser" not in FIR_WINDOWS  # needs its beta
