@@ -275,9 +275,12 @@ def run_summary(run: Run) -> dict:
     return out
 
 
-def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
+def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
+            against: list[dict[str, np.ndarray] | None] | None = None) -> dict:
     """The command's summary: the run's settings and data, then one run (or the six of
-    ``--compare`` under ``runs``)."""
+    ``--compare`` under ``runs``); `against`, one per run, their errors against a
+    reference (:func:`reference_series`)."""
+    against = against or [None] * len(runs)
     d = case.data
     s = case.settings
     out = {
@@ -308,10 +311,11 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool) -> dict:
         "compare": compare,
     }
     if compare:
-        out["runs"] = [run_summary(r) | reference_errors(sc, r) for r in runs]
+        out["runs"] = [run_summary(r) | reference_errors(e)
+                       for r, e in zip(runs, against, strict=True)]
         out["compute_s"] = float(sum(r.compute_s for r in runs))
     else:
-        out |= run_summary(runs[0]) | reference_errors(sc, runs[0])
+        out |= run_summary(runs[0]) | reference_errors(against[0])
     return out
 
 
@@ -337,10 +341,10 @@ def reference_series(sc: Scenario, run: Run) -> dict[str, np.ndarray] | None:
             "pos": position_error_enu(r.pos[inside], pos, run.data.earth)}
 
 
-def reference_errors(sc: Scenario, run: Run) -> dict:
-    """The summary's errors against a reference at the last epoch it covers, in the fields
-    navigate gives against truth: ``final_error`` and ``error_source: "reference"``."""
-    e = reference_series(sc, run)
+def reference_errors(e: dict[str, np.ndarray] | None) -> dict:
+    """The summary's errors against a reference (:func:`reference_series`) at the last
+    epoch it covers, in the fields navigate gives against truth: ``final_error`` and
+    ``error_source: "reference"``."""
     if e is None:
         return {}
     return {"error_source": "reference", "final_error": {
@@ -364,12 +368,12 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             else [run_filter(case)])
     if progress is not None and not compare:
         progress(1, 1, "filter run")
-    out = summary(sc, case, runs, compare)
+    against = [reference_series(sc, r) for r in runs]  # read and interpolated once
+    out = summary(sc, case, runs, compare, against)
     from gcalign.app.at_rest import zero_velocity_warnings  # a moving recording under ZUPT
 
     result = tuple(r.result for r in runs) if compare else runs[0].result
     warnings = (*zero_velocity_warnings(sc, case, out), *filter_warnings(runs, compare))
-    against = [reference_series(sc, r) for r in runs]
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare, against),
                    case.truth(), case.seed, warnings, result=result)
 
