@@ -148,7 +148,7 @@ def recording_record(sc: Scenario) -> dict | None:
     so this costs nothing after the run)."""
     if sc.imu_file is None or Path(sc.imu_file).suffix.lower() in HDF5_SUFFIXES:
         return None
-    if sc.align is not None and sc.align.mode == "transfer":  # reads its own files (spec 006)
+    if sc.reads_own_recording:
         return None
     imu, _ = read_data_file(sc.imu_file, sc.recording_layout())
     return imu.meta.get("recording")

@@ -34,7 +34,7 @@ def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
     """Samples and interval of the scenario's data, or None if it has none. A recorded file
     is read and validated when `read_recorded` (once per process and file version), else
     only checked to exist."""
-    if sc.align is not None and sc.align.mode == "transfer":  # reads its own files (spec 006)
+    if sc.reads_own_recording:
         return None
     if sc.imu_file is not None:
         if not read_recorded:

@@ -212,6 +212,13 @@ class Scenario(Model):
             if f is not None and f.path is not None and not f.path.is_absolute():
                 f.path = (Path(folder) / f.path).resolve()
 
+    @property
+    def reads_own_recording(self) -> bool:
+        """Whether the run reads `imu_file` itself rather than through the generic reader
+        (transfer alignment: slave and master from one MAT file, spec 006), so neither the
+        extent check nor the results file's /recording record read it."""
+        return self.align is not None and self.align.mode == "transfer"
+
     def recording_layout(self):
         """How to read `imu_file` (:class:`gcalign.io.recorded.Layout`)."""
         from gcalign.io.recorded import Layout
