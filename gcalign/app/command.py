@@ -20,6 +20,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from gcalign.errors import ScenarioError
+
 if TYPE_CHECKING:
     from gcalign.app.registry import Outcome
     from gcalign.io.scenario import Scenario
@@ -91,6 +93,9 @@ class Command:
     name: str = ""
     help: str = ""
     section: str | None = None  #: the scenario section it reads
+    #: the keys of a section the command cannot run without, for the refusal when it is
+    #: missing (None: the section is optional)
+    section_keys: str | None = None
     builtin: str | None = None  #: its built-in scenario (package data gcalign/scenarios)
     options: Options = Options()
     layout: tuple[str, ...] = ()  #: the HDF5 groups of its results file beside /truth
@@ -104,6 +109,9 @@ class Command:
         """Refuse (ScenarioError, one line naming the field) what the run would refuse;
         `ext` is the scenario's data (None: it has none, or a recorded file not read)."""
         section = getattr(sc, self.section) if self.section else None
+        if section is None and self.section_keys is not None:
+            raise ScenarioError(f"{self.section}: missing; the scenario needs a "
+                                f"'{self.section}' section ({self.section_keys})")
         check = getattr(section, "check", None)
         if callable(check):
             check(sc)
@@ -170,7 +178,6 @@ def builtin_text(name: str) -> str:
 
 def stride(sc: Scenario, ext: Extent) -> int:
     """Samples per stored row (``output.rate_hz``); ScenarioError naming the field."""
-    from gcalign.errors import ScenarioError
 
     try:
         return sc.output.stride(1.0 / ext.ts, ext.samples * ext.ts)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from gcalign.app.command import DOUBLE, SIMULATE_OPS, Command, Cost, Extent, Options
-from gcalign.errors import ScenarioError
 
 READING_DOUBLES = 16  #: per dwell reading: gyro and accelerometer means, per method results
 
@@ -18,13 +17,8 @@ class Northfind(Command):
     layout = ("northfind",)
     run = "gcalign.app.northfind.run"
     table_of = "gcalign.app.northfind.tables.northfind_table"
+    section_keys = "positions, dwell_s, azimuth_deg or sweep, tilt_deg, …"
     figures_of = "gcalign.app.northfind.plots.figures"
-
-    def check(self, sc, ext: Extent | None) -> None:
-        if sc.northfind is None:
-            raise ScenarioError("northfind: missing; the scenario needs a 'northfind' section "
-                                "(positions, dwell_s, azimuth_deg or sweep, tilt_deg, …)")
-        sc.northfind.check(sc)
 
     def cost(self, sc, ext: Extent | None) -> Cost:
         cfg = sc.northfind

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 from gcalign.app.command import DOUBLE, Command, Cost, Extent, Options
-from gcalign.errors import ScenarioError
 
 NOTCH_OPS = 5.0  #: a second-order IIR section per sample
 SOLUTION_DOUBLES = 24  #: per attitude solution: truth, output and each predictor's error
@@ -20,13 +19,8 @@ class Realtime(Command):
     layout = ("realtime",)
     run = "gcalign.app.realtime.run"
     table_of = "gcalign.app.realtime.tables.realtime_table"
+    section_keys = "cases or a turntable motion, filter, sensor, tracker, pulses"
     figures_of = "gcalign.app.realtime.plots.figures"
-
-    def check(self, sc, ext: Extent | None) -> None:
-        if sc.realtime is None:
-            raise ScenarioError("realtime: missing; the scenario needs a 'realtime' section "
-                                "(cases or a turntable motion, filter, sensor, tracker, pulses)")
-        sc.realtime.check(sc)
 
     def cost(self, sc, ext: Extent | None) -> Cost:
         """Three gyro channels through the chain's FIR (taps × samples, a direct
