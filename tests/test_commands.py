@@ -236,3 +236,16 @@ def test_the_built_in_scenarios_fit_the_default_limits():
         cost = preflight.budget(sc, c, preflight.extent(sc))
         assert 0 < cost.memory_bytes < 2**30, name
         assert 0 < cost.work < limits.MAX_WORK.value() / 10, name
+
+
+@pytest.mark.parametrize("name, keys", [("northfind", "positions, dwell_s"),
+                                        ("realtime", "cases or a turntable motion")])
+def test_a_required_section_that_is_missing_is_one_line_naming_it(tmp_path, name, keys):
+    from gcalign.cli import app
+
+    path = tmp_path / "s.yaml"
+    path.write_text("name: x\nsite: {lat_deg: 40, lon_deg: 116}\n")
+    res = CliRunner().invoke(app, [name, str(path), "-o", str(tmp_path / "o.h5")])
+    assert res.exit_code == 2 and not (tmp_path / "o.h5").exists()
+    assert res.stderr.strip().startswith(
+        f"error: {name}: missing; the scenario needs a '{name}' section ({keys}")
