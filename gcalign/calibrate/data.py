@@ -101,6 +101,11 @@ class FlightData:
     x_true : (21,) the true initial navigation errors and IMU errors (state order of
         :data:`gcalign.estimation.ins_error.STATE_NAMES`), or None when unknown.
     earth : the earth model the INS navigates in.
+    lever_arm_v_b, lever_arm_p_b : (3,) the points whose velocity and whose position the
+        aiding measures (a GNSS antenna), from the IMU in body axes (x right, y forward,
+        z up), m; zero: the IMU itself. The filter applies them
+        (:func:`gcalign.estimation.ins_error.lever_arm_terms`); ref_v_n, ref_pos are then
+        the antenna's.
     """
 
     t: np.ndarray
@@ -113,6 +118,8 @@ class FlightData:
     truth: Trajectory | None = None
     x_true: np.ndarray | None = None
     earth: EarthModel = field(default=WGS84)
+    lever_arm_v_b: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    lever_arm_p_b: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     @property
     def ts(self) -> float:

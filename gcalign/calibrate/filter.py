@@ -14,6 +14,9 @@ divide the navigation rate. Per filter step of S navigation steps:
    to 1e-2, ``tests/test_ins_error.py``);
 4. predict, and update in Joseph form (:func:`gcalign.estimation.kalman.update`) with
    z = INS − reference (+ noise): horizontal velocity, horizontal position in metres, or both;
+   an aiding antenna at a lever arm (``FlightData.lever_arm_v_b``, ``lever_arm_p_b``) adds
+   the INS's prediction of the antenna's offset to z and its φ, ε, δKg columns to H
+   (:func:`gcalign.estimation.ins_error.lever_arm_terms`, where the terms are derived);
 5. closed loop (default): feed the estimate back and reset it, ``C_nb ← exp([φ̂×]) C_nb``,
    ``v −= δv̂``, ``p −= δp̂``, and for the sensors the exact composition
    ``ε̂ += (1 + δK̂g) x_ε``, ``1 + δK̂g ← (1 + δK̂g)(1 + x_δKg)`` (likewise ∇, δKa), so that
@@ -42,6 +45,7 @@ from gcalign.nav.rotation import (
     euler_to_quat,
     quat_conj,
     quat_mult,
+    quat_to_dcm,
     quat_to_euler,
     quat_to_rotvec,
     rotvec_to_quat,
@@ -224,6 +228,15 @@ def _measurement(measure: str, v_n: np.ndarray, pos: np.ndarray, ref_v: np.ndarr
     return (dp if measure == "position" else np.concatenate([dv, dp])) - noise
 
 
+def _lever_arm(value: np.ndarray, which: str) -> np.ndarray:
+    """A lever arm of FlightData as (3,) finite metres; ScenarioError (one line) otherwise."""
+    lever = np.asarray(value, dtype=float)
+    if lever.shape != (3,) or not np.isfinite(lever).all():
+        raise ScenarioError(f"lever_arm_{which}_b: must be 3 finite numbers (body x right, "
+                            f"y forward, z up; m), got {np.ravel(lever).tolist()}")
+    return lever
+
+
 def _noise_sigma(s: Settings) -> np.ndarray:
     return np.array({"velocity": [s.sigma_v] * 2, "position": [s.sigma_p] * 2,
                      "both": [s.sigma_v] * 2 + [s.sigma_p] * 2}[s.measure])
@@ -274,6 +287,8 @@ def calibrate(data: FlightData, settings: Settings | None = None,
     truth, x_true = data.truth, data.x_true
     if truth is None or x_true is None:
         truth = x_true = None
+    lever_v, lever_p = _lever_arm(data.lever_arm_v_b, "v"), _lever_arm(data.lever_arm_p_b, "p")
+    levered = bool(lever_v.any() or lever_p.any())
 
     est, sig = np.zeros((K + 1, N_STATES)), np.zeros((K + 1, N_STATES))
     innov, stdz, nis = np.zeros((K, m)), np.zeros((K, m)), np.zeros(K)
@@ -307,7 +322,12 @@ def calibrate(data: FlightData, settings: Settings | None = None,
                               E)
         x_prior, P_prior = predict(x, P, Phi, Qd)
         z = _measurement(s.measure, v, p, data.ref_v_n[j], data.ref_pos[j], noise[k], earth)
-        u = update(x_prior, P_prior, z, ie.measurement_matrix(s.measure, p, earth), R)
+        H = ie.measurement_matrix(s.measure, p, earth)
+        if levered:  # the fixes are the antenna's: z and H of the INS's antenna
+            off, H_l = ie.lever_arm_terms(s.measure, quat_to_dcm(q), dth[-1] / ts,
+                                          earth.omega_ie_n(p[0]), lever_v, lever_p)
+            z, H = z + off, H + H_l
+        u = update(x_prior, P_prior, z, H, R)
         innov[k], stdz[k], nis[k] = u.innovation, u.standardized, u.nis
         sig[k + 1], P = np.sqrt(np.diag(u.P)), u.P
         est[k + 1, NAV] = u.x[NAV]
