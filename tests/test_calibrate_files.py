@@ -97,7 +97,11 @@ def test_mems_gyro_biases_from_the_fog_solution(tmp_path):
     fog = m["fogavp"]
     rot = Rotation.from_matrix(euler_to_dcm(fog[:, :3]))
     t = e["t_s"]
-    assert fog[0, 9] <= t <= fog[-1, 9]
+    # the epochs count from sample 0, one 10 ms step before the MAT's first row (t = 0 s):
+    # the reference is taken at the file's time
+    t_data = t + float(m["mimu"][0, 6]) - 0.01
+    assert fog[0, 9] - 1e-6 <= t_data <= fog[-1, 9] + 1e-6
+    t_data = float(np.clip(t_data, fog[0, 9], fog[-1, 9]))  # to round-off
     with h5py.File(tmp_path / "c.h5") as f:  # the INS solution at that epoch
         g = f["calibrate/runs/00"]
         k = int(np.argmin(np.abs(g["t"][()] - t)))
@@ -107,15 +111,16 @@ def test_mems_gyro_biases_from_the_fog_solution(tmp_path):
     assert series["t"][-1] == t and np.degrees(series["att"][-1]).tolist() == e["attitude_deg"]
     assert series["pos"][-1].tolist() == e["position_m"]
     assert "reference_errors" in gcalign.read(tmp_path / "c.h5").figures()
-    ref_att = dcm_to_euler(Slerp(fog[:, 9], rot)([t]).as_matrix())[0]
+    ref_att = dcm_to_euler(Slerp(fog[:, 9], rot)([t_data]).as_matrix())[0]
     err = (att - ref_att + np.pi) % (2 * np.pi) - np.pi
     np.testing.assert_allclose(e["attitude_deg"], np.degrees(err), atol=1e-9)
-    ref_v = [np.interp(t, fog[:, 9], fog[:, 3 + i]) for i in range(3)]
+    ref_v = [np.interp(t_data, fog[:, 9], fog[:, 3 + i]) for i in range(3)]
     np.testing.assert_allclose(e["velocity_mps"], v_n - ref_v, atol=1e-9)
     # the aiding holds the horizontal position and velocity to the FOG's; the attitude
     # stays within the filter's prior of the FOG's (the mounting mu0, 18′ at most, is not
     # separated in 100 s)
-    assert np.hypot(*e["position_m"][:2]) < 2.0 and np.hypot(*e["velocity_mps"][:2]) < 0.3
+    # (to 0.1 m: taken 10 ms off, at 15 m/s, the reference would be 0.15 m away)
+    assert np.hypot(*e["position_m"][:2]) < 0.1 and np.hypot(*e["velocity_mps"][:2]) < 0.3
     assert np.all(np.abs(e["attitude_deg"]) < 0.5)
 
 
@@ -137,9 +142,22 @@ def test_calibrate_files_refusals(tmp_path):
         assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel, "position": real})],
                        "calibrate.files.position:", "no common time", "seconds of week")
     near = _gnss_csv(tmp_path / "near.csv", fog)
-    assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel, "position": {
-        "path": near, "format": "csv", "lever_arm_m": [0, 1.2, 0.8]}})], "lever_arm_m",
-        "no lever-arm term")
+    for key, bad, why in (("position", [0, 1.2], "at least 3 items"),
+                          ("position", [0, ".nan", 0], "finite number"),
+                          ("velocity", [0, 1.2, 0.8, 0], "at most 3 items"),
+                          ("velocity", [0, 250, 0], "must be within [-100, 100] m")):
+        files = {"velocity": dict(vel), "position": {"path": near, "format": "csv"}}
+        files[key]["lever_arm_m"] = bad
+        text = open(_scenario(tmp_path, files)).read().replace("'.nan'", ".nan")
+        (tmp_path / "cal.yaml").write_text(text)
+        assert_bad_run(run, tmp_path, [tmp_path / "cal.yaml"],
+                       f"calibrate.files.{key}.lever_arm_m", why)
+    # a file that ends before the run does (the FOG's positions to 60 s only)
+    short = {"path": _gnss_csv(tmp_path / "short.csv", fog[fog[:, 9] < 60.05]),
+             "format": "csv"}
+    assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel, "position": short})],
+                   "calibrate.files.position:", "covers 0.100 .. 60.000 s", "the run needs",
+                   "move calibrate.start_s or set calibrate.duration_s")
     assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel}, measure="velocity",
                                              gnss_noise=True)], "calibrate.gnss_noise")
     assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel}, measure="velocity",

@@ -241,6 +241,17 @@ def measurement_matrix(measure: str, pos: np.ndarray, earth: EarthModel = WGS84)
     return {"velocity": H_v, "position": H_p, "both": np.vstack([H_v, H_p])}[measure]
 
 
+def antenna_offset(C_nb: ArrayLike, omega_ib_b: ArrayLike, omega_ie_n: ArrayLike,
+                   lever_b: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """``(v_a − v, r_a − r)`` (3,) ENU, m/s and m: the velocity and position of a point at
+    `lever_b` (body axes, m) beyond the IMU's, ``C (ω_ib^b × l) − ω_ie^n × C l`` and
+    ``C l`` (derived in :func:`lever_arm_terms`)."""
+    C = np.asarray(C_nb, dtype=float)
+    Cl = C @ np.asarray(lever_b, dtype=float)
+    u = -(C @ _skew(np.asarray(lever_b, dtype=float))) @ np.asarray(omega_ib_b, dtype=float)
+    return u - _skew(np.asarray(omega_ie_n, dtype=float)) @ Cl, Cl
+
+
 def lever_arm_terms(measure: str, C_nb: ArrayLike, omega_ib_b: ArrayLike,
                     omega_ie_n: ArrayLike, lever_v_b: ArrayLike | None = None,
                     lever_p_b: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -282,15 +293,14 @@ def lever_arm_terms(measure: str, C_nb: ArrayLike, omega_ib_b: ArrayLike,
     w_ie = np.asarray(omega_ie_n, dtype=float)
     l_v = np.zeros(3) if lever_v_b is None else np.asarray(lever_v_b, dtype=float)
     l_p = np.zeros(3) if lever_p_b is None else np.asarray(lever_p_b, dtype=float)
-    Cl = C @ l_v
+    off_v, Cl = antenna_offset(C, w, w_ie, l_v)
     ClX = C @ _skew(l_v)  # C [l×]
     u = -ClX @ w  # C (ω × l)
-    W_ie = _skew(w_ie)
     H_v = np.zeros((3, N_STATES))
-    H_v[:, PHI] = _skew(u) - W_ie @ _skew(Cl)
+    H_v[:, PHI] = _skew(u) - _skew(w_ie) @ _skew(Cl)
     H_v[:, EB] = -ClX
     H_v[:, DKG] = -ClX * w[None, :]  # −C [l×] diag(ω)
-    off_v = (u - W_ie @ Cl)[:2]
+    off_v = off_v[:2]
     Cl_p = C @ l_p
     H_p = np.zeros((3, N_STATES))
     H_p[:, PHI] = _skew(Cl_p)

@@ -55,7 +55,9 @@ class Case:
     or the recorded file. aiding : "dgnss" | "zero-velocity". subsamples : IMU increments
     per navigation step. imu_rate : Hz. seed : the run's seed (None for recorded data).
     truth_source : "scenario" | "draw" | None. coarse_att : the coarse attitude (rad) of
-    recorded data. window : (start, coarse end, end) in data time, s.
+    recorded data. window : (start, coarse end, end), s from sample 0 as ``data.t``.
+    t0 : the recording's own time of sample 0 (s; 0 for a simulation): ``data.t + t0`` is
+    the time of the recording's files and reference.
     """
 
     data: FlightData
@@ -68,6 +70,7 @@ class Case:
     truth_source: str | None
     coarse_att: np.ndarray | None
     window: tuple[float, float, float]
+    t0: float = 0.0
 
     @property
     def navigation_rate(self) -> float:
@@ -150,18 +153,18 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
     except ValueError as err:
         raise ScenarioError(f"calibrate.coarse.duration_s: {err}") from None
     aiding = cfg.aiding_for(sc)
+    t0 = float(imu.t[0] - ts)  # the recording's time of sample 0
     if aiding == "file":  # measured velocity / position (gcalign.app.calibration_files)
         from gcalign.app.calibration_files import file_data
 
         dth, dv = combine_increments(imu.dtheta[i1:i2], imu.dv[i1:i2], n)
         t = coarse_end + np.arange(len(dth) + 1) * n * ts
-        data, att, _ = file_data(sc, cfg, t, dth, dv, att, site, earth, float(imu.t[0] - ts),
-                                 imu.att0)
+        data, att, _ = file_data(sc, cfg, t, dth, dv, att, site, earth, t0, imu.att0)
     else:
         data = parked_data(imu.dtheta[i1:i2], imu.dv[i1:i2], ts, att, site, t0=coarse_end,
                            subsamples=n, earth=earth)
     return Case(data, cfg.settings(site, earth), imu.source, aiding, n, rate, None,
-                None, att, (start, coarse_end, end))
+                None, att, (start, coarse_end, end), t0)
 
 
 def scenario_case(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Case:
@@ -308,6 +311,7 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
         "display_units": dict(zip(ie.STATE_NAMES, ie.DISPLAY_UNITS, strict=True)),
         "coarse_attitude_deg": None if case.coarse_att is None
         else np.degrees(case.coarse_att).tolist(),
+        "aiding_files": aiding_files(config_of(sc)),
         "compare": compare,
     }
     if compare:
@@ -319,11 +323,22 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
     return out
 
 
-def reference_series(sc: Scenario, run: Run) -> dict[str, np.ndarray] | None:
+def aiding_files(cfg: CalibrateConfig) -> dict | None:
+    """The files of ``aiding: file`` with the point each measures (the lever arm the filter
+    applies), or None."""
+    if cfg.files is None:
+        return None
+    return {key: {"path": str(f.path), "format": f.format, "lever_arm_m": list(f.lever_arm_m)}
+            for key, f in (("velocity", cfg.files.velocity), ("position", cfg.files.position))
+            if f is not None}
+
+
+def reference_series(sc: Scenario, run: Run, t0: float = 0.0) -> dict[str, np.ndarray] | None:
     """A recording's INS solution against the scenario's reference at every filter epoch
-    the reference covers (SI): ``t``, ``att`` (Euler differences est − reference, roll and
-    yaw wrapped; the reference's attitude by slerp), ``v_n`` (ENU), ``pos`` (m ENU); None
-    without a reference, with truth, or with no epoch inside the reference."""
+    the reference covers (SI): ``t`` (the run's epochs, s from sample 0), ``att`` (Euler
+    differences est − reference, roll and yaw wrapped; the reference's attitude by slerp),
+    ``v_n`` (ENU), ``pos`` (m ENU), the reference taken at the recording's time ``t + t0``
+    (:attr:`Case.t0`); None without a reference, with truth, or with no epoch inside it."""
     r = run.result
     if sc.reference is None or r.truth is not None:
         return None
@@ -332,11 +347,12 @@ def reference_series(sc: Scenario, run: Run) -> dict[str, np.ndarray] | None:
     from gcalign.nav.rotation import attitude_error
 
     ref = sc.reference.read()
-    inside = (r.t >= ref.t[0] - 1e-6) & (r.t <= ref.t[-1] + 1e-6)
+    t_data = r.t + t0
+    inside = (t_data >= ref.t[0] - 1e-6) & (t_data <= ref.t[-1] + 1e-6)
     if not inside.any():
         return None
     t = r.t[inside]
-    att, v_n, pos = reference_at(ref, t, tol=1e-6)
+    att, v_n, pos = reference_at(ref, t_data[inside], tol=1e-6)
     return {"t": t, "att": attitude_error(r.att[inside], att), "v_n": r.v_n[inside] - v_n,
             "pos": position_error_enu(r.pos[inside], pos, run.data.earth)}
 
@@ -368,7 +384,7 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             else [run_filter(case)])
     if progress is not None and not compare:
         progress(1, 1, "filter run")
-    against = [reference_series(sc, r) for r in runs]  # read and interpolated once
+    against = [reference_series(sc, r, case.t0) for r in runs]  # read and interpolated once
     out = summary(sc, case, runs, compare, against)
     from gcalign.app.at_rest import zero_velocity_warnings  # a moving recording under ZUPT
 

@@ -53,7 +53,8 @@ def _title(s: dict, what: str) -> str:
 
 def run_table(s: dict) -> Table:
     names, scale, units = _display(s)
-    aid = "zero-velocity updates" if s["aiding"] == "zero-velocity" else f"DGNSS {s['measure']}"
+    aid = {"zero-velocity": "zero-velocity updates",
+           "file": f"{s['measure']} from files"}.get(s["aiding"], f"DGNSS {s['measure']}")
     table = Table(title=_title(s, f"{aid} over {s['duration_s']:.0f} s"),
                   title_justify="left", header_style="bold")
     heads = ("state", "unit", "injected", "estimate", "error", "σ final", "σ0", "error/σ")
@@ -86,13 +87,21 @@ def run_table(s: dict) -> Table:
                  f"{att[2]:.4f}°" + (
                      f"; coarse {'  '.join(numbers(s['coarse_attitude_deg'], most=4))}°"
                      if s.get("coarse_attitude_deg") else ""))
+    for key, f in (s.get("aiding_files") or {}).items():
+        lever = f["lever_arm_m"]
+        notes.append(f"{key} from {f['path'].rsplit('/', 1)[-1]} ({f['format']}), measured at "
+                     + ("the IMU" if not any(lever) else
+                        f"lever arm ({', '.join(f'{x:g}' for x in lever)}) m, body RFU"))
     sm = s.get("smoothed_initial")
     if sm:
         k = scale["phiU"]
-        notes.append(f"RTS smoother: φU at the start σ {sm['phiU']['filtered_sigma'] * k:.3g}′ "
-                     f"filtered → {sm['phiU']['sigma'] * k:.3g}′ smoothed (the sensor errors, "
-                     "constants without process noise, gain nothing: their smoothed σ is the "
-                     "final filtered σ)")
+        phi = ", ".join(f"{sm[n]['estimate'] * scale[n]:.3g} ± {sm[n]['sigma'] * scale[n]:.3g}"
+                        f"{UNIT_TEXT.get(units[n], units[n])}" for n in ("phiE", "phiN", "phiU"))
+        notes.append(f"RTS smoother: φ at the start (E, N, U) {phi}; φU σ "
+                     f"{sm['phiU']['filtered_sigma'] * k:.3g}′ filtered → "
+                     f"{sm['phiU']['sigma'] * k:.3g}′ smoothed (the sensor errors, constants "
+                     "without process noise, gain nothing: their smoothed σ is the final "
+                     "filtered σ)")
     e = s.get("final_error") if s.get("error_source") == "reference" else None
     if e:
         a = [angle_text(math.radians(x)) for x in e["attitude_deg"]]

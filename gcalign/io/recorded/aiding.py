@@ -249,11 +249,14 @@ def read_velocity_aiding(path, format: str, columns=None, variable: str | None =
                       record={**ref.record, "format": f"{format} (the reference's velocity)"})
 
 
-def velocity_at(vel: Velocities, t, what: str = "aiding") -> tuple[np.ndarray, bool]:
+def velocity_at(vel: Velocities, t, what: str = "aiding",
+                hint: str = "move align.start_s, shorten align.t2_s / t3_s"
+                ) -> tuple[np.ndarray, bool]:
     """The aiding velocity at times `t` (M,), linearly interpolated between its epochs:
     ``(v (M, 3), body)``, ENU m/s, or (``body`` True) the odometer's speed times its body
     axis. ScenarioError (one line) when the file shares no time with `t`
-    (:func:`overlap`) or does not cover all of it, naming both spans."""
+    (:func:`overlap`) or does not cover all of it, naming both spans and, in `hint`, the
+    keys that move the run."""
     t = np.asarray(t, dtype=float)
     name = vel.record.get("path", "the aiding file")
     overlap(vel.t, t, name, what)
@@ -261,9 +264,9 @@ def velocity_at(vel: Velocities, t, what: str = "aiding") -> tuple[np.ndarray, b
     tol = 1e-6 * (float(t[1] - t[0]) if len(t) > 1 else 1.0)
     if t[0] < lo - tol or t[-1] > hi + tol:
         raise ScenarioError(
-            f"{what}: {name} covers {lo:.3f} .. {hi:.3f} s, the alignment needs "
+            f"{what}: {name} covers {lo:.3f} .. {hi:.3f} s, the run needs "
             f"{float(t[0]):.3f} .. {float(t[-1]):.3f} s (data time): every sample it aids "
-            "must lie inside the file (move align.start_s, shorten align.t2_s / t3_s)")
+            f"must lie inside the file ({hint})")
     tq = np.clip(t, lo, hi)
     if vel.speed is not None:
         assert vel.axis_b is not None

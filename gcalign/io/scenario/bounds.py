@@ -107,5 +107,7 @@ ATTITUDE_SIGMA_ARCSEC = Bound(1e-4, 3600.0, "″", "from a thousandth of the sen
 P0_ANGLE_ARCSEC = Bound(1e-4, 6.48e5, "″", f"up to 180°; {_FLOOR}")
 P0_RATE_DPS = Bound(1e-6, 3600.0, "°/s", f"up to the largest rate; {_FLOOR}")
 P0_ANGULAR_ACCEL_DPS2 = Bound(1e-6, 1e5, "°/s²", f"up to the largest acceleration; {_FLOOR}")
+LEVER_ARM_M = Bound(0.0, 100.0, "m", "an aiding antenna on the vehicle carrying the IMU "
+                    "(the largest aircraft span 80 m)", magnitude=True)
 NOISE_MPS = Bound(0.0, 1e3, "m/s", "no information beyond it")
 CLOCK_DRIFT_PPM = Bound(0.0, 1e5, "ppm", "10 %, more than any clock drifts", magnitude=True)

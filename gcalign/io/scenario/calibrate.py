@@ -19,7 +19,8 @@
       initial_error: {attitude_arcsec: [20, -20, 1800]}  # φ ENU; velocity_enu_mps, position_enu_m
       gnss_noise: true           # add DGNSS noise of σ to the simulated measurements
       aiding: auto               # dgnss (simulated truth) | zero-velocity (a parked vehicle)
-                                 # | file (recorded: files: {velocity: {path, format}, position})
+                                 # | file (recorded: files: {velocity: {path, format,
+                                 #   lever_arm_m}, position: {path, format, lever_arm_m}})
       coarse: {method: none}     # none (start from truth + initial_error) | analytic | inertial
       start_s: 0                 # data time at which the calibration (or coarse) window opens
       # duration_s: 400          # default: to the end of the data
@@ -43,7 +44,7 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BeforeValidator, Field, model_validator
+from pydantic import BeforeValidator, Field
 
 from gcalign import units as u
 from gcalign.errors import ScenarioError
@@ -128,6 +129,12 @@ class Coarse(Model):
     duration_s: float = Field(60.0, gt=0, description="coarse window at the start")
 
 
+LeverArm = Annotated[Vec3, B.LEVER_ARM_M]
+_LEVER_HELP = ("the point the file measures (a GNSS antenna, a reference INS) from the IMU, "
+               "body axes x right, y forward, z up, m; the filter applies it")
+REFERENCE_POSITION_FORMATS = ("psins-mat", "i2nav-nav", "reference-csv")
+
+
 class VelocityFile(Model):
     """A measured velocity: a velocity CSV (ENU/NED) or a reference solution's velocity."""
 
@@ -136,24 +143,22 @@ class VelocityFile(Model):
                     "reference-csv"]
     columns: list[str] | None = None
     variable: str | None = None
+    lever_arm_m: LeverArm = Field(default_factory=lambda: [0.0, 0.0, 0.0],
+                                  description=_LEVER_HELP)
 
 
 class PositionFile(Model):
-    """Measured positions: GNSS fixes (KF-GINS text, RTKLIB .pos, CSV)."""
+    """Measured positions: GNSS fixes (KF-GINS text, RTKLIB .pos, CSV) or a reference
+    solution's positions (the formats of a velocity file's reference). R is
+    ``calibrate.sigma_p_m``; the σ a GNSS file states is recorded, not used."""
 
     path: Path
-    format: Literal["i2nav-gnss", "rtklib-pos", "csv"] = "i2nav-gnss"
+    format: Literal["i2nav-gnss", "rtklib-pos", "csv", "psins-mat", "i2nav-nav",
+                    "reference-csv"] = "i2nav-gnss"
     columns: list[str] | None = None
-    lever_arm_m: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], description=(
-        "antenna in body axes (x right, y forward, z up), m; the filter has no lever-arm "
-        "term, so only 0 is accepted: give the positions of the IMU"))
-
-    @model_validator(mode="after")
-    def _no_lever_arm(self):
-        if any(self.lever_arm_m):
-            raise ValueError(f"lever_arm_m: {self.lever_arm_m} cannot be applied (the "
-                             "filter has no lever-arm term); give the IMU's positions and 0")
-        return self
+    variable: str | None = None
+    lever_arm_m: LeverArm = Field(default_factory=lambda: [0.0, 0.0, 0.0],
+                                  description=_LEVER_HELP)
 
 
 class AidingFiles(Model):
