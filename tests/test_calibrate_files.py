@@ -10,6 +10,7 @@ import json
 
 import h5py
 import numpy as np
+import pytest
 import scipy.io
 import yaml
 from cli_checks import assert_bad_run
@@ -19,7 +20,8 @@ from typer.testing import CliRunner
 import gcalign
 from conftest import ROOT
 from gcalign.cli import app
-from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
+from gcalign.nav.earth import WGS84
+from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm, quat_to_euler
 from gcalign.units import DPH, UG
 
 runner = CliRunner()
@@ -37,6 +39,35 @@ def _gnss_csv(path, fog: np.ndarray, t_shift: float = 0.0) -> str:
                             fog[:, 8], *np.tile([[0.1], [0.1], [0.2]], len(fog))])
     path.write_text("t,lat,lon,h,sn,se,sd\n" + "\n".join(
         ",".join(repr(float(x)) for x in r) for r in rows) + "\n")
+    return str(path)
+
+
+#: The FOG solution's positions written as 1 Hz GNSS fixes with this σ (north, east; down
+#: twice it), m. The FOG solution is not GNSS: its noise is far below; 0.1 m is an RTK-grade
+#: receiver's σ and covers the unknown MEMS-to-FOG lever arm (0.2 m swings ±0.1 m at ±33°
+#: of roll).
+SIGMA_P_M = 0.1
+SIGMA_V_MPS = 0.1  #: the 1 Hz velocities' σ, the transfer demo's velocity R
+
+
+def _whole_seconds(fog: np.ndarray) -> np.ndarray:
+    """The FOG epochs on whole seconds (1 Hz from its 10 Hz)."""
+    return fog[np.abs(fog[:, 9] - np.round(fog[:, 9])) < 1e-6]
+
+
+def _i2nav_gnss(path, fog: np.ndarray, sigma: float = SIGMA_P_M) -> str:
+    """KF-GINS GNSS-RTK text (t, lat, lon deg, h m, σ N, E, D m) of the FOG's 1 Hz epochs."""
+    rows = [[f[9], np.degrees(f[6]), np.degrees(f[7]), f[8], sigma, sigma, 2 * sigma]
+            for f in _whole_seconds(fog)]
+    path.write_text("\n".join(" ".join(repr(float(x)) for x in r) for r in rows) + "\n")
+    return str(path)
+
+
+def _velocity_csv(path, fog: np.ndarray) -> str:
+    """The FOG's 1 Hz velocities, ``t ve vn vu`` (velocity-enu)."""
+    rows = _whole_seconds(fog)[:, [9, 3, 4, 5]]
+    path.write_text("t,ve,vn,vu\n" + "\n".join(",".join(repr(float(x)) for x in r)
+                                                for r in rows) + "\n")
     return str(path)
 
 
@@ -174,3 +205,169 @@ def test_validate_shows_the_files(tmp_path):
     assert res.exit_code == 0, res.output
     assert "velocity transfer_align_fog_mems.mat (psins-mat); position fog.csv (csv)" in \
         res.stdout
+
+
+def _one_hz(tmp_path, files: dict, measure: str, **calibrate) -> str:
+    """The 1 Hz GNSS-like runs: filter epochs on the FOG's whole seconds (start at data
+    time 1.00 s: sample 11 is 0.10 s, the coarse window 0.9 s), σ of the fixtures."""
+    return _scenario(tmp_path, files, measure=measure, filter_rate_hz=1, sigma_p_m=SIGMA_P_M,
+                     sigma_v_mps=SIGMA_V_MPS, coarse={"method": "inertial", "duration_s": 0.9},
+                     **calibrate)
+
+
+def test_lever_arms_reach_the_filter_and_the_start(tmp_path):
+    """The file route: each file's lever_arm_m is the FlightData's (the filter applies it),
+    the INS starts at the IMU (the files' first fix minus C_b^n l and the antenna's
+    velocity C_b^n(ω × l) − ω_ie × C_b^n l), and the FOG's positions read from the MAT file
+    (a reference format) are the 1 Hz fixes written from it, at every filter epoch."""
+    from gcalign.app.calibrate.run import recorded_case
+    from gcalign.io.scenario import load_scenario
+
+    m = scipy.io.loadmat(MAT)
+    fog = m["fogavp"]
+    l_v, l_p = [0.3, -1.2, 0.9], [0.1, 0.8, 1.5]
+    gnss = {"velocity": {"path": _velocity_csv(tmp_path / "v.csv", fog),
+                         "format": "velocity-enu", "lever_arm_m": l_v},
+            "position": {"path": _i2nav_gnss(tmp_path / "p.gnss", fog), "format": "i2nav-gnss",
+                         "lever_arm_m": l_p}}
+    a = recorded_case(load_scenario(_one_hz(tmp_path, gnss, "both"))[0])
+    d = a.data
+    assert d.lever_arm_v_b.tolist() == l_v and d.lever_arm_p_b.tolist() == l_p
+    k = np.argmin(np.abs(fog[:, 9] - 1.0))  # the start: the FOG at 1.0 s
+    C = euler_to_dcm(fog[k, :3])
+    assert d.t[0] + a.t0 == pytest.approx(1.0)
+    np.testing.assert_allclose(quat_to_euler(d.start.q_nb), fog[k, :3], atol=1e-12)
+    r_m, r_n = WGS84.radii(fog[k, 6])
+    h = fog[k, 8]
+    Cl = C @ l_p
+    want = fog[k, 6:9] - [Cl[1] / (r_m + h), Cl[0] / ((r_n + h) * np.cos(fog[k, 6])), Cl[2]]
+    np.testing.assert_allclose(d.start.pos, want, rtol=0, atol=1e-12)
+    w = d.dtheta[0] / d.ts
+    w_ie = WGS84.omega_ie * np.array([0.0, np.cos(fog[k, 6]), np.sin(fog[k, 6])])
+    v_ant = C @ np.cross(w, l_v) - np.cross(w_ie, C @ l_v)
+    np.testing.assert_allclose(d.start.v_n, fog[k, 3:6] - v_ant, atol=1e-9)
+
+    mat = {"position": {"path": str(MAT), "format": "psins-mat"}}
+    b = recorded_case(load_scenario(_one_hz(tmp_path, mat, "position"))[0]).data
+    epochs = np.arange(0, len(b.t), 100)  # 100 Hz navigation, 1 Hz filter
+    assert np.abs(b.t[epochs] + a.t0 - np.round(b.t[epochs] + a.t0)).max() < 1e-6
+    np.testing.assert_allclose(b.ref_pos[epochs, :2], d.ref_pos[epochs, :2], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(b.ref_pos[epochs, 2], d.ref_pos[epochs, 2], rtol=0, atol=1e-8)
+
+
+def test_smoother_on_a_recording(tmp_path):
+    """--smoother on file aiding runs, is stored and printed; the RTS smoother's closed
+    properties on the real data: the smoothed σ never exceeds the filtered σ at any epoch,
+    and at the last epoch the smoothed estimate and σ are the filtered ones."""
+    fog = scipy.io.loadmat(MAT)["fogavp"]
+    files = {"velocity": {"path": _velocity_csv(tmp_path / "v.csv", fog),
+                          "format": "velocity-enu"},
+             "position": {"path": _i2nav_gnss(tmp_path / "p.gnss", fog), "format": "i2nav-gnss"}}
+    out = tmp_path / "s.h5"
+    res = runner.invoke(app, ["calibrate", _one_hz(tmp_path, files, "both", duration_s=30),
+                              "--smoother", "-o", str(out)], env={"COLUMNS": "120"})
+    assert res.exit_code == 0, res.output
+    assert "RTS smoother: φ at the start (E, N, U)" in res.stdout
+    assert "position from p.gnss (i2nav-gnss), measured at the IMU" in res.stdout
+    with h5py.File(out) as f:
+        g = f["calibrate/runs/00"]
+        est, sig = g["estimate"][()], g["sigma"][()]
+        s_est, s_sig = g["smoothed/estimate"][()], g["smoothed/sigma"][()]
+    assert len(sig) == 30  # the start (data time 1 s) and 29 updates, 2 ... 30 s
+    assert np.all(s_sig <= sig * (1 + 1e-9))
+    np.testing.assert_allclose(s_sig[-1], sig[-1], rtol=1e-12)
+    np.testing.assert_allclose(s_est[-1], est[-1], rtol=1e-12, atol=0)
+    assert np.all(s_sig[0, :3] < sig[0, :3])  # the start attitude gains
+
+
+def _run_json(args) -> dict:
+    res = runner.invoke(app, ["calibrate", *map(str, args), "--json"])
+    assert res.exit_code == 0, res.output
+    return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def _est(s: dict, names) -> tuple[np.ndarray, np.ndarray]:
+    return (np.array([s["states"][n]["estimate"] for n in names]),
+            np.array([s["states"][n]["sigma"] for n in names]))
+
+
+EB, DB, PHI = ("ebx", "eby", "ebz"), ("dbx", "dby", "dbz"), ("phiE", "phiN", "phiU")
+
+
+@pytest.mark.slow
+def test_fog_positions_and_velocities_beside_the_transfer_alignment(tmp_path):
+    """The MEMS calibrated with the FOG solution as a 1 Hz GNSS receiver would give it
+    (positions σ 0.1 m as KF-GINS GNSS-RTK text, velocities σ 0.1 m/s as a velocity CSV):
+    position only, velocity only and both, beside the transfer alignment of the same data
+    (attitude + velocity matching at 10 Hz, gcalign.transfer, the demo's settings) and
+    PSINS's stored eb0, db0, mu0.
+
+    * The gyro x, y biases agree with eb0 and with the transfer alignment within 3σ (a
+      second filter, other measurements, on the same data); the accelerometer biases with
+      the transfer alignment within 3σ of the two combined.
+    * Adding a measurement never raises a sensor state's σ (both ≤ each alone, to 1 %).
+    * What 100 s of positions or velocities do not support: the heading to the mounting's
+      scale (σ(φU) at the end above |mu0 z| = 17.6′), and the up gyro to the 8.5 °/h by
+      which the transfer alignment and eb0 differ (σ(ε z) above it): this route cannot
+      decide between them.
+    * The smoothed start attitude (the INS starts from the FOG's attitude, the MEMS is the
+      FOG turned by mu0, so φ0 = C_b^n mu0) lies within 3σ of C_b^n mu0.
+    * configs/mems_fog_calibrate.yaml (the FOG read from the MAT file, no derived file) gives
+      the fixtures' 'both' run to 1e-6.
+    """
+    from gcalign.transfer import MasterSeries, TransferSettings, transfer_align
+    from gcalign.units import ARCMIN
+
+    m = scipy.io.loadmat(MAT)
+    fog, mimu = m["fogavp"], m["mimu"]
+    eb0, db0, mu0 = m["eb0"].ravel(), m["db0"].ravel(), m["mu0"].ravel()
+    pos = {"path": _i2nav_gnss(tmp_path / "fog_1hz.gnss", fog), "format": "i2nav-gnss"}
+    vel = {"path": _velocity_csv(tmp_path / "fog_1hz_vel.csv", fog), "format": "velocity-enu"}
+    runs = {}
+    for measure, files in (("position", {"position": pos}), ("velocity", {"velocity": vel}),
+                           ("both", {"position": pos, "velocity": vel})):
+        (tmp_path / measure).mkdir()
+        runs[measure] = _run_json([_one_hz(tmp_path / measure, files, measure, smoother=True),
+                                   "-o", tmp_path / measure / "c.h5"])
+    tr = transfer_align(mimu[:, 0:3], mimu[:, 3:6], mimu[:, 6],
+                        MasterSeries(fog[:, 9], fog[:, 0:3], fog[:, 3:6], fog[:, 6:9]),
+                        TransferSettings())
+    fin = tr.final()
+    t_eb = np.array([fin[n][0] for n in EB]), np.array([fin[n][1] for n in EB])
+    t_db = np.array([fin[n][0] for n in DB]), np.array([fin[n][1] for n in DB])
+    k0 = int(np.argmin(np.abs(fog[:, 9] - 1.0)))
+    phi0 = euler_to_dcm(fog[k0, :3]) @ mu0  # the start attitude error of the INS
+
+    for measure, s in runs.items():
+        eb, sb = _est(s, EB)
+        db, sd = _est(s, DB)
+        sm = s["smoothed_initial"]
+        p0, sp0 = (np.array([sm[n][key] for n in PHI]) for key in ("estimate", "sigma"))
+        print(f"{measure:8s} eb {np.round(eb / DPH, 2).tolist()} ± {np.round(sb / DPH, 2).tolist()}"
+              f" °/h; db {np.round(db / UG).tolist()} ± {np.round(sd / UG).tolist()} µg; "
+              f"σ(φ) end {np.round(_est(s, PHI)[1] / ARCMIN, 1).tolist()}′; smoothed φ0 "
+              f"{np.round(p0 / ARCMIN, 1).tolist()} ± {np.round(sp0 / ARCMIN, 1).tolist()}′ "
+              f"(C mu0 {np.round(phi0 / ARCMIN, 1).tolist()}′); NIS {s['nis']['mean']:.3f}/"
+              f"{s['nis']['dof']}; against the FOG at the end {s['final_error']}")
+        assert np.all(np.abs(eb - eb0)[:2] < 3 * sb[:2]), measure
+        assert np.all(np.abs(eb - t_eb[0])[:2] < 3 * np.hypot(sb, t_eb[1])[:2]), measure
+        assert np.all(np.abs(db - t_db[0]) < 3 * np.hypot(sd, t_db[1])), measure
+        assert _est(s, PHI)[1][2] > np.abs(mu0[2]), measure
+        assert sb[2] > abs(eb0[2] - t_eb[0][2]), measure
+        assert np.all(np.abs(p0 - phi0) < 3 * sp0), measure
+    mu = [fin[n][0] / ARCMIN for n in ("mux", "muy", "muz")]
+    print(f"transfer eb {np.round(t_eb[0] / DPH, 2).tolist()} ± "
+          f"{np.round(t_eb[1] / DPH, 2).tolist()} °/h; db {np.round(t_db[0] / UG).tolist()} ± "
+          f"{np.round(t_db[1] / UG).tolist()} µg; mu {np.round(mu, 2).tolist()}′; stored eb0 "
+          f"{np.round(eb0 / DPH, 2).tolist()} °/h, db0 {np.round(db0 / UG).tolist()} µg")
+    both = np.array([runs["both"]["states"][n]["sigma"] for n in EB + DB])
+    for one in ("position", "velocity"):
+        alone = np.array([runs[one]["states"][n]["sigma"] for n in EB + DB])
+        assert np.all(both <= alone * 1.01), one
+
+    cfg = _run_json([ROOT / "configs/mems_fog_calibrate.yaml", "-o", tmp_path / "cfg.h5"])
+    for n in EB + DB + PHI:
+        assert cfg["states"][n]["estimate"] == pytest.approx(
+            runs["both"]["states"][n]["estimate"], rel=1e-6, abs=1e-12), n
+        assert cfg["states"][n]["sigma"] == pytest.approx(runs["both"]["states"][n]["sigma"],
+                                                          rel=1e-6), n
