@@ -311,7 +311,9 @@ def test_fog_positions_and_velocities_beside_the_transfer_alignment(tmp_path):
       which the transfer alignment and eb0 differ (σ(ε z) above it): this route cannot
       decide between them.
     * The smoothed start attitude (the INS starts from the FOG's attitude, the MEMS is the
-      FOG turned by mu0, so φ0 = C_b^n mu0) lies within 3σ of C_b^n mu0.
+      FOG turned by mu0, so φ0 = C_b^n mu0) lies within 3σ of C_b^n mu0, and at the end the
+      turn from the FOG to the calibrated MEMS attitude (body axes; ≈ ENU here: heading
+      −3°, pitch −3.5°, roll 0.7°) within 3σ(φ) of mu0.
     * configs/mems_fog_calibrate.yaml (the FOG read from the MAT file, no derived file) gives
       the fixtures' 'both' run to 1e-6.
     """
@@ -341,20 +343,28 @@ def test_fog_positions_and_velocities_beside_the_transfer_alignment(tmp_path):
     for measure, s in runs.items():
         eb, sb = _est(s, EB)
         db, sd = _est(s, DB)
+        with h5py.File(tmp_path / measure / "c.h5") as f:
+            att_end = f["calibrate/runs/00/att"][-1]
+        C_fog = Rotation.from_matrix(euler_to_dcm(fog[-1, :3]))  # the last epoch: 100.00 s
+        mu_end = (C_fog.inv() * Rotation.from_matrix(euler_to_dcm(att_end))).as_rotvec()
         sm = s["smoothed_initial"]
         p0, sp0 = (np.array([sm[n][key] for n in PHI]) for key in ("estimate", "sigma"))
         print(f"{measure:8s} eb {np.round(eb / DPH, 2).tolist()} ± {np.round(sb / DPH, 2).tolist()}"
               f" °/h; db {np.round(db / UG).tolist()} ± {np.round(sd / UG).tolist()} µg; "
               f"σ(φ) end {np.round(_est(s, PHI)[1] / ARCMIN, 1).tolist()}′; smoothed φ0 "
               f"{np.round(p0 / ARCMIN, 1).tolist()} ± {np.round(sp0 / ARCMIN, 1).tolist()}′ "
-              f"(C mu0 {np.round(phi0 / ARCMIN, 1).tolist()}′); NIS {s['nis']['mean']:.3f}/"
-              f"{s['nis']['dof']}; against the FOG at the end {s['final_error']}")
+              f"(C mu0 {np.round(phi0 / ARCMIN, 1).tolist()}′); FOG to MEMS at the end "
+              f"{np.round(mu_end / ARCMIN, 1).tolist()}′ (mu0 {np.round(mu0 / ARCMIN, 2).tolist()}"
+              f"′); NIS {s['nis']['mean']:.3f}/{s['nis']['dof']}; against the FOG at the end "
+              f"{s['final_error']}")
         assert np.all(np.abs(eb - eb0)[:2] < 3 * sb[:2]), measure
         assert np.all(np.abs(eb - t_eb[0])[:2] < 3 * np.hypot(sb, t_eb[1])[:2]), measure
         assert np.all(np.abs(db - t_db[0]) < 3 * np.hypot(sd, t_db[1])), measure
         assert _est(s, PHI)[1][2] > np.abs(mu0[2]), measure
         assert sb[2] > abs(eb0[2] - t_eb[0][2]), measure
         assert np.all(np.abs(p0 - phi0) < 3 * sp0), measure
+        assert s["final_error"]["t_s"] - 0.01 == pytest.approx(fog[-1, 9])
+        assert np.all(np.abs(mu_end - mu0) < 3 * _est(s, PHI)[1]), measure
     mu = [fin[n][0] / ARCMIN for n in ("mux", "muy", "muz")]
     print(f"transfer eb {np.round(t_eb[0] / DPH, 2).tolist()} ± "
           f"{np.round(t_eb[1] / DPH, 2).tolist()} °/h; db {np.round(t_db[0] / UG).tolist()} ± "
