@@ -58,7 +58,6 @@ from gcalign.nav.rotation import (
     quat_to_rotvec,
     rotvec_to_quat,
 )
-from gcalign.transfer import _kernel
 from gcalign.transfer.model import measurement_matrix
 from gcalign.units import ARCMIN, DEG, DPH, DPSH, G0, UG, UGPSHZ
 
@@ -242,7 +241,8 @@ def _slerp_master(master: MasterSeries, t: np.ndarray
     return quat_mult(q[j], rotvec_to_quat(quat_to_rotvec(dq) * a)), v, pos
 
 
-def _epochs(t_imu: np.ndarray, master: MasterSeries) -> tuple[int, np.ndarray, np.ndarray]:
+def measurement_epochs(t_imu: np.ndarray, master: MasterSeries
+                       ) -> tuple[int, np.ndarray, np.ndarray]:
     """Start sample and measurement samples: the slave starts at the first master epoch
     inside the IMU run (at the IMU sample nearest to it); a measurement is taken at the
     IMU sample nearest to each later master epoch, the master interpolated to it."""
@@ -292,13 +292,15 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
         by default the master's at the start, as the demo (then the initial φ is −C_nb μ,
         fully correlated with μ, which P0 does not say).
     """
+    from gcalign.transfer import _kernel  # numba, loaded only by a run (validate checks)
+
     s = settings or TransferSettings()
     dtheta, dv, t = (np.asarray(a, dtype=float) for a in (dtheta, dv, t))
     if s.matching != "velocity" and master.att is None:
         raise ScenarioError(f"matching: {s.matching!r} needs the reference's attitude; this "
                             "reference has none (allowed: 'velocity')")
     ts = float(np.median(np.diff(t)))
-    k0, k_meas, t_meas = _epochs(t, master)
+    k0, k_meas, t_meas = measurement_epochs(t, master)
     qm_meas, vm_meas, pm_meas = _slerp_master(master, t_meas)
     qm0, vm0, pm0 = _slerp_master(master, t[k0:k0 + 1])
     earth, n, rows = s.earth, s.n, s.rows
