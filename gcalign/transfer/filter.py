@@ -67,6 +67,9 @@ GRAVITY_MODELS = ("normal", "constant")
 NAMES_15 = ("phiE", "phiN", "phiU", "dvE", "dvN", "dvU", "ebx", "eby", "ebz",
             "dbx", "dby", "dbz", "mux", "muy", "muz")
 NAMES_FLEXURE = ("thx", "thy", "thz", "wx", "wy", "wz")
+#: SI unit of each state's estimate and σ, in the order of the names
+UNITS_15 = ("rad",) * 3 + ("m/s",) * 3 + ("rad/s",) * 3 + ("m/s^2",) * 3 + ("rad",) * 3
+UNITS_FLEXURE = ("rad",) * 3 + ("rad/s",) * 3
 PHI, DV, EB, DB, MU, TH, OM = (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12),
                                slice(12, 15), slice(15, 18), slice(18, 21))
 BIASES = slice(6, 12)
@@ -140,6 +143,11 @@ class TransferSettings:
         return NAMES_15 + (NAMES_FLEXURE if self.flexure else ())
 
     @property
+    def units(self) -> tuple[str, ...]:
+        """SI unit of each state (:attr:`names`' order)."""
+        return UNITS_15 + (UNITS_FLEXURE if self.flexure else ())
+
+    @property
     def n(self) -> int:
         return 21 if self.flexure else 15
 
@@ -194,6 +202,17 @@ class TransferResult:
         w = self.t >= self.t[-1] - last_s
         return {"final": self.attitude_error[-1],
                 "rms_last": np.sqrt(np.mean(self.attitude_error[w] ** 2, axis=0))}
+
+    def health_warnings(self, label: str = "") -> list[str]:
+        """Does the filter agree with its data (:mod:`gcalign.estimation.health`, the checks
+        of in-flight calibration)? One line if the mean NIS lies outside the 95 % band of a
+        mean of as many χ²_m, one per state whose σ grows past 10× its P0 σ; `label` heads
+        each line. Needs no truth: it holds on recorded data."""
+        from gcalign.estimation.health import nis_warnings, sigma_growth_warnings
+
+        return (nis_warnings(self.nis, self.m, label)
+                + sigma_growth_warnings(self.sigma0, self.sigma, self.names,
+                                        self.settings.units, label))
 
     def convergence_s(self) -> dict[str, float]:
         """Per state, the first time (s from the start) after which the estimate stays
