@@ -168,7 +168,11 @@ class TransferResult:
     freedom m; q_slave (K, 4) and att_slave (K, 3) the slave attitude corrected by φ̂;
     v_slave (K, 3); q_master (K, 4) the master at the measurement epochs;
     attitude_error (K, 3) rad, the corrected slave against master ∘ (μ̂ + θ̂); t0 the
-    start of the run (s).
+    start of the run (s). The filter's own error model at each epoch, for its
+    observability (:mod:`gcalign.transfer.observability`): C_nb (K, 3, 3) the slave
+    attitude of H (and of the last step's Φ), f_n (K, 3) m/s² the mean specific force of
+    the steps since the previous epoch (their Φ(δv,φ) = [f^n T ×]), omega_in_n (K, 3)
+    rad/s the ω_in^n of those steps, dt (K,) s their length.
     """
 
     t: np.ndarray
@@ -187,6 +191,10 @@ class TransferResult:
     attitude_error: np.ndarray
     t0: float
     settings: TransferSettings
+    C_nb: np.ndarray
+    f_n: np.ndarray
+    omega_in_n: np.ndarray
+    dt: np.ndarray
 
     def index(self, name: str) -> int:
         return self.names.index(name)
@@ -356,12 +364,16 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
     out_x, out_P = np.zeros((K, n)), np.zeros((K, n, n))
     out_fed, out_nis = np.zeros((K, 6)), np.zeros(K)
     out_q, out_v, out_err = np.zeros((K, 4)), np.zeros((K, 3)), np.zeros((K, 3))
-    C_nb = np.zeros((3, 3))
+    out_C, out_f, out_w, out_dt = np.zeros((K, 3, 3)), np.zeros((K, 3)), np.zeros((K, 3)), \
+        np.zeros(K)
+    C_nb, dv_n = np.zeros((3, 3)), np.zeros(3)
     k_prev = k0 + 1
     for j, k in enumerate(k_meas):
         # mechanisation and prediction over the IMU samples up to this epoch (the kernel)
         _kernel.propagate(q_s, v_s, x, P, dtheta, dv, k_prev, k + 1, fed, w_in, g_cc, ts,
-                          Phi, Qd, C_nb)
+                          Phi, Qd, C_nb, dv_n)
+        out_dt[j] = (k + 1 - k_prev) * ts
+        out_C[j], out_f[j], out_w[j] = C_nb, dv_n / out_dt[j], w_in
         k_prev = k + 1
         w_in, g_cc = earth_terms(pm_meas[j], vm_meas[j])
         H = measurement_matrix(C_nb, "attitude+velocity", n)
@@ -393,7 +405,8 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
         names=s.names, bias_fed=out_fed, nis=out_nis, m=len(rows), q_slave=out_q,
         att_slave=quat_to_euler(out_q), v_slave=out_v,
         q_master=qm_meas if qm_meas is not None else np.full((K, 4), np.nan),
-        attitude_error=out_err, t0=float(t[k0]), settings=s)
+        attitude_error=out_err, t0=float(t[k0]), settings=s, C_nb=out_C, f_n=out_f,
+        omega_in_n=out_w, dt=out_dt)
 
 
 def attitude_error_vs(result: TransferResult, mu: np.ndarray) -> np.ndarray:
