@@ -212,10 +212,12 @@ def table(s: dict):
         d = DECIMALS[unit]
         eta = last["degree"].get(name)
         sep = s["separation"].get(name)
+        eta_text = ("—" if eta is None else "n/a" if eta == 0 and name not in unobs
+                    else _sci(eta))
         t.add_row(name + (" ·" if name in unobs else ""), unit,
                   f"{s['sigma0'][name] * k:.{d}f}", f"{s['sigma_final'][name] * k:.{d}f}",
-                  _ratio(s["covariance_degree_final"][name]),
-                  "—" if eta is None else _sci(eta), "—" if sep is None else f"{sep:.1e}")
+                  _ratio(s["covariance_degree_final"][name]), eta_text,
+                  "—" if sep is None else f"{sep:.1e}")
         if name in ("phiU", "dvU", "ebz", "dbz", "muz", "thz"):
             t.add_section()
     w = s["weakest"]
@@ -233,7 +235,8 @@ def table(s: dict):
         f"{w['ratio']:.1e}): {combo}",
         "σ0/σ: the filter's own covariance reduction (PSINS kfstat; 1 = nothing learnt). "
         "η: SVD degree σ_(k)/σ_0 of the whole run's SOM (seed eq. 17, σ_0 of the measured "
-        "φ or δv). sep.: distance of the state's TOM column from the span of the others "
+        "φ or δv; n/a: no singular vector has its largest part on the state, though its "
+        "column is not zero). sep.: distance of the state's TOM column from the span of the others "
         "(0: a combination of them; unchanged by P0 and units). θ, ω (flexure, a "
         "noise-driven Markov process): σ only.",
         f"Per window and cumulative: --json, the results file, gcalign plot. Compute "
