@@ -22,19 +22,25 @@ What the model's structure says (the tests hold the command to it):
 * velocity matching: μ enters neither F nor the velocity rows of H, so its columns of every
   O_j are zero (η = 0, separation 0) and, with P0 diagonal, its covariance never changes:
   σ(μ) = σ0 exactly;
-* attitude matching on a vehicle that rolls about its forward axis y only (heading and pitch
-  constant): ``C_nb e_y = d`` is constant, and ``x = (φ = d, μ_y = 1)`` gives ``H x = d − C_nb
-  e_y = 0`` and ``F x = (−ω_in × d, 0, …)``: μ_y is told from a constant attitude error along
-  the forward axis only through the earth and transport rate ω_in (7e-5 rad/s), so its
-  separation is of the order of |ω_in × d| and its σ stays far above μ_x's and μ_z's, whose
-  columns −C_nb e_x, −C_nb e_z turn with the roll;
+* attitude matching on a vehicle that rolls about its body y axis only (heading and pitch
+  constant), the slave turned from the body by μ: with C_nb = C_b(t) C(μ), the forward axis
+  d = C_b(t) e_y constant and the roll axis in slave axes u = C(μ)ᵀ e_y (e_y but for μ
+  itself), ``x = (φ = d, μ = u)`` gives ``H x = d − C_b(t) e_y = 0`` on every piece and
+  ``F x = (−ω_in × d, f^n × d, 0, …)``, whose attitude rows vanish without the earth and
+  transport rate ω_in (7e-5 rad/s): μ along the roll axis, mostly μ_y, is told from a
+  constant attitude error about the forward axis only through ω_in, while μ_x, μ_z (columns
+  −C_nb e_x, −C_nb e_z that turn with the roll) are observed; δv and ∇ reach neither H's
+  attitude rows nor φ (zero columns). The filter's own C_nb, off the slave's by its
+  estimation error, separates the combination a little more than the truth does
+  (docs/decisions/014);
 * attitude + velocity matching: φ along d is a tilt, which the velocity sees through
   ``f^n × φ`` (f^n ≈ g up, d horizontal): every μ is observable.
 
 The flexure θ, ω (21 states) are a stationary Markov process driven by noise: a
 deterministic analysis of the initial state cannot rate them (the fast mode β_z = 10 s⁻¹
-puts F^20 at 1e26 and swamps the SVD), so the PWCS covers the 15 constant-error states and
-the flexure rows carry the covariance degree only.
+puts its block of F^20 at 2e22 and swamps the SVD), so the PWCS covers the 15
+constant-error states and the flexure rows carry the covariance degree only
+(docs/decisions/014).
 
 >>> from gcalign.transfer.filter import NAMES_15
 >>> PWCS_STATES == NAMES_15
