@@ -37,6 +37,15 @@ def group_of(name: str) -> str:
     return next(g for g in ("phi", "dv", "eb", "db", "mu", "th", "w") if name.startswith(g))
 
 
+def reference_path(sc) -> Path:
+    """The master's file: the imu_file itself (``reference.path`` null), else the path,
+    a relative one taken from the imu_file's folder."""
+    path = sc.align.transfer.reference.path
+    if path is None:
+        return sc.imu_file
+    return path if path.is_absolute() else sc.imu_file.parent / path
+
+
 def load_inputs(sc):
     """The slave's increments, the master series and the file's stored PSINS values
     (``eb0``, ``db0``, ``mu0`` in SI, those present), read by the recorded-data readers of
@@ -65,9 +74,7 @@ def load_inputs(sc):
         field = ("align.transfer.imu_variable" if ": variable" in text
                  else "" if text.startswith("imu_file") else "imu_file")
         raise ScenarioError(f"{field}: {text}" if field else text) from None
-    ref = cfg.reference
-    path = sc.imu_file if ref.path is None else (
-        ref.path if ref.path.is_absolute() else sc.imu_file.parent / ref.path)
+    ref, path = cfg.reference, reference_path(sc)
     if not path.is_file():
         raise ScenarioError(f"align.transfer.reference.path: {path}: file not found")
     try:
@@ -89,6 +96,7 @@ def load_inputs(sc):
 
 def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
     """The run's summary: ``states`` in SI, the rest in the units their keys name."""
+    from gcalign.estimation.health import mean_nis_band
     from gcalign.transfer import attitude_error_vs
 
     r, s = result, result.settings
@@ -97,8 +105,6 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
     states = {n: {"estimate": float(r.x[-1, i]), "sigma": float(r.sigma[-1, i]),
                   "sigma0": float(r.sigma0[i])} for i, n in enumerate(r.names)}
     lo, hi = _chi2_band(r.m)
-    from gcalign.estimation.health import mean_nis_band
-
     mean_lo, mean_hi = mean_nis_band(len(r.nis), r.m)
     out = {
         "scenario": sc.name,
@@ -208,17 +214,14 @@ EPOCH_DOUBLES = 40  #: per epoch beside x, σ and P: NIS, attitudes, velocity, e
 
 
 def sizes(sc) -> tuple[int, int, int]:
-    """IMU samples, master epochs (at most the measurements) and states of a run, from the
-    MAT files' headers (no data read; the check has read them)."""
+    """IMU samples, master epochs (the measurements are at most as many) and states of a
+    run, from the MAT files' headers (no data read; the check has read them)."""
     from gcalign.io.recorded.mat import shapes
 
     cfg = sc.align.transfer
     variable = sc.recording_layout().variable or cfg.imu_variable
     imu = shapes(sc.imu_file).get(variable, (0,))
-    ref = cfg.reference
-    path = sc.imu_file if ref.path is None else (
-        ref.path if ref.path.is_absolute() else sc.imu_file.parent / ref.path)
-    master = shapes(path).get(ref.variable, (0,))
+    master = shapes(reference_path(sc)).get(cfg.reference.variable, (0,))
     return imu[0], master[0], 21 if cfg.flexure else 15
 
 
@@ -305,7 +308,7 @@ def _nis_line(nis: dict, epochs: int) -> str:
     check), marked when outside it; the band of one epoch beside it."""
     lo, hi = nis.get("band_95_of_mean", (None, None))
     one = (f"one epoch {nis['band_95'][0]:.2f}–{nis['band_95'][1]:.2f}")
-    if lo is None:  # a results file written before the check
+    if lo is None:  # a results file of an earlier version (gcalign show)
         return f"NIS mean {nis['mean']:.2f} (dof {nis['dof']}, 95 % band of {one})"
     text = (f"NIS mean {nis['mean']:.3g} over {epochs} epochs (dof {nis['dof']}); 95 % band "
             f"of such a mean {lo:.2f}–{hi:.2f}, of {one}")
