@@ -165,3 +165,13 @@ def test_show_does_not_import_numba(tmp_path):
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          cwd=root, check=True)
     assert json.loads(res.stdout.strip().splitlines()[-1]) == [0, False]
+
+
+def test_one_module_opens_matlab_files():
+    """PSINS .mat files are opened in one place (gcalign.io.recorded.mat): the IMU, the
+    reference and transfer alignment's master and stored values all read them there."""
+    opened = sorted(str(p.relative_to(PKG)) for p in PKG.rglob("*.py")
+                    if any(f"scipy.io.{fn}" in p.read_text(encoding="utf-8")
+                           or f"import {fn}" in p.read_text(encoding="utf-8")
+                           for fn in ("loadmat", "whosmat")))
+    assert opened == ["io/recorded/mat.py"], opened

@@ -157,6 +157,27 @@ def test_export_to_i2nav_nav_reads_back_as_a_reference(tmp_path):
     np.testing.assert_allclose(ref.pos, s["pos"][0], rtol=1e-15)
 
 
+def test_a_reference_without_attitude_only_where_allowed(tmp_path):
+    """A master of 7 columns [v lat lon h t] (velocity matching in transfer alignment):
+    read with att None where the caller allows it, its columns the 10-column avp's last
+    seven; refused with one line otherwise, and by reference_at (which needs attitude)."""
+    import scipy.io
+
+    full = read_reference(MAT, "psins-mat")
+    p = tmp_path / "vp.mat"
+    scipy.io.savemat(p, {"vp": scipy.io.loadmat(MAT)["fogavp"][:, 3:]})
+    ref = read_reference(p, "psins-mat", "vp", attitude_optional=True)
+    assert ref.att is None and ref.record["variable"] == "vp"
+    np.testing.assert_array_equal(ref.t, full.t)
+    np.testing.assert_array_equal(ref.v_n, full.v_n)
+    np.testing.assert_array_equal(ref.pos, full.pos)
+    with pytest.raises(ScenarioError, match=r"'vp' is not an N x 10 avp array") as err:
+        read_reference(p, "psins-mat", "vp")
+    assert "\n" not in str(err.value)
+    with pytest.raises(ScenarioError, match="has no attitude"):
+        reference_at(ref, ref.t[:2])
+
+
 def test_initial_state_sources_and_the_refusal_listing_three():
     ref = read_reference(MAT, "psins-mat")
     att, v, src = initial_state("f", 0.1, reference=ref)

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 import scipy.io
 import yaml
-from cli_checks import assert_bad_run
+from cli_checks import assert_bad_input, assert_bad_run
 from typer.testing import CliRunner
 
 from gcalign.cli import app
@@ -95,9 +95,11 @@ def _mat(tmp_path: Path, t_imu: float = 10.0, fog=None, name: str = "case.mat") 
     return p
 
 
-def _scenario(tmp_path: Path, mat: Path, **transfer) -> Path:
+def _scenario(tmp_path: Path, mat: Path, mode: str | None = None, **transfer) -> Path:
     sc = {"name": "t", "imu_file": str(mat),
           "align": {"transfer": {"flexure": False, **transfer}}}
+    if mode is not None:
+        sc["align"]["mode"] = mode
     p = tmp_path / "sc.yaml"
     p.write_text(yaml.safe_dump(sc))
     return p
@@ -157,3 +159,34 @@ def test_validate_and_void_gyrocompass_keys(tmp_path):
     assert res.exit_code == 0, res.output
     w = json.loads(res.stdout)["warnings"]
     assert any(x.startswith("align.t2_s: cannot matter") for x in w), w
+
+
+def test_validate_reads_the_slave_by_its_variable(tmp_path):
+    """A master without attitude has 7 columns, as the slave: validate reads the slave by
+    align.transfer.imu_variable, as the run does (not by 'the one 7-column array'); a
+    variable the file lacks is one line naming the key, in validate and in the run."""
+    mat = _mat(tmp_path, fog=lambda f: f[f[:, 9] <= 10.0 + 1e-9][:, 3:])
+    p = _scenario(tmp_path, mat, mode="transfer", matching="velocity")
+    res = runner.invoke(app, ["validate", str(p)])
+    assert res.exit_code == 0, res.output  # was: 'more than one array of 7 columns'
+    p = _scenario(tmp_path, mat, mode="transfer", matching="velocity", imu_variable="imu")
+    res = runner.invoke(app, ["validate", str(p)])
+    assert_bad_input(res, tmp_path / "none.h5", "align.transfer.imu_variable", "'imu'")
+    assert_bad_run(_align, tmp_path, [p], "align.transfer.imu_variable", "'imu'")
+    p = _scenario(tmp_path, mat, mode="transfer", reference={"variable": "fog"})
+    assert_bad_run(_align, tmp_path, [p], "align.transfer.reference.variable", "'fog'")
+
+
+def test_validate_and_the_run_cost_the_filter_alike(monkeypatch, tmp_path):
+    """The cost model counts the filter's arithmetic from the files' sizes: per IMU step
+    Φ P Φᵀ (2·21³), per master epoch the update (4·21³): (2·10001 + 4·1000)·21³ =
+    2.22e8 operations on the demo; a smaller limit refuses validate and the run with one
+    and the same line before any work."""
+    monkeypatch.setenv("GCALIGN_MAX_WORK", "2.2e8")
+    run = _align(CONFIG, "-o", tmp_path / "o.h5")
+    check = runner.invoke(app, ["validate", str(CONFIG)])
+    assert_bad_input(run, tmp_path / "o.h5", "align: needs 2.22e+08 operations",
+                     "GCALIGN_MAX_WORK")
+    assert check.output == run.output
+    monkeypatch.setenv("GCALIGN_MAX_WORK", "2.3e8")
+    assert runner.invoke(app, ["validate", str(CONFIG)]).exit_code == 0

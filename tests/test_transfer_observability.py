@@ -1,9 +1,15 @@
 """Observability of transfer alignment on the simulated wing-rock drive by the library's
 piece-wise constant systems + SVD (:mod:`gcalign.estimation.observability`, seed 002 §3),
 with the continuous model of :mod:`gcalign.transfer.model`: the same structure the filter's
-covariance shows (spec 006, "What the data support")."""
+covariance shows (spec 006, "What the data support"). Then the table of
+:func:`gcalign.transfer.observability.transfer_observability` on the filter's own run,
+against the rank argument of attitude matching on a roll about body y: the combination
+(φ along the forward axis, μ along the roll axis in slave axes C(μ)ᵀ e_y) is an exact null
+vector without the earth rate."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -11,7 +17,10 @@ import pytest
 from gcalign.estimation.observability import degree, piece_matrix, separation, tom
 from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import euler_to_dcm, quat_to_dcm, rotvec_to_quat
+from gcalign.transfer import transfer_align
+from gcalign.transfer.filter import P0_SIGMA_DEFAULT
 from gcalign.transfer.model import error_matrix, measurement_matrix
+from gcalign.transfer.observability import transfer_observability
 from gcalign.transfer.simulate import transfer_case
 
 MU = (12, 13, 14)
@@ -70,3 +79,53 @@ def test_attitude_matching_sees_roll_axis_mu_only_weakly(pieces):
     assert a[1] < 0.05 * min(a[0], a[2]), a        # roll axis: nearly a combination of others
     assert av[1] > 10 * a[1], (a, av)                # velocity matching separates it
     assert separation(_tom(pieces, "attitude"), 13, 1) > 0  # not exactly zero: earth rate
+
+
+# ------------------------------------------------------------------ the filter's own F and H
+
+@pytest.fixture(scope="module")
+def attitude_run():
+    """The command's route on the case (from the master's attitude, the demo's P0 of φ,
+    attitude feedback), attitude matching; and the slave's true attitude at its epochs."""
+    c = transfer_case(np.random.default_rng(3), duration=20.0)
+    p0 = (*(P0_SIGMA_DEFAULT[0],) * 3, *c.settings.p0_sigma[3:])
+    s = replace(c.settings, p0_sigma=p0, attitude_feedback=True, matching="attitude")
+    r = transfer_align(c.dtheta, c.dv, c.t, c.master, s)
+    k = np.rint(r.t / 0.01).astype(int)
+    C_mu = quat_to_dcm(rotvec_to_quat(c.mu))
+    return c, r, euler_to_dcm(c.truth.att[k]) @ C_mu, C_mu
+
+
+def test_roll_axis_combination_is_exactly_unobservable_without_earth_rate(attitude_run):
+    """Rank argument (attitude matching, roll about body y only): with C_nb the slave's
+    true attitude C_b(t) C(μ) and ω_in = 0, x = (φ = C_b(0) e_y, μ = C(μ)ᵀ e_y) gives
+    H x = C_b(0) e_y − C_b(t) e_y = 0 and F x = 0 in the attitude rows, on every piece: an
+    exact null vector. The weakest combination of the table is it (scaled by P0 σ) to
+    round-off, with σ_min/σ_max at round-off; the earth rate lifts it to ~1e-6."""
+    c, r, C_true, C_mu = attitude_run
+    flat = transfer_observability(replace(r, C_nb=C_true, omega_in_n=0 * r.omega_in_n))
+    x = np.zeros(15)
+    x[0:3] = euler_to_dcm(c.truth.att[0]) @ [0.0, 1.0, 0.0]
+    x[12:15] = C_mu.T @ [0.0, 1.0, 0.0]
+    y = x / np.asarray(r.sigma0[:15])
+    y /= np.linalg.norm(y)
+    assert flat.weakest_ratio < 1e-14
+    np.testing.assert_allclose(flat.weakest, y, atol=1e-12)
+    earth = transfer_observability(replace(r, C_nb=C_true))
+    assert 1e-8 < earth.weakest_ratio < 1e-4
+    np.testing.assert_allclose(earth.weakest, y, atol=1e-3)
+
+
+def test_the_filter_own_model_keeps_the_roll_axis_weakest(attitude_run):
+    """The filter's own C_nb (its mechanised attitude, off the slave's by its estimation
+    error) moves the weakest combination by less than 0.02 from the closed form, and it is
+    mostly μ_y (> 0.99 of the unit vector)."""
+    c, r, _, C_mu = attitude_run
+    own = transfer_observability(r)
+    x = np.zeros(15)
+    x[0:3] = euler_to_dcm(c.truth.att[0]) @ [0.0, 1.0, 0.0]
+    x[12:15] = C_mu.T @ [0.0, 1.0, 0.0]
+    y = x / np.asarray(r.sigma0[:15])
+    y /= np.linalg.norm(y)
+    assert np.abs(own.weakest - y).max() < 0.02 and own.weakest[13] > 0.99
+    assert own.weakest_ratio < 1e-2

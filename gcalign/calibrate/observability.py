@@ -92,11 +92,6 @@ def pieces(truth: Trajectory, segments: Sequence[Span], piece_s: float = 1.0) ->
     return Pieces(F=F, duration=np.concatenate(durs), segment=np.concatenate(seg))
 
 
-def _stack_r(R: np.ndarray | None, rows: np.ndarray) -> np.ndarray:  # (≤ n, n)
-    """Triangular factor of ``[R; rows]``: the SVD of a stack only needs it."""
-    return ob.r_factor(rows if R is None else np.vstack([R, rows]))
-
-
 @dataclass(frozen=True)
 class ObservabilitySettings:
     """Settings of :func:`observability` (see :func:`observability_table` for each)."""
@@ -145,43 +140,9 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
     measured = np.flatnonzero(np.any(H != 0.0, axis=0))
     scale = (np.sqrt(np.diag(s.covariances(truth.pos[0], truth.earth)[0])) if scaling == "p0"
              else None)
-    sc = np.ones(ie.N_STATES) if scale is None else scale
     pc = pieces(truth, segments, piece_s)
-    # O_j = Q_j R_j: every stack of O_j (SOM) or O_j M (TOM) has the singular values and
-    # right vectors of the same stack of R_j, half the rows
-    O = ob.piece_matrix(pc.F, H)
-    Rp = np.asarray(np.linalg.qr(O, mode="r"))
-    Phi = ob.expm_stack(pc.F * pc.duration[:, None, None])
-    # condition of seed eq. (12), in the coordinates the ranks are taken in (x = diag(sc) y)
-    resid_piece = ob.null_space_residual(Rp * sc, pc.F * sc / sc[:, None], rtol)
-
-    n_seg = len(segments)
-    eta, sig = np.zeros((n_seg, ie.N_STATES)), np.zeros((n_seg, ie.N_STATES))
-    eta_c = np.zeros((n_seg, ie.N_STATES))
-    rank, tom_rank, rank_c, tom_c = (np.zeros(n_seg, int) for _ in range(4))
-    resid, margin, margin_c = np.zeros(n_seg), np.zeros(n_seg), np.zeros(n_seg)
-    R_cum: np.ndarray | None = None
-    R_tom_cum: np.ndarray | None = None
-    M_cum = np.eye(ie.N_STATES)
-    for i in range(n_seg):
-        js = np.flatnonzero(pc.segment == i)
-        R_seg = _stack_r(None, ob.som(Rp[js]))
-        d = ob.degree(R_seg, measured, scale, rtol)
-        eta[i], sig[i], rank[i], margin[i] = d.eta, d.sigma_state, d.rank, d.margin
-        # TOM of the segment alone (from its first piece) and from the start of the run
-        M = np.eye(ie.N_STATES)
-        rows, rows_cum = [], []
-        for j in js:
-            rows.append(Rp[j] @ M)
-            rows_cum.append(Rp[j] @ M_cum)
-            M, M_cum = Phi[j] @ M, Phi[j] @ M_cum
-        tom_rank[i] = ob.degree(_stack_r(None, np.vstack(rows)), measured, scale, rtol).rank
-        R_tom_cum = _stack_r(R_tom_cum, np.vstack(rows_cum))
-        tom_c[i] = ob.degree(R_tom_cum, measured, scale, rtol).rank
-        R_cum = _stack_r(R_cum, R_seg)
-        dc = ob.degree(R_cum, measured, scale, rtol)
-        eta_c[i], rank_c[i], margin_c[i] = dc.eta, dc.rank, dc.margin
-        resid[i] = resid_piece[js].max()
+    tab = ob.segment_table(pc.F, H, pc.duration, pc.segment, len(segments), measured, scale,
+                           rtol)
 
     cov = cov_seg = None
     if covariance:
@@ -193,7 +154,8 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
                           / np.diagonal(P_end, axis1=1, axis2=2))
     return ObservabilityTable(
         segments=tuple(sp.name for sp in segments), measure=measure, scaling=scaling, rtol=rtol,
-        piece_s=piece_s, eta=eta, sigma_state=sig, rank=rank, tom_rank=tom_rank,
-        null_residual=resid, condition=resid <= null_tol, eta_cum=eta_c, rank_cum=rank_c,
-        tom_rank_cum=tom_c, cov_degree=cov, cov_degree_segment=cov_seg, margin=margin,
-        margin_cum=margin_c)
+        piece_s=piece_s, eta=tab.eta, sigma_state=tab.sigma_state, rank=tab.rank,
+        tom_rank=tab.tom_rank, null_residual=tab.null_residual,
+        condition=tab.null_residual <= null_tol, eta_cum=tab.eta_cum, rank_cum=tab.rank_cum,
+        tom_rank_cum=tab.tom_rank_cum, cov_degree=cov, cov_degree_segment=cov_seg,
+        margin=tab.margin, margin_cum=tab.margin_cum)

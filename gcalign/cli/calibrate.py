@@ -10,10 +10,13 @@ from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
+from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["calibrate"].builtin or ""
 SCENARIO_HELP = "Scenario YAML; without it, the built-in seed 002 designed 590 s take-off."
 MEASURE_HELP = "DGNSS measurement: velocity | position | both."
+MATCHING_HELP = ("Transfer alignment (align.mode: transfer): attitude+velocity | velocity | "
+                 "attitude (sets align.transfer.matching).")
 
 
 def load_checked(path: Path | None, section: str, overrides: dict, sets: list[str] | None):
@@ -55,12 +58,21 @@ def observability(
     scaling: str | None = typer.Option(
         None, "--scaling",
         help="p0 (default: columns × initial σ, unit-free ranks) | none (the paper: unscaled)."),
+    matching: str | None = typer.Option(None, "--matching", help=MATCHING_HELP),
     output: Output = None,
     as_json: Json = False,
     set_: Sets = None,
 ):
     """Observability of the flight's manoeuvres: PWCS pieces, SOM/TOM ranks and the seed's
-    SVD degree η per segment and cumulative (Table 1 analogue)."""
+    SVD degree η per segment and cumulative (Table 1 analogue); on a transfer-alignment
+    scenario, of the transfer filter's run per window and per state."""
     overrides = {"measure": measure, "scaling": scaling}
-    sc, text = load_checked(scenario, "observability", overrides, set_)
+    sets = list(set_ or [])
+    if matching is not None:
+        sc, _ = load_checked(scenario, "observability", overrides, set_)
+        if sc.align is None or sc.align.mode != "transfer":
+            raise ScenarioError(f"--matching: {matching!r} applies to a transfer-alignment "
+                                "scenario (align.mode: transfer); a flight takes --measure")
+        sets.append(f"align.transfer.matching={matching}")
+    sc, text = load_checked(scenario, "observability", overrides, sets)
     run_and_show("observability", sc, text, None, output, as_json)

@@ -46,11 +46,11 @@ RANK_RTOL_DEFAULT = 1e-12
 def piece_matrix(F: np.ndarray, H: np.ndarray) -> np.ndarray:
     """``O = [H; H F; …; H F^{n−1}]`` (seed eq. 9), vectorised over leading axes of F.
 
-    F (..., n, n), H (m, n) -> (..., n·m, n).
+    F (..., n, n), H (m, n) or one per piece (..., m, n) -> (..., n·m, n).
     """
-    F = np.asarray(F, dtype=float)
+    F, H = np.asarray(F, dtype=float), np.asarray(H, dtype=float)
     n = F.shape[-1]
-    rows = [np.broadcast_to(np.asarray(H, dtype=float), F.shape[:-2] + H.shape)]
+    rows = [np.broadcast_to(H, F.shape[:-2] + H.shape[-2:])]
     for _ in range(n - 1):
         rows.append(rows[-1] @ F)
     return np.concatenate(rows, axis=-2)
@@ -192,6 +192,117 @@ def degree(Q: np.ndarray, measured: Iterable[int], scale: ArrayLike | None = Non
     eta = sigma_state / sigma_0 if sigma_0 > 0 else np.zeros(n)
     return Degree(sigma=sigma, V=V, owner=owner, sigma_state=sigma_state, eta=eta,
                   sigma_0=sigma_0, rank=int(np.sum(sigma > cut)), rtol=rtol)
+
+
+def column_separation(Q: np.ndarray) -> np.ndarray:
+    """Per state k, ``‖(I − Π_k) Q e_k‖ / ‖Q e_k‖`` with Π_k the projection on the span of
+    the other columns of Q (rows, n): 1 when the state acts unlike any combination of the
+    others, 0 when it is one (unobservable: a null vector of Q has its component), and 0
+    for a zero column. Association-free (no singular value is assigned to a state) and
+    unchanged by any scaling of the columns, so by the units and P0; the SVD degree's
+    companion when two states trade places under a scaling. (n,)
+
+    >>> Q = np.array([[1.0, 2.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])  # x1 = 2·x0 alike
+    >>> column_separation(Q).round(12).tolist()
+    [0.0, 0.0, 1.0]
+    """
+    Q = np.asarray(Q, dtype=float)
+    n = Q.shape[1]
+    if Q.shape[0] > 2 * n:
+        Q = r_factor(Q)  # the same column geometry (QᵀQ = RᵀR) in n rows
+    out = np.zeros(n)
+    for k in range(n):
+        q = Q[:, k]
+        norm = float(np.linalg.norm(q))
+        if norm == 0.0:
+            continue
+        others = np.delete(Q, k, axis=1)
+        coef, *_ = np.linalg.lstsq(others, q, rcond=None)
+        out[k] = float(np.linalg.norm(q - others @ coef)) / norm
+    return out
+
+
+@dataclass(frozen=True)
+class SegmentTable:
+    """SOM/TOM degrees of a run cut into S segments of PWCS pieces (n states).
+
+    eta, sigma_state : (S, n) per-segment SOM degree and the state's singular value.
+    rank, tom_rank : (S,) per-segment SOM and TOM (from the segment's first piece) ranks.
+    null_residual : (S,) the largest piece residual of seed eq. (12) in the segment.
+    eta_cum, rank_cum, tom_rank_cum : from the start of the run to each segment's end.
+    margin, margin_cum : (S,) the SOM ranks' distance from the cut-off.
+    R_som_cum, R_tom_cum : (n, n) triangular factors of the whole run's SOM and TOM, scaled
+        by `scale` (their singular values and right vectors; :func:`column_separation`).
+    """
+
+    eta: np.ndarray
+    sigma_state: np.ndarray
+    rank: np.ndarray
+    tom_rank: np.ndarray
+    null_residual: np.ndarray
+    eta_cum: np.ndarray
+    rank_cum: np.ndarray
+    tom_rank_cum: np.ndarray
+    margin: np.ndarray
+    margin_cum: np.ndarray
+    R_som_cum: np.ndarray
+    R_tom_cum: np.ndarray
+
+
+def _stack_r(R: np.ndarray | None, rows: np.ndarray) -> np.ndarray:  # (≤ n, n)
+    """Triangular factor of ``[R; rows]``: the SVD of a stack only needs it."""
+    return r_factor(rows if R is None else np.vstack([R, rows]))
+
+
+def segment_table(F: np.ndarray, H: np.ndarray, duration: np.ndarray, segment: np.ndarray,
+                  n_segments: int, measured: Iterable[int], scale: ArrayLike | None = None,
+                  rtol: float = RANK_RTOL_DEFAULT) -> SegmentTable:
+    """Per segment and cumulative SOM/TOM degrees and ranks of PWCS pieces (seed eqs.
+    9–17): F (J, n, n) per piece, H (m, n) or (J, m, n), duration (J,) s, segment (J,) the
+    segment index of each piece (non-decreasing, 0 … n_segments − 1); `measured`, `scale`
+    and `rtol` as :func:`degree`."""
+    F, measured = np.asarray(F, dtype=float), list(measured)
+    n = F.shape[-1]
+    sc = np.ones(n) if scale is None else np.asarray(scale, dtype=float)
+    # O_j = Q_j R_j: every stack of O_j (SOM) or O_j M (TOM) has the singular values and
+    # right vectors of the same stack of R_j, half the rows
+    O = piece_matrix(F, H)
+    Rp = np.asarray(np.linalg.qr(O, mode="r"))
+    Phi = expm_stack(F * np.asarray(duration, dtype=float)[:, None, None])
+    # condition of seed eq. (12), in the coordinates the ranks are taken in (x = diag(sc) y)
+    resid_piece = null_space_residual(Rp * sc, F * sc / sc[:, None], rtol)
+
+    eta, sig = np.zeros((n_segments, n)), np.zeros((n_segments, n))
+    eta_c = np.zeros((n_segments, n))
+    rank, tom_rank, rank_c, tom_c = (np.zeros(n_segments, int) for _ in range(4))
+    resid, margin, margin_c = (np.zeros(n_segments) for _ in range(3))
+    R_cum: np.ndarray | None = None
+    R_tom_cum: np.ndarray | None = None
+    M_cum = np.eye(n)
+    for i in range(n_segments):
+        js = np.flatnonzero(segment == i)
+        R_seg = _stack_r(None, som(Rp[js]))
+        d = degree(R_seg, measured, scale, rtol)
+        eta[i], sig[i], rank[i], margin[i] = d.eta, d.sigma_state, d.rank, d.margin
+        # TOM of the segment alone (from its first piece) and from the start of the run
+        M = np.eye(n)
+        rows, rows_cum = [], []
+        for j in js:
+            rows.append(Rp[j] @ M)
+            rows_cum.append(Rp[j] @ M_cum)
+            M, M_cum = Phi[j] @ M, Phi[j] @ M_cum
+        tom_rank[i] = degree(_stack_r(None, np.vstack(rows)), measured, scale, rtol).rank
+        R_tom_cum = _stack_r(R_tom_cum, np.vstack(rows_cum))
+        tom_c[i] = degree(R_tom_cum, measured, scale, rtol).rank
+        R_cum = _stack_r(R_cum, R_seg)
+        dc = degree(R_cum, measured, scale, rtol)
+        eta_c[i], rank_c[i], margin_c[i] = dc.eta, dc.rank, dc.margin
+        resid[i] = resid_piece[js].max()
+    assert R_cum is not None and R_tom_cum is not None
+    return SegmentTable(eta=eta, sigma_state=sig, rank=rank, tom_rank=tom_rank,
+                        null_residual=resid, eta_cum=eta_c, rank_cum=rank_c,
+                        tom_rank_cum=tom_c, margin=margin, margin_cum=margin_c,
+                        R_som_cum=R_cum * sc, R_tom_cum=R_tom_cum * sc)
 
 
 def covariance_degree(P0: np.ndarray, P: np.ndarray) -> np.ndarray:

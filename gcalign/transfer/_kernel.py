@@ -24,10 +24,13 @@ Array = NDArray[np.float64]
 @njit(cache=True)
 def propagate(q: Array, v: Array, x: Array, P: Array, dtheta: Array, dv: Array, k_from: int,
               k_to: int, fed: Array, w_in: Array, g_cc: Array, ts: float, Phi: Array,
-              Qd: Array, C_nb: Array) -> None:
+              Qd: Array, C_nb: Array, dv_n: Array) -> None:
     """Steps k_from … k_to − 1, in place on q (4,), v (3,), x (n,), P (n, n) and Phi (n, n)
     (its flexure block and identity set by the caller). On return C_nb (3, 3) holds the
-    slave attitude at the start of the last step (the demo's ``Cnbs`` of its update)."""
+    slave attitude at the start of the last step (the demo's ``Cnbs`` of its update) and
+    dv_n (3,) the sum of the steps' Δv^n (the specific force of their Φ, for the
+    observability of the run)."""
+    dv_n[:] = 0.0
     wx, wy, wz = w_in[0] * ts, w_in[1] * ts, w_in[2] * ts
     for k in range(k_from, k_to):
         bx, by, bz = dtheta[k, 0] - fed[0] * ts, dtheta[k, 1] - fed[1] * ts, \
@@ -45,6 +48,9 @@ def propagate(q: Array, v: Array, x: Array, P: Array, dtheta: Array, dv: Array, 
         C_nb[2, 2] = q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3
         fx, fy, fz = specific_force_increment(q0, q1, q2, q3, bx, by, bz, dx, dy, dz,
                                               wx, wy, wz)
+        dv_n[0] += fx
+        dv_n[1] += fy
+        dv_n[2] += fz
         v[0] += fx + g_cc[0] * ts
         v[1] += fy + g_cc[1] * ts
         v[2] += fz + g_cc[2] * ts

@@ -58,7 +58,6 @@ from gcalign.nav.rotation import (
     quat_to_rotvec,
     rotvec_to_quat,
 )
-from gcalign.transfer import _kernel
 from gcalign.transfer.model import measurement_matrix
 from gcalign.units import ARCMIN, DEG, DPH, DPSH, G0, UG, UGPSHZ
 
@@ -68,6 +67,9 @@ GRAVITY_MODELS = ("normal", "constant")
 NAMES_15 = ("phiE", "phiN", "phiU", "dvE", "dvN", "dvU", "ebx", "eby", "ebz",
             "dbx", "dby", "dbz", "mux", "muy", "muz")
 NAMES_FLEXURE = ("thx", "thy", "thz", "wx", "wy", "wz")
+#: SI unit of each state's estimate and σ, in the order of the names
+UNITS_15 = ("rad",) * 3 + ("m/s",) * 3 + ("rad/s",) * 3 + ("m/s^2",) * 3 + ("rad",) * 3
+UNITS_FLEXURE = ("rad",) * 3 + ("rad/s",) * 3
 PHI, DV, EB, DB, MU, TH, OM = (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12),
                                slice(12, 15), slice(15, 18), slice(18, 21))
 BIASES = slice(6, 12)
@@ -141,6 +143,11 @@ class TransferSettings:
         return NAMES_15 + (NAMES_FLEXURE if self.flexure else ())
 
     @property
+    def units(self) -> tuple[str, ...]:
+        """SI unit of each state (:attr:`names`' order)."""
+        return UNITS_15 + (UNITS_FLEXURE if self.flexure else ())
+
+    @property
     def n(self) -> int:
         return 21 if self.flexure else 15
 
@@ -161,7 +168,11 @@ class TransferResult:
     freedom m; q_slave (K, 4) and att_slave (K, 3) the slave attitude corrected by φ̂;
     v_slave (K, 3); q_master (K, 4) the master at the measurement epochs;
     attitude_error (K, 3) rad, the corrected slave against master ∘ (μ̂ + θ̂); t0 the
-    start of the run (s).
+    start of the run (s). The filter's own error model at each epoch, for its
+    observability (:mod:`gcalign.transfer.observability`): C_nb (K, 3, 3) the slave
+    attitude of H (and of the last step's Φ), f_n (K, 3) m/s² the mean specific force of
+    the steps since the previous epoch (their Φ(δv,φ) = [f^n T ×]), omega_in_n (K, 3)
+    rad/s the ω_in^n of those steps, dt (K,) s their length.
     """
 
     t: np.ndarray
@@ -180,6 +191,10 @@ class TransferResult:
     attitude_error: np.ndarray
     t0: float
     settings: TransferSettings
+    C_nb: np.ndarray
+    f_n: np.ndarray
+    omega_in_n: np.ndarray
+    dt: np.ndarray
 
     def index(self, name: str) -> int:
         return self.names.index(name)
@@ -195,6 +210,17 @@ class TransferResult:
         w = self.t >= self.t[-1] - last_s
         return {"final": self.attitude_error[-1],
                 "rms_last": np.sqrt(np.mean(self.attitude_error[w] ** 2, axis=0))}
+
+    def health_warnings(self, label: str = "") -> list[str]:
+        """Does the filter agree with its data (:mod:`gcalign.estimation.health`, the checks
+        of in-flight calibration)? One line if the mean NIS lies outside the 95 % band of a
+        mean of as many χ²_m, one per state whose σ grows past 10× its P0 σ; `label` heads
+        each line. Needs no truth: it holds on recorded data."""
+        from gcalign.estimation.health import nis_warnings, sigma_growth_warnings
+
+        return (nis_warnings(self.nis, self.m, label)
+                + sigma_growth_warnings(self.sigma0, self.sigma, self.names,
+                                        self.settings.units, label))
 
     def convergence_s(self) -> dict[str, float]:
         """Per state, the first time (s from the start) after which the estimate stays
@@ -242,7 +268,8 @@ def _slerp_master(master: MasterSeries, t: np.ndarray
     return quat_mult(q[j], rotvec_to_quat(quat_to_rotvec(dq) * a)), v, pos
 
 
-def _epochs(t_imu: np.ndarray, master: MasterSeries) -> tuple[int, np.ndarray, np.ndarray]:
+def measurement_epochs(t_imu: np.ndarray, master: MasterSeries
+                       ) -> tuple[int, np.ndarray, np.ndarray]:
     """Start sample and measurement samples: the slave starts at the first master epoch
     inside the IMU run (at the IMU sample nearest to it); a measurement is taken at the
     IMU sample nearest to each later master epoch, the master interpolated to it."""
@@ -292,13 +319,15 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
         by default the master's at the start, as the demo (then the initial φ is −C_nb μ,
         fully correlated with μ, which P0 does not say).
     """
+    from gcalign.transfer import _kernel  # numba, loaded only by a run (validate checks)
+
     s = settings or TransferSettings()
     dtheta, dv, t = (np.asarray(a, dtype=float) for a in (dtheta, dv, t))
     if s.matching != "velocity" and master.att is None:
         raise ScenarioError(f"matching: {s.matching!r} needs the reference's attitude; this "
                             "reference has none (allowed: 'velocity')")
     ts = float(np.median(np.diff(t)))
-    k0, k_meas, t_meas = _epochs(t, master)
+    k0, k_meas, t_meas = measurement_epochs(t, master)
     qm_meas, vm_meas, pm_meas = _slerp_master(master, t_meas)
     qm0, vm0, pm0 = _slerp_master(master, t[k0:k0 + 1])
     earth, n, rows = s.earth, s.n, s.rows
@@ -335,12 +364,16 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
     out_x, out_P = np.zeros((K, n)), np.zeros((K, n, n))
     out_fed, out_nis = np.zeros((K, 6)), np.zeros(K)
     out_q, out_v, out_err = np.zeros((K, 4)), np.zeros((K, 3)), np.zeros((K, 3))
-    C_nb = np.zeros((3, 3))
+    out_C, out_f, out_w, out_dt = np.zeros((K, 3, 3)), np.zeros((K, 3)), np.zeros((K, 3)), \
+        np.zeros(K)
+    C_nb, dv_n = np.zeros((3, 3)), np.zeros(3)
     k_prev = k0 + 1
     for j, k in enumerate(k_meas):
         # mechanisation and prediction over the IMU samples up to this epoch (the kernel)
         _kernel.propagate(q_s, v_s, x, P, dtheta, dv, k_prev, k + 1, fed, w_in, g_cc, ts,
-                          Phi, Qd, C_nb)
+                          Phi, Qd, C_nb, dv_n)
+        out_dt[j] = (k + 1 - k_prev) * ts
+        out_C[j], out_f[j], out_w[j] = C_nb, dv_n / out_dt[j], w_in
         k_prev = k + 1
         w_in, g_cc = earth_terms(pm_meas[j], vm_meas[j])
         H = measurement_matrix(C_nb, "attitude+velocity", n)
@@ -372,7 +405,8 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
         names=s.names, bias_fed=out_fed, nis=out_nis, m=len(rows), q_slave=out_q,
         att_slave=quat_to_euler(out_q), v_slave=out_v,
         q_master=qm_meas if qm_meas is not None else np.full((K, 4), np.nan),
-        attitude_error=out_err, t0=float(t[k0]), settings=s)
+        attitude_error=out_err, t0=float(t[k0]), settings=s, C_nb=out_C, f_n=out_f,
+        omega_in_n=out_w, dt=out_dt)
 
 
 def attitude_error_vs(result: TransferResult, mu: np.ndarray) -> np.ndarray:

@@ -1,4 +1,6 @@
-"""`gcalign align`: gyrocompass alignment with forward/reverse passes (seed 000)."""
+"""`gcalign align`: gyrocompass alignment with forward/reverse passes (seed 000), and in
+``align.mode: transfer`` a slave IMU aligned against a master INS (spec 006,
+:mod:`gcalign.app.align.transfer`: its own check and cost, the same command)."""
 
 from __future__ import annotations
 
@@ -70,8 +72,14 @@ class Align(Command):
 
     def check(self, sc, ext: Extent | None) -> None:
         """The latitude (the scenario's site, else the data file's), what needs truth, the
-        times against the data, the stored-row stride."""
+        times against the data, the stored-row stride; in mode transfer its files, settings
+        and the master's cover of the run."""
         cfg = _config(sc)
+        if cfg.mode == "transfer":
+            from gcalign.app.align import transfer
+
+            transfer.check(sc)
+            return
         lat = sc.site.lat_deg if sc.site is not None else (
             None if ext is None or ext.lat is None else math.degrees(ext.lat))
         if lat is not None and abs(lat) > MAX_LAT_DEG:
@@ -92,6 +100,10 @@ class Align(Command):
         stride(sc, ext)
 
     def cost(self, sc, ext: Extent | None) -> Cost:
+        if _config(sc).mode == "transfer":
+            from gcalign.app.align import transfer
+
+            return transfer.cost(sc)
         if ext is None:
             return Cost()
         lo, hi = window(sc, ext)

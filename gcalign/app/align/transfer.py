@@ -7,7 +7,8 @@ Scenario -> arrays (the slave's increments from ``imu_file``, the master from
 figures in the manner of PSINS's ``kfplot`` (estimates with ±σ against time, the file's
 stored ``eb0``, ``db0``, ``mu0`` as reference lines).
 
-PSINS ``.mat`` files are read here by :func:`_read_mat` (``scipy.io.loadmat``).
+PSINS ``.mat`` files are read by the recorded-data readers of that format
+(:mod:`gcalign.io.recorded`), as every other command reads them.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gcalign.app.command import DOUBLE, Cost
 from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.units import ARCMIN, DPH, UG
@@ -35,32 +37,23 @@ def group_of(name: str) -> str:
     return next(g for g in ("phi", "dv", "eb", "db", "mu", "th", "w") if name.startswith(g))
 
 
-def _read_mat(path: Path, field: str) -> dict:
-    """The numeric variables of a PSINS ``.mat`` file (MATLAB v5), as float arrays."""
-    import scipy.io
-
-    try:
-        d = scipy.io.loadmat(path)
-    except (OSError, ValueError, NotImplementedError) as err:
-        raise ScenarioError(f"{field}: {path}: not a readable MATLAB file ({err})") from None
-    return {k: np.asarray(v, dtype=float) for k, v in d.items()
-            if not k.startswith("__") and isinstance(v, np.ndarray) and v.dtype.kind in "fiu"}
-
-
-def _variable(d: dict, name: str, cols: tuple[int, ...], field: str, path: Path) -> np.ndarray:
-    if name not in d:
-        raise ScenarioError(f"{field}: {name!r} is not a variable of {path} (it has: "
-                            f"{', '.join(sorted(d)) or 'none'})")
-    a = d[name]
-    if a.ndim != 2 or a.shape[1] not in cols or len(a) < 2:
-        raise ScenarioError(f"{field}: {name!r} in {path} has shape {a.shape}; allowed: "
-                            f"(N ≥ 2, {' or '.join(map(str, cols))})")
-    return a
+def reference_path(sc) -> Path:
+    """The master's file: the imu_file itself (``reference.path`` null), else the path,
+    a relative one taken from the imu_file's folder."""
+    path = sc.align.transfer.reference.path
+    if path is None:
+        return sc.imu_file
+    return path if path.is_absolute() else sc.imu_file.parent / path
 
 
 def load_inputs(sc):
     """The slave's increments, the master series and the file's stored PSINS values
-    (``eb0``, ``db0``, ``mu0`` in SI, those present)."""
+    (``eb0``, ``db0``, ``mu0`` in SI, those present), read by the recorded-data readers of
+    the psins-mat format (:mod:`gcalign.io.recorded`): the slave as a recording with the
+    scenario's layout (variable ``align.transfer.imu_variable``), the master as a reference
+    (10 columns, or 7 without attitude)."""
+    from gcalign.io.recorded import read_recording, read_reference
+    from gcalign.io.recorded.mat import read_vectors
     from gcalign.transfer import MasterSeries
 
     cfg = sc.align.transfer
@@ -70,31 +63,40 @@ def load_inputs(sc):
                             f"{sc.imu_file}")
     if not sc.imu_file.is_file():
         raise ScenarioError(f"imu_file: {sc.imu_file}: file not found")
-    imu_vars = _read_mat(sc.imu_file, "imu_file")
-    imu = _variable(imu_vars, cfg.imu_variable, (7,), "align.transfer.imu_variable",
-                    sc.imu_file)
-    ref = cfg.reference
-    path = sc.imu_file if ref.path is None else (
-        ref.path if ref.path.is_absolute() else sc.imu_file.parent / ref.path)
+    layout = sc.recording_layout()
+    if "imu_variable" in cfg.model_fields_set and layout.variable != cfg.imu_variable:
+        raise ScenarioError(f"align.transfer.imu_variable: {cfg.imu_variable!r} contradicts "
+                            f"imu_file.variable {layout.variable!r}; give one of them")
+    try:
+        imu = read_recording(sc.imu_file, layout)
+    except ScenarioError as err:
+        text = str(err)
+        field = ("align.transfer.imu_variable" if ": variable" in text
+                 else "" if text.startswith("imu_file") else "imu_file")
+        raise ScenarioError(f"{field}: {text}" if field else text) from None
+    ref, path = cfg.reference, reference_path(sc)
     if not path.is_file():
         raise ScenarioError(f"align.transfer.reference.path: {path}: file not found")
-    ref_vars = imu_vars if path == sc.imu_file else _read_mat(path, "align.transfer.reference")
-    avp = _variable(ref_vars, ref.variable, (10, 7), "align.transfer.reference.variable", path)
-    has_att = avp.shape[1] == 10
-    if cfg.matching != "velocity" and not has_att:
+    try:
+        avp = read_reference(path, ref.format, ref.variable, attitude_optional=True)
+    except ScenarioError as err:
+        field = "variable" if "variable" in str(err) else "path"
+        raise ScenarioError(f"align.transfer.reference.{field}: {err}") from None
+    if cfg.matching != "velocity" and avp.att is None:
         raise ScenarioError(f"align.transfer.matching: {cfg.matching!r} needs the reference's "
                             f"attitude; {ref.variable!r} in {path} has 7 columns [v pos t], "
                             "no attitude (allowed: 'velocity')")
-    a0 = 3 if has_att else 0
-    master = MasterSeries(t=avp[:, -1], att=avp[:, :3] if has_att else None,
-                          v_n=avp[:, a0:a0 + 3], pos=avp[:, a0 + 3:a0 + 6])
-    stored = {k: ref_vars.get(k, imu_vars.get(k)) for k in ("eb0", "db0", "mu0")}
-    stored = {k: v.ravel() for k, v in stored.items() if v is not None and v.size == 3}
-    return imu[:, 0:3], imu[:, 3:6], imu[:, 6], master, stored, path
+    master = MasterSeries(t=avp.t, att=avp.att, v_n=avp.v_n, pos=avp.pos)
+    names = ("eb0", "db0", "mu0")
+    stored = read_vectors(path, names)
+    if path != sc.imu_file:  # the demo keeps them beside the slave
+        stored = {**read_vectors(sc.imu_file, names), **stored}
+    return imu.dtheta, imu.dv, imu.t, master, stored, path
 
 
 def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
     """The run's summary: ``states`` in SI, the rest in the units their keys name."""
+    from gcalign.estimation.health import mean_nis_band
     from gcalign.transfer import attitude_error_vs
 
     r, s = result, result.settings
@@ -103,6 +105,7 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
     states = {n: {"estimate": float(r.x[-1, i]), "sigma": float(r.sigma[-1, i]),
                   "sigma0": float(r.sigma0[i])} for i, n in enumerate(r.names)}
     lo, hi = _chi2_band(r.m)
+    mean_lo, mean_hi = mean_nis_band(len(r.nis), r.m)
     out = {
         "scenario": sc.name,
         "mode": "transfer",
@@ -125,7 +128,9 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
         and np.isnan(r.q_master).any() else {
             "final": (err["final"] / ARCMIN).tolist(),
             "rms_last_10s": (err["rms_last"] / ARCMIN).tolist()},
-        "nis": {"mean": float(r.nis.mean()), "dof": r.m, "band_95": [lo, hi]},
+        "nis": {"mean": float(r.nis.mean()), "dof": r.m, "band_95": [lo, hi],
+                "band_95_of_mean": [mean_lo, mean_hi],
+                "consistent": bool(mean_lo <= r.nis.mean() <= mean_hi)},
         "slave_attitude_deg": np.degrees(r.att_slave[-1]).tolist(),
         "psins_stored": {"eb0_dph": (stored["eb0"] / DPH).tolist() if "eb0" in stored else None,
                          "db0_ug": (stored["db0"] / UG).tolist() if "db0" in stored else None,
@@ -180,6 +185,61 @@ def write(f, result, stored: dict) -> None:
         description="ε (3), ∇ (3) fed back into the compensation so far")
 
 
+def _covered(sc, t, master, ref_path) -> None:
+    """The core's check that the master covers the IMU run (its measurement epochs), as a
+    refusal naming the key and both files."""
+    from gcalign.transfer.filter import measurement_epochs
+
+    try:
+        measurement_epochs(t, master)
+    except ScenarioError as err:
+        raise ScenarioError(f"align.transfer.{err} ({ref_path} against {sc.imu_file})"
+                            ) from None
+
+
+def check(sc) -> None:
+    """Refuse what the run would refuse (``gcalign validate``, the preflight of a run): the
+    files and their variables, the matching against the reference's columns, the settings,
+    the reference's cover of the IMU run. Reads the files; loads no numba."""
+    dtheta, dv, t, master, _, ref_path = load_inputs(sc)
+    sc.align.transfer.settings(sc.earth_model)
+    _covered(sc, t, master, ref_path)
+
+
+#: multiply-adds of the filter per n³ (n states): an IMU step's Φ P Φᵀ with a dense Φ, and
+#: a measurement epoch's gain and Joseph-form update
+STEP_OPS_N3, UPDATE_OPS_N3 = 2.0, 4.0
+INPUT_DOUBLES = 4 * 7  #: per IMU sample: the file's array, the reader's copies, the kernel's
+EPOCH_DOUBLES = 40  #: per epoch beside x, σ and P: NIS, attitudes, velocity, errors, feedback
+
+
+def sizes(sc) -> tuple[int, int, int]:
+    """IMU samples, master epochs (the measurements are at most as many) and states of a
+    run, from the MAT files' headers (no data read; the check has read them)."""
+    from gcalign.io.recorded.mat import shapes
+
+    cfg = sc.align.transfer
+    variable = sc.recording_layout().variable or cfg.imu_variable
+    imu = shapes(sc.imu_file).get(variable, (0,))
+    master = shapes(reference_path(sc)).get(cfg.reference.variable, (0,))
+    return imu[0], master[0], 21 if cfg.flexure else 15
+
+
+def cost(sc, runs: int = 1) -> Cost:
+    """`runs` filter runs over the whole file: per IMU step the covariance propagation, per
+    master epoch the update; held at once: the inputs and every epoch's x, σ and P (the
+    result); stored: x, σ and the series of :func:`write`."""
+    N, K, n = sizes(sc)
+    per_epoch = n * n + 2 * n + EPOCH_DOUBLES
+    return Cost(samples=float(N),
+                memory_bytes=(N * INPUT_DOUBLES + K * per_epoch) * DOUBLE,
+                output_bytes=K * (2 * n + 16) * DOUBLE,
+                work=runs * (N * STEP_OPS_N3 + K * UPDATE_OPS_N3) * n**3,
+                work_what=f"{runs} run(s) × (IMU samples × {STEP_OPS_N3:g} + epochs × "
+                f"{UPDATE_OPS_N3:g}) × {n}³",
+                memory_what="the inputs and every epoch's covariance")
+
+
 def execute(sc, seed: int | None = None, cache_key: str | None = None,
             progress=None) -> Outcome:
     """Read the slave and the master, align, summarise (the align room's mode transfer)."""
@@ -187,14 +247,12 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None,
 
     cfg = sc.align.transfer
     dtheta, dv, t, master, stored, ref_path = load_inputs(sc)
+    _covered(sc, t, master, ref_path)
     start = time.process_time()
-    try:
-        result = transfer_align(dtheta, dv, t, master, cfg.settings(sc.earth_model))
-    except ScenarioError as err:  # coverage of the run: name the file and the key
-        raise ScenarioError(f"align.transfer.{err} ({ref_path} against {sc.imu_file})"
-                            ) from None
+    result = transfer_align(dtheta, dv, t, master, cfg.settings(sc.earth_model))
     out = summary(sc, result, stored, ref_path, time.process_time() - start)
-    warnings = tuple(sc.align.unused(sc))
+    # the filter's consistency (mean NIS, σ growth): calibrate's checks, on recorded data too
+    warnings = (*sc.align.unused(sc), *result.health_warnings())
     out["warnings"] = list(warnings)
     return Outcome(out, lambda f: write(f, result, stored), None, None, warnings)
 
@@ -232,8 +290,7 @@ def table(s: dict):
     notes = ["corrected slave vs master ∘ μ̂: the reference has no attitude" if e is None
              else f"corrected slave vs master ∘ μ̂ (φ E, N, U, ′): final "
              f"{_three(e['final'])}, RMS last 10 s {_three(e['rms_last_10s'])}",
-             f"NIS mean {s['nis']['mean']:.2f} (dof {s['nis']['dof']}, 95 % band of one "
-             f"epoch {s['nis']['band_95'][0]:.2f}–{s['nis']['band_95'][1]:.2f})",
+             _nis_line(s["nis"], s["epochs"]),
              "conv. s: first time after which the estimate stays within 2σ of its final "
              "value; PSINS: the file's eb0, db0, mu0 (PSINS's own end-of-run estimates, "
              "not a truth)"]
@@ -241,10 +298,23 @@ def table(s: dict):
         e0 = s["attitude_error_vs_psins_mu0_arcmin"]
         notes.insert(1, f"corrected slave vs master ∘ PSINS mu0 (′): final "
                         f"{_three(e0['final'])}, RMS last 10 s {_three(e0['rms_last_10s'])}")
-    notes += [f"warning: {w}" for w in s.get("warnings", [])]
     t.caption = "\n".join(notes)
     t.caption_justify = "left"
     return t
+
+
+def _nis_line(nis: dict, epochs: int) -> str:
+    """The mean NIS against the 95 % band of a mean over the run's epochs (the health
+    check), marked when outside it; the band of one epoch beside it."""
+    lo, hi = nis.get("band_95_of_mean", (None, None))
+    one = (f"one epoch {nis['band_95'][0]:.2f}–{nis['band_95'][1]:.2f}")
+    if lo is None:  # a results file of an earlier version (gcalign show)
+        return f"NIS mean {nis['mean']:.2f} (dof {nis['dof']}, 95 % band of {one})"
+    text = (f"NIS mean {nis['mean']:.3g} over {epochs} epochs (dof {nis['dof']}); 95 % band "
+            f"of such a mean {lo:.2f}–{hi:.2f}, of {one}")
+    if nis.get("consistent", True):
+        return text
+    return f"[bold yellow]{text}: the mean lies OUTSIDE its band (see the warning)[/]"
 
 
 def _three(v) -> str:

@@ -1,4 +1,6 @@
-"""`gcalign observability`: the PWCS/SVD observability table of a flight (seed 002 §4)."""
+"""`gcalign observability`: the PWCS/SVD observability table of a flight (seed 002 §4), or of
+a transfer-alignment run (``align.mode: transfer``, spec 006, :mod:`.transfer`): one command,
+its check, cost, run, table and figures chosen by the scenario's mode."""
 
 from __future__ import annotations
 
@@ -15,9 +17,14 @@ N = 21  #: states
 PIECE_OPS = 40.0 * N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, its QR
 
 
+def transfer_mode(sc) -> bool:
+    """A transfer-alignment scenario (its table is the transfer filter's, spec 006)."""
+    return sc.align is not None and sc.align.mode == "transfer"
+
+
 class Observability(Command):
     name = "observability"
-    help = "PWCS/SVD observability table of a flight (seed 002)."
+    help = "PWCS/SVD observability table of a flight (seed 002) or a transfer alignment."
     section = "observability"
     builtin = "seed002_designed.yaml"
     options = Options(batch_metrics=("rank_final",))
@@ -30,6 +37,10 @@ class Observability(Command):
         from gcalign.io.scenario.calibrate import ObservabilityConfig
 
         (sc.observability or ObservabilityConfig()).check(sc)
+        if transfer_mode(sc):
+            from gcalign.app.observability import transfer
+
+            transfer.check(sc)
 
     def cost(self, sc, ext: Extent | None) -> Cost:
         """Per PWCS piece F, Φ, R and the stacked observability matrix (measurements × 21
@@ -37,6 +48,10 @@ class Observability(Command):
         the covariance run's epochs."""
         from gcalign.io.scenario.calibrate import ObservabilityConfig
 
+        if transfer_mode(sc):
+            from gcalign.app.observability import transfer
+
+            return transfer.cost(sc)
         cfg = sc.observability or ObservabilityConfig()
         n, nav, epochs = steps(sc, ext)
         segments = len(sc.motion.segments) if sc.motion is not None and hasattr(

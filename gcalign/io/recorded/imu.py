@@ -37,7 +37,6 @@ format          layout (columns in file order; see spec 005)
 
 from __future__ import annotations
 
-import io
 import math
 import os
 import re
@@ -59,6 +58,7 @@ from gcalign.io.imu_files import (
     read_bytes,
     read_psins_imu,
 )
+from gcalign.io.recorded import mat
 from gcalign.io.recorded.axes import axes_text, rotation_to_rfu
 from gcalign.sim.imu import ImuData
 
@@ -239,19 +239,7 @@ def _read_psins(name: str, path) -> _Raw:
 
 
 def _read_psins_mat(name: str, data: bytes, layout: Layout) -> _Raw:
-    import scipy.io
-
-    try:
-        mat = scipy.io.loadmat(io.BytesIO(data))
-    except NotImplementedError:
-        raise ImuFileError(f"{name}: a MAT v7.3 (HDF5) file; save it with save(..., '-v7') "
-                           "for format psins-mat") from None
-    except (ValueError, TypeError, OSError) as exc:
-        raise ImuFileError(f"{name}: not a MATLAB file that scipy.io.loadmat reads "
-                           f"({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
-                           ) from None
-    arrays = {k: v for k, v in mat.items() if not k.startswith("__")
-              and isinstance(v, np.ndarray) and v.dtype.kind in "fiu"}
+    arrays = mat.arrays(name, data)
     if layout.variable is not None:
         if layout.variable not in arrays:
             raise ImuFileError(f"{name}: variable: {layout.variable!r} is not a numeric array "

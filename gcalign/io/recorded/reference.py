@@ -4,7 +4,9 @@
 format          layout
 ==============  ===========================================================================
 ``psins-mat``   MATLAB file, an ``avp`` array ``[att(3) v(3) lat lon h t]``: rad, m/s ENU,
-                rad, m, s (PSINS's ``avp``, ``fogavp``; ``variable`` names one of several)
+                rad, m, s (PSINS's ``avp``, ``fogavp``; ``variable`` names one of several);
+                where the caller allows it, a ``vp`` array ``[v(3) lat lon h t]`` of 7
+                columns, a reference without attitude
 ``i2nav-nav``   text (KF-GINS result): week, seconds of week, lat, lon (deg), h (m),
                 vN, vE, vD (m/s), roll, pitch, yaw (deg; NED, FRD: yaw is the heading)
 ``csv``         declared ``columns`` (default ``t pitch roll yaw ve vn vu lat lon h``),
@@ -21,7 +23,6 @@ else the recording's header; with none of them the refusal lists the three.
 
 from __future__ import annotations
 
-import io
 import os
 from dataclasses import dataclass, field
 
@@ -29,6 +30,7 @@ import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.io.imu_files import ImuFileError, read_bytes
+from gcalign.io.recorded import mat
 from gcalign.io.recorded.imu import _table, _text_lines
 from gcalign.io.recorded.rows import _check_rows, _columns, _finite
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
@@ -45,11 +47,12 @@ _NAV_LABELS = ("week", "seconds of week", "lat", "lon", "h", "vN", "vE", "vD", "
 
 @dataclass(frozen=True)
 class Reference:
-    """t (N,) s; att (N, 3) [pitch, roll, yaw] rad (ENU, RFU); v_n (N, 3) ENU m/s;
+    """t (N,) s; att (N, 3) [pitch, roll, yaw] rad (ENU, RFU), None for a reference without
+    attitude (read only where the caller allows one); v_n (N, 3) ENU m/s;
     pos (N, 3) [lat rad, lon rad, h m]; record: what was read."""
 
     t: np.ndarray
-    att: np.ndarray
+    att: np.ndarray | None
     v_n: np.ndarray
     pos: np.ndarray
     record: dict = field(default_factory=dict)
@@ -65,9 +68,11 @@ def reference_format_of(path) -> str:
 
 
 def read_reference(path, format: str = "psins-mat", variable: str | None = None,
-                   columns=None) -> Reference:
+                   columns=None, attitude_optional: bool = False) -> Reference:
     """A reference solution from `path` in `format` (module docstring); ScenarioError
-    naming the file, row and what is allowed."""
+    naming the file, row and what is allowed. `attitude_optional`: a psins-mat `variable`
+    of 7 columns ``[v(3) lat lon h t]`` is read too, with ``att`` None (a master that
+    gives velocity only)."""
     name = os.fspath(path)
     if format not in REFERENCE_FORMATS:
         raise ScenarioError(f"reference.format: {format!r} is not a reference format; "
@@ -75,8 +80,10 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     data = read_bytes(name)[1]
     notes: dict = {}
     if format == "psins-mat":
-        a, key, where = _avp(name, data, variable)
-        t, att, v, pos = a[:, 9], a[:, 0:3], a[:, 3:6], a[:, 6:9]
+        a, key, where = _avp(name, data, variable, attitude_optional)
+        a0 = a.shape[1] - 7  # 3 with attitude, 0 without
+        t, v, pos = a[:, -1], a[:, a0:a0 + 3], a[:, a0 + 3:a0 + 6]
+        att = a[:, 0:3] if a0 else None
         notes["variable"] = key
         origin = "seconds, the avp array's last column"
     elif format == "i2nav-nav":
@@ -104,19 +111,12 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     record = {"format": format, "path": name, "epochs": int(len(t)), "t_first_s": float(t[0]),
               "t_last_s": float(t[-1]), "time_origin": origin,
               "rate_hz": float(1.0 / np.median(np.diff(t))), **notes}
-    return Reference(t.copy(), att.copy(), v.copy(), pos.copy(), record)
+    return Reference(t.copy(), None if att is None else att.copy(), v.copy(), pos.copy(),
+                     record)
 
 
-def _avp(name: str, data: bytes, variable: str | None):
-    import scipy.io
-
-    try:
-        mat = scipy.io.loadmat(io.BytesIO(data))
-    except (NotImplementedError, ValueError, TypeError, OSError) as exc:
-        raise ImuFileError(f"{name}: not a MATLAB file that scipy.io.loadmat reads "
-                           f"({type(exc).__name__})") from None
-    arrays = {k: v for k, v in mat.items() if not k.startswith("__")
-              and isinstance(v, np.ndarray) and v.dtype.kind in "fiu" and v.ndim == 2}
+def _avp(name: str, data: bytes, variable: str | None, attitude_optional: bool = False):
+    arrays = {k: v for k, v in mat.arrays(name, data).items() if v.ndim == 2}
     if variable is None:
         ten = sorted(k for k, v in arrays.items() if v.shape[1] == 10 and v.shape[0] >= 2)
         if len(ten) != 1:
@@ -125,11 +125,15 @@ def _avp(name: str, data: bytes, variable: str | None):
                                f"({', '.join(f'{k} {arrays[k].shape}' for k in sorted(arrays))}"
                                "); name one with variable:")
         variable = ten[0]
-    if variable not in arrays or arrays[variable].shape[1] != 10:
-        raise ImuFileError(f"{name}: variable {variable!r} is not an N x 10 avp array; the "
-                           f"file holds {', '.join(sorted(arrays)) or 'none'}")
+    widths = (10, 7) if attitude_optional else (10,)
+    if variable not in arrays or arrays[variable].shape[1] not in widths:
+        what = ("an N x 10 avp array [att(3) v(3) lat lon h t] or an N x 7 [v(3) lat lon h "
+                "t]" if attitude_optional else "an N x 10 avp array")
+        held = ", ".join(f"{k} {arrays[k].shape}" for k in sorted(arrays)) or "none"
+        raise ImuFileError(f"{name}: variable {variable!r} is not {what}; the file holds "
+                           f"{held}")
     a = np.asarray(arrays[variable], dtype=float)
-    labels = ("pitch", "roll", "yaw", "vE", "vN", "vU", "lat", "lon", "h", "t")
+    labels = ("pitch", "roll", "yaw", "vE", "vN", "vU", "lat", "lon", "h", "t")[10 - a.shape[1]:]
     where = lambda k: f": {variable} row {k + 1}"  # noqa: E731
     _finite(name, a, labels, where)
     return a, variable, where
@@ -153,6 +157,10 @@ def reference_at(ref: Reference, t, tol: float = 1e-9) -> tuple[np.ndarray, np.n
     from scipy.spatial.transform import Rotation, Slerp
 
     t = np.atleast_1d(np.asarray(t, dtype=float))
+    if ref.att is None:
+        raise ScenarioError(f"reference: {ref.record.get('path', 'the reference')} has no "
+                            "attitude (7 columns [v lat lon h t]); an avp of 10 columns "
+                            "[att v lat lon h t] is needed here")
     _covers(ref, t, tol)
     tq = np.clip(t, ref.t[0], ref.t[-1])
     slerp = Slerp(ref.t, Rotation.from_matrix(euler_to_dcm(ref.att)))

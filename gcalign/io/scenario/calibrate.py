@@ -337,23 +337,56 @@ class CalibrateConfig(Model):
 
 
 class ObservabilityConfig(Model):
+    """``observability``: the PWCS/SVD table of a flight's manoeuvres (seed 002), or of a
+    transfer-alignment run (``align.mode: transfer``, spec 006: its matching is
+    ``align.transfer.matching``, its rows windows of ``window_s``)."""
+
     measure: Literal["velocity", "position", "both"] = "velocity"
     scaling: Literal["none", "p0"] = "p0"  # docs/decisions/013
     piece_s: float = Field(1.0, gt=0)
+    window_s: float = Field(10.0, gt=0, description="transfer alignment: the table's windows")
     rank_rtol: float = Field(1e-12, gt=0, lt=1)
     null_tol: float = Field(1e-9, gt=0)
     covariance: bool = True
 
     def check(self, sc) -> None:
+        if _transfer(sc):
+            return  # the run's inputs: the align command's transfer check
         if sc.motion is None:
             raise ScenarioError("motion: missing; the observability table needs a simulated "
-                                "motion (its truth)")
+                                "motion (its truth), or a transfer-alignment scenario "
+                                "(align.mode: transfer)")
         if sc.calibrate is not None:
             sc.calibrate.check(sc)
 
+    def unused(self, sc) -> list[str]:
+        """Keys that cannot matter, one line each (shown as warnings)."""
+        fields = self.model_fields_set
+        if not _transfer(sc):
+            return (["observability.window_s: cannot matter for a flight (its rows are the "
+                     "motion's segments); it cuts a transfer-alignment run"]
+                    if "window_s" in fields else [])
+        out = []
+        if "measure" in fields:
+            out.append("observability.measure: cannot matter in transfer alignment (the "
+                       "matching is align.transfer.matching: --matching)")
+        if "covariance" in fields:
+            out.append("observability.covariance: cannot matter in transfer alignment (the "
+                       "filter's run gives the table its F, so its covariance comes with it)")
+        return out
+
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
-        return [("observability.measure", self.measure, ""),
+        transfer = _transfer(sc)
+        rows = [("observability.measure", sc.align.transfer.matching,
+                 "align.transfer.matching") if transfer else
+                ("observability.measure", self.measure, ""),
                 ("observability.scaling", self.scaling, "unscaled states (the paper)"
                  if self.scaling == "none" else "columns × initial σ"),
-                ("observability.piece_s", f"{self.piece_s:g} s", ""),
-                ("observability.rank_rtol", f"{self.rank_rtol:g}", "")]
+                ("observability.piece_s", f"{self.piece_s:g} s", "")]
+        if transfer:
+            rows.append(("observability.window_s", f"{self.window_s:g} s", "the table's windows"))
+        return rows + [("observability.rank_rtol", f"{self.rank_rtol:g}", "")]
+
+
+def _transfer(sc) -> bool:
+    return sc.align is not None and sc.align.mode == "transfer"

@@ -220,10 +220,18 @@ class Scenario(Model):
         return self.align is not None and self.align.mode == "transfer"
 
     def recording_layout(self):
-        """How to read `imu_file` (:class:`gcalign.io.recorded.Layout`)."""
+        """How to read `imu_file` (:class:`gcalign.io.recorded.Layout`); in transfer
+        alignment the slave's MAT variable is ``align.transfer.imu_variable`` unless the
+        layout names one."""
+        from dataclasses import replace
+
         from gcalign.io.recorded import Layout
 
-        return Layout() if self.imu_layout is None else self.imu_layout.to_layout()
+        layout = Layout() if self.imu_layout is None else self.imu_layout.to_layout()
+        if self.reads_own_recording and self.align is not None \
+                and self.align.transfer is not None and layout.variable is None:
+            layout = replace(layout, variable=self.align.transfer.imu_variable)
+        return layout
 
     @model_validator(mode="after")
     def _source(self):

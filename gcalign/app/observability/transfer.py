@@ -1,0 +1,289 @@
+"""`gcalign observability` on a transfer-alignment scenario (``align.mode: transfer``, spec
+006): the filter's run for the scenario's matching (``align.transfer.matching``,
+``--matching``) gives F, H and the covariance; :func:`gcalign.transfer.observability.
+transfer_observability` gives the PWCS/SVD table of its windows.
+
+The summary keeps the command's usual shape (``segments`` and ``cumulative`` per window with
+``degree`` and ``covariance_degree``, ``rank_final``, ``degree_final``), plus per state the
+separation, σ0 and σ at the end, the unobservable states and the weakest combination. The
+results file: ``/observability`` as for a flight (windows in place of segments; ``eta``
+over the 15 PWCS states, ``cov_degree`` over all the filter's states, named by the
+``states`` and ``covariance_states`` attributes) and the filter's σ against time.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import h5py
+import numpy as np
+
+from gcalign.app.align.transfer import DECIMALS, DISPLAY, SI_UNIT, group_of
+from gcalign.app.command import DOUBLE, Cost
+from gcalign.app.registry import Outcome
+from gcalign.io.results import put
+
+PWCS_N = 15
+PIECE_OPS = 40.0 * PWCS_N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, QR
+
+
+def _config(sc):
+    from gcalign.io.scenario.calibrate import ObservabilityConfig
+
+    return sc.observability or ObservabilityConfig()
+
+
+def check(sc) -> None:
+    """The transfer run's refusals (files, variables, matching, settings, cover)."""
+    from gcalign.app.align import transfer
+
+    transfer.check(sc)
+
+
+def cost(sc) -> Cost:
+    """One filter run (:func:`gcalign.app.align.transfer.cost`) and the PWCS pieces, at
+    most one per master epoch (the bound: the files' headers give no times), each F, Φ, R
+    and its observability matrix (6·15 rows of 15) held at once."""
+    from gcalign.app.align import transfer
+
+    run = transfer.cost(sc)
+    _, K, n = transfer.sizes(sc)
+    pieces = float(K)
+    per_piece = 4 * PWCS_N**2 + 6 * PWCS_N * PWCS_N
+    return Cost(samples=run.samples,
+                memory_bytes=run.memory_bytes + pieces * per_piece * DOUBLE,
+                output_bytes=K * n * DOUBLE + run.output_bytes,
+                work=run.work + pieces * PIECE_OPS,
+                work_what=f"{run.work_what} + PWCS pieces × 40 · 15³",
+                memory_what=run.memory_what)
+
+
+def execute(sc, seed: int | None = None, cache_key: str | None = None,
+            progress: Any = None) -> Outcome:
+    """The filter's run and its table (no randomness: the seed only names the run)."""
+    from gcalign.app.align.transfer import _covered, load_inputs
+    from gcalign.transfer import transfer_align
+    from gcalign.transfer.observability import transfer_observability
+
+    cfg, tcfg = _config(sc), sc.align.transfer
+    if progress is not None:
+        progress(0, 2, f"transfer filter ({tcfg.matching})")
+    dtheta, dv, t, master, _, ref_path = load_inputs(sc)
+    _covered(sc, t, master, ref_path)
+    start = time.perf_counter()
+    result = transfer_align(dtheta, dv, t, master, tcfg.settings(sc.earth_model))
+    if progress is not None:
+        progress(1, 2, "PWCS + SVD table")
+    obs = transfer_observability(result, cfg.piece_s, cfg.window_s, cfg.scaling,
+                                 cfg.rank_rtol, cfg.null_tol)
+    if progress is not None:
+        progress(2, 2, "PWCS + SVD table")
+    warnings = tuple(result.health_warnings())
+    out = summary(sc, obs, time.perf_counter() - start)
+    out["warnings"] = list(warnings)
+    return Outcome(out, lambda f: write(f, obs, result), None, None, warnings, result=obs)
+
+
+def _per_state(names, values) -> dict:
+    return {n: float(v) for n, v in zip(names, values, strict=True)}
+
+
+def summary(sc, obs, compute_s: float) -> dict:
+    """Plain numbers: the JSON contract of ``gcalign observability`` on a transfer run."""
+    from gcalign.app.observability.run import _finite
+
+    tab, pw, names = obs.table, obs.pwcs, obs.names
+    segs, cum = [], []
+    for i in range(len(obs.t0)):
+        name = f"{obs.t0[i]:.0f}–{obs.t1[i]:.0f} s"
+        segs.append({"name": name, "t0_s": float(obs.t0[i]), "t1_s": float(obs.t1[i]),
+                     "rank": int(tab.rank[i]), "rank_margin": _finite(tab.margin[i]),
+                     "tom_rank": int(tab.tom_rank[i]),
+                     "null_residual": float(tab.null_residual[i]),
+                     "condition": bool(obs.condition[i]), "degree": _per_state(pw, tab.eta[i]),
+                     "covariance_degree": _per_state(names, obs.cov_degree_segment[i])})
+        cum.append({"name": name, "t0_s": float(obs.t0[0]), "t1_s": float(obs.t1[i]),
+                    "rank": int(tab.rank_cum[i]), "rank_margin": _finite(tab.margin_cum[i]),
+                    "tom_rank": int(tab.tom_rank_cum[i]),
+                    "degree": _per_state(pw, tab.eta_cum[i]),
+                    "covariance_degree": _per_state(names, obs.cov_degree[i])})
+    return {
+        "scenario": sc.name,
+        "mode": "transfer",
+        "measure": obs.matching,
+        "matching": obs.matching,
+        "scaling": obs.scaling,
+        "rank_rtol": obs.rtol,
+        "piece_s": obs.piece_s,
+        "window_s": obs.window_s,
+        "pieces": obs.pieces,
+        "states": list(pw),
+        "covariance_states": list(names),
+        "segments": segs,
+        "cumulative": cum,
+        "rank_final": int(tab.rank_cum[-1]),
+        "tom_rank_final": int(tab.tom_rank_cum[-1]),
+        "degree_final": [float(v) for v in tab.eta_cum[-1]],
+        "separation": _per_state(pw, obs.separation),
+        "singular_values": [float(v) for v in obs.singular_values],
+        "unobservable": [n for n, z in zip(pw, obs.unobservable, strict=True) if z],
+        "weakest": {"ratio": obs.weakest_ratio, "vector": _per_state(pw, obs.weakest)},
+        "sigma0": _per_state(names, obs.sigma0),
+        "sigma_final": _per_state(names, obs.sigma_end[-1]),
+        "covariance_degree_final": _per_state(names, obs.cov_degree[-1]),
+        "units": {n: SI_UNIT[group_of(n)] for n in names},
+        "display_units": {n: DISPLAY[group_of(n)][0] for n in names},
+        "display_scale": {n: DISPLAY[group_of(n)][1] for n in names},
+        "compute_s": compute_s,
+    }
+
+
+DEGREE = "(windows, states) in the order of the 'states' attribute"
+COVARIANCE = "(windows, states) in the order of the 'covariance_states' attribute"
+
+
+def write(f: h5py.File, obs, result) -> None:
+    """``/observability`` (module docstring) and the filter's σ per epoch."""
+    g = f.create_group("observability")
+    g.attrs["mode"] = "transfer"
+    g.attrs["measure"] = obs.matching
+    g.attrs["scaling"], g.attrs["rank_rtol"] = obs.scaling, obs.rtol
+    g.attrs["piece_s"], g.attrs["window_s"] = obs.piece_s, obs.window_s
+    g.attrs["states"] = ",".join(obs.pwcs)
+    g.attrs["covariance_states"] = ",".join(obs.names)
+    g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in obs.names)
+    g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in obs.names])
+    names = [f"{a:.0f}–{b:.0f} s" for a, b in zip(obs.t0, obs.t1, strict=True)]
+    g.create_dataset("segment_name", data=np.array(names, dtype=h5py.string_dtype()))
+    put(g, "t0", obs.t0, "s", description="window start, from the start of the run")
+    put(g, "t1", obs.t1, "s")
+    tab = obs.table
+    put(g, "eta", tab.eta, "1", shape=DEGREE, description="seed eq. 17 per window")
+    put(g, "eta_cum", tab.eta_cum, "1", shape=DEGREE, description="from the start of the run")
+    put(g, "sigma_state", tab.sigma_state, "SOM units", shape=DEGREE)
+    for name in ("rank", "tom_rank", "rank_cum", "tom_rank_cum", "null_residual"):
+        put(g, name, getattr(tab, name), "1")
+    put(g, "condition", obs.condition.astype(np.int8), "1",
+        description="null(O_j) in null(F_j) for every piece (seed eq. 12)")
+    put(g, "separation", obs.separation, "1", description="of each state's TOM column from "
+        "the span of the others (whole run)")
+    put(g, "singular_values", obs.singular_values, "1", description="whole run's TOM")
+    put(g, "weakest", obs.weakest, "1", description="right singular vector of the smallest "
+        "singular value, scaled coordinates")
+    put(g, "cov_degree", obs.cov_degree, "1", shape=COVARIANCE,
+        description="sigma(0)/sigma(t_end), PSINS kfstat")
+    put(g, "cov_degree_segment", obs.cov_degree_segment, "1", shape=COVARIANCE,
+        description="sigma(t_start)/sigma(t_end)")
+    put(g, "sigma0", obs.sigma0, "SI", description="P0 sigma, 'covariance_states' order")
+    put(g, "t", result.t - result.t0, "s", description="master epochs, from the start")
+    put(g, "sigma", result.sigma, "SI", description="the filter's sigma per epoch, "
+        "'covariance_states' order")
+
+
+# -- table and figures (rich and matplotlib loaded by the caller's import of this module) --
+
+def _sci(x: float) -> str:
+    return "0" if x == 0 else f"{x:.1e}"
+
+
+def _ratio(x: float) -> str:
+    """σ0/σ with one decimal (1.0: nothing learnt), scientific from 10⁴."""
+    return f"{x:.1f}" if x < 1e4 else f"{x:.1e}"
+
+
+def table(s: dict):
+    """One row per state: σ0, σ at the end (display units), σ0/σ, the whole run's degree η
+    and separation."""
+    from rich.table import Table
+
+    from gcalign.app.observability.tables import margin
+
+    last = s["cumulative"][-1]
+    t = Table(title=f"gcalign observability: {s['scenario']} — transfer alignment, "
+              f"{s['matching']} matching, scaling {s['scaling']}, {s['pieces']} pieces of "
+              f"{s['piece_s']:g} s in {len(s['segments'])} windows of {s['window_s']:g} s",
+              title_justify="left", header_style="bold")
+    for head in ("state", "unit", "σ0", "σ end", "σ0/σ", "η", "sep."):
+        t.add_column(head, justify="left" if head in ("state", "unit") else "right")
+    unobs = set(s["unobservable"])
+    for name in s["covariance_states"]:
+        k, unit = s["display_scale"][name], s["display_units"][name]
+        d = DECIMALS[unit]
+        eta = last["degree"].get(name)
+        sep = s["separation"].get(name)
+        eta_text = ("—" if eta is None else "n/a" if eta == 0 and name not in unobs
+                    else _sci(eta))
+        t.add_row(name + (" ·" if name in unobs else ""), unit,
+                  f"{s['sigma0'][name] * k:.{d}f}", f"{s['sigma_final'][name] * k:.{d}f}",
+                  _ratio(s["covariance_degree_final"][name]), eta_text,
+                  "—" if sep is None else f"{sep:.1e}")
+        if name in ("phiU", "dvU", "ebz", "dbz", "muz", "thz"):
+            t.add_section()
+    w = s["weakest"]
+    parts = sorted(((v, n) for n, v in w["vector"].items() if abs(v) >= 0.05),
+                   key=lambda p: -abs(p[0]))
+    combo = " ".join(f"{v:+.2f} {n}" for v, n in parts)
+    conditions = sum(seg["condition"] for seg in s["segments"])
+    notes = [
+        f"whole run: SOM rank {last['rank']} (margin {margin(last.get('rank_margin'))}), "
+        f"TOM rank {s['tom_rank_final']} of {len(s['states'])}; the null-space condition "
+        f"of seed eq. 12 holds in {conditions} of {len(s['segments'])} windows",
+        ("· unobservable (zero TOM column: in no measurement and no path to one): "
+         + ", ".join(s["unobservable"])) if unobs else "no state with a zero TOM column",
+        f"weakest combination, in units of the scaled states (σ_min/σ_max of the others "
+        f"{w['ratio']:.1e}): {combo}",
+        "σ0/σ: the filter's own covariance reduction (PSINS kfstat; 1 = nothing learnt). "
+        "η: SVD degree σ_(k)/σ_0 of the whole run's SOM (seed eq. 17, σ_0 of the measured "
+        "φ or δv; n/a: no singular vector has its largest part on the state, though its "
+        "column is not zero). sep.: distance of the state's TOM column from the span of the others "
+        "(0: a combination of them; unchanged by P0 and units). θ, ω (flexure, a "
+        "noise-driven Markov process): σ only.",
+        f"Per window and cumulative: --json, the results file, gcalign plot. Compute "
+        f"{s['compute_s']:.2f} s; output {s.get('output') or '—'}",
+    ]
+    t.caption = "\n".join(notes)
+    t.caption_justify = "left"
+    return t
+
+
+def figures(f, name: str) -> dict:
+    """The cumulative degree η per window (heat map, windows × 15 states), the covariance
+    degree σ0/σ likewise (all states), and σ/σ0 against time per state group."""
+    from gcalign.app.observability.plots import heat_map
+    from gcalign.app.plots import _s, finish, new_figure
+
+    g = f["observability"]
+    states = _s(g.attrs["states"]).split(",")
+    cov_states = _s(g.attrs["covariance_states"]).split(",")
+    wins = [_s(n) for n in g["segment_name"][()]]
+    how = f"{_s(g.attrs['measure'])} matching, scaling {_s(g.attrs['scaling'])}"
+    figs = {
+        "observability_cumulative": heat_map(
+            g["eta_cum"][()], [f"to {w}" for w in wins], states,
+            f"{name}: cumulative degree η from the start (transfer alignment, {how}; grey ·: "
+            "0, unobservable)", "log10 η", "·"),
+        "covariance_degree": heat_map(
+            g["cov_degree"][()], [f"after {w}" for w in wins], cov_states,
+            f"{name}: covariance degree σ(0)/σ(t) at the end of each window ({how})",
+            "log10 σ(0)/σ(t)", exponents=False),
+    }
+    t, sig, sig0 = g["t"][()], g["sigma"][()], g["sigma0"][()]
+    groups = [gr for gr in ("phi", "dv", "eb", "db", "mu", "th", "w")
+              if any(group_of(n) == gr for n in cov_states)]
+    label = {"phi": "φ", "dv": "δv", "eb": "ε", "db": "∇", "mu": "μ", "th": "θ", "w": "ω"}
+    fig, axes = new_figure(len(groups), width=9.0, height=1.6 * len(groups) + 1.2)
+    colours = ("tab:blue", "tab:orange", "tab:green")
+    for ax, gr in zip(axes, groups, strict=True):
+        idx = [i for i, n in enumerate(cov_states) if group_of(n) == gr]
+        ratio = sig[:, idx] / sig0[idx]
+        for c, i, y in zip(colours, idx, ratio.T, strict=True):
+            ax.plot(t, y, color=c, linewidth=1.0, label=cov_states[i])
+        if ratio.max() > 10 * ratio.min():  # decades: log; within one, linear reads better
+            ax.set_yscale("log")
+        ax.axhline(1.0, color="0.5", linewidth=0.8, linestyle=":", label="_P0")
+    figs["sigma_reduction"] = finish(
+        fig, axes, "time from the start of the run (s)",
+        f"{name}: the filter's σ / σ0 ({how}); 1 = nothing learnt",
+        [f"{label[gr]} σ/σ0" for gr in groups])
+    return figs
