@@ -219,3 +219,16 @@ def test_error_kernel_is_numpy_to_the_bit(block, data, block_truth, reverse):
     short = np.delete(kept, 10)
     missing = int(np.flatnonzero(idx == kept[10])[0])
     assert AK.attitude_errors(q, idx, short, block_truth[short], out) == missing
+
+
+@pytest.mark.parametrize("n", [1, 2, 9, 14501])
+def test_column_spread_is_numpy_to_the_bit(n):
+    """The spread of a pass's errors (mean, std ddof 0, max |·| per column) as NumPy's
+    reductions give it: rows summed in order, the variance from the deviations."""
+    rng = np.random.default_rng(n)
+    e = 1e-3 * rng.standard_normal((n, 3)) + rng.standard_normal(3)
+    mean, std, peak = AK.column_spread(e)
+    assert np.array_equal(mean, e.mean(0)) and np.array_equal(std, e.std(0))
+    assert np.array_equal(peak, np.abs(e).max(0))
+    e[n // 2, 1] = np.nan
+    assert np.isnan(AK.column_spread(e)[2][1]) and np.isnan(np.abs(e).max(0)[1])

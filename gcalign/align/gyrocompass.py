@@ -366,8 +366,9 @@ class Alignment:
         err = self.pass_error_rows(len(self.passes) - 1, slice(h, None))
         if err is None:
             return None
-        return Spread(err.mean(0), err.std(0), np.abs(err).max(0),
-                      float(min(r.t[h], r.t[-1])), float(max(r.t[h], r.t[-1])), len(err))
+        mean, std, peak = K.column_spread(err)
+        return Spread(mean, std, peak, float(min(r.t[h], r.t[-1])), float(max(r.t[h], r.t[-1])),
+                      len(err))
 
 
 def _phi(att_est: Array, att_true: Array) -> Array:
@@ -389,7 +390,8 @@ def _array(name: str, value: ArrayLike, shape: tuple[int, ...]) -> Array:
                                                                      strict=True)):
         want = "(" + ", ".join("N" if s == -1 else str(s) for s in shape) + ")"
         raise InputError(name, f"must have shape {want}, got {a.shape}")
-    if not np.isfinite(a).all():
+    # NaN and ±inf show in the extremes: two reductions, no temporary of the array's size
+    if a.size and not (math.isfinite(a.min()) and math.isfinite(a.max())):
         raise InputError(name, "must be finite (NaN or infinity found)")
     return a
 

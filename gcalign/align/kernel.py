@@ -202,6 +202,29 @@ def attitude_errors(q: np.ndarray, samples: np.ndarray, truth_samples: np.ndarra
     return m
 
 
+@njit(cache=True)
+def column_spread(e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean, standard deviation (ddof 0) and max |·| of the columns of `e` (n, 3), as
+    ``e.mean(0)``, ``e.std(0)``, ``np.abs(e).max(0)`` give them, to the bit: NumPy reduces
+    the rows of an (n, 3) array in order, and its variance is the mean of the squared
+    deviations from the mean. One pass for the sums and maxima, one for the deviations,
+    and no temporary array."""
+    n = e.shape[0]
+    total, peak, dev = np.zeros(3), np.zeros(3), np.zeros(3)
+    for i in range(n):
+        for c in range(3):
+            total[c] += e[i, c]
+            a = abs(e[i, c])
+            if a > peak[c] or a != a:  # a NaN stays, as in NumPy
+                peak[c] = a
+    mean = total / n
+    for i in range(n):
+        for c in range(3):
+            d = e[i, c] - mean[c]
+            dev[c] += d * d
+    return mean, np.sqrt(dev / n), peak
+
+
 def stored_rows(lo: int, hi: int, stride: int) -> int:
     """Rows :func:`gyrocompass_range` writes over samples lo … hi: both ends and the
     multiples of `stride` between them."""
