@@ -29,7 +29,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Literal
 
 import numpy as np
@@ -222,14 +222,24 @@ def truth_samples(settings: AlignSettings, ts: float, samples: int,
     """The record samples (increasing) at which :func:`align` reads the truth for a record
     of `samples` increments at interval `ts` and the passes' `stride`: every sample the
     passes keep, T1, T2 and T3 (with a 'measured' T3, every sample from T2 to the end of the
-    data it may take)."""
+    data it may take). Read-only; the same array for the same arguments (a batch's runs of
+    a variant, the caller that collects the truth and align() itself)."""
+    return _truth_samples(settings, float(ts), int(samples), int(stride))
+
+
+@lru_cache(maxsize=16)
+def _truth_samples(settings: AlignSettings, ts: float, samples: int,
+                   stride: int) -> NDArray[np.int64]:
     tl = timeline(settings, ts, samples)
     end = tl.i3 if settings.realtime_conventional and tl.i3 is not None else tl.i2
     kept = tl.i1 + kept_samples(end - tl.i1, settings.mode, settings.pass_count,
                                 settings.level_phase_s, ts, stride)
     if tl.i3 is None:  # every sample T3 may fall on
-        return np.union1d(kept, np.arange(tl.i2, tl.hi + 1)).astype(np.int64)
-    return with_samples(kept, [tl.i1, tl.i2, tl.i3])
+        k = np.union1d(kept, np.arange(tl.i2, tl.hi + 1)).astype(np.int64)
+    else:
+        k = with_samples(kept, [tl.i1, tl.i2, tl.i3])
+    k.flags.writeable = False
+    return k
 
 
 @dataclass(frozen=True)
@@ -457,11 +467,15 @@ def _truth(truth_att: ArrayLike | TruthRows | None, settings: AlignSettings, ts:
     if truth_att is None:
         return None
     if isinstance(truth_att, TruthRows):
+        need = truth_samples(settings, ts, tl_samples, stride)
+        if truth_att.samples is need and isinstance(truth_att.att, np.ndarray) \
+                and truth_att.att.shape == (len(need), 3) and truth_att.att.dtype == float:
+            _array("truth_att", truth_att.att, (len(need), 3))  # finite
+            return truth_att  # the rows of truth_samples itself (a collecting caller's)
         k = np.asarray(truth_att.samples)
         if k.ndim != 1 or k.dtype.kind not in "iu" or np.any(np.diff(k) <= 0):
             raise InputError("truth_att", "samples must be increasing whole sample numbers")
         rows = TruthRows(k.astype(np.int64), _array("truth_att", truth_att.att, (len(k), 3)))
-        need = truth_samples(settings, ts, tl_samples, stride)
         if np.array_equal(rows.samples, need):
             return rows
         return TruthRows(need, rows.at(need))  # InputError for a row it lacks
