@@ -291,10 +291,14 @@ def test_truth_at_its_samples_alone_gives_the_whole_truth_result(t3, stride):
     assert len(k) < (len(dth) + 1) / stride + 20 if stride > 1 else k[-1] == len(dth)
     part = align(dth, dv, ts, [LAT, 0.0, 0.0], s, truth_att=TruthRows(k, truth[k]),
                  stride=stride)
-    for name in ("coarse_att", "att_t2", "att_t3", "truth_t2", "error_t2"):
+    for name in ("coarse_att", "att_t2", "truth_t2", "error_t2"):
         assert np.array_equal(getattr(whole, name), getattr(part, name)), name
-    if t3 != "measured":  # the measured latency is the wall time of the passes
+    if t3 != "measured":  # a measured T3 is T2 plus the wall time of the passes
+        assert np.array_equal(whole.att_t3, part.att_t3)
         assert np.array_equal(whole.error_t3, part.error_t3)
+    else:  # wherever it falls, its truth is held
+        assert part.truth_t3 is not None and np.array_equal(part.truth_t3, truth[
+            round(part.t3 / ts)])
     for a, b, ea, eb, ta, tb in zip(whole.passes, part.passes, whole.pass_errors,
                                     part.pass_errors, whole.pass_truth, part.pass_truth,
                                     strict=True):
