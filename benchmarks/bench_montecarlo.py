@@ -5,8 +5,9 @@ One run of a batch, exactly as a pool worker executes it (``warm_up`` as the wor
 initializer does, then ``run_task``: the scenario, the sensor errors on the shared
 noise-free simulation, coarse alignment, the 5 passes over [10, 300] s, the T2 → T3
 compensation, the summary and the metrics), timed in CPU (user + system) per run over
-consecutive seeds after a warm-up; and, right after each run, the floor: the passes alone
-on the same block (``run_passes``, no truth). Target: ≤ 25 ms CPU a run.
+consecutive seeds after a warm-up, one run after another as in a worker; then the floor of
+each: the passes alone on the same block (``run_passes``, its data prepared beforehand).
+Target: ≤ 25 ms CPU a run.
 
 ``--before DIR`` runs the same seeds in a second process on the checkout DIR (e.g. a
 ``git worktree`` of main), seed by seed in turn with this one (before, after, before, …),
@@ -86,25 +87,31 @@ class Runs:
                                   settings.level_phase_s, stream.earth)
 
     def run(self, k: int) -> dict:
-        """Seed k's run, then its floor: CPU ms of each, system ms and page faults of the run."""
-        task = self.tasks[k]
-        floor = self.passes_of(task)
+        """Seed k's run: CPU ms, system ms, page faults, its error at T3."""
         u0, s0, f0 = usage()
-        rec = self.B.run_task(task)
+        rec = self.B.run_task(self.tasks[k])
         u1, s1, f1 = usage()
-        floor()
-        u2, s2, _ = usage()
         assert rec["status"] == "ok", rec
         return {"run": (u1 - u0 + s1 - s0) * 1e3, "sys": (s1 - s0) * 1e3, "faults": f1 - f0,
-                "floor": (u2 - u1 + s2 - s1) * 1e3, "error_t3": rec["metrics"]["error_t3_deg"]}
+                "error_t3": rec["metrics"]["error_t3_deg"]}
+
+    def floor(self, k: int) -> dict:
+        """Seed k's passes alone (its block prepared beforehand): CPU ms."""
+        if not hasattr(self, "floors"):
+            self.floors = [self.passes_of(t) for t in self.tasks]
+        u0, s0, _ = usage()
+        self.floors[k]()
+        u1, s1, _ = usage()
+        return {"floor": (u1 - u0 + s1 - s0) * 1e3}
 
 
 def serve(seeds: int) -> None:
-    """Child mode: read seed indices on stdin, answer one JSON line each."""
+    """Child mode: read "run K" or "floor K" on stdin, answer one JSON line each."""
     runs = Runs(seeds)
     print("ready", flush=True)
     for line in sys.stdin:
-        print(json.dumps(runs.run(int(line))), flush=True)
+        what, k = line.split()
+        print(json.dumps(runs.run(int(k)) if what == "run" else runs.floor(int(k))), flush=True)
 
 
 class Child:
@@ -115,9 +122,9 @@ class Child:
                                   env=env, cwd=tree)
         assert self.p.stdout is not None and self.p.stdout.readline().strip() == "ready"
 
-    def run(self, k: int) -> dict:
+    def ask(self, what: str, k: int) -> dict:
         assert self.p.stdin is not None and self.p.stdout is not None
-        self.p.stdin.write(f"{k}\n")
+        self.p.stdin.write(f"{what} {k}\n")
         self.p.stdin.flush()
         return json.loads(self.p.stdout.readline())
 
@@ -139,10 +146,15 @@ def main() -> None:
     sides = {"after": Child(HERE.parents[1], args.seeds)}
     if args.before is not None:
         sides = {"before": Child(args.before.resolve(), args.seeds), **sides}
+    # the runs one after another, as a worker runs them (nothing else allocating between),
+    # then the floors; each seed on both sides in turn
     res: dict[str, list[dict]] = {k: [] for k in sides}
     for k in range(1, args.seeds + 1):
         for name, child in sides.items():
-            res[name].append(child.run(k))
+            res[name].append(child.ask("run", k))
+    for k in range(1, args.seeds + 1):
+        for name, child in sides.items():
+            res[name][k - 1].update(child.ask("floor", k))
     for child in sides.values():
         child.close()
     if "before" in res:  # the same seeds: the same numbers (the change keeps the results)

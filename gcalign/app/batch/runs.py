@@ -146,42 +146,10 @@ def kernel_cache_stats() -> dict:
             "missed": sorted(set(missed))}
 
 
-#: glibc's mallopt parameters (malloc.h) and the values a batch worker sets.
-M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
-TRIM_THRESHOLD_B, MMAP_THRESHOLD_B = 512 << 20, 32 << 20
-
-
-def keep_freed_memory() -> bool:
-    """Have the C library's malloc keep the memory a run frees, for the next run of this
-    process to reuse (a batch worker runs the same sizes again and again).
-
-    By default glibc hands back to the kernel any free heap beyond twice the largest block
-    freed so far, and maps blocks above that afresh: every run of a §5.3 Monte Carlo then
-    faults its arrays of about 1 MB in again (about 2000 page faults, a sixth of the run's
-    CPU as system time). Here free heap is kept up to :data:`TRIM_THRESHOLD_B` and only
-    blocks above :data:`MMAP_THRESHOLD_B` are mapped. glibc only (``mallopt``); elsewhere
-    nothing changes. Returns whether both settings took."""
-    if not sys.platform.startswith("linux"):
-        return False
-    import ctypes
-
-    try:
-        mallopt = ctypes.CDLL(None).mallopt  # the C library this process runs on
-    except (OSError, AttributeError):  # not glibc (musl has none)
-        return False
-    mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
-    return (mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD_B) == 1
-            and mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD_B) == 1)
-
-
 def warm_up(command: str = "align") -> dict:
-    """Prepare a process for runs: the memory a run frees is kept for the next
-    (:func:`keep_freed_memory`), and the numba kernels the command runs are loaded (from
-    the on-disk JIT cache) with a tiny run of its room's ``warm_up()``, if it has one;
-    once per process."""
+    """Load the numba kernels a command runs (from the on-disk JIT cache) with a tiny run of
+    its room's ``warm_up()``, if it has one; once per process."""
     from gcalign.app.registry import COMMANDS
-
-    keep_freed_memory()
 
     if command in COMMANDS:
         try:
