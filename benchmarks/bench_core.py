@@ -144,7 +144,7 @@ def gyrocompass_on_seed_data() -> tuple[float, int]:
 
     import yaml
 
-    from gcalign.align.gyrocompass import align, timeline
+    from gcalign.align.gyrocompass import align, timeline, truth_samples
     from gcalign.app.align.run import AlignConfig, collect, settings_of
     from gcalign.cli.common import builtin_text
 
@@ -153,12 +153,13 @@ def gyrocompass_on_seed_data() -> tuple[float, int]:
     stream = scenario_stream(sc)
     settings = settings_of(cfg, "moving")
     tl = timeline(settings, stream.ts, stream.samples)
-    data = collect(stream, tl, cfg.aiding)
+    data = collect(stream, tl, cfg.aiding, keep=truth_samples(settings, stream.ts,
+                                                              stream.samples))
 
     def run():
         return align(data.dtheta, data.dv, stream.ts, stream.site, settings,
                      earth=stream.earth, position_t1=data.pos_t1, vref=data.vref,
-                     vref_body=cfg.aiding.body, truth_att=data.truth_att, t0=stream.t0,
+                     vref_body=cfg.aiding.body, truth_att=data.truth, t0=stream.t0,
                      first_sample=tl.lo, samples=stream.samples).compute_s
 
     run()  # warm-up

@@ -1,94 +1,182 @@
 """CPU per run of the seed 000 §5.3 Monte Carlo inside ``gcalign batch``, against the
-passes-only floor.
+passes-only floor; optionally against another checkout, interleaved.
 
-One run of a batch, exactly as a pool worker executes it (``run_task``: the scenario, the
-sensor errors on the shared noise-free simulation, coarse alignment, the 5 passes over
-[10, 300] s, the T2 → T3 compensation, the summary and the metrics), timed in CPU (user +
-system) per run over consecutive seeds after a warm-up; and, interleaved with it, the
-floor: the passes alone on the same block (``run_passes``). Target: ≤ 25 ms CPU a run.
+One run of a batch, exactly as a pool worker executes it (``warm_up`` as the worker's
+initializer does, then ``run_task``: the scenario, the sensor errors on the shared
+noise-free simulation, coarse alignment, the 5 passes over [10, 300] s, the T2 → T3
+compensation, the summary and the metrics), timed in CPU (user + system) per run over
+consecutive seeds after a warm-up, one run after another as in a worker; then the floor of
+each: the passes alone on the same block (``run_passes``, its data prepared beforehand).
+Target: ≤ 25 ms CPU a run.
 
-Run: ``python benchmarks/bench_montecarlo.py [--seeds 40]``
+``--before DIR`` runs the same seeds in a second process on the checkout DIR (e.g. a
+``git worktree`` of main), seed by seed in turn with this one (before, after, before, …),
+so that both see the same load; each side times its own runs.
+
+Run: ``python benchmarks/bench_montecarlo.py [--seeds 40] [--before DIR]``
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import resource
 import statistics
+import subprocess
 import sys
 import tempfile
 from importlib import resources
 from pathlib import Path
 
-import numpy as np
-
 SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 TARGET_RUN_MS = 25.0
+HERE = Path(__file__).resolve()
 
 
-def cpu() -> float:
+def usage() -> tuple[float, float, int]:
     r = resource.getrusage(resource.RUSAGE_SELF)
-    return r.ru_utime + r.ru_stime
+    return r.ru_utime, r.ru_stime, r.ru_minflt
 
 
-def main() -> None:
-    from gcalign.align import kernel as AK
-    from gcalign.align.cycles import Block, run_passes
-    from gcalign.align.gyrocompass import timeline
-    from gcalign.app import batch as B
-    from gcalign.app.align.run import AlignConfig, collect, settings_of
-    from gcalign.app.data import scenario_data, stream_of
-    from gcalign.nav.rotation import euler_to_quat
+class Runs:
+    """The sweep's tasks in this process, and a run of one seed with its floor."""
 
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=3 if SMOKE else 40)
-    seeds = ap.parse_args().seeds
-    base = resources.files("gcalign.scenarios").joinpath("seed000_moving_full_cycle.yaml")
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "mc.yaml"
-        path.write_text(f"name: mc\nbase: {Path(str(base)).resolve()}\nseeds: {seeds + 1}\n"
-                        "metrics: [error_t3_deg, error_t2_deg]\n", encoding="utf-8")
-        sweep = B.load_sweep(path)
-    tasks = B._tasks(sweep, sweep.run_keys())
+    def __init__(self, seeds: int):
+        from gcalign.app import batch as B
 
-    def passes_of(task: dict):
+        self.B = B
+        base = resources.files("gcalign.scenarios").joinpath("seed000_moving_full_cycle.yaml")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "mc.yaml"
+            path.write_text(f"name: mc\nbase: {Path(str(base)).resolve()}\nseeds: {seeds + 1}\n"
+                            "metrics: [error_t3_deg, error_t2_deg]\n", encoding="utf-8")
+            sweep = B.load_sweep(path)
+        self.tasks = B._tasks(sweep, sweep.run_keys())
+        B.runs.warm_up("align")  # what a worker's initializer does
+        rec = B.run_task(self.tasks[0])  # warm-up: JIT cache, imports, the simulation
+        assert rec["status"] == "ok", rec
+
+    def passes_of(self, task: dict):
         """The floor of a run: its passes on its block (the block prepared beforehand)."""
-        sc = B.runs._scenario(task)
+        import numpy as np
+
+        from gcalign.align import kernel as AK
+        from gcalign.align.cycles import Block, run_passes
+        from gcalign.align.gyrocompass import timeline
+        from gcalign.app.align.run import AlignConfig, collect, settings_of
+        from gcalign.app.data import scenario_data, stream_of
+        from gcalign.nav.rotation import euler_to_quat
+
+        sc = self.B.runs._scenario(task)
         cfg = sc.align or AlignConfig()
-        stream = stream_of(scenario_data(sc, task["seed"], B.runs.noise_free_key(sc)))
+        stream = stream_of(scenario_data(sc, task["seed"], self.B.runs.noise_free_key(sc)))
         settings = settings_of(cfg, sc.motion.kind if sc.motion else None)
         tl = timeline(settings, stream.ts, stream.samples)
         w = collect(stream, tl, cfg.aiding)
         i, j = tl.i1 - tl.lo, tl.i2 - tl.lo
-        block = Block(t=np.arange(tl.i1, tl.i2 + 1) * stream.ts, dtheta=w.dtheta[i:j],
-                      dv=w.dv[i:j], vref=w.vref[i:j + 1], vref_body=False, ts=stream.ts)
-        state0 = AK.new_state(euler_to_quat(w.truth_att[i]), w.vref[i], w.pos_t1)
+        rows = (w.dtheta[i:j], w.dv[i:j], w.vref[i:j + 1], False, stream.ts)
+        if "first" in Block.__dataclass_fields__:  # no array of times
+            block = Block(tl.i1, 0.0, *rows)
+        else:  # a checkout whose blocks carry their times
+            block = Block(np.arange(tl.i1, tl.i2 + 1) * stream.ts, *rows)
+        truth = w.truth.att if hasattr(w, "truth") else w.truth_att
+        state0 = AK.new_state(euler_to_quat(truth[i]), w.vref[i], w.pos_t1)
         return lambda: run_passes(state0, block, settings.mode, settings.pass_count,
                                   list(settings.stages), settings.azimuth_poles,
                                   settings.level_phase_s, stream.earth)
 
-    rec = B.run_task(tasks[0])  # warm-up: JIT cache, imports, the noise-free simulation
-    assert rec["status"] == "ok", rec
-    floor_fns = [passes_of(t) for t in tasks[1:]]
-    runs_ms, floor_ms = [], []
-    for task, floor in zip(tasks[1:], floor_fns, strict=True):
-        c0 = cpu()
-        rec = B.run_task(task)
-        c1 = cpu()
-        floor()
-        c2 = cpu()
+    def run(self, k: int) -> dict:
+        """Seed k's run: CPU ms, system ms, page faults, its error at T3."""
+        u0, s0, f0 = usage()
+        rec = self.B.run_task(self.tasks[k])
+        u1, s1, f1 = usage()
         assert rec["status"] == "ok", rec
-        runs_ms.append((c1 - c0) * 1e3)
-        floor_ms.append((c2 - c1) * 1e3)
-    run, flo = statistics.median(runs_ms), statistics.median(floor_ms)
-    print(f"§5.3 Monte Carlo run inside gcalign batch, {len(runs_ms)} seeds, CPU per run "
+        return {"run": (u1 - u0 + s1 - s0) * 1e3, "sys": (s1 - s0) * 1e3, "faults": f1 - f0,
+                "error_t3": rec["metrics"]["error_t3_deg"]}
+
+    def floor(self, k: int) -> dict:
+        """Seed k's passes alone (its block prepared beforehand): CPU ms."""
+        if not hasattr(self, "floors"):
+            self.floors = [self.passes_of(t) for t in self.tasks]
+        u0, s0, _ = usage()
+        self.floors[k]()
+        u1, s1, _ = usage()
+        return {"floor": (u1 - u0 + s1 - s0) * 1e3}
+
+
+def serve(seeds: int) -> None:
+    """Child mode: read "run K" or "floor K" on stdin, answer one JSON line each."""
+    runs = Runs(seeds)
+    print("ready", flush=True)
+    for line in sys.stdin:
+        what, k = line.split()
+        print(json.dumps(runs.run(int(k)) if what == "run" else runs.floor(int(k))), flush=True)
+
+
+class Child:
+    def __init__(self, tree: Path, seeds: int):
+        env = dict(os.environ, PYTHONPATH=str(tree))
+        self.p = subprocess.Popen([sys.executable, str(HERE), "--serve", "--seeds", str(seeds)],
+                                  stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                                  env=env, cwd=tree)
+        assert self.p.stdout is not None and self.p.stdout.readline().strip() == "ready"
+
+    def ask(self, what: str, k: int) -> dict:
+        assert self.p.stdin is not None and self.p.stdout is not None
+        self.p.stdin.write(f"{what} {k}\n")
+        self.p.stdin.flush()
+        return json.loads(self.p.stdout.readline())
+
+    def close(self) -> None:
+        assert self.p.stdin is not None
+        self.p.stdin.close()
+        self.p.wait()
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=3 if SMOKE else 40)
+    ap.add_argument("--before", type=Path, help="another checkout, run interleaved")
+    ap.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.serve:
+        serve(args.seeds)
+        return
+    sides = {"after": Child(HERE.parents[1], args.seeds)}
+    if args.before is not None:
+        sides = {"before": Child(args.before.resolve(), args.seeds), **sides}
+    # the runs one after another, as a worker runs them (nothing else allocating between),
+    # then the floors; each seed on both sides in turn
+    res: dict[str, list[dict]] = {k: [] for k in sides}
+    for k in range(1, args.seeds + 1):
+        for name, child in sides.items():
+            res[name].append(child.ask("run", k))
+    for k in range(1, args.seeds + 1):
+        for name, child in sides.items():
+            res[name][k - 1].update(child.ask("floor", k))
+    for child in sides.values():
+        child.close()
+    if "before" in res:  # the same seeds: the same numbers (the change keeps the results)
+        same = all(a["error_t3"] == b["error_t3"]
+                   for a, b in zip(res["before"], res["after"], strict=True))
+    print(f"§5.3 Monte Carlo run inside gcalign batch, {args.seeds} seeds, CPU per run "
           f"(medians; load {os.getloadavg()[0]:.1f}, {os.cpu_count()} CPUs, python "
           f"{sys.version.split()[0]}):")
-    print(f"  one run (run_task)   {run:7.1f} ms   target ≤ {TARGET_RUN_MS:g} ms  "
-          f"{'OK' if run <= TARGET_RUN_MS else 'MISSED'}")
-    print(f"  the passes alone     {flo:7.1f} ms   (the floor)")
-    print(f"  run / floor          {run / flo:7.2f}")
+
+    def med(name: str, key: str) -> float:
+        return statistics.median(r[key] for r in res[name])
+
+    width = max(len(n) for n in res)
+    for name in res:
+        run, flo = med(name, "run"), med(name, "floor")
+        print(f"  {name:<{width}}  one run {run:6.1f} ms (system {med(name, 'sys'):4.1f} ms, "
+              f"{med(name, 'faults'):5.0f} page faults)   passes alone {flo:5.1f} ms   "
+              f"run / passes {run / flo:4.2f}")
+    run = med("after", "run")
+    print(f"  target: one run ≤ {TARGET_RUN_MS:g} ms: {'OK' if run <= TARGET_RUN_MS else 'MISSED'}"
+          + ("" if "before" not in res else
+             f"; error at T3 the same in every run: {'yes' if same else 'NO'}"))
 
 
 if __name__ == "__main__":

@@ -287,3 +287,44 @@ def run_stored(state, block, lo: int, hi: int, reverse: bool, gains, mode,
     if not idx:  # an empty range: the state as it is
         return np.array([hi if reverse else lo]), state[0:4][None].copy()
     return np.concatenate(idx), np.concatenate(qs)
+
+
+def run_passes(state0, block, mode: str, passes: int, stages, azimuth_poles: str,
+               level_s: float, earth=WGS84, stride: int = 1):
+    """The passes as they were: each range through :func:`run_stored`, the level phase and
+    the compass part of the first pass concatenated, the times picked from an array of the
+    block's sample times."""
+    from gcalign.align import kernel as K
+    from gcalign.align.cycles import PassRecord, loop_gains, pass_plan
+    from gcalign.align.stages import stage_of_passes
+
+    state = state0.copy()
+    n = len(block.dtheta)
+    stage_idx = stage_of_passes(stages, passes)
+    lat, h = state[K.POS][0], state[K.POS][2]
+    gains_by_stage = [loop_gains(st, lat, h, azimuth_poles, earth) for st in stages]
+    records = []
+    direction_prev = "forward"
+    t_all = block.t
+    for i, (direction, kind) in enumerate(pass_plan(mode, passes)):
+        reverse = direction == "reverse"
+        if direction != direction_prev:
+            state[K.FLIP] *= -1.0
+        direction_prev = direction
+        gains = gains_by_stage[stage_idx[i]]
+        if kind == "attitude":
+            idx, q = run_stored(state, block, 0, n, reverse, gains, K.ATTITUDE, stride, earth)
+        elif i == 0 and level_s > 0:
+            n_level = min(int(round(level_s / block.ts)), n)
+            i_a, q_a = run_stored(state, block, 0, n_level, False, gains, K.LEVEL, stride, earth)
+            i_b, q_b = run_stored(state, block, n_level, n, False, gains, K.COMPASS, stride,
+                                  earth)
+            idx, q = np.concatenate([i_a, i_b[1:]]), np.concatenate([q_a, q_b[1:]])
+        else:
+            idx, q = run_stored(state, block, 0, n, reverse, gains, K.COMPASS, stride, earth)
+        records.append(PassRecord(i, direction, kind, stage_idx[i], gains, t_all[idx], q,
+                                  block.first + idx))
+    if direction_prev == "reverse":
+        state[K.FLIP] *= -1.0
+    return state, records
+

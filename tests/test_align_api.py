@@ -15,7 +15,7 @@ import yaml
 import gcalign
 from gcalign import units as u
 from gcalign.align.gains import azimuth_gains
-from gcalign.align.gyrocompass import AlignSettings, align, timeline
+from gcalign.align.gyrocompass import AlignSettings, TruthRows, align, timeline, truth_samples
 from gcalign.align.stages import Stage
 from gcalign.errors import InputError, ScenarioError
 from gcalign.nav import earth
@@ -273,3 +273,41 @@ def test_the_cores_refusals_name_the_scenario_field(tmp_path, overrides, message
         gcalign.run("align", sc, output=tmp_path / "x.h5")
     assert str(err.value).startswith(message) and err.value.exit_code == 2
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("t3, stride", [(80.0, 7), ("measured", 1)])
+def test_truth_at_its_samples_alone_gives_the_whole_truth_result(t3, stride):
+    """A long run need hold the truth only where the alignment reads it
+    (truth_samples: at 7-sample output, about 1/7 of the samples): the truth given at
+    those rows alone gives the result of the truth at every sample, to the bit, errors
+    along the passes included; a row short is refused, naming truth_att."""
+    dth, dv, ts = static_imu(np.radians([0.5, 0.2, 40.0]), 120.0)
+    rng = np.random.default_rng(2)
+    truth = np.radians([0.5, 0.2, 40.0]) + 1e-5 * rng.standard_normal((len(dth) + 1, 3))
+    s = AlignSettings(mode="full-cycle", t1_s=10.0, t2_s=60.0, t3_s=t3, level_s=10.0,
+                      coarse="given", stages=(Stage(20.0, 100.0, 0.707),))
+    whole = align(dth, dv, ts, [LAT, 0.0, 0.0], s, truth_att=truth, stride=stride)
+    k = truth_samples(s, ts, len(dth), stride)
+    assert len(k) < (len(dth) + 1) / stride + 20 if stride > 1 else k[-1] == len(dth)
+    part = align(dth, dv, ts, [LAT, 0.0, 0.0], s, truth_att=TruthRows(k, truth[k]),
+                 stride=stride)
+    for name in ("coarse_att", "att_t2", "truth_t2", "error_t2"):
+        assert np.array_equal(getattr(whole, name), getattr(part, name)), name
+    if t3 != "measured":  # a measured T3 is T2 plus the wall time of the passes
+        assert np.array_equal(whole.att_t3, part.att_t3)
+        assert np.array_equal(whole.error_t3, part.error_t3)
+    else:  # wherever it falls, its truth is held
+        assert part.truth_t3 is not None and np.array_equal(part.truth_t3, truth[
+            round(part.t3 / ts)])
+    for a, b, ea, eb, ta, tb in zip(whole.passes, part.passes, whole.pass_errors,
+                                    part.pass_errors, whole.pass_truth, part.pass_truth,
+                                    strict=True):
+        assert np.array_equal(a.q_nb, b.q_nb) and np.array_equal(ea, eb)
+        assert np.array_equal(ta, tb) and np.array_equal(ta, truth[a.samples])
+    spread_w, spread_p = whole.last_pass_spread(), part.last_pass_spread()
+    assert spread_w is not None and spread_p is not None
+    assert np.array_equal(spread_w.std, spread_p.std)
+    with pytest.raises(InputError, match="^truth_att: has no row at sample"):
+        short = np.delete(k, len(k) // 2)
+        align(dth, dv, ts, [LAT, 0.0, 0.0], s, truth_att=TruthRows(short, truth[short]),
+              stride=stride)

@@ -41,7 +41,8 @@ def test_compensation_reaches_the_true_attitude(kind, method, body):
     v_n = truth.v_n
     vref = np.einsum("kji,kj->ki", euler_to_dcm(truth.att), v_n) if body else v_n
     after = Block(
-        t=truth.t[i2 : i3 + 1],
+        first=i2,
+        t0=0.0,
         dtheta=imu.dtheta[i2:i3],
         dv=imu.dv[i2:i3],
         vref=vref[i2 : i3 + 1],
@@ -57,7 +58,8 @@ def test_compensation_reaches_the_true_attitude(kind, method, body):
 def test_none_reports_the_t2_attitude():
     truth, imu = ideal_imu(MOTIONS["swing"], SITE, 0.01)
     after = Block(
-        t=truth.t[100:201],
+        first=100,
+        t0=0.0,
         dtheta=imu.dtheta[100:200],
         dv=imu.dv[100:200],
         vref=np.zeros((101, 3)),

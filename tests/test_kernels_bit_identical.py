@@ -11,6 +11,8 @@ test_attitude_kernel.py.)
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import kernels_prev as prev
 import numpy as np
 import pytest
@@ -21,7 +23,7 @@ from gcalign.align.cycles import Block, loop_gains
 from gcalign.align.stages import Stage
 from gcalign.nav import _kernels as K
 from gcalign.nav.earth import WGS84
-from gcalign.nav.rotation import euler_to_quat
+from gcalign.nav.rotation import attitude_error, euler_to_quat, quat_to_euler
 from gcalign.sim.imu import ideal_imu
 from gcalign.sim.motions import Moving, Segment
 from gcalign.units import DEG
@@ -109,11 +111,11 @@ def block(data):
     odometer variant gets the body-frame forward speed."""
     dtheta, dv, _, _ = data
     rng = np.random.default_rng(3)
-    t = np.arange(N + 1) * TS
+    t = np.arange(N + 1) * TS  # the block starts at record sample 0, time 0
     vref = np.zeros((N + 1, 3))
     vref[:, 1] = np.clip(t - 5.0, 0.0, 10.0)
     vref += 0.01 * rng.standard_normal((N + 1, 3))
-    return {body: Block(t, dtheta, dv, vref, body, TS) for body in (False, True)}
+    return {body: Block(0, 0.0, dtheta, dv, vref, body, TS) for body in (False, True)}
 
 
 @pytest.mark.parametrize("mode", [AK.ATTITUDE, AK.LEVEL, AK.COMPASS])
@@ -160,16 +162,73 @@ def test_kernel_calls_of_a_long_pass_are_the_previous_to_the_bit(block, data, re
     assert np.array_equal(s_new, s_old)
 
 
+@pytest.fixture(scope="module")
+def block_truth(data):
+    """A true attitude at every sample of the block (the simulation's, with a yaw near
+    ±180° in places so that the wrap of the errors is taken both ways)."""
+    rng = np.random.default_rng(5)
+    att = np.zeros((N + 1, 3))
+    att[:, 0] = 0.5 * DEG + 1e-4 * rng.standard_normal(N + 1)
+    att[:, 1] = -0.3 * DEG + 1e-4 * rng.standard_normal(N + 1)
+    att[:, 2] = np.where(np.arange(N + 1) % 3 == 0, 179.9, 30.0) * DEG
+    return att
+
+
 @pytest.mark.parametrize("mode", ["full-cycle", "half-cycle", "conventional"])
-def test_passes_are_the_previous_to_the_bit(block, data, mode, monkeypatch):
-    """The whole sequence of passes (level phase, direction changes, stages)."""
+@pytest.mark.parametrize("chunk", [cycles.CHUNK, 1000])
+@pytest.mark.parametrize("stride", [1, 10])
+def test_passes_are_the_previous_to_the_bit(block, data, mode, chunk, stride, monkeypatch):
+    """The whole sequence of passes (level phase, direction changes, stages, several kernel
+    calls a pass), each pass's rows written once into arrays of their size: the same
+    times, samples, attitude and final state as the passes as they were; and the samples
+    they keep are those kept_samples names (where the truth must be held)."""
+    monkeypatch.setattr(cycles, "CHUNK", chunk)
+    monkeypatch.setattr(prev, "CHUNK", chunk)
     stages = [Stage(20.0, 100.0, 0.707, 3), Stage(10.0, 50.0, 0.707)]
     s0 = AK.new_state(data[2][K.Q], [0.0, 0.0, 0.0], data[2][K.P])
-    new = cycles.run_passes(s0, block[False], mode, 5, stages, "double-oscillator", 6.0,
-                            stride=10)
-    monkeypatch.setattr(cycles, "run_stored", prev.run_stored)
-    old = cycles.run_passes(s0, block[False], mode, 5, stages, "double-oscillator", 6.0,
-                            stride=10)
+    passes = 1 if mode == "conventional" else 5
+    b = replace(block[False], first=40)  # block sample k is record sample 40 + k
+    new = cycles.run_passes(s0, b, mode, passes, stages, "double-oscillator", 6.0,
+                            stride=stride)
+    old = prev.run_passes(s0, b, mode, passes, stages, "double-oscillator", 6.0,
+                          stride=stride)
     assert np.array_equal(new[0], old[0])
-    for a, b in zip(new[1], old[1], strict=True):
-        assert np.array_equal(a.t, b.t) and np.array_equal(a.q_nb, b.q_nb)
+    for a, o in zip(new[1], old[1], strict=True):
+        assert np.array_equal(a.t, o.t) and np.array_equal(a.q_nb, o.q_nb)
+        assert np.array_equal(a.samples, o.samples)
+    kept = cycles.kept_samples(N, mode, passes, 6.0, TS, stride)
+    stored = np.unique(np.concatenate([r.samples for r in new[1]])) - 40
+    assert np.array_equal(stored, kept) and 600 in kept
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_error_kernel_is_numpy_to_the_bit(block, data, block_truth, reverse):
+    """The error kernel on a pass's stored rows (forward or reverse order, from the truth
+    at the kept samples only) gives what NumPy gives from the truth gathered at every row:
+    rotation.attitude_error(rotation.quat_to_euler(q), truth), to the bit, with the roll
+    and yaw wrap taken both ways (yaw near ±180°)."""
+    s0 = AK.new_state(data[2][K.Q], [0.3, 0.5, 0.0], data[2][K.P])
+    gains = loop_gains(Stage(20.0, 100.0, 0.707), SITE[0], SITE[2], "double-oscillator")
+    idx, q = cycles.run_stored(s0, block[True], 0, N, reverse, gains, AK.COMPASS, 3)
+    kept = np.unique(idx)
+    out = np.full((len(idx), 3), np.nan)
+    assert AK.attitude_errors(q, idx, kept, block_truth[kept], out) == len(idx)
+    expected = attitude_error(quat_to_euler(q), block_truth[idx])
+    assert np.array_equal(out, expected)
+    assert (np.abs(out[:, 2]) > np.radians(100)).any()  # the wrapped rows are there
+    short = np.delete(kept, 10)
+    missing = int(np.flatnonzero(idx == kept[10])[0])
+    assert AK.attitude_errors(q, idx, short, block_truth[short], out) == missing
+
+
+@pytest.mark.parametrize("n", [1, 2, 9, 14501])
+def test_column_spread_is_numpy_to_the_bit(n):
+    """The spread of a pass's errors (mean, std ddof 0, max |·| per column) as NumPy's
+    reductions give it: rows summed in order, the variance from the deviations."""
+    rng = np.random.default_rng(n)
+    e = 1e-3 * rng.standard_normal((n, 3)) + rng.standard_normal(3)
+    mean, std, peak = AK.column_spread(e)
+    assert np.array_equal(mean, e.mean(0)) and np.array_equal(std, e.std(0))
+    assert np.array_equal(peak, np.abs(e).max(0))
+    e[n // 2, 1] = np.nan
+    assert np.isnan(AK.column_spread(e)[2][1]) and np.isnan(np.abs(e).max(0)[1])

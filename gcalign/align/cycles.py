@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from gcalign.align import kernel as K
 from gcalign.align.gains import azimuth_gains, level_gains
@@ -27,23 +28,39 @@ MODES = ("conventional", "full-cycle", "half-cycle")
 class Block:
     """The data a sequence of passes runs on, in forward time order (SI).
 
-    t : (N+1,) sample times, t[0] the start of the block.
-    dtheta, dv : (N, 3) increments; vref : (N+1, 3) reference velocity at the sample times,
-    in ENU or, if `vref_body`, the body frame (odometer).
+    first : the record sample of the block's start (block sample k is record sample
+        first + k, at record time ``t0 + (first + k)·ts``: no array of times is held).
+    dtheta, dv : (N, 3) increments; vref : (N+1, 3) reference velocity at the samples, in
+    ENU or, if `vref_body`, the body frame (odometer).
     """
 
-    t: np.ndarray
+    first: int
+    t0: float
     dtheta: np.ndarray
     dv: np.ndarray
     vref: np.ndarray
     vref_body: bool
     ts: float
 
+    def times(self, idx: np.ndarray) -> np.ndarray:
+        """Record times of block samples `idx`: the float of the record sample times ts
+        plus t0, in that order (the values of ``np.arange(a, b + 1.0) * ts + t0``)."""
+        t = (self.first + np.asarray(idx, np.int64)).astype(float)
+        t *= self.ts
+        t += self.t0
+        return t
+
+    @property
+    def t(self) -> np.ndarray:
+        """(N+1,) record times of the block's samples."""
+        return self.times(np.arange(len(self.dtheta) + 1))
+
 
 @dataclass(frozen=True)
 class PassRecord:
     """One pass: its direction, kind ("compass" or "attitude"), stage, gains, and the
-    attitude after every step (processing order; a reverse pass's `t` decreases)."""
+    attitude at the samples it kept (processing order; a reverse pass's `t` decreases):
+    record times `t`, q_nb, and the record samples there."""
 
     index: int
     direction: str
@@ -52,6 +69,7 @@ class PassRecord:
     gains: np.ndarray
     t: np.ndarray
     q_nb: np.ndarray
+    samples: np.ndarray
 
 
 def pass_plan(mode: str, passes: int) -> list[tuple[str, str]]:
@@ -108,28 +126,84 @@ def _range(state: np.ndarray, block: Block, lo: int, hi: int, reverse: bool,
 CHUNK = 1 << 16
 
 
+def calls(lo: int, hi: int, reverse: bool) -> list[tuple[int, int]]:
+    """The kernel calls (c_lo, c_hi) of a range, in processing order: :data:`CHUNK` steps
+    each from the range's start (its end for a reverse pass); one call for an empty range."""
+    if hi <= lo:
+        return [(lo, lo)]
+    if reverse:
+        return [(max(a - CHUNK, lo), a) for a in range(hi, lo, -CHUNK)]
+    return [(a, min(a + CHUNK, hi)) for a in range(lo, hi, CHUNK)]
+
+
 def run_stored(state: np.ndarray, block: Block, lo: int, hi: int, reverse: bool,
                gains: np.ndarray, mode: int, stride: int,
                earth: EarthModel = WGS84) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`run_block` in calls of :data:`CHUNK` steps, keeping only the attitude at the
-    block samples that are multiples of `stride` from the block's start, at both ends of
-    the range and at the end of each call (only those rows are written).
+    """:func:`run_block` in :func:`calls`, keeping only the attitude at the block samples
+    that are multiples of `stride` from the block's start, at both ends of the range and at
+    the end of each call (only those rows are written, each once, into arrays of their
+    size: a call's first row is the previous call's last).
 
     Returns (block sample indices in processing order, q_nb there (m, 4)).
     """
-    idx: list[np.ndarray] = []
-    qs: list[np.ndarray] = []
-    order = range(hi, lo, -CHUNK) if reverse else range(lo, hi, CHUNK)
-    for a in order if hi > lo else [lo]:
-        c_lo, c_hi = (max(a - CHUNK, lo), a) if reverse else (a, min(a + CHUNK, hi))
-        m = K.stored_rows(c_lo, c_hi, stride)
-        i, q = np.empty(m, np.int64), np.empty((m, 4))
-        rows = _range(state, block, c_lo, c_hi, reverse, gains, mode, stride, i, q, earth)
-        assert rows == m
-        start = 1 if idx else 0  # a call's first row is the previous call's last
-        idx.append(i[start:])
-        qs.append(q[start:])
-    return np.concatenate(idx), np.concatenate(qs)
+    return _run_segments(state, block, [(lo, hi, mode)], reverse, gains, stride, earth)
+
+
+def _run_segments(state: np.ndarray, block: Block, segments: list[tuple[int, int, int]],
+                  reverse: bool, gains: np.ndarray, stride: int,
+                  earth: EarthModel) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`run_stored` over consecutive ranges (lo, hi, mode) of one pass, in
+    processing order, into one set of rows (each range starts where the last ended)."""
+    parts = [(a, b, mode) for lo, hi, mode in segments for a, b in calls(lo, hi, reverse)]
+    sizes = [K.stored_rows(a, b, stride) for a, b, _ in parts]
+    m = sum(sizes) - (len(parts) - 1)
+    idx, q = np.empty(m, np.int64), np.empty((m, 4))
+    row = 0
+    for (a, b, mode), size in zip(parts, sizes, strict=True):
+        rows = _range(state, block, a, b, reverse, gains, mode, stride, idx[row:row + size],
+                      q[row:row + size], earth)
+        assert rows == size
+        row += size - 1
+    return idx, q
+
+
+def pass_segments(i: int, kind: str, n: int, level_n: int | None) -> list[tuple[int, int, int]]:
+    """The ranges (lo, hi, kernel mode) of pass `i` over a block of `n` increments: the
+    first pass starts with `level_n` samples of level-only loops (None: no level phase)."""
+    if kind == "attitude":
+        return [(0, n, K.ATTITUDE)]
+    if i == 0 and level_n is not None:
+        return [(0, level_n, K.LEVEL), (level_n, n, K.COMPASS)]
+    return [(0, n, K.COMPASS)]
+
+
+def level_samples(level_s: float, ts: float, n: int) -> int | None:
+    """Samples of the level-only phase at the start of the first pass (at most the block);
+    None for none."""
+    return min(int(round(level_s / ts)), n) if level_s > 0 else None
+
+
+def kept_samples(n: int, mode: str, passes: int, level_s: float, ts: float,
+                 stride: int) -> np.ndarray:
+    """Every block sample (of a block of `n` increments) at which :func:`run_passes` keeps
+    the attitude, increasing: the multiples of `stride` and the ends of every kernel call
+    (the ends of the block and of the level phase among them)."""
+    level_n = level_samples(level_s, ts, n)
+    ends = []
+    for i, (direction, kind) in enumerate(pass_plan(mode, passes)):
+        for lo, hi, _ in pass_segments(i, kind, n, level_n):
+            for a, b in calls(lo, hi, direction == "reverse"):
+                ends += [a, b]
+    return with_samples(np.arange(0, n + 1, stride, dtype=np.int64), ends)
+
+
+def with_samples(a: np.ndarray, extra: ArrayLike) -> np.ndarray:
+    """The increasing sample numbers `a` with the few samples `extra` merged in (each once;
+    what ``np.union1d`` gives, without sorting or hashing the long array)."""
+    extra = np.unique(np.asarray(extra, np.int64))
+    pos = np.searchsorted(a, extra)
+    present = a[np.minimum(pos, len(a) - 1)] == extra if len(a) else np.zeros(len(extra), bool)
+    return np.insert(a, pos[~present], extra[~present])
 
 
 def run_passes(
@@ -155,6 +229,7 @@ def run_passes(
     stage_idx = stage_of_passes(stages, passes)
     lat, h = state[K.POS][0], state[K.POS][2]
     gains_by_stage = [loop_gains(st, lat, h, azimuth_poles, earth) for st in stages]
+    level_n = level_samples(level_s, block.ts, n)
     records = []
     direction_prev = "forward"
     for i, (direction, kind) in enumerate(pass_plan(mode, passes)):
@@ -163,18 +238,10 @@ def run_passes(
             state[K.FLIP] *= -1.0
         direction_prev = direction
         gains = gains_by_stage[stage_idx[i]]
-        if kind == "attitude":
-            idx, q = run_stored(state, block, 0, n, reverse, gains, K.ATTITUDE, stride, earth)
-        elif i == 0 and level_s > 0:
-            n_level = min(int(round(level_s / block.ts)), n)
-            i_a, q_a = run_stored(state, block, 0, n_level, False, gains, K.LEVEL, stride, earth)
-            i_b, q_b = run_stored(state, block, n_level, n, False, gains, K.COMPASS, stride,
-                                  earth)
-            idx, q = np.concatenate([i_a, i_b[1:]]), np.concatenate([q_a, q_b[1:]])
-        else:
-            idx, q = run_stored(state, block, 0, n, reverse, gains, K.COMPASS, stride, earth)
-        t = block.t[idx]
-        records.append(PassRecord(i, direction, kind, stage_idx[i], gains, t, q))
+        segments = pass_segments(i, kind, n, level_n)
+        idx, q = _run_segments(state, block, segments, reverse, gains, stride, earth)
+        records.append(PassRecord(i, direction, kind, stage_idx[i], gains, block.times(idx),
+                                  q, block.first + idx))
     if direction_prev == "reverse":
         state[K.FLIP] *= -1.0
     return state, records

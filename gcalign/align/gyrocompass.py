@@ -29,7 +29,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Literal
 
 import numpy as np
@@ -38,7 +38,14 @@ from numpy.typing import ArrayLike, NDArray
 from gcalign.align import coarse as coarse_mod
 from gcalign.align import kernel as K
 from gcalign.align.compensate import METHODS, compensate
-from gcalign.align.cycles import MODES, Block, PassRecord, run_passes
+from gcalign.align.cycles import (
+    MODES,
+    Block,
+    PassRecord,
+    kept_samples,
+    run_passes,
+    with_samples,
+)
 from gcalign.align.gains import AZIMUTH_METHODS
 from gcalign.align.stages import Stage
 from gcalign.errors import InputError
@@ -53,8 +60,8 @@ from gcalign.nav.rotation import (
     quat_to_euler,
 )
 
-__all__ = ["AlignSettings", "Alignment", "Spread", "Timeline", "align",
-           "timeline"]
+__all__ = ["AlignSettings", "Alignment", "Spread", "Timeline", "TruthRows", "align",
+           "timeline", "truth_samples"]
 
 Array = NDArray[np.float64]
 
@@ -187,6 +194,55 @@ def timeline(settings: AlignSettings, ts: float, samples: int) -> Timeline:
 
 
 @dataclass(frozen=True)
+class TruthRows:
+    """The true attitude (rad, ``[pitch, roll, yaw]``) at some samples of a record:
+    `samples` (M,) increasing record sample indices, `att` (M, 3) there.
+
+    All that :func:`align` reads of the truth is its rows at :func:`truth_samples`, so a
+    caller with a long run keeps those only (at 1 Hz output, 1 % of the samples).
+    """
+
+    samples: NDArray[np.int64]
+    att: Array
+
+    def at(self, samples: ArrayLike) -> Array:
+        """The rows at record `samples`; InputError naming truth_att for one it lacks."""
+        want = np.asarray(samples, np.int64)
+        i = np.minimum(np.searchsorted(self.samples, want), len(self.samples) - 1)
+        missing = self.samples[i] != want if len(self.samples) else np.ones(want.shape, bool)
+        if np.any(missing):
+            k = int(np.atleast_1d(want)[np.argmax(np.atleast_1d(missing))])
+            raise InputError("truth_att", f"has no row at sample {k}; give the rows at "
+                             "truth_samples(settings, ts, samples, stride)")
+        return self.att[i]
+
+
+def truth_samples(settings: AlignSettings, ts: float, samples: int,
+                  stride: int = 1) -> NDArray[np.int64]:
+    """The record samples (increasing) at which :func:`align` reads the truth for a record
+    of `samples` increments at interval `ts` and the passes' `stride`: every sample the
+    passes keep, T1, T2 and T3 (with a 'measured' T3, every sample from T2 to the end of the
+    data it may take). Read-only; the same array for the same arguments (a batch's runs of
+    a variant, the caller that collects the truth and align() itself)."""
+    return _truth_samples(settings, float(ts), int(samples), int(stride))
+
+
+@lru_cache(maxsize=16)
+def _truth_samples(settings: AlignSettings, ts: float, samples: int,
+                   stride: int) -> NDArray[np.int64]:
+    tl = timeline(settings, ts, samples)
+    end = tl.i3 if settings.realtime_conventional and tl.i3 is not None else tl.i2
+    kept = tl.i1 + kept_samples(end - tl.i1, settings.mode, settings.pass_count,
+                                settings.level_phase_s, ts, stride)
+    if tl.i3 is None:  # every sample T3 may fall on
+        k = np.union1d(kept, np.arange(tl.i2, tl.hi + 1)).astype(np.int64)
+    else:
+        k = with_samples(kept, [tl.i1, tl.i2, tl.i3])
+    k.flags.writeable = False
+    return k
+
+
+@dataclass(frozen=True)
 class Spread:
     """The error over the second half of the last pass: mean, std (ddof 0), max |·| per
     angle (rad), over `rows` stored rows between record times `t_from` and `t_to` (s)."""
@@ -206,9 +262,11 @@ class Alignment:
     t1, t2, t3 : alignment times of T1, T2, T3 actually used (whole samples), s.
     t3_source : ``configured`` or ``measured``.
     coarse_att : (3,) attitude at T1 the passes start from, rad.
-    passes : one :class:`gcalign.align.cycles.PassRecord` per pass (record times `t`,
-        attitude `q_nb` every `stride` samples and at both ends, in processing order).
-    pass_truth : the true attitude (n, 3) at each pass's stored rows, or None.
+    passes : one :class:`gcalign.align.cycles.PassRecord` per pass (record times and
+        samples, attitude `q_nb` every `stride` samples and at both ends, in processing
+        order).
+    truth : the true attitude at the samples the alignment read it (:class:`TruthRows`),
+        or None.
     att_t2, att_t3 : (3,) attitude at T2 and T3; truth_t2, truth_t3 : the truth there.
     compute_s : wall time of the passes, s. equivalent_s : data length the passes
         amount to (coarse window + passes × fine block), s.
@@ -223,7 +281,7 @@ class Alignment:
     t3_source: str
     coarse_att: Array
     passes: list[PassRecord]
-    pass_truth: list[Array] | None
+    truth: TruthRows | None
     att_t2: Array
     att_t3: Array
     truth_t2: Array | None
@@ -256,18 +314,40 @@ class Alignment:
         return None if self.truth_t3 is None else _phi(self.att_t3, self.truth_t3)
 
     @cached_property
+    def pass_truth(self) -> list[Array] | None:
+        """The true attitude (n, 3) at each pass's stored rows, or None."""
+        if self.truth is None:
+            return None
+        return [self.truth.at(r.samples) for r in self.passes]
+
+    @cached_property
     def pass_att(self) -> list[Array]:
         """Euler angles (n, 3) rad along each pass (its stored rows)."""
         return [quat_to_euler(r.q_nb) for r in self.passes]
 
+    def pass_error_rows(self, i: int, rows: slice = slice(None)) -> Array | None:
+        """Euler-angle error (rad; est − true, roll and yaw wrapped) at `rows` of pass i's
+        stored rows, or None without truth: computed by the error kernel on those rows
+        alone, each against the truth at its sample (a batch's summary needs the second
+        half of the last pass and the end of each, not the 5 × 29001 rows of a §5.3 run)."""
+        if self.truth is None:
+            return None
+        done = self.__dict__.get("pass_errors")
+        if done is not None:
+            return done[i][rows]
+        r = self.passes[i]
+        q, k = r.q_nb[rows], r.samples[rows]
+        out = np.empty((len(k), 3))
+        found = K.attitude_errors(q, k, self.truth.samples, self.truth.att, out)
+        if found < len(k):
+            self.truth.at(k[found])  # raises, naming the sample
+        return out
+
     @cached_property
     def pass_errors(self) -> list[Array | None]:
-        """Euler-angle error (n, 3) rad along each pass; computed when first asked for
-        (a batch needs only the end of each pass)."""
-        if self.pass_truth is None:
-            return [None] * len(self.passes)
-        return [attitude_error(a, tr) for a, tr in zip(self.pass_att, self.pass_truth,
-                                                         strict=True)]
+        """Euler-angle error (n, 3) rad along each pass (est − true, roll and yaw wrapped);
+        computed when first asked for."""
+        return [self.pass_error_rows(i) for i in range(len(self.passes))]
 
     @cached_property
     def pass_phi(self) -> list[Array | None]:
@@ -279,9 +359,8 @@ class Alignment:
 
     def pass_end_error(self, i: int) -> Array | None:
         """Euler-angle error at the end of pass i (rad)."""
-        if self.pass_truth is None:
-            return None
-        return attitude_error(quat_to_euler(self.passes[i].q_nb[-1]), self.pass_truth[i][-1])
+        err = self.pass_error_rows(i, slice(-1, None))
+        return None if err is None else err[0].copy()
 
     @property
     def pass_end_errors(self) -> list[Array | None]:
@@ -292,13 +371,14 @@ class Alignment:
         """The error's spread over the second half of the last pass (where a pass has
         settled; the first half of a conventional run's only pass holds the coarse
         transient); None without truth."""
-        if self.pass_truth is None:
-            return None
-        r, tr = self.passes[-1], self.pass_truth[-1]
+        r = self.passes[-1]
         h = len(r.t) // 2
-        err = attitude_error(quat_to_euler(r.q_nb[h:]), tr[h:])
-        return Spread(err.mean(0), err.std(0), np.abs(err).max(0),
-                      float(min(r.t[h], r.t[-1])), float(max(r.t[h], r.t[-1])), len(err))
+        err = self.pass_error_rows(len(self.passes) - 1, slice(h, None))
+        if err is None:
+            return None
+        mean, std, peak = K.column_spread(err)
+        return Spread(mean, std, peak, float(min(r.t[h], r.t[-1])), float(max(r.t[h], r.t[-1])),
+                      len(err))
 
 
 def _phi(att_est: Array, att_true: Array) -> Array:
@@ -320,7 +400,8 @@ def _array(name: str, value: ArrayLike, shape: tuple[int, ...]) -> Array:
                                                                      strict=True)):
         want = "(" + ", ".join("N" if s == -1 else str(s) for s in shape) + ")"
         raise InputError(name, f"must have shape {want}, got {a.shape}")
-    if not np.isfinite(a).all():
+    # NaN and ±inf show in the extremes: two reductions, no temporary of the array's size
+    if a.size and not (math.isfinite(a.min()) and math.isfinite(a.max())):
         raise InputError(name, "must be finite (NaN or infinity found)")
     return a
 
@@ -366,9 +447,9 @@ def _window(settings: AlignSettings, ts: float, n: int, first: int,
     return tl
 
 
-def _given(settings: AlignSettings, att_t1: ArrayLike | None, truth: Array | None,
-           k1: int) -> Array | None:
-    """The attitude at T1 of coarse method 'given' (`att_t1`, else the truth's row k1)."""
+def _given(settings: AlignSettings, att_t1: ArrayLike | None, truth: TruthRows | None,
+           i1: int) -> Array | None:
+    """The attitude at T1 of coarse method 'given' (`att_t1`, else the truth at sample i1)."""
     if settings.coarse != "given":
         return None
     if att_t1 is not None:
@@ -376,7 +457,31 @@ def _given(settings: AlignSettings, att_t1: ArrayLike | None, truth: Array | Non
     if truth is None:
         raise InputError("coarse", "'given' needs att_t1 or truth_att; use 'analytic' or "
                          "'inertial' for recorded data")
-    return truth[k1]
+    return truth.at(i1)
+
+
+def _truth(truth_att: ArrayLike | TruthRows | None, settings: AlignSettings, ts: float,
+           tl_samples: int, stride: int, lo: int, n: int) -> TruthRows | None:
+    """The truth as :class:`TruthRows`: given so, checked; an (N+1, 3) array of every
+    sample of the arrays, its rows at :func:`truth_samples` (all the alignment reads)."""
+    if truth_att is None:
+        return None
+    if isinstance(truth_att, TruthRows):
+        need = truth_samples(settings, ts, tl_samples, stride)
+        if truth_att.samples is need and isinstance(truth_att.att, np.ndarray) \
+                and truth_att.att.shape == (len(need), 3) and truth_att.att.dtype == float:
+            _array("truth_att", truth_att.att, (len(need), 3))  # finite
+            return truth_att  # the rows of truth_samples itself (a collecting caller's)
+        k = np.asarray(truth_att.samples)
+        if k.ndim != 1 or k.dtype.kind not in "iu" or np.any(np.diff(k) <= 0):
+            raise InputError("truth_att", "samples must be increasing whole sample numbers")
+        rows = TruthRows(k.astype(np.int64), _array("truth_att", truth_att.att, (len(k), 3)))
+        if np.array_equal(rows.samples, need):
+            return rows
+        return TruthRows(need, rows.at(need))  # InputError for a row it lacks
+    full = _array("truth_att", truth_att, (n + 1, 3))
+    k = truth_samples(settings, ts, tl_samples, stride)
+    return TruthRows(k, full[k - lo])
 
 
 def _passes(settings: AlignSettings, state0: Array, tl: Timeline,
@@ -411,7 +516,7 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
           settings: AlignSettings = AlignSettings(), *, earth: EarthModel = WGS84,
           att_t1: ArrayLike | None = None, position_t1: ArrayLike | None = None,
           vref: ArrayLike | None = None, vref_body: bool = False,
-          truth_att: ArrayLike | None = None, t0: float = 0.0, stride: int = 1,
+          truth_att: ArrayLike | TruthRows | None = None, t0: float = 0.0, stride: int = 1,
           first_sample: int = 0, samples: int | None = None) -> Alignment:
     """Coarse alignment, the passes of the mode and the T2 → T3 compensation (seed 000).
 
@@ -427,7 +532,8 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
     position_t1 : (3,) position at T1 (default `site`); the loops carry it along `vref`.
     vref, vref_body : (N+1, 3) reference velocity at the samples (m/s; ENU, or body frame
         if `vref_body`: an odometer); default zero (a static or swinging base).
-    truth_att : (N+1, 3) true attitude at the samples (rad), for the errors.
+    truth_att : the true attitude (rad), for the errors: (N+1, 3) at the samples, or a
+        :class:`TruthRows` with (at least) the rows at :func:`truth_samples`.
     t0 : record time of sample 0, s (the pass records' `t` are record times).
     stride : the passes keep their attitude every `stride` samples (and at their ends).
     first_sample, samples : where the arrays sit in a longer record of `samples`
@@ -448,11 +554,12 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
     dvb = _array("dv", dv, (n, 3))
     pos0 = _site(site)
     ref = np.zeros((n + 1, 3)) if vref is None else _array("vref", vref, (n + 1, 3))
-    truth = None if truth_att is None else _array("truth_att", truth_att, (n + 1, 3))
     lo = first_sample
     tl = _window(settings, ts, n, lo, samples)
+    truth = _truth(truth_att, settings, ts, lo + n if samples is None else samples, int(stride),
+                   lo, n)
     i0, i1, i2 = tl.i0, tl.i1, tl.i2
-    given = _given(settings, att_t1, truth, i1 - lo)
+    given = _given(settings, att_t1, truth, i1)
     pos1 = pos0.copy() if position_t1 is None else _array("position_t1", position_t1, (3,))
     att1 = _coarse_attitude(settings, dth[i0 - lo:i1 - lo], dvb[i0 - lo:i1 - lo], ts, pos0,
                             earth, given)
@@ -460,13 +567,10 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
     v1 = quat_to_dcm(q1) @ ref[i1 - lo] if vref_body else ref[i1 - lo]
 
     def block(a: int, b: int) -> Block:
-        """Increments a .. b-1 and the reference at samples a .. b, as the passes take them."""
+        """Increments a .. b-1 and the reference at samples a .. b, as the passes take them
+        (block sample k is record sample a + k)."""
         i, j = a - lo, b - lo
-        t = np.arange(a, b + 1, dtype=float)  # t0 + k·ts in place: one array of the window
-        t *= ts
-        t += t0
-        return Block(t=t, dtheta=dth[i:j], dv=dvb[i:j], vref=ref[i:j + 1],
-                     vref_body=vref_body, ts=ts)
+        return Block(a, t0, dth[i:j], dvb[i:j], ref[i:j + 1], vref_body, ts)
 
     records, q2, q3, i3, compute = _passes(settings, K.new_state(q1, v1, pos1), tl, block,
                                            t0, ts, earth, stride)
@@ -474,9 +578,6 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
         equivalent = (i3 - i0) * ts
     else:
         equivalent = (i1 - i0) * ts + settings.pass_count * (i2 - i1) * ts
-    pass_truth = None
-    if truth is not None:
-        pass_truth = [truth[np.rint((r.t - t0) / ts).astype(int) - lo] for r in records]
     return Alignment(
         settings=settings,
         t1=(i1 - i0) * ts,  # the sample times actually used
@@ -485,11 +586,11 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
         t3_source="measured" if settings.t3_s == "measured" else "configured",
         coarse_att=att1,
         passes=records,
-        pass_truth=pass_truth,
+        truth=truth,
         att_t2=quat_to_euler(q2),
         att_t3=quat_to_euler(q3),
-        truth_t2=None if truth is None else truth[i2 - lo],
-        truth_t3=None if truth is None else truth[i3 - lo],
+        truth_t2=None if truth is None else truth.at(i2),
+        truth_t3=None if truth is None else truth.at(i3),
         compute_s=compute,
         equivalent_s=equivalent,
         index_offset=i0,

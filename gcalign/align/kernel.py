@@ -32,10 +32,12 @@ from numba import njit
 from gcalign.nav._kernels import (
     attitude_update,
     earth_at,
+    euler_of,
     position_update,
     qrot,
     specific_force_increment,
     transport_rate,
+    wrap_pi,
 )
 
 ATTITUDE, LEVEL, COMPASS = 0, 1, 2
@@ -52,7 +54,7 @@ FLIP = slice(4, 9)
 GAINS_SIZE = 10
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def gyrocompass_range(state: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, vref: np.ndarray,
                       vref_body: bool, ts: float, lo: int, hi: int, reverse: bool,
                       data_sign: float, earth_sign: float, E: np.ndarray, gains: np.ndarray,
@@ -69,6 +71,8 @@ def gyrocompass_range(state: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, vre
     Kept: the first and the last sample of the range and every sample that is a multiple of
     `stride` (block indices), in processing order, into `idx_out` (their block indices) and
     `q_out` (q_nb), both preallocated for :func:`stored_rows` rows.
+    (error_model "numpy": a division by zero would give inf instead of raising; none of
+    the step's divisors can be zero, and the test before each division is gone.)
     """
     ke1, ke2, ke3 = gains[0], gains[1], gains[2]
     kn1, kn2, kn3 = gains[3], gains[4], gains[5]
@@ -172,6 +176,53 @@ def gyrocompass_range(state: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, vre
     state[4], state[5], state[6], state[7], state[8] = ve, vn, ie, inn, wcu
     state[9], state[10], state[11] = lat, lon, h
     return row
+
+
+@njit(cache=True)
+def attitude_errors(q: np.ndarray, samples: np.ndarray, truth_samples: np.ndarray,
+                    truth_att: np.ndarray, out: np.ndarray) -> int:
+    """Euler-angle errors of the attitudes `q` (m, 4) kept at record `samples` (m,) against
+    the true attitude `truth_att` (M, 3) given at the increasing record samples
+    `truth_samples` (M,), into `out` (m, 3): est − true with roll and yaw wrapped to
+    [−π, π), as ``rotation.attitude_error(rotation.quat_to_euler(q), truth)`` computes
+    them, to the bit (the same operations in the same order, and libm's asin and atan2).
+
+    Each row's truth is found by bisection (no gathered copy of the truth). Returns m, or
+    the index of the first row whose sample has no truth row (the rows before it written).
+    """
+    m, big = samples.shape[0], truth_samples.shape[0]
+    for i in range(m):
+        k = np.searchsorted(truth_samples, samples[i])
+        if k >= big or truth_samples[k] != samples[i]:
+            return i
+        pitch, roll, yaw = euler_of(q[i, 0], q[i, 1], q[i, 2], q[i, 3])
+        out[i, 0] = pitch - truth_att[k, 0]
+        out[i, 1] = wrap_pi(roll - truth_att[k, 1])
+        out[i, 2] = wrap_pi(yaw - truth_att[k, 2])
+    return m
+
+
+@njit(cache=True)
+def column_spread(e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean, standard deviation (ddof 0) and max |·| of the columns of `e` (n, 3), as
+    ``e.mean(0)``, ``e.std(0)``, ``np.abs(e).max(0)`` give them, to the bit: NumPy reduces
+    the rows of an (n, 3) array in order, and its variance is the mean of the squared
+    deviations from the mean. One pass for the sums and maxima, one for the deviations,
+    and no temporary array."""
+    n = e.shape[0]
+    total, peak, dev = np.zeros(3), np.zeros(3), np.zeros(3)
+    for i in range(n):
+        for c in range(3):
+            total[c] += e[i, c]
+            a = abs(e[i, c])
+            if a > peak[c] or a != a:  # a NaN stays, as in NumPy
+                peak[c] = a
+    mean = total / n
+    for i in range(n):
+        for c in range(3):
+            d = e[i, c] - mean[c]
+            dev[c] += d * d
+    return mean, np.sqrt(dev / n), peak
 
 
 def stored_rows(lo: int, hi: int, stride: int) -> int:

@@ -109,7 +109,8 @@ def check_finite_block(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray) -> Non
     from gcalign.io.imu_files import MAX_DTHETA_RAD, MAX_DV_MPS
 
     for name, a, bound in (("gyro", dtheta, MAX_DTHETA_RAD), ("accel", dv, MAX_DV_MPS)):
-        if np.abs(a).max(initial=0.0) <= bound:  # NaN propagates: False
+        # NaN propagates into the extremes: False (and no temporary of the block's size)
+        if a.max(initial=0.0) <= bound and -a.min(initial=0.0) <= bound:
             continue
         ok = (np.abs(a) <= bound).all(1)  # False for NaN too
         if not ok.all():

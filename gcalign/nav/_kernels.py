@@ -408,6 +408,14 @@ def wrapped(d: float) -> float:
     return d
 
 
+@njit(cache=True, inline="always")
+def wrap_pi(d: float) -> float:
+    """`d` wrapped to [−π, π) by the formula of rotation.wrap_pi, ``(d + π) mod 2π − π``,
+    to the bit (the sum with π rounds: unlike :func:`wrapped`, which leaves d in
+    [−π, π) untouched)."""
+    return (d + math.pi) % (2.0 * math.pi) - math.pi
+
+
 @njit(cache=True)
 def error_block(states: np.ndarray, q_bs: np.ndarray, has_qbs: bool, att_t: np.ndarray,
                 q_t: np.ndarray, v_t: np.ndarray, pos_t: np.ndarray, has_truth: bool,

@@ -77,7 +77,9 @@ class _Channel:
         if self.asym is not None:
             out += self.asym * np.abs(ideal)
         if self.rng is not None:
-            out += self.rng.standard_normal(ideal.shape) * self.sigma
+            noise = self.rng.standard_normal(ideal.shape)
+            noise *= self.sigma  # in place: one block-sized temporary fewer
+            out += noise
         if err.quantum > 0:
             # Quantise the running sum, then difference it (the remainder is kept).
             run = np.cumsum(np.concatenate([self.running[None], out]), axis=0)[1:]

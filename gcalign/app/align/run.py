@@ -18,8 +18,10 @@ from gcalign.align.gyrocompass import (
     Alignment,
     AlignSettings,
     Timeline,
+    TruthRows,
     align,
     timeline,
+    truth_samples,
 )
 from gcalign.app.data import RunData, Stream, scenario_data, scenario_stream, stream_of
 from gcalign.app.registry import Outcome
@@ -53,13 +55,13 @@ def settings_of(cfg: AlignConfig, motion_kind: str | None) -> AlignSettings:
 @dataclass(frozen=True)
 class Window:
     """Samples lo .. hi of a run as the core takes them (SI): increments lo .. hi-1, the
-    reference velocity and the true attitude at samples lo .. hi (truth None for recorded
-    data), the true position at T1 (the site without truth)."""
+    reference velocity at samples lo .. hi, the true attitude at the samples kept (None for
+    recorded data without a reference), the true position at T1 (the site without truth)."""
 
     dtheta: np.ndarray
     dv: np.ndarray
     vref: np.ndarray
-    truth_att: np.ndarray | None
+    truth: TruthRows | None
     pos_t1: np.ndarray
 
 
@@ -86,18 +88,22 @@ def _reference(aiding: Aiding, att, v_n, rng: np.random.Generator, body: bool,
 
 
 def collect(stream: Stream, tl: Timeline, aiding: Aiding,
-            progress: Progress | None = None, reference=None) -> Window:
+            progress: Progress | None = None, reference=None,
+            keep: np.ndarray | None = None) -> Window:
     """One pass over the stream for the samples tl.lo .. tl.hi; the rest of the run is
     never held (nor, simulated, generated). `progress(done_s, total_s, what)` hears of
     every block (the simulation, if it is one, is most of an alignment's time). A
     `reference` (:class:`gcalign.io.recorded.Reference`, recorded data) stands for the
-    truth attitude, for the errors only."""
+    truth attitude, for the errors only. The truth is kept at the record samples `keep`
+    (increasing, within lo .. hi: :func:`gcalign.align.gyrocompass.truth_samples`, all that
+    the alignment reads), by default at every sample lo .. hi."""
     source = aiding.source  # simulated aiding on recorded data is refused by Align.check
     has_truth = stream.truth0 is not None
     body = source == "odometer"
     rng = np.random.default_rng([0 if stream.seed is None else stream.seed, 1])
     lo, hi, i1 = tl.lo, tl.hi, tl.i1
     m = hi - lo
+    samples = np.arange(lo, hi + 1) if keep is None else np.asarray(keep, np.int64)
     dtheta, dv = np.empty((m, 3)), np.empty((m, 3))
     vref = np.zeros((m + 1, 3))
     if source == "file":  # the file's velocity at the samples lo .. hi
@@ -106,10 +112,10 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
         t_samples = stream.t0 + np.arange(lo, hi + 1) * stream.ts
         vref, _ = velocity_at(aiding.read(), t_samples, "align.aiding")
         source = "none"  # nothing more to take from the truth
-    truth_att = np.empty((m + 1, 3)) if has_truth else None
+    truth_att = np.empty((len(samples), 3)) if has_truth else None
     pos_t1 = stream.site.copy()
     if reference is not None and not has_truth:
-        truth_att = _reference_attitude(reference, stream, lo, hi)
+        truth_att = _reference_attitude(reference, stream, lo, hi, samples)
 
     def take(k0: int, att, v_n, pos) -> None:
         """Truth rows of samples k0 .. k0+len-1: reference velocity, attitude, pos at T1."""
@@ -124,7 +130,8 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
             else:
                 vref[out] = ref
         assert truth_att is not None
-        truth_att[out] = att[rows]
+        kept = slice(*np.searchsorted(samples, [k0, k0 + n]))  # the kept samples here
+        truth_att[kept] = att[samples[kept] - k0]
         if k0 <= i1 <= k0 + n - 1:
             pos_t1 = pos[i1 - k0].copy()
 
@@ -144,22 +151,24 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
             progress(min(b.k0 + n, hi) * stream.ts, hi * stream.ts, what)
         if b.k0 + n >= hi:
             break  # everything needed is in; the rest of the run is never generated
-    return Window(dtheta, dv, vref, truth_att, pos_t1)
+    truth = None if truth_att is None else TruthRows(samples, truth_att)
+    return Window(dtheta, dv, vref, truth, pos_t1)
 
 
-def _reference_attitude(reference, stream: Stream, lo: int, hi: int) -> np.ndarray:
-    """The reference's attitude at samples lo .. hi (slerp); ScenarioError naming
-    align.start_s when it does not cover them."""
+def _reference_attitude(reference, stream: Stream, lo: int, hi: int,
+                        samples: np.ndarray) -> np.ndarray:
+    """The reference's attitude at record `samples` (slerp); ScenarioError naming
+    align.start_s when it does not cover the samples lo .. hi the alignment reads."""
     from gcalign.io.recorded import reference_at
 
-    t = stream.t0 + np.arange(lo, hi + 1) * stream.ts
+    t_lo, t_hi = stream.t0 + lo * stream.ts, stream.t0 + hi * stream.ts
     lo_t, hi_t = float(reference.t[0]), float(reference.t[-1])
-    if t[0] < lo_t - 1e-6 * stream.ts or t[-1] > hi_t + 1e-6 * stream.ts:
+    if t_lo < lo_t - 1e-6 * stream.ts or t_hi > hi_t + 1e-6 * stream.ts:
         raise ScenarioError(
             f"reference: {reference.record.get('path', 'the reference')} covers {lo_t:.3f} .. "
-            f"{hi_t:.3f} s, the alignment reads {t[0]:.3f} .. {t[-1]:.3f} s (data time): "
+            f"{hi_t:.3f} s, the alignment reads {t_lo:.3f} .. {t_hi:.3f} s (data time): "
             "move align.start_s or shorten align.t2_s / t3_s, or remove the reference")
-    return reference_at(reference, t, tol=1e-6)[0]
+    return reference_at(reference, stream.t0 + samples * stream.ts, tol=1e-6)[0]
 
 
 #: The share of the signal an excursion of the base may reach before the analytic coarse
@@ -248,7 +257,8 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
         settings = settings_of(cfg, kind)
         tl = timeline(settings, ts, stream.samples)
         reference = sc.reference.read() if sc.reference is not None else None
-        data = collect(stream, tl, cfg.aiding, progress, reference)
+        keep = truth_samples(settings, ts, stream.samples, stride)
+        data = collect(stream, tl, cfg.aiding, progress, reference, keep)
         if settings.coarse == "analytic":
             k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
             warnings += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
@@ -257,7 +267,7 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
             warnings += _at_rest_warnings(sc, stream, tl, data)
         run = align(data.dtheta, data.dv, ts, stream.site, settings, earth=stream.earth,
                     position_t1=data.pos_t1, vref=data.vref,
-                    vref_body=cfg.aiding.body, truth_att=data.truth_att,
+                    vref_body=cfg.aiding.body, truth_att=data.truth,
                     t0=stream.t0, stride=stride, first_sample=tl.lo, samples=stream.samples)
     except InputError as err:
         raise _scenario_error(err) from None
