@@ -253,6 +253,9 @@ class _Stdout:
 
 def main() -> None:
     """The command line as the ``gcalign`` script runs it (:mod:`gcalign.__main__`)."""
+    from gcalign.app import command
+
+    command.ONE_SHOT = True  # one command, then the process ends (command.loading)
     sys.stdout = _Stdout(sys.stdout)  # type: ignore[assignment]
     try:
         app()

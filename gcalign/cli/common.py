@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from gcalign.app.command import loading
 from gcalign.app.registry import COMMANDS, builtin_text
 from gcalign.cli import consoles, emit_json
 from gcalign.errors import ScenarioError
@@ -164,6 +165,8 @@ def parse_set(item: str) -> tuple[str, object]:
 
 def _apply_sets(data: dict, sets: list[str], taken: set[str], source: str,
                 applied: list) -> None:
+    if not sets:  # nothing to apply: no scenario validated for them
+        return
     from gcalign.app.batch.overrides import apply_override
     from gcalign.io.scenario import parse_scenario
 
@@ -238,10 +241,11 @@ def load_with_overrides(
     may take options out of `given` that it wrote elsewhere in the section. The text stored
     in results files records the overrides.
     """
-    import yaml
+    with loading():  # yaml and the scenario models (pydantic builds each as it loads)
+        import yaml
 
-    from gcalign.io.scenario import parse_scenario
-    from gcalign.io.scenario.loader import read_yaml
+        from gcalign.io.scenario import parse_scenario
+        from gcalign.io.scenario.loader import read_yaml
 
     if data is not None:
         source = str(path) if path is not None else f"<built-in {builtin}>"
