@@ -17,6 +17,7 @@ from __future__ import annotations
 import gc
 import importlib
 import inspect
+import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -28,9 +29,10 @@ if TYPE_CHECKING:
     from gcalign.app.registry import Outcome
     from gcalign.io.scenario import Scenario
 
-#: Set by the command line's ``main`` (:func:`gcalign.cli.main`): this process runs one
-#: command and ends, so what :func:`loading` makes lives until the end.
-ONE_SHOT = False
+#: The id of the process that runs one command and ends, set by the command line's ``main``
+#: (:func:`gcalign.cli.main`): there, what :func:`loading` makes lives until the end. A
+#: process it forks (a batch's workers, which run many runs) is not it.
+ONE_SHOT: int | None = None
 
 
 @contextmanager
@@ -41,7 +43,7 @@ def loading() -> Iterator[None]:
     (left out of every later collection): otherwise the collector walks those 10^5 objects
     again and again, a tenth of a warm ``gcalign align``. Elsewhere (the API, a test's
     CliRunner, a batch worker) nothing changes."""
-    if not ONE_SHOT or not gc.isenabled():
+    if ONE_SHOT != os.getpid() or not gc.isenabled():
         yield
         return
     gc.disable()

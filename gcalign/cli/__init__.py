@@ -255,7 +255,7 @@ def main() -> None:
     """The command line as the ``gcalign`` script runs it (:mod:`gcalign.__main__`)."""
     from gcalign.app import command
 
-    command.ONE_SHOT = True  # one command, then the process ends (command.loading)
+    command.ONE_SHOT = os.getpid()  # one command, then this process ends (command.loading)
     sys.stdout = _Stdout(sys.stdout)  # type: ignore[assignment]
     try:
         app()
