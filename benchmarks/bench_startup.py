@@ -99,7 +99,7 @@ def unneeded(tree: Path, args: list[str], names: tuple[str, ...], cwd: Path) -> 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=2 if SMOKE else 7, help="timed runs of each")
+    ap.add_argument("--runs", type=int, default=1 if SMOKE else 7, help="timed runs of each")
     ap.add_argument("--before", type=Path, help="another checkout, interleaved as 'before'")
     args = ap.parse_args()
     if not SMOKE and args.runs < 5:
@@ -122,8 +122,8 @@ def main() -> None:
                 cases[f"gcalign {name}{tag}"] = ([*script(tree), *argv], env)
                 probes.append((f"gcalign {name}{tag}", tree, argv,
                                UNNEEDED["help" if name == "--help" else name]))
-        for cmd, env in cases.values():  # warm: numba's cache, .pyc files, the OS's caches
-            cpu_of(cmd, env, tmp)
+        for cmd, env in cases.values() if not SMOKE else ():  # warm: numba's cache, .pyc
+            cpu_of(cmd, env, tmp)  # files, the OS's caches (smoke: the figures mean nothing)
         load0 = os.getloadavg()
         times: dict[str, list[float]] = {k: [] for k in cases}
         for _ in range(args.runs):
