@@ -1,11 +1,13 @@
 """``python -m gcalign`` and the ``gcalign`` script: the command line (:mod:`gcalign.cli`).
 
-A short command's start-up is largely Python's cyclic garbage collector walking, again and
-again, the objects that importing typer, pydantic, numpy and numba creates (about 10^5, all
-alive until the process ends): collection is paused while the command line is imported and
-what the import made is then frozen (never walked again); :func:`gcalign.cli.main` freezes
-what is alive at exit, so that the interpreter's finalisation does not walk it either.
-Importing :mod:`gcalign.cli` as a library changes nothing of the collector.
+About a quarter of a short command's CPU went to Python's cyclic garbage collector walking,
+again and again, the objects that importing typer, pydantic, numpy and numba creates (about
+10^5, all alive until the process ends), and walking them once more in the interpreter's
+finalisation. Here collection is paused while the command line is imported and what the
+import made is then frozen (never walked again); a command does the same while it loads
+the scenario models and its kernels (:func:`gcalign.app.command.loading`), and
+:func:`gcalign.cli.main` freezes what is alive at exit. Importing :mod:`gcalign.cli` as a
+library changes nothing of the collector.
 """
 
 import gc
