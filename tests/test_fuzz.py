@@ -138,12 +138,12 @@ def test_an_unexpected_exception_is_one_line_and_exit_1(fuzz_env, monkeypatch):
     """A bug (any exception gcalign does not expect) is one line, exit 1, not a traceback:
     the handler once named an exception class typer no longer has, so every unexpected
     exception escaped as AttributeError."""
-    import gcalign.cli.data as cli_data
+    import gcalign.app.preflight
 
     def boom(*args, **kwargs):
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(cli_data, "preflight", boom)
+    monkeypatch.setattr(gcalign.app.preflight, "preflight", boom)  # validate's checks
     (fuzz_env / "a.yaml").write_bytes(F.emit(F.S).encode())
     res = runner.invoke(app, ["validate", "a.yaml"], catch_exceptions=True)
     assert res.exit_code == 1 and isinstance(res.exception, SystemExit), res.exception

@@ -14,9 +14,12 @@ so that ``gcalign show`` and ``gcalign validate`` never load them.
 
 from __future__ import annotations
 
+import gc
 import importlib
 import inspect
-from collections.abc import Callable
+import os
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -25,6 +28,31 @@ from gcalign.errors import ScenarioError
 if TYPE_CHECKING:
     from gcalign.app.registry import Outcome
     from gcalign.io.scenario import Scenario
+
+#: The id of the process that runs one command and ends, set by the command line's ``main``
+#: (:func:`gcalign.cli.main`): there, what :func:`loading` makes lives until the end. A
+#: process it forks (a batch's workers, which run many runs) is not it.
+ONE_SHOT: int | None = None
+
+
+@contextmanager
+def loading() -> Iterator[None]:
+    """A stretch that loads modules (the scenario models, a command's kernels and numba with
+    them) whose objects live as long as the process. In a one-shot process (:data:`ONE_SHOT`)
+    Python's cyclic collector is paused during it and what it made is frozen afterwards
+    (left out of every later collection): otherwise the collector walks those 10^5 objects
+    again and again, a tenth of a warm ``gcalign align``. Elsewhere (the API, a test's
+    CliRunner, a batch worker) nothing changes."""
+    if ONE_SHOT != os.getpid() or not gc.isenabled():
+        yield
+        return
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.freeze()
+        gc.enable()
+
 
 DOUBLE = 8  #: bytes of one float64
 #: Operations (multiply-adds) of one step, for the work of the cost models: a strapdown

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from gcalign import limits
-from gcalign.app.command import DOUBLE, Command, Cost, Extent
+from gcalign.app.command import DOUBLE, Command, Cost, Extent, loading
 from gcalign.app.registry import COMMANDS, Outcome, command
 from gcalign.errors import GcalignError, ScenarioError
 from gcalign.io.paths import not_a_file
@@ -132,7 +132,9 @@ def checked_execute(name: str, sc: Scenario, seed: int | None = None, *args: Any
     check_seed(seed)
     preflight(sc, name)
     cmd = command(name)
-    if progress is not None and cmd.accepts("progress"):
+    with loading():  # the run's modules, numba and its kernels with them
+        takes_progress = cmd.accepts("progress")
+    if progress is not None and takes_progress:
         options["progress"] = progress
     outcome = cmd.execute(sc, seed, *args, **options)
     finite_summary(outcome.summary, name)

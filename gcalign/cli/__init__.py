@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import errno
 import functools
+import gc
 import json
 import math
 import os
@@ -19,9 +20,9 @@ import sys
 import threading
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
-from rich.console import Console
 from typer.core import TyperGroup
 
 try:  # typer ≥ 0.2x carries its own copy of click
@@ -32,6 +33,9 @@ except ImportError:  # pragma: no cover - older typer on the real click
 from gcalign import __version__
 from gcalign.app.registry import COMMANDS
 from gcalign.errors import GcalignError
+
+if TYPE_CHECKING:
+    from rich.console import Console
 
 
 def _top_help() -> str:
@@ -117,6 +121,8 @@ def _root(
 
 def consoles(as_json: bool) -> Console:
     """Where tables go: stdout normally, stderr under --json (stdout then holds JSON only)."""
+    from rich.console import Console
+
     return Console(stderr=as_json, highlight=False)
 
 
@@ -246,6 +252,10 @@ class _Stdout:
 
 
 def main() -> None:
+    """The command line as the ``gcalign`` script runs it (:mod:`gcalign.__main__`)."""
+    from gcalign.app import command
+
+    command.ONE_SHOT = os.getpid()  # one command, then this process ends (command.loading)
     sys.stdout = _Stdout(sys.stdout)  # type: ignore[assignment]
     try:
         app()
@@ -254,6 +264,9 @@ def main() -> None:
             sys.stdout.flush()
         except OSError as err:
             _stdout_failed(err)
+        # The process ends here: what is alive now needs no collection, and the
+        # interpreter's finalisation would otherwise walk it all (a third of a second).
+        gc.freeze()
 
 
 # Commands register themselves on `app`.

@@ -12,8 +12,7 @@ from pathlib import Path
 
 import typer
 
-from gcalign.app import batch as engine
-from gcalign.app.batch.sweep import sweep_from_files
+from gcalign.app import batch as engine  # its parts load when used
 from gcalign.cli import app, consoles, default_output, emit_json, user_errors
 from gcalign.cli.options import Json, Sets
 from gcalign.errors import ScenarioError
@@ -57,6 +56,7 @@ def load_batch(files: list[Path], command: str | None, seeds: int | None,
     """One sweep file, or a plain list of scenario files (each file a variant). On a sweep
     file, --seeds and --seed-start replace the file's (said in `notes`); --set changes the
     base scenario of a sweep, or every file of a list."""
+    from gcalign.app.batch.sweep import sweep_from_files
     from gcalign.cli.common import parse_set
     from gcalign.io.scenario.loader import read_yaml
 

@@ -36,17 +36,18 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
-import yaml
 
+from gcalign.app.command import loading
 from gcalign.app.registry import COMMANDS, builtin_text
 from gcalign.cli import consoles, emit_json
 from gcalign.errors import ScenarioError
-from gcalign.io import results
 from gcalign.io.paths import not_a_file
-from gcalign.io.scenario import Scenario, parse_scenario
-from gcalign.io.scenario.loader import parse_override, read_yaml
+
+if TYPE_CHECKING:  # loaded by the functions that use them: `gcalign --help` needs neither
+    from gcalign.io.scenario import Scenario
 
 # --------------------------------------------------------------------------- options
 
@@ -157,12 +158,17 @@ def install(app: typer.Typer) -> None:
 
 def parse_set(item: str) -> tuple[str, object]:
     """``KEY=VALUE`` -> (key, YAML value); ScenarioError names the option."""
+    from gcalign.io.scenario.loader import parse_override
+
     return parse_override(item)
 
 
 def _apply_sets(data: dict, sets: list[str], taken: set[str], source: str,
                 applied: list) -> None:
+    if not sets:  # nothing to apply: no scenario validated for them
+        return
     from gcalign.app.batch.overrides import apply_override
+    from gcalign.io.scenario import parse_scenario
 
     try:
         base = parse_scenario(copy.deepcopy(data), source)
@@ -235,6 +241,12 @@ def load_with_overrides(
     may take options out of `given` that it wrote elsewhere in the section. The text stored
     in results files records the overrides.
     """
+    with loading():  # yaml and the scenario models (pydantic builds each as it loads)
+        import yaml
+
+        from gcalign.io.scenario import parse_scenario
+        from gcalign.io.scenario.loader import read_yaml
+
     if data is not None:
         source = str(path) if path is not None else f"<built-in {builtin}>"
         text = text or yaml.safe_dump(data, sort_keys=False)
@@ -351,6 +363,8 @@ def _replaced_other(out: Path, kind: str, text: str, seed: int | None) -> str | 
     """A warning if `out` exists and holds a run of other inputs."""
     if not out.is_file():
         return None
+    from gcalign.io import results
+
     try:
         _, _, attrs = results.read_summary(out)
     except (ScenarioError, KeyError, ValueError):

@@ -6,19 +6,13 @@ import re
 from pathlib import Path
 
 import typer
-import yaml
 
-from gcalign.app.preflight import preflight
 from gcalign.app.registry import COMMANDS
-from gcalign.app.report import kv_table, summary_table, with_warnings
 from gcalign.cli import app, consoles, emit_json, user_errors
 from gcalign.cli.common import imu_file_given, load_with_overrides, run_and_show, warn
 from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
-from gcalign.io import results
 from gcalign.io.paths import not_a_file
-from gcalign.io.results import HDF5_SUFFIXES
-from gcalign.io.scenario.resolve import resolved_rows
 
 DATA_SUFFIXES = {".imu", ".csv", ".txt", ".mat"}
 COMPRESSED = (".gz", ".xz")
@@ -75,6 +69,11 @@ def navigate(
     Recorded data have no truth: the table shows the final state and its drift from the
     start (`final_error` is null in the JSON).
     """
+    import yaml
+
+    from gcalign.io import results
+    from gcalign.io.results import HDF5_SUFFIXES
+
     overrides = {"vertical": vertical, "start_s": start, "duration_s": duration}
     for what, given in (("--init", init), ("the source", source)):
         if output is not None and given not in (None, "truth", "header") and \
@@ -114,6 +113,7 @@ def show(
 ):
     """Print the summary of a results file again, from the file alone."""
     from gcalign.app.checked import read_checked
+    from gcalign.app.report import summary_table
 
     kind, summary, attrs = read_checked(file)
     console = consoles(as_json)
@@ -135,6 +135,10 @@ def validate(
 ):
     """Check a scenario and print its resolved values in user units and SI, and the keys
     that cannot matter (as warnings)."""
+    from gcalign.app.preflight import preflight
+    from gcalign.app.report import kv_table, with_warnings
+    from gcalign.io.scenario.resolve import resolved_rows
+
     sc, _, _ = load_with_overrides(scenario, "", "", {}, sets=set_)
     preflight(sc)  # the checks every command runs first, for every section
     rows = resolved_rows(sc)

@@ -5,13 +5,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-import yaml
 
 from gcalign.app.registry import COMMANDS
 from gcalign.cli import app, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
-from gcalign.io.scenario.loader import read_yaml
 
 BUILTIN = COMMANDS["modulate"].builtin or ""
 
@@ -26,6 +24,10 @@ def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
     """Scenario and text with --scheme/--dwell written into ``mechanism`` and the other
     options into ``modulate`` before validation. --scheme replaces the scenario's mechanism
     (a table too; its timing keys stay) and, without --compare, is the one scheme run."""
+    import yaml
+
+    from gcalign.io.scenario.loader import read_yaml
+
     if path is None:
         text = builtin_text(BUILTIN)
         data = yaml.safe_load(text)

@@ -15,14 +15,14 @@ def write_alignment(f: h5py.File, run, stream=None, error_source: str = "truth")
     /align/gains, and the true attitude at the stored samples under /truth (t, att), or
     the reference's under /reference (`error_source` "reference": recorded data)."""
     if run.pass_truth is not None:
-        rows = {}
-        for rec, tr in zip(run.passes, run.pass_truth, strict=True):
-            for t, a in zip(rec.t, tr, strict=True):
-                rows[float(t)] = a
-        t = np.array(sorted(rows))
+        # every stored sample once, in time order (a later pass's row of a time kept, as a
+        # mapping from time to row would); not a Python loop over the 10^5 rows
+        t_all = np.concatenate([rec.t for rec in run.passes])
+        att_all = np.concatenate(run.pass_truth)
+        t, last = np.unique(t_all[::-1], return_index=True)
         tg = f.create_group(error_source)
         put(tg, "t", t, "s", description="the samples the passes stored (output rate)")
-        put(tg, "att", np.array([rows[x] for x in t]), "rad", ATT_FRAME)
+        put(tg, "att", att_all[::-1][last], "rad", ATT_FRAME)
     g = f.create_group("align")
     g.attrs["error_source"] = error_source
     g.attrs["mode"] = run.settings.mode
