@@ -21,7 +21,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from calibrate_cases import conventional, designed, ideal, motion, short, site
-from scipy.stats import chi2
+from lazy import lazy_attr
 
 from gcalign.calibrate import (
     Settings,
@@ -37,6 +37,8 @@ from gcalign.io.scenario.motion import flight_extent
 from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import quat_mult, quat_to_rotvec, rotvec_to_quat
 from gcalign.units import DEG
+
+chi2 = lazy_attr("scipy.stats", "chi2")
 
 IMU = ie.IMU
 

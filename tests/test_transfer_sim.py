@@ -20,12 +20,14 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from scipy.stats import chi2
+from lazy import lazy_attr
 
 from gcalign.estimation.kalman import nees
 from gcalign.transfer import transfer_align
 from gcalign.transfer.simulate import estimation_error, transfer_case
 from gcalign.units import ARCMIN, DEG, DPH
+
+chi2 = lazy_attr("scipy.stats", "chi2")
 
 
 def _run(seed: int, duration: float = 20.0, **kw):
