@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import ast
 import doctest
+import gc
 import importlib
 import sys
 from collections.abc import Iterator
@@ -41,6 +42,19 @@ def _doctest_only(path: Path) -> bool:
         return True
     return (path.is_relative_to(TESTS) and not path.name.startswith("test_")
             and path.name != "conftest.py")
+
+
+def pytest_configure(config) -> None:
+    gc.disable()  # until the collection is done: see pytest_collection_finish
+
+
+def pytest_collection_finish(session) -> None:
+    """The imported modules and the collected items live as long as the session: moved out
+    of the cyclic garbage collector's way (gc.freeze) so that its full collections during
+    the tests, and the five pytest makes at the end of the session, do not walk them again;
+    the collector runs from here on."""
+    gc.freeze()
+    gc.enable()
 
 
 def pytest_ignore_collect(collection_path: Path, config) -> bool | None:
