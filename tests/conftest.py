@@ -9,6 +9,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
+import typer.testing
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The PSINS lasergyro.imu recording, compressed (tests/data/README.md).
@@ -22,6 +23,28 @@ def lasergyro(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("data") / "lasergyro.imu"
     path.write_bytes(lzma.decompress(LASERGYRO_XZ.read_bytes()))
     return path
+
+
+@pytest.fixture(scope="session", autouse=True)
+def one_click_command_per_app():
+    """typer's CliRunner converts the Typer app into its click command on every invoke
+    (about 20 ms: the signature and type hints of every option of every command); the
+    command line does it once per process, and so do the tests here: once per app and set
+    of registered commands."""
+    build = typer.testing._get_command
+    built: dict = {}
+
+    def cached(app):
+        # the objects themselves (hashed by identity, kept alive): no id reused
+        key = (app, tuple(app.registered_commands), tuple(app.registered_groups),
+               app.registered_callback)
+        if key not in built:
+            built[key] = build(app)
+        return built[key]
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(typer.testing, "_get_command", cached)
+        yield
 
 
 def _untracked() -> set[str] | None:

@@ -12,10 +12,10 @@ import json
 
 import numpy as np
 import pytest
-import scipy.io
+import scipy  # scipy.io is loaded on first use (scipy's lazy submodules)
 import yaml
 from cli_checks import assert_bad_run
-from scipy.spatial.transform import Rotation
+from lazy import lazy_attr
 from test_align_api import small
 from typer.testing import CliRunner
 
@@ -25,6 +25,8 @@ from gcalign.cli import app
 from gcalign.io.recorded import read_reference, reference_at
 from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
+
+Rotation = lazy_attr("scipy.spatial.transform", "Rotation")
 
 runner = CliRunner()
 MAT = ROOT / "tests/data/transfer_align_fog_mems.mat"

@@ -11,10 +11,10 @@ import json
 import h5py
 import numpy as np
 import pytest
-import scipy.io
+import scipy  # scipy.io is loaded on first use (scipy's lazy submodules)
 import yaml
 from cli_checks import assert_bad_run
-from scipy.spatial.transform import Rotation, Slerp
+from lazy import lazy_attr
 from typer.testing import CliRunner
 
 import gcalign
@@ -23,6 +23,9 @@ from gcalign.cli import app
 from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm, quat_to_euler
 from gcalign.units import DPH, UG
+
+Rotation = lazy_attr("scipy.spatial.transform", "Rotation")
+Slerp = lazy_attr("scipy.spatial.transform", "Slerp")
 
 runner = CliRunner()
 MAT = ROOT / "tests/data/transfer_align_fog_mems.mat"

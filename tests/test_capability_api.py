@@ -95,6 +95,7 @@ def test_northfind_array_inputs_are_checked_by_name(change, text):
     assert text in str(err.value)
 
 
+@pytest.mark.slow  # child processes (in-process: test_cli_northfind.py::test_bad_options_exit_2)
 @pytest.mark.parametrize("args", [["--positions", "1"], ["--dwell", "0"]])
 def test_northfind_bad_setting_exits_2_with_one_line(args):
     res = subprocess.run([sys.executable, "-m", "gcalign", "northfind", *args, "--json"],

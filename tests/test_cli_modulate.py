@@ -14,7 +14,6 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from gcalign.app.batch import load_sweep
 from gcalign.cli import app
 from gcalign.cli.common import builtin_text
 
@@ -188,11 +187,6 @@ def test_validate_lists_the_schemes(tmp_path):
     assert "modulate.compare: seed-12" in values
     bad = runner.invoke(app, ["validate", _bad_table(tmp_path)[-1]])
     assert bad.exit_code == 2 and "does not return the IMU" in bad.output
-
-
-def test_dwell_sweep_config_validates():
-    sweep = load_sweep(ROOT / "configs/sweeps/seed004_dwell.yaml")
-    assert sweep.command == "modulate" and len(sweep.variants) >= 5
 
 
 @pytest.mark.slow

@@ -222,7 +222,9 @@ def test_batch_set_and_seeds_on_a_sweep(tmp_path):
                                                                      "half-cycle"]},
              "seeds": 5, "metrics": ["error_t3_deg"]}
     p = _write(tmp_path, sweep, "sweep")
-    res = runner.invoke(app, ["batch", str(p), "--seeds", "2", "--set", "align.t3_s=measured",
+    # T3 = 65 s, not 'measured' (T2 + the passes' wall time: the batch's run and the single
+    # run would differ by the machine's load); the literal 'measured' is the last run's.
+    res = runner.invoke(app, ["batch", str(p), "--seeds", "2", "--set", "align.t3_s=65",
                               "-w", "1", "-o", str(tmp_path / "b.h5"), "--json"])
     assert res.exit_code == 0, res.output
     s = json.loads(res.stdout)
@@ -230,7 +232,7 @@ def test_batch_set_and_seeds_on_a_sweep(tmp_path):
     assert "note: --seeds 2 replaces the sweep's seeds (5)" in res.stderr
     assert f"wrote {tmp_path / 'b.h5'}" in res.stderr
     one = runner.invoke(app, ["align", str(small_align(tmp_path)), "--mode", "half-cycle",
-                              "--t3", "measured", "--seed", "2", "-o", str(tmp_path / "1.h5"),
+                              "--t3", "65", "--seed", "2", "-o", str(tmp_path / "1.h5"),
                               "--json"])
     import h5py
     import numpy as np

@@ -21,10 +21,12 @@ import numpy as np
 import pytest
 import yaml
 from cli_checks import assert_bad_run
-from scipy import signal
+from lazy import lazy_module
 from typer.testing import CliRunner
 
 from gcalign.cli import app
+
+signal = lazy_module("scipy.signal")
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()

@@ -9,7 +9,7 @@ import json
 import h5py
 import numpy as np
 import pytest
-import scipy.io
+import scipy  # scipy.io is loaded on first use (scipy's lazy submodules)
 import yaml
 from cli_checks import assert_bad_input
 from typer.testing import CliRunner

@@ -534,6 +534,7 @@ def test_full_disk_during_modulate_is_exit_1_one_line_and_nothing_kept(tmp_path,
     assert not (tmp_path / "o.h5").exists() and temps(tmp_path) == []
 
 
+@pytest.mark.slow  # child processes
 def test_stdout_that_refuses_writes_is_exit_1_one_line(tmp_path):
     """``> /dev/full`` and a closed stdout: exit 1, "cannot write to stdout" (they were
     internal errors)."""

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.stats import chi2
+from lazy import lazy_attr
 
 from gcalign.estimation.kalman import nees, predict, update, van_loan
+
+chi2 = lazy_attr("scipy.stats", "chi2")
 
 
 def test_van_loan_matches_the_closed_form_of_a_jerk_model():

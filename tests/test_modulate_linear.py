@@ -8,13 +8,15 @@ import math
 
 import numpy as np
 import pytest
-from scipy.linalg import expm
+from lazy import lazy_attr
 from seed004 import EPS, NABLA, OMEGA, PARITY, R_M, R_N, SPEC_TABLE, TS, WS, G, L, R
 
 from gcalign.modulate.linear import _Modes, error_matrix, linear_errors
 from gcalign.modulate.schemes import Turn, builtin_scheme
 from gcalign.modulate.terms import ErrorTerms
 from gcalign.units import ARCMIN, ARCSEC, DPSH, HOUR
+
+expm = lazy_attr("scipy.linalg", "expm")
 
 SEED = ErrorTerms.seed004()
 

@@ -243,6 +243,7 @@ def test_spec_table_and_the_four_position_gain(seed_case):
     assert max(gyro_only["max_misalignment_arcsec"]) <= 15.0
 
 
+@pytest.mark.slow  # the seed case, 72 h of four schemes (the fast suite: test_modulate_summary)
 def test_navigation_agrees_with_the_linear_model(seed_case):
     """The two routes, for the seed's errors: the nonlinear navigation and the linear model
     agree at every report hour within 0.5 % + 2 m, and in the largest misalignment within

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from scipy.integrate import solve_ivp
+from lazy import lazy_attr
 
 from gcalign.app.data import gather, scenario_stream
 from gcalign.io.scenario import parse_scenario
@@ -18,6 +18,8 @@ from gcalign.nav.earth import WGS84
 from gcalign.nav.rotation import euler_to_dcm, quat_to_rotvec, rotvec_to_quat
 from gcalign.sim.motions import FlightSegment, Moving, Segment, Swing, flight
 from gcalign.sim.schedule import AngleProfile, Schedule, Step
+
+solve_ivp = lazy_attr("scipy.integrate", "solve_ivp")
 
 ROOT = Path(__file__).resolve().parents[1]
 D = math.pi / 180.0

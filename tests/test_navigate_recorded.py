@@ -11,9 +11,9 @@ import json
 import h5py
 import numpy as np
 import pytest
-import scipy.io
+import scipy  # scipy.io is loaded on first use (scipy's lazy submodules)
 from cli_checks import assert_bad_run
-from scipy.spatial.transform import Rotation
+from lazy import lazy_attr
 from typer.testing import CliRunner
 
 from conftest import ROOT
@@ -22,6 +22,8 @@ from gcalign.io.recorded import read_recording, read_reference, reference_at
 from gcalign.nav.navigate import navigate, position_error_enu
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm, misalignment
 from gcalign.nav.strapdown import NavState, Vertical
+
+Rotation = lazy_attr("scipy.spatial.transform", "Rotation")
 
 runner = CliRunner()
 MAT = ROOT / "tests/data/transfer_align_fog_mems.mat"

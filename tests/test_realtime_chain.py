@@ -9,7 +9,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from scipy import signal
+from lazy import lazy_module
 
 from gcalign.nav.earth import WGS84
 from gcalign.realtime import (
@@ -31,6 +31,8 @@ from gcalign.realtime import (
 )
 from gcalign.realtime.chain import build_chain
 from gcalign.units import ARCSEC, DEG
+
+signal = lazy_module("scipy.signal")
 
 QUIET = SensorSettings(quantum=0.0, arw=0.0, dither_amplitude=0.0)
 FIR_ONLY = FilterSettings(notch_hz=None)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy import signal
+from lazy import lazy_module
 
 from gcalign.realtime.filters import (
     FilterChain,
@@ -17,6 +17,8 @@ from gcalign.realtime.filters import (
     notch_dc_delay,
 )
 from gcalign.realtime.settings import FilterSettings
+
+signal = lazy_module("scipy.signal")
 
 FS = 5000.0
 

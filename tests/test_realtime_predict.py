@@ -8,7 +8,7 @@ import warnings
 
 import numpy as np
 import pytest
-from scipy.stats import chi2
+from lazy import lazy_attr
 
 from gcalign.realtime.predict import (
     TrackerModel,
@@ -25,6 +25,8 @@ from gcalign.realtime.predict import (
     unwrap,
 )
 from gcalign.units import ARCSEC, DEG
+
+chi2 = lazy_attr("scipy.stats", "chi2")
 
 TAU = 1e-3
 R = (0.03 * ARCSEC) ** 2

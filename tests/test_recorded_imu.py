@@ -11,7 +11,7 @@ import sys
 
 import numpy as np
 import pytest
-import scipy.io
+import scipy  # scipy.io is loaded on first use (scipy's lazy submodules)
 from cli_checks import assert_bad_input
 from typer.testing import CliRunner
 

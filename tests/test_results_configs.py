@@ -6,6 +6,7 @@ section files in a fixed order."""
 from __future__ import annotations
 
 import copy
+import functools
 import importlib.util
 from pathlib import Path
 
@@ -20,9 +21,15 @@ ROOT = Path(__file__).resolve().parents[1]
 CONFIGS, SWEEPS = ROOT / "configs", ROOT / "configs" / "sweeps"
 
 
+@functools.cache
+def _sweep(name: str):
+    """A sweep of configs/sweeps/, loaded once (a load builds every variant's scenario)."""
+    return load_sweep(SWEEPS / f"{name}.yaml")
+
+
 def scenario_of(sweep: str, **match):
     """The scenario (model) of the one variant of a sweep whose overrides match."""
-    sw = load_sweep(SWEEPS / f"{sweep}.yaml")
+    sw = _sweep(sweep)
     want = {k.replace("__", "."): v for k, v in match.items()}
     hits = [v for v in sw.variants if all(v.overrides.get(k) == x for k, x in want.items())]
     assert len(hits) == 1, (sweep, want, len(hits))

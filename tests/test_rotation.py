@@ -21,9 +21,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
+from lazy import lazy_attr
 
 from gcalign.nav import rotation as rot
+
+Rotation = lazy_attr("scipy.spatial.transform", "Rotation")
 
 TOL = 1e-15  #: entries of DCMs and unit quaternions (4.5 ulp of 1)
 EPS = np.finfo(float).eps

@@ -5,7 +5,6 @@ built-in scenario stays inside them."""
 
 from __future__ import annotations
 
-import copy
 import json
 from importlib import resources
 from pathlib import Path
@@ -146,8 +145,8 @@ def test_every_builtin_scenario_validates(name):
 
 @pytest.mark.parametrize("path", SWEEPS, ids=[p.name for p in SWEEPS])
 def test_every_variant_of_every_shipped_sweep_validates(path):
-    for v in load_sweep(path).variants:
-        parse_scenario(copy.deepcopy(v.scenario), f"{path.name}: {v.overrides}")
+    # load_sweep parses and preflights every variant before anything runs (its contract)
+    assert load_sweep(path).variants
 
 
 @pytest.mark.parametrize("bound", [b for b in vars(B).values() if isinstance(b, B.Bound)])

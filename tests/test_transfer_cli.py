@@ -13,7 +13,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-import scipy.io
+import scipy  # scipy.io is loaded on first use (scipy's lazy submodules)
 import yaml
 from cli_checks import assert_bad_input, assert_bad_run
 from typer.testing import CliRunner

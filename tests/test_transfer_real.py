@@ -12,10 +12,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.linalg import expm
+from lazy import lazy_attr
 
 from gcalign.transfer import MasterSeries, TransferSettings, transfer_align
 from gcalign.units import ARCMIN, DEG, DPH, G0, UG
+
+expm = lazy_attr("scipy.linalg", "expm")
 
 DATA = Path(__file__).parent / "data" / "transfer_align_fog_mems.mat"
 
