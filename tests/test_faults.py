@@ -567,3 +567,71 @@ def test_address_space_limit_is_out_of_memory_not_a_bad_output(tmp_path, command
     assert res.returncode == 1, res.stderr
     assert one_error_line(res.stderr).startswith("error: out of memory")
     assert not (tmp_path / "o.h5").exists() and temps(tmp_path) == []
+
+
+def _limited(limit_mb: int):
+    lim = limit_mb * 2**20
+    return lambda: resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("limit_mb", [600, 540, 450])
+def test_openblas_under_an_address_space_limit_is_never_its_own_message(tmp_path, limit_mb):
+    """``ulimit -v`` and the real-time run (SciPy's OpenBLAS takes its buffer late, in
+    expm): OpenBLAS printed "Memory allocation still failed after 10 retries, giving up"
+    and called exit(1) at 600 and 540 MB (the temporary file stayed), and retried without
+    end at 500 MB. With one OpenBLAS thread and the buffers taken when the libraries load,
+    the run succeeds or is exit 1, our one "out of memory" line; nothing is left."""
+    res = subprocess.run(GCALIGN + ["realtime", "-o", "o.h5"], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=300,
+                         preexec_fn=_limited(limit_mb))
+    assert "OpenBLAS" not in res.stderr, res.stderr
+    assert temps(tmp_path) == []
+    if res.returncode == 0:
+        assert (tmp_path / "o.h5").is_file() and res.stderr.strip() == "wrote o.h5"
+    else:
+        assert res.returncode == 1, res.stderr
+        assert one_error_line(res.stderr).startswith("error: out of memory")
+        assert not (tmp_path / "o.h5").exists()
+
+
+@pytest.mark.slow  # child processes
+def test_an_address_space_limit_gives_one_openblas_thread_unless_one_is_asked_for(tmp_path):
+    """Under a limit the command line sets OPENBLAS_NUM_THREADS=1 before NumPy loads (each
+    further thread maps a buffer and a stack of its own); a count the user set stays, and
+    without a limit nothing is set."""
+    probe = ("import os, gcalign.cli, numpy; "
+             "print(os.environ.get('OPENBLAS_NUM_THREADS'))")
+
+    def threads(limit_mb: int | None, **env) -> str:
+        e = {k: v for k, v in os.environ.items() if not k.endswith("NUM_THREADS")} | env
+        res = subprocess.run([sys.executable, "-c", probe], cwd=tmp_path, env=e,
+                             capture_output=True, text=True, timeout=120,
+                             preexec_fn=None if limit_mb is None else _limited(limit_mb))
+        assert res.returncode == 0, res.stderr
+        return res.stdout.strip()
+
+    assert threads(2000) == "1"
+    assert threads(2000, OPENBLAS_NUM_THREADS="2") == "2"
+    assert threads(None) == "None"
+
+
+@pytest.mark.slow  # a child process
+def test_no_room_for_numpys_openblas_buffer_is_one_line(tmp_path):
+    """A limit that leaves too little room for NumPy's OpenBLAS buffer at start-up: exit 1,
+    one "out of memory" line naming the limit (OpenBLAS itself would end the process or
+    retry without end)."""
+    from gcalign.cli.address_space import BUFFER_BYTES, mapped_bytes
+
+    probe = ("import resource, sys; from gcalign.cli.address_space import mapped_bytes; "
+             f"import numpy; lim = mapped_bytes() + {BUFFER_BYTES // 2}; "
+             "resource.setrlimit(resource.RLIMIT_AS, (lim, lim)); "
+             "sys.modules.pop('gcalign.cli.address_space'); "
+             "import gcalign.cli.address_space")
+    assert mapped_bytes() > 0  # Linux
+    res = subprocess.run([sys.executable, "-c", probe], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=120)
+    assert res.returncode == 1, res.stderr
+    line = one_error_line(res.stderr)
+    assert line.startswith("error: out of memory: the address-space limit (ulimit -v, ")
+    assert "numpy's OpenBLAS needs 48 MB" in line

@@ -30,6 +30,10 @@ try:  # typer ≥ 0.2x carries its own copy of click
 except ImportError:  # pragma: no cover - older typer on the real click
     from click import exceptions as click_errors  # type: ignore[no-redef]
 
+# First, before anything loads NumPy: its OpenBLAS under an address-space limit
+from gcalign.cli import address_space  # noqa: F401
+
+# isort: split
 from gcalign import __version__
 from gcalign.app.registry import COMMANDS
 from gcalign.errors import GcalignError
