@@ -47,6 +47,16 @@ def one_click_command_per_app():
         yield
 
 
+@pytest.fixture(scope="session")
+def results_of_every_kind(tmp_path_factory) -> dict[str, Path]:
+    """One small real results file of every kind, by kind (``transfer``: align in transfer
+    mode), made once per session (:func:`damage_cases.make_files`); the scenarios beside
+    them (``S.yaml``: the alignment's)."""
+    import damage_cases
+
+    return damage_cases.make_files(tmp_path_factory.mktemp("kinds"))
+
+
 def _untracked() -> set[str] | None:
     """Files of the checkout that git does not track (ignored ones included: runs/ is), or
     None outside a git checkout."""

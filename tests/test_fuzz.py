@@ -306,21 +306,10 @@ def test_the_python_api_refuses_bad_arguments_as_scenario_errors():
 
 
 @pytest.fixture(scope="module")
-def results_of_kinds(tmp_path_factory):
-    """Small valid results files of the newer commands (and align)."""
-    folder = tmp_path_factory.mktemp("kinds")
-    bases = {"calibrate": F.CALIBRATE, "observability": F.CALIBRATE, "realtime": F.REALTIME,
-             "modulate": F.MODULATE, "align": F.S}
-    here = os.getcwd()
-    os.chdir(folder)
-    try:
-        for kind, data in bases.items():
-            (folder / f"{kind}.yaml").write_text(F.emit(data))
-            res = runner.invoke(app, [kind, f"{kind}.yaml", "-o", f"{kind}.h5"])
-            assert res.exit_code == 0, res.stderr
-    finally:
-        os.chdir(here)
-    return folder
+def results_of_kinds(results_of_every_kind):
+    """The folder of small valid results files of every kind (``calibrate.h5``, ...) and
+    their scenarios (``S.yaml``: the alignment's)."""
+    return results_of_every_kind["align"].parent
 
 
 def _first_series(f, kind: str) -> str:
@@ -345,10 +334,12 @@ def _first_time(f, kind: str) -> str:
 def _damage(kind: str, how: str):
     import numpy as np
 
-    def zeros3(f):
+    def zeros3(f):  # its attributes kept: units do not make a series of three zeros valid
         name = _first_series(f, kind)
+        attrs = {k: v for k, v in f[name].attrs.items() if k != "DIMENSION_LIST"}
         del f[name]
         f[name] = np.zeros(3)
+        f[name].attrs.update(attrs)
         return name
 
     def strings(f):
@@ -404,7 +395,7 @@ def test_damaged_results_files_are_refused_by_plot_show_export_and_init(
         where = _damage(kind, how)(f)
     for argv in (["plot", "d.h5", "-o", "figs"], ["show", "d.h5"],
                  ["export", "d.h5", "--format", "csv"],
-                 ["navigate", "--init", "d.h5", str(results_of_kinds / "align.yaml"),
+                 ["navigate", "--init", "d.h5", str(results_of_kinds / "S.yaml"),
                   "-o", "n.h5"]):
         res = runner.invoke(app, argv)
         assert res.exit_code == 2, (argv, res.stderr)

@@ -1,11 +1,33 @@
-"""Results files read back (plot, show, export, ``navigate --init``): the summary, and the
-groups of the command that wrote it checked against that command's layout."""
+"""Results files read back (plot, show, export, ``navigate --init``): the summary, the
+groups of the command that wrote it (its ``layout``), and one check per kind of what those
+groups hold.
+
+Each dataset is checked alone first (:func:`gcalign.io.results.check_layout`: numbers
+with their units, finite, times monotonic), then against the kind's :data:`SCHEMAS`: the
+datasets the readers need are there, and every dataset has the shape its writer gives it,
+with sizes that agree across the group (the time ``t`` of length N and every series
+(N, k); an attitude (N, 3); the estimates (K + 1, n) of the n states named by the
+``states`` attribute; innovations one row fewer), whole numbers where indices are stored,
+unit quaternions, segment indices within the segment names. A size is what most of the
+datasets that share it say (the odd one is named, not the time it disagrees with).
+
+A dataset of a schema's group that no entry names is checked alone only; the damage suite
+(``tests/test_damage.py``) holds each writer's files to their schemas.
+"""
 
 from __future__ import annotations
 
+import fnmatch
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
+import h5py
+import numpy as np
+
 from gcalign.app.registry import COMMANDS
+from gcalign.errors import ScenarioError
 from gcalign.io import results
 
 #: kinds whose every dataset has units and finite values when written (north-finding stores
@@ -13,12 +35,426 @@ from gcalign.io import results
 #: errors without truth; /imu and /truth have readers of their own)
 STRICT = frozenset({"align", "calibrate", "observability", "realtime", "modulate"})
 
+Dim = int | str  #: a fixed size, a size named within the kind ("N", "N-1"), or "_" (any)
+
+
+@dataclass(frozen=True)
+class Data:
+    """What one dataset holds: one of `shapes`, numbers (or `text`), finite unless told,
+    whole numbers (`whole`), and a `rule`: ``increasing`` (strictly), ``unit`` (rows of
+    unit norm: quaternions), ``index<G`` (whole numbers in [0, G)), ``range`` (0, 1, ...,
+    n - 1: the index scales of HDF5's dimensions)."""
+
+    shapes: tuple[tuple[Dim, ...], ...]
+    text: bool = False
+    finite: bool = True
+    whole: bool = False
+    rule: str = ""
+
+
+def num(*shapes: tuple[Dim, ...], **kw) -> Data:
+    return Data(tuple(shapes), **kw)
+
+
+def text(*shapes: tuple[Dim, ...]) -> Data:
+    return Data(tuple(shapes), text=True)
+
+
+def times(n: str) -> Data:
+    return Data(((n,),), rule="increasing")
+
+
+@dataclass(frozen=True)
+class Block:
+    """The datasets of each group matching `where` (``*`` for one level of any name) by
+    path within it (``error/phi``; ``*`` matches any name; a trailing ``?``: optional), and
+    the sizes given by text attributes of comma-separated names, ``("S", "calibrate",
+    "states")`` (``.``: the group itself), by numeric attributes of one value per name
+    (`numbers`, same form), or by a count attribute of the group (`counts`: ``("H",
+    "order", 1)``, H = order + 1; absent from a file: no say)."""
+
+    where: str
+    items: dict[str, Data]
+    names: tuple[tuple[str, str, str], ...] = ()  #: (size, group or ".", attribute)
+    numbers: tuple[tuple[str, str, str], ...] = ()
+    counts: tuple[tuple[str, str, int], ...] = ()  #: (size, attribute of the group, + k)
+
+
+V3 = num(("N", 3))
+STATES = num(("K", "S"))
+INDEX = num(("_",), rule="range")  # the dimension scales of HDF5's netCDF view
+
+TRUTH = Block("truth", {"t": times("N"), "att": V3, "v_n?": V3, "pos?": V3,
+                        "segment?": num(("N",), whole=True, rule="index<G"),
+                        "segment_names?": text(("G",)), "component*?": INDEX})
+REFERENCE = Block("reference", {"t": times("N"), "att": V3, "component*?": INDEX})
+IMU = Block("imu", {"t": times("N"), "dtheta": V3, "dv": V3,
+                    "q_bs?": num(("N", 4), rule="unit"), "component*?": INDEX})
+NAVIGATION = {"t": times("N"), "att?": V3, "v_n?": V3, "pos?": V3, "error/att?": V3,
+              "error/v_n?": V3, "error/pos?": V3, "error/phi?": V3, "component*?": INDEX}
+RESULT_ATT = num((3,))
+
+SCHEMAS: dict[str, tuple[Block, ...]] = {
+    "simulate": (TRUTH, IMU),
+    "navigate": (Block("navigate", {**NAVIGATION, "att": V3, "v_n": V3, "pos": V3}), TRUTH,
+                 REFERENCE),
+    "align": (
+        Block("align/pass_*", {"t": num(("N",)), "att": V3, "gains?": num((10,)),
+                               "error?": V3, "phi?": V3, "component*?": INDEX}),
+        Block("align/result", {"coarse_att": RESULT_ATT, "att_t2": RESULT_ATT,
+                               "att_t3": RESULT_ATT, "truth_t2?": RESULT_ATT,
+                               "truth_t3?": RESULT_ATT, "error_t2?": RESULT_ATT,
+                               "error_t3?": RESULT_ATT, "phi_t2?": RESULT_ATT,
+                               "phi_t3?": RESULT_ATT}),
+        Block("align/transfer", {"t": times("K"), "estimate": STATES, "sigma": STATES,
+                                 "sigma0?": num(("S",)), "nis?": num(("K",)), "att?": num(("K", 3)),
+                                 "v_n?": num(("K", 3)), "attitude_error?": num(("K", 3)),
+                                 "bias_fed?": num(("K", 6)), "component*?": INDEX},
+              names=(("S", ".", "states"), ("S", ".", "display_units")),
+              numbers=(("S", ".", "display_scale"),)),
+        TRUTH, REFERENCE),
+    "northfind": (Block("northfind", {
+        "azimuth_true": num(("M",)), "theta?": num(("P",)), "tilt_true?": num(("M",)),
+        "tilt_direction_true?": num(("M",)), "tilt_est?": num(("R", "M")),
+        "tilt_direction_est?": num(("R", "M")), "pitch_est?": num(("R", "M")),
+        "roll_est?": num(("R", "M")), "gyro_coef?": num(("R", "M", 3)),
+        "accel_coef?": num(("R", "M", 2, 3)), "*/estimate?": num(("R", "M"), ("M",)),
+        "*/error": num(("R", "M"), ("M",)), "*/error_pred?": num(("M",), finite=False),
+        "*/std_pred?": num(("M",), finite=False)},
+        counts=(("P", "positions", 0), ("R", "repeats", 0))),),
+    "calibrate": (
+        Block("calibrate", {}, names=(("S", ".", "states"), ("S", ".", "display_units")),
+              numbers=(("S", ".", "display_scale"),)),
+        Block("calibrate/segments", {"name": text(("G",)), "t0": times("G"),
+                                     "t1": times("G")}),
+        Block("calibrate/runs/*", {
+            "t": times("K"), "estimate": STATES, "sigma": STATES, "truth?": STATES,
+            "nees?": num(("K",)), "innovation?": num(("K-1", "m")),
+            "standardized": num(("K-1", "m")), "nis": num(("K-1",)), "att": num(("K", 3)),
+            "v_n?": num(("K", 3)), "pos?": num(("K", 3)), "smoothed/estimate?": STATES,
+            "smoothed/sigma?": STATES, "reference_error/t?": times("E"),
+            "reference_error/att?": num(("E", 3)), "reference_error/v_n?": num(("E", 3)),
+            "reference_error/pos?": num(("E", 3)), "component*?": INDEX},
+            names=(("S", "calibrate", "states"), ("m", ".", "measure_names"))),
+        TRUTH, REFERENCE),
+    "observability": (
+        Block("observability", {
+            "segment_name": text(("Q",)), "t0": times("Q"), "t1": times("Q"),
+            "eta": num(("Q", "S")), "eta_cum": num(("Q", "S")),
+            "sigma_state?": num(("Q", "S")), "cov_degree?": num(("Q", "S")),
+            "cov_degree_segment?": num(("Q", "S")), "rank?": num(("Q",), whole=True),
+            "tom_rank?": num(("Q",), whole=True), "rank_cum?": num(("Q",), whole=True),
+            "tom_rank_cum?": num(("Q",), whole=True), "null_residual?": num(("Q",)),
+            "condition?": num(("Q",), whole=True)},
+            names=(("S", ".", "states"),)),
+        TRUTH),
+    "realtime": (
+        Block("realtime/cases/*", {
+            "t": times("P"), "k?": num(("P",), whole=True), "dt_true?": num(("P",)),
+            "dt?": num(("P",)), "t_valid?": num(("P",)), "latched": num(("P", 3)),
+            "truth": num(("P", 3)), "ins_ref": num(("P", 3)), "predicted/*": num(("P", 3)),
+            "component*?": INDEX}),
+        Block("realtime/filter", {
+            "h?": num(("H",)), "freq": times("F"), "magnitude": num(("F",)),
+            "magnitude_fir": num(("F",)), "magnitude_notch?": num(("F",)),
+            "group_delay": num(("F",)), "notch_b?": num((3,)), "notch_a?": num((3,))},
+              counts=(("H", "order", 1),))),
+    "modulate": (Block("modulate/*", {
+        **NAVIGATION, "error/pos": V3, "error/phi": V3,
+        "mechanism/t?": times("C"), "mechanism/angle?": num(("C", 3)),
+        "mechanism/C_diag?": num(("C", 3)), "mechanism/q?": num(("C", 4), rule="unit"),
+        "mechanism/component*?": INDEX,
+        **{f"invariants/{k}?": num((3, 3)) for k in ("integral_C", "mean_C",
+                                                     "abs_rate_integral")},
+        "invariants/rate_tensor?": num((3, 3, 3)), "invariants/*?": num((3,)),
+        "linear/t?": times("L"), "linear/north?": num(("L",)), "linear/east?": num(("L",)),
+        "linear/horizontal?": num(("L",)), "linear/sigma_horizontal?": num(("L",)),
+        "linear/phi?": num(("L", 3)), "linear/component*?": INDEX}),),
+    "batch": (
+        Block("batch/runs", {
+            "variant": num(("R",), whole=True), "seed": num(("R",), whole=True),
+            "status": text(("R",)), "error?": text(("R",)), "vkey?": text(("R",)),
+            "wall_s?": num(("R",), finite=False),
+            "metrics/*": num(("R",), ("R", "_"), finite=False)}),
+        Block("batch/aggregate/*/*", {"*": num((), ("k",), finite=False)})),
+}
+
 
 def read_checked(path: Path) -> tuple[str, dict, dict]:
     """``(kind, summary, root attributes)`` of a results file whose command's groups
     (:attr:`gcalign.app.command.Command.layout`) are present and undamaged
-    (:func:`gcalign.io.results.check_layout`); ScenarioError (one line) otherwise."""
+    (:func:`gcalign.io.results.check_layout`) and whose datasets fit together as the
+    kind's writer makes them (:data:`SCHEMAS`); ScenarioError (one line) otherwise."""
     kind, summary, attrs = results.read_summary(path)
     if kind in COMMANDS:
         results.check_layout(Path(path), kind, COMMANDS[kind].layout, kind in STRICT)
+        with results.open_results(path) as f:
+            for block in SCHEMAS.get(kind, ()):
+                for g in _groups(f, block.where):
+                    _check_block(Path(path), f, g, block)
+            extra = EXTRA.get(kind)
+            if extra is not None:
+                extra(Path(path), f, summary)
     return kind, summary, attrs
+
+
+# --------------------------------------------------------------------------- the check
+
+
+def _groups(f: h5py.File, where: str) -> list[h5py.Group]:
+    """The groups of `f` at the path `where`, each part a name or a pattern."""
+    found: list[h5py.Group] = [f]
+    for part in where.split("/"):
+        found = [g[k] for g in found for k in g
+                 if fnmatch.fnmatchcase(k, part) and isinstance(g[k], h5py.Group)]
+    return found
+
+
+class _Tree:
+    """The objects under one group by relative path, opened once (a schema's entries are
+    patterns matched against these paths)."""
+
+    def __init__(self, g: h5py.Group):
+        self.group = g
+        self.objects: dict[str, h5py.Dataset | h5py.Group] = {}
+        g.visititems(lambda name, obj: self.objects.__setitem__(name, obj))
+
+    def matches(self, rel: str, leaf=h5py.Dataset) -> list:
+        """The datasets (or groups, ``leaf=h5py.Group``; ``""``: the group itself) at the
+        relative path `rel`, each part a name or a pattern, in file order."""
+        if not rel:
+            return [self.group]
+        parts = rel.split("/")
+        return [obj for name, obj in self.objects.items()
+                if isinstance(obj, leaf) and name.count("/") == len(parts) - 1
+                and all(fnmatch.fnmatchcase(a, b) for a, b in
+                        zip(name.split("/"), parts, strict=True))]
+
+
+def _base(dim: str) -> str:
+    return dim[:-2] if dim.endswith("-1") else dim
+
+
+@dataclass
+class _Votes:
+    """The sizes each named dimension of a group is given, and by what (in order)."""
+
+    by: dict[str, list[tuple[int, str]]] = field(default_factory=dict)
+
+    def add(self, dim: str, size: int, what: str) -> None:
+        self.by.setdefault(_base(dim), []).append((size + (dim != _base(dim)), what))
+
+    def sizes(self) -> dict[str, tuple[int, str]]:
+        """Each dimension's size (the most given; of a tie, the first) and who gave it."""
+        out = {}
+        for dim, votes in self.by.items():
+            count = Counter(n for n, _ in votes)
+            best = max(count.values())
+            out[dim] = next((n, w) for n, w in votes if count[n] == best)
+        return out
+
+
+def _size(dim: Dim, sizes: dict[str, tuple[int, str]]) -> int | None:
+    if isinstance(dim, int):
+        return dim
+    if _base(dim) not in sizes:  # "_", or a size nothing gave
+        return None
+    return sizes[_base(dim)][0] - (dim != _base(dim))
+
+
+def _attribute_votes(path: Path, f: h5py.File, g: h5py.Group, block: Block,
+                     votes: _Votes) -> None:
+    for dim, where, attr in (*block.names, *block.numbers):
+        owner = g if where == "." else f.get(where)
+        label = f"{owner.name if owner is not None else '/' + where} attribute {attr!r}"
+        v = owner.attrs.get(attr) if owner is not None else None
+        if (dim, where, attr) in block.names:
+            v = v.decode("utf-8", "replace") if isinstance(v, bytes) else v
+            if not isinstance(v, str):
+                raise ScenarioError(f"{path}: {label} must list names separated by commas, "
+                                    f"got {results._short(v)}")
+            votes.add(dim, len(v.split(",")), label)
+            continue
+        try:
+            a = np.asarray(v, dtype=float)
+        except (TypeError, ValueError):
+            a = np.array([np.nan])
+        if v is None or a.ndim != 1 or not np.isfinite(a).all():
+            raise ScenarioError(f"{path}: {label} must hold finite numbers, one per name, "
+                                f"got {results._short(v)}")
+        votes.add(dim, len(a), label)
+    for dim, attr, k in block.counts:
+        if attr in g.attrs:
+            v = g.attrs[attr]
+            try:
+                n = int(v)
+            except (TypeError, ValueError):
+                n = -1
+            if n < 0 or n != v:
+                raise ScenarioError(f"{path}: {g.name} attribute {attr!r} must be a count, "
+                                    f"got {results._short(v)}")
+            votes.add(dim, n + k, f"{g.name} attribute {attr!r}" + (f" + {k}" if k else ""))
+
+
+def _required(path: Path, tree: _Tree, rel: str) -> None:
+    """ScenarioError when the dataset `rel` (no pattern in its last part) is missing from
+    the group, or from any group its parent path matches (``*/error``: every method's)."""
+    g = tree.group
+    parent, _, leaf = rel.rpartition("/")
+    owners = tree.matches(parent, h5py.Group)
+    if not owners and "*" not in parent:
+        raise ScenarioError(f"{path}: dataset {g.name}/{rel} missing (a results file of "
+                            "this kind has it)")
+    for h in owners:
+        if not isinstance(h.get(leaf), h5py.Dataset):
+            raise ScenarioError(f"{path}: dataset {h.name}/{leaf} missing (a results file "
+                                "of this kind has it)")
+
+
+def _check_block(path: Path, f: h5py.File, g: h5py.Group, block: Block) -> None:
+    """One group of a schema: its datasets alone, then their sizes against each other and
+    against the attributes that name them."""
+    votes = _Votes()
+    _attribute_votes(path, f, g, block, votes)
+    tree = _Tree(g)
+    found: list[tuple[h5py.Dataset, Data, tuple[Dim, ...]]] = []
+    seen: set[str] = set()
+    for rel, spec in block.items.items():
+        optional, rel = rel.endswith("?"), rel.rstrip("?")
+        if not optional and "*" not in rel.rpartition("/")[2]:
+            _required(path, tree, rel)
+        for ds in tree.matches(rel):
+            if ds.name in seen:  # named by an earlier entry
+                continue
+            seen.add(ds.name)
+            _check_values(path, ds, spec)
+            shape = next((s for s in spec.shapes if len(s) == ds.ndim), None)
+            found.append((ds, spec, shape or spec.shapes[0]))
+            for dim, n in zip(shape or (), ds.shape if shape else (), strict=True):
+                if isinstance(dim, str) and dim != "_":  # (no say when the axes differ)
+                    votes.add(dim, n, ds.name)
+    sizes = votes.sizes()
+    for dim, given in votes.by.items():  # an attribute the datasets outvote
+        for n, what in given:
+            if " attribute " in what and n != sizes[dim][0]:
+                raise ScenarioError(f"{path}: {what} gives {n} names or values, the datasets "
+                                    f"{sizes[dim][0]} (as {sizes[dim][1]})")
+    for ds, spec, shape in found:
+        expected = tuple(_size(d, sizes) for d in shape)
+        if len(expected) != ds.ndim or any(e is not None and e != n for e, n in
+                                           zip(expected, ds.shape, strict=True)):
+            shown = " or ".join(_shown(tuple(_size(d, sizes) for d in s)) for s in spec.shapes)
+            why = [f"{sizes[_base(d)][0]} as {sizes[_base(d)][1]}" for s in spec.shapes
+                   for d in s if isinstance(d, str) and _base(d) in sizes]
+            raise ScenarioError(f"{path}: dataset {ds.name} must have shape {shown}, got "
+                                f"{ds.shape}" + (f" ({'; '.join(dict.fromkeys(why))})"
+                                                 if why else ""))
+        if spec.rule.startswith("index<"):
+            _check_index(path, ds, spec.rule[len("index<"):], sizes)
+
+
+def _shown(shape: tuple[int | None, ...]) -> str:
+    text = ", ".join("any" if n is None else str(n) for n in shape)
+    return f"({text},)" if len(shape) == 1 else f"({text})"
+
+
+def _check_values(path: Path, ds: h5py.Dataset, spec: Data) -> None:
+    """Type, finiteness, whole numbers and the rule of one dataset on its own."""
+    is_text = h5py.check_string_dtype(ds.dtype) is not None or ds.dtype.kind in "OSU"
+    if spec.text:
+        if not is_text:
+            raise ScenarioError(f"{path}: dataset {ds.name} must hold text, got {ds.dtype}")
+        return
+    if is_text or ds.dtype.kind not in "fiub":
+        raise ScenarioError(f"{path}: dataset {ds.name} must hold numbers, got "
+                            f"{'text' if is_text else ds.dtype}")
+    a = np.asarray(ds[()], dtype=float)
+    bad = ~np.isfinite(a)
+    if spec.finite and bad.any():
+        at = np.argwhere(np.atleast_1d(bad))[0].tolist()
+        raise ScenarioError(f"{path}: dataset {ds.name} holds a value that is not finite at "
+                            f"{at}; finite numbers expected")
+    if spec.whole and np.any(a[~bad] != np.round(a[~bad])):
+        raise ScenarioError(f"{path}: dataset {ds.name} must hold whole numbers (indices, "
+                            "counts)")
+    if spec.rule == "increasing" and a.size > 1:
+        step = np.diff(a)
+        if not (step > 0).all():
+            i = int(np.argmax(~(step > 0)))
+            raise ScenarioError(f"{path}: dataset {ds.name} (time) must increase strictly: "
+                                f"row {i} {float(a[i])!r}, row {i + 1} {float(a[i + 1])!r}")
+    if spec.rule == "range" and not np.array_equal(a, np.arange(a.size)):
+        raise ScenarioError(f"{path}: dataset {ds.name} (an index scale) must hold 0, 1, ..., "
+                            f"{a.size - 1}")
+    if spec.rule == "unit" and a.ndim == 2 and len(a):
+        norm = np.linalg.norm(a, axis=1)
+        off = np.abs(norm - 1.0) > 1e-6
+        if off.any():
+            i = int(np.argmax(off))
+            raise ScenarioError(f"{path}: dataset {ds.name} must hold unit quaternions; row "
+                                f"{i} has norm {norm[i]:.6g}")
+
+
+def _check_index(path: Path, ds: h5py.Dataset, dim: str, sizes) -> None:
+    n = sizes.get(dim, (None,))[0]
+    if n is None:
+        return
+    a = np.asarray(ds[()], dtype=float)
+    out = (a < 0) | (a >= n)
+    if out.any():
+        i = int(np.argmax(out))
+        raise ScenarioError(f"{path}: dataset {ds.name} must index the {n} names of "
+                            f"{sizes[dim][1]}: row {i} holds {a[i]:g}")
+
+
+# --------------------------------------------------------------------------- by kind
+
+
+def _batch(path: Path, f: h5py.File, summary: dict) -> None:
+    """A batch's runs against its summary: each metric stored, variants that exist,
+    statuses ``ok``/``failed``, and a finite value of every metric for each run that
+    succeeded (a failed run's metrics are NaN; vector metrics are padded with NaN)."""
+    runs = f["batch/runs"]
+    variants = summary.get("variants")
+    metrics = summary.get("metrics")
+    if not isinstance(variants, list) or not isinstance(metrics, list):
+        raise ScenarioError(f"{path}: root attribute 'summary_json' of a batch must list its "
+                            "'variants' and 'metrics'")
+    v = runs["variant"][()]
+    if len(v) and (v.min() < 0 or v.max() >= len(variants)):
+        i = int(np.argmax((v < 0) | (v >= len(variants))))
+        raise ScenarioError(f"{path}: dataset {runs.name}/variant must index the "
+                            f"{len(variants)} variants of the summary: row {i} holds {v[i]}")
+    status = [s.decode() if isinstance(s, bytes) else str(s) for s in runs["status"][()]]
+    odd = [s for s in status if s not in ("ok", "failed")]
+    if odd:
+        raise ScenarioError(f"{path}: dataset {runs.name}/status must hold 'ok' or 'failed', "
+                            f"got {odd[0][:40]!r}")
+    ok = np.array([s == "ok" for s in status], dtype=bool)
+    for m in metrics:
+        ds = runs.get(f"metrics/{m}") if isinstance(m, str) else None
+        if not isinstance(ds, h5py.Dataset):
+            raise ScenarioError(f"{path}: dataset {runs.name}/metrics/{m} missing (the "
+                                "summary lists it)")
+        a = np.asarray(ds[()], dtype=float).reshape(len(ok), -1)
+        empty = ok & ~np.isfinite(a).any(axis=1)
+        if empty.any():
+            i = int(np.argmax(empty))
+            raise ScenarioError(f"{path}: dataset {ds.name} holds no finite value at row {i}, "
+                                "a run that succeeded")
+        for stats in _groups(f, f"batch/aggregate/*/{m}"):  # one value per component
+            for stat in stats.values():
+                if isinstance(stat, h5py.Dataset) and stat.shape != ds.shape[1:]:
+                    raise ScenarioError(f"{path}: dataset {stat.name} must have shape "
+                                        f"{ds.shape[1:]}, got {stat.shape} (as the runs' "
+                                        f"{ds.name})")
+
+
+def _align(path: Path, f: h5py.File, summary: dict) -> None:
+    g = f["align"]
+    if not any(k.startswith("pass_") for k in g) and "transfer" not in g:
+        raise ScenarioError(f"{path}: /align holds no pass_NN group and no /align/transfer")
+
+
+#: checks of a kind beyond its schema's shapes
+EXTRA: dict[str, Callable[[Path, h5py.File, dict], None]] = {"batch": _batch, "align": _align}
