@@ -1,4 +1,4 @@
-"""Faults (issue 14): kill -9 and SIGTERM at random points, a full disk, a second batch on
+"""Faults: kill -9 and SIGTERM at random points, a full disk, a second batch on
 the same output, symlinks at temporary names, and Dask schedulers that do not answer.
 
 Runs are child processes (``python -m``-style, the real command line) so that they can be

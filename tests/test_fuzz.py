@@ -25,7 +25,7 @@ from gcalign.cli import app
 
 SEED = int(os.environ.get("GCALIGN_FUZZ_SEED", "14"))
 CASES = F.all_cases(SEED)
-FIXED = F.fixed_cases()  # the reproductions of the issue, by name
+FIXED = F.fixed_cases()  # the first round's reproductions, by name
 GENERATED = CASES[len(FIXED):]
 MAX_RSS_MB = 3000.0  # peak resident memory of the whole test process
 runner = CliRunner()
@@ -116,7 +116,7 @@ def test_reproduction(case, fuzz_env):
 
 def _case_id(i: int) -> str:
     """Index, class and the start of the name: the crafted files, journals and options
-    (recorded_cases, journal_cases, ...) include reproductions of the issue by name."""
+    (recorded_cases, journal_cases, ...) include the first round's reproductions by name."""
     c = GENERATED[i]
     name = "".join(ch if ch.isprintable() and ch not in "[]:" else "_" for ch in c.name[:60])
     return f"{i}-c{c.cls}-{name}"
