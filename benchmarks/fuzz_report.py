@@ -1,4 +1,4 @@
-"""Run the fuzz cases of issue 14 in child processes and count violations per class.
+"""Run the fuzz cases in child processes and count violations per class.
 
 Each case runs ``gcalign`` in a new process, in an empty folder, under a time limit and an
 address-space limit, so that a version without the fixes (hangs, memory blow-ups) can be
