@@ -22,23 +22,31 @@ from gcalign.io.results import put
 DEGREE = "(segments, 21) in the order of the 'states' attribute"
 
 
+def put_rows(g: h5py.Group, tab, names, t0, t1, condition, *, shape: str, row: str,
+             t0_description: str | None = None) -> None:
+    """The rows of an observability table (a segment or a window each) and their ranks: the
+    datasets every /observability group has, the seed-002 flight's and a transfer run's."""
+    g.create_dataset("segment_name", data=np.array(names, dtype=h5py.string_dtype()))
+    put(g, "t0", t0, "s", **({} if t0_description is None else
+                             {"description": t0_description}))
+    put(g, "t1", t1, "s")
+    put(g, "eta", tab.eta, "1", shape=shape, description=f"seed eq. 17 per {row}")
+    put(g, "eta_cum", tab.eta_cum, "1", shape=shape, description="from the start of the run")
+    put(g, "sigma_state", tab.sigma_state, "SOM units", shape=shape)
+    for name in ("rank", "tom_rank", "rank_cum", "tom_rank_cum", "null_residual"):
+        put(g, name, getattr(tab, name), "1")
+    put(g, "condition", condition.astype(np.int8), "1",
+        description="null(O_j) in null(F_j) for every piece (seed eq. 12)")
+
+
 def write_observability(f: h5py.File, tab, truth, spans) -> None:
     write_segments(f, truth, spans)
     g = f.create_group("observability")
     g.attrs["measure"], g.attrs["scaling"] = tab.measure, tab.scaling
     g.attrs["rank_rtol"], g.attrs["piece_s"] = tab.rtol, tab.piece_s
     g.attrs["states"] = ",".join(ie.STATE_NAMES)
-    g.create_dataset("segment_name", data=np.array([s.name for s in spans],
-                                                   dtype=h5py.string_dtype()))
-    put(g, "t0", [s.start for s in spans], "s")
-    put(g, "t1", [s.end for s in spans], "s")
-    put(g, "eta", tab.eta, "1", shape=DEGREE, description="seed eq. 17 per segment")
-    put(g, "eta_cum", tab.eta_cum, "1", shape=DEGREE, description="from the start of the run")
-    put(g, "sigma_state", tab.sigma_state, "SOM units", shape=DEGREE)
-    for name in ("rank", "tom_rank", "rank_cum", "tom_rank_cum", "null_residual"):
-        put(g, name, getattr(tab, name), "1")
-    put(g, "condition", tab.condition.astype(np.int8), "1",
-        description="null(O_j) in null(F_j) for every piece (seed eq. 12)")
+    put_rows(g, tab, [s.name for s in spans], [s.start for s in spans],
+             [s.end for s in spans], tab.condition, shape=DEGREE, row="segment")
     if tab.cov_degree is not None:
         put(g, "cov_degree", tab.cov_degree, "1", shape=DEGREE,
             description="sigma(0)/sigma(t_end), PSINS kfstat")

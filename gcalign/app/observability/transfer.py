@@ -21,6 +21,7 @@ import numpy as np
 
 from gcalign.app.align.transfer import DECIMALS, DISPLAY, SI_UNIT, group_of
 from gcalign.app.command import DOUBLE, Cost
+from gcalign.app.observability.hdf5 import put_rows
 from gcalign.app.registry import Outcome
 from gcalign.io.results import put
 
@@ -155,17 +156,8 @@ def write(f: h5py.File, obs, result) -> None:
     g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in obs.names)
     g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in obs.names])
     names = [f"{a:.0f}–{b:.0f} s" for a, b in zip(obs.t0, obs.t1, strict=True)]
-    g.create_dataset("segment_name", data=np.array(names, dtype=h5py.string_dtype()))
-    put(g, "t0", obs.t0, "s", description="window start, from the start of the run")
-    put(g, "t1", obs.t1, "s")
-    tab = obs.table
-    put(g, "eta", tab.eta, "1", shape=DEGREE, description="seed eq. 17 per window")
-    put(g, "eta_cum", tab.eta_cum, "1", shape=DEGREE, description="from the start of the run")
-    put(g, "sigma_state", tab.sigma_state, "SOM units", shape=DEGREE)
-    for name in ("rank", "tom_rank", "rank_cum", "tom_rank_cum", "null_residual"):
-        put(g, name, getattr(tab, name), "1")
-    put(g, "condition", obs.condition.astype(np.int8), "1",
-        description="null(O_j) in null(F_j) for every piece (seed eq. 12)")
+    put_rows(g, obs.table, names, obs.t0, obs.t1, obs.condition, shape=DEGREE, row="window",
+             t0_description="window start, from the start of the run")
     put(g, "separation", obs.separation, "1", description="of each state's TOM column from "
         "the span of the others (whole run)")
     put(g, "singular_values", obs.singular_values, "1", description="whole run's TOM")
