@@ -484,13 +484,18 @@ def test_a_terminated_pool_worker_dies_even_under_the_commands_sigterm_handler(t
     """The command's SIGTERM handler raises (so that it can remove its temporary files);
     forked pool workers inherit it. ``close(cancel=True)`` terminates the workers: they must
     die, not send the exception back through a queue no one reads (which hung the process
-    that ran the batch in-process, at its exit). In a fresh process: a pool is forked only
-    from a process with a single thread."""
+    that ran the batch in-process, at its exit). The second worker is held 0.5 s after its
+    fork, before the pool's initializer resets the handler: terminated there, it must die
+    too (it lived on, exit code 1 or None). In a fresh process: a pool is forked only from a
+    process with a single thread."""
     code = """if True:
-        import signal, sys, time
+        import os, signal, sys, time
         from gcalign.app.batch.backends import LocalBackend
         from gcalign.cli import _terminate
         signal.signal(signal.SIGTERM, _terminate)
+        forks = [0]
+        os.register_at_fork(after_in_parent=lambda: forks.__setitem__(0, forks[0] + 1),
+                            after_in_child=lambda: forks[0] == 1 and time.sleep(0.5))
         backend = LocalBackend(2, "simulate")
         assert backend.start_method == "fork", backend.start_method
         procs = list(backend._pool._processes.values())

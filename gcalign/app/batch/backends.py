@@ -35,6 +35,9 @@ def _init_worker(command: str) -> None:  # pragma: no cover - runs in workers
     # command removes its temporary files): a worker that the pool terminates must die,
     # not send the exception back through a queue nobody reads any more (a hang at exit).
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    # Forked with SIGTERM blocked (LocalBackend._new_pool): one sent before this point was
+    # held, and is delivered now, with the default action.
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
     threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True).start()
     warm_up(command)
 
@@ -80,7 +83,15 @@ class LocalBackend:
         pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx,
                                    initializer=_init_worker, initargs=(self.command,))
         if self.start_method == "fork":
-            pool.submit(os.getpid).result()  # forks every worker now (all at once for fork)
+            # Forks every worker now (all at once for fork), with SIGTERM blocked: until its
+            # initializer runs, a worker has the command's handler, under which a terminate
+            # raised inside it and left it alive. The parent receives a held one on unblock.
+            blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+            try:
+                first = pool.submit(os.getpid)
+            finally:
+                signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+            first.result()
         return pool
 
     def submit(self, chunk):
