@@ -509,7 +509,10 @@ def test_a_terminated_pool_worker_dies_even_under_the_commands_sigterm_handler(t
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=60, cwd=tmp_path)
     assert res.returncode == 0, res.stderr
-    assert res.stdout.strip() == f"[{-signal.SIGTERM}, {-signal.SIGTERM}]", res.stdout
+    # killed by the signal, or (not held) already gone on the pool's own shutdown sentinel
+    codes = json.loads(res.stdout)
+    assert codes[1] == -signal.SIGTERM and codes[0] in (-signal.SIGTERM, 0), codes
+    assert res.stderr == ""  # no exception raised in a worker (it exits 0 then, logged)
 
 
 def test_results_files_have_ordinary_permissions(tmp_path):
