@@ -7,6 +7,22 @@ class GcalignError(Exception):
     exit_code = 1
 
 
+class Terminated(BaseException):
+    """SIGTERM: unwinds like Ctrl-C, so that temporary files are removed."""
+
+
+#: Set by the command line's SIGTERM handler before it raises: a raise that lands in a
+#: finaliser or a weakref callback is printed as "Exception ignored" and lost, and the run
+#: went on to write its file; the points that commit a result ask here (check_terminated).
+TERMINATE_REQUESTED = [False]
+
+
+def check_terminated() -> None:
+    """Raise :class:`Terminated` if a SIGTERM arrived, even one whose exception was lost."""
+    if TERMINATE_REQUESTED[0]:
+        raise Terminated()
+
+
 class ScenarioError(GcalignError, ValueError):
     """Bad input: a scenario, option or input file that cannot be used (exit code 2).
 

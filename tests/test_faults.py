@@ -124,6 +124,50 @@ def test_sigterm_of_a_run_removes_its_temp_file(tmp_path):
     assert temps(tmp_path) == [] and not (tmp_path / "l.h5").exists()
 
 
+class _RaisesOnFinalise:
+    """Its finaliser runs the command line's SIGTERM handler: the exception it raises there
+    cannot propagate (Python prints it as "Exception ignored" and goes on)."""
+
+    def __del__(self):
+        from gcalign.cli import _terminate
+
+        _terminate(signal.SIGTERM, None)
+
+
+def test_a_sigterm_lost_in_a_finaliser_still_keeps_the_file_from_its_name(tmp_path,
+                                                                          monkeypatch):
+    """The handler's exception swallowed by a finaliser (seen: a weakref callback inside
+    h5py, after which the run wrote its file and exited 0): the commit point raises it."""
+    from gcalign import errors
+
+    monkeypatch.setattr(sys, "unraisablehook", lambda info: None)
+    try:
+        with pytest.raises(errors.Terminated), results.atomic_h5(tmp_path / "o.h5") as f:
+            f.attrs["x"] = 1
+            _RaisesOnFinalise()  # freed at once: its exception is lost
+    finally:
+        errors.TERMINATE_REQUESTED[0] = False
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow  # a child process
+def test_a_sigterm_lost_in_a_finaliser_is_exit_143_one_line():
+    """The same through the command line's wrapper, for a command that writes no file: exit
+    143, the one error line and no "Exception ignored" traceback."""
+    code = """if True:
+        import sys, typer
+        from test_faults import _RaisesOnFinalise
+        from gcalign.cli import user_errors
+        try:
+            user_errors(lambda: _RaisesOnFinalise() and None)()
+        except typer.Exit as e:
+            sys.exit(e.exit_code)
+    """
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=60, cwd=Path(__file__).parent)
+    assert res.returncode == 143 and one_error_line(res.stderr) == "error: terminated (SIGTERM)"
+
+
 class _Signal(BaseException):
     """What the SIGTERM handler raises (the command line's Terminated), anywhere."""
 

@@ -36,7 +36,7 @@ from gcalign.cli import address_space  # noqa: F401
 # isort: split
 from gcalign import __version__
 from gcalign.app.registry import COMMANDS
-from gcalign.errors import GcalignError
+from gcalign.errors import TERMINATE_REQUESTED, GcalignError, Terminated, check_terminated
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -54,10 +54,6 @@ def _top_help() -> str:
 
 
 MAX_LINE = 400  #: characters of an error line (values in it are cut at about 80)
-
-
-class Terminated(BaseException):
-    """SIGTERM: unwinds like Ctrl-C, so that temporary files are removed."""
 
 
 def error_line(message: str) -> str:
@@ -147,7 +143,16 @@ def emit_json(obj: dict) -> None:
 
 
 def _terminate(signum, frame):
+    TERMINATE_REQUESTED[0] = True
     raise Terminated()
+
+
+def _unraisable(info) -> None:
+    """A SIGTERM's exception raised in a finaliser or a weakref callback cannot propagate:
+    no "Exception ignored" traceback for it; the flag it set ends the run at the next
+    check (errors.check_terminated)."""
+    if not isinstance(info.exc_value, Terminated):
+        sys.__unraisablehook__(info)
 
 
 def user_errors(fn):
@@ -159,13 +164,19 @@ def user_errors(fn):
     def wrapper(*args, **kwargs):
         main_thread = threading.current_thread() is threading.main_thread()
         previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
+        hook = sys.unraisablehook
+        if main_thread:
+            TERMINATE_REQUESTED[0] = False
+            sys.unraisablehook = _unraisable
         try:
             with warnings.catch_warnings():
                 # NumPy's overflow/invalid-value warnings would print lines before the one
                 # error line; a result that is not finite is refused by name anyway
                 # (results.finite_summary)
                 warnings.simplefilter("ignore", RuntimeWarning)
-                return fn(*args, **kwargs)
+                out = fn(*args, **kwargs)
+            check_terminated()  # one whose exception a finaliser swallowed (_unraisable)
+            return out
         except GcalignError as err:
             sys.stderr.write(f"error: {error_line(str(err))}\n")
             raise typer.Exit(err.exit_code) from None
@@ -194,6 +205,7 @@ def user_errors(fn):
         finally:
             if previous is not None:
                 signal.signal(signal.SIGTERM, previous)
+                sys.unraisablehook = hook
 
     return wrapper
 
@@ -268,6 +280,12 @@ def main() -> None:
             sys.stdout.flush()
         except OSError as err:
             _stdout_failed(err)
+        if TERMINATE_REQUESTED[0]:
+            # A SIGTERM that landed inside h5py leaves HDF5 objects half made; freeing them
+            # in the interpreter's finalisation crashed the process (SIGSEGV after the error
+            # line). The temporary files are gone by now: end without finalisation.
+            sys.stderr.flush()
+            os._exit(143)
         # The process ends here: what is alive now needs no collection, and the
         # interpreter's finalisation would otherwise walk it all (a third of a second).
         gc.freeze()

@@ -25,7 +25,7 @@ import h5py
 import numpy as np
 
 from gcalign import __version__
-from gcalign.errors import GcalignError, ScenarioError
+from gcalign.errors import GcalignError, ScenarioError, check_terminated
 from gcalign.io.paths import not_a_file
 from gcalign.limits import SEED_MAX
 from gcalign.sim.imu import ImuData
@@ -268,6 +268,7 @@ def atomic_h5(path: Path) -> Iterator[h5py.File]:
         raw.close()
         if guard.error is not None:
             raise guard.error
+        check_terminated()  # a SIGTERM whose exception a finaliser swallowed
         os.replace(tmp, path)
     except BaseException as err:
         if raw is None:
