@@ -134,6 +134,10 @@ class _RaisesOnFinalise:
         _terminate(signal.SIGTERM, None)
 
 
+def _lose_a_sigterm() -> None:
+    _RaisesOnFinalise()  # freed on return: its exception is lost
+
+
 def test_a_sigterm_lost_in_a_finaliser_still_keeps_the_file_from_its_name(tmp_path,
                                                                           monkeypatch):
     """The handler's exception swallowed by a finaliser (seen: a weakref callback inside
@@ -148,6 +152,55 @@ def test_a_sigterm_lost_in_a_finaliser_still_keeps_the_file_from_its_name(tmp_pa
     finally:
         errors.TERMINATE_REQUESTED[0] = False
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.fixture(scope="module")
+def small_nav(tmp_path_factory):
+    """A 20 s navigate results file, made in this process."""
+    from typer.testing import CliRunner
+
+    from gcalign.cli import app
+
+    d = tmp_path_factory.mktemp("nav")
+    sc = scenario(d, duration_s=20.0)
+    res = CliRunner().invoke(app, ["navigate", str(sc), "-o", str(d / "n.h5")])
+    assert res.exit_code == 0, res.output
+    return d / "n.h5"
+
+
+@pytest.mark.parametrize("commit", ["export", "plot", "journal"])
+def test_a_sigterm_lost_in_a_finaliser_keeps_every_other_commit_from_its_name(
+        tmp_path, monkeypatch, small_nav, commit):
+    """export's, plot's and the batch journal's renames ask for a lost SIGTERM too: nothing
+    is left under the name, nor a temporary file beside it."""
+    from matplotlib.figure import Figure
+
+    from gcalign import errors
+    from gcalign.app import export, plots
+    from gcalign.app.batch.store import Journal
+
+    def csv_then_lost(tmp, *a):
+        Path(tmp).write_text("t\n0\n")
+        _lose_a_sigterm()
+
+    def savefig_then_lost(self, p, **kw):
+        Path(p).write_bytes(b"png")
+        _lose_a_sigterm()
+
+    monkeypatch.setattr(sys, "unraisablehook", lambda info: None)
+    monkeypatch.setattr(export, "_csv", csv_then_lost)
+    monkeypatch.setattr(Figure, "savefig", savefig_then_lost)
+    out = tmp_path / "out"
+    run = {"export": lambda: export.export(small_nav, "csv", out),
+           "plot": lambda: plots.plot_file(small_nav, out),
+           "journal": lambda: (_lose_a_sigterm(), Journal(out, {"v": 1}, [{"id": "a"}]))}
+    try:
+        with pytest.raises(errors.Terminated):
+            run[commit]()
+    finally:
+        errors.TERMINATE_REQUESTED[0] = False
+    assert not out.exists() or (out.is_dir() and list(out.iterdir()) == [])
+    assert temps(tmp_path) == []
 
 
 @pytest.mark.slow  # a child process

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gcalign.errors import ScenarioError
+from gcalign.errors import ScenarioError, check_terminated
 from gcalign.io import results
 
 FORMATS = {"csv": ".csv", "mat": ".mat", "i2nav-nav": ".nav", "psins-avp": ".avp.mat"}
@@ -68,6 +68,7 @@ def export(path, fmt: str, out=None, group: str | None = None, week: int = 0) ->
     os.close(fd)
     try:
         writer(tmp, path, group, data, week)
+        check_terminated()  # a SIGTERM whose exception a finaliser swallowed
         os.replace(tmp, out)
     except BaseException:
         tmp.unlink(missing_ok=True)

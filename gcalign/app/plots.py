@@ -30,7 +30,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign import units
-from gcalign.errors import ScenarioError
+from gcalign.errors import ScenarioError, check_terminated
 from gcalign.io.paths import not_a_file
 
 ANGLES = ("pitch", "roll", "yaw")
@@ -282,6 +282,7 @@ def plot_file(path: Path, out_dir: Path | str | None = None, progress=None) -> l
                 raise write_error(out_dir / p.name, err) from None
             if progress is not None:
                 progress(i + 1, len(figs), "figures")
+        check_terminated()  # a SIGTERM whose exception a finaliser swallowed
         for stem in figs:
             os.replace(tmp / f"{stem}.png", out_dir / f"{stem}.png")
             written.append(out_dir / f"{stem}.png")

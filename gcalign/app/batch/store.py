@@ -25,7 +25,7 @@ import numpy as np
 
 from gcalign.app.batch.aggregate import STATS, components, metric_units
 from gcalign.app.batch.sweep import Sweep
-from gcalign.errors import GcalignError, ScenarioError
+from gcalign.errors import GcalignError, ScenarioError, check_terminated
 
 JOURNAL_SUFFIX = ".journal.jsonl"
 
@@ -75,11 +75,15 @@ class Journal:
                     f.write(json.dumps(obj) + "\n")
                 f.flush()
                 os.fsync(f.fileno())
+            check_terminated()
             os.replace(tmp, self.path)
             self._f = open(self.path, "a", encoding="utf-8")  # noqa: SIM115
         except OSError as err:
             tmp.unlink(missing_ok=True)
             raise _journal_error(self.path, err) from None
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
 
     @property
     def exists(self) -> bool:
