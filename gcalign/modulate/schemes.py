@@ -58,6 +58,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import cast
 
 import numpy as np
@@ -366,6 +367,7 @@ def builtin_rows(name: str, *, dwell: float | None = None, turn: Turn = SEED_TUR
     return tuple(_turn_rows(table, turn, SEED_DWELL if dwell is None else dwell))
 
 
+@lru_cache(maxsize=64)  # a sweep's validation asks for the same few schemes hundreds of times
 def builtin_scheme(name: str, *, dwell: float | None = None, turn: Turn = SEED_TURN,
                    rate: float = 6.0 * DEG, axis: str = "z") -> Scheme:
     """Built-in scheme `name` as a :class:`Scheme` (arguments as :func:`builtin_rows`).
@@ -375,6 +377,10 @@ def builtin_scheme(name: str, *, dwell: float | None = None, turn: Turn = SEED_T
     the others are body-referenced.
     """
     rows = builtin_rows(name, dwell=dwell, turn=turn, rate=rate, axis=axis)
-    reference = "navigation" if name.startswith(("seed-12", "four-position")) else "body"
-    return scheme_from_rows(rows, name=name, reference=reference,
+    return scheme_from_rows(rows, name=name, reference=builtin_reference(name),
                             description=_DESCRIPTIONS[name])
+
+
+def builtin_reference(name: str) -> str:
+    """The frame built-in scheme `name` turns in (see :func:`builtin_scheme`)."""
+    return "navigation" if name.startswith(("seed-12", "four-position")) else "body"

@@ -169,7 +169,9 @@ class MechanismConfig(Model):
         if self.reference is not None:
             return self.reference
         if self.scheme is not None:
-            return self.scheme_of(self.scheme).reference
+            from gcalign.modulate.schemes import builtin_reference
+
+            return builtin_reference(self.scheme)
         return "body"
 
     def lever(self) -> tuple[float, float, float] | None:
