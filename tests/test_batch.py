@@ -139,6 +139,40 @@ def test_bad_grid_exits_2_before_any_run(tmp_path, grid, message):
     assert len(lines) == 1 and message in lines[0], res.stderr
     assert "Traceback" not in res.output
     assert not out.exists() and not B.journal_path(out).exists()
+    checked = runner.invoke(app, ["validate", str(tmp_path / "sweep.yaml")])
+    assert checked.exit_code == 2 and checked.stderr == res.stderr  # validate says the same
+
+
+def test_validate_of_a_sweep_says_what_the_batch_would_run(tmp_path):
+    res = runner.invoke(app, ["validate", str(write_sweep(tmp_path)), "--json"])
+    assert res.exit_code == 0, res.output
+    sw = json.loads(res.stdout)["sweep"]
+    assert (sw["command"], sw["runs"], sw["seeds"], sw["metrics"]) == ("align", 24, [1, 2, 3, 4],
+                                                                       METRICS)
+    assert sw["variants"][:2] == ["align.mode=conventional, align.stages.0.t_z_s=40",
+                                  "align.mode=conventional, align.stages.0.t_z_s=60"]
+    shown = runner.invoke(app, ["validate", str(tmp_path / "sweep.yaml")])
+    assert shown.exit_code == 0 and "valid" in shown.stdout
+    assert [ln.split()[1:4] for ln in shown.stdout.splitlines() if "│ runs" in ln] == [
+        ["runs", "│", "24"]]
+
+
+def test_a_grid_key_that_cannot_matter_is_a_warning_of_validate_and_batch(tmp_path):
+    """Conventional real-time alignment runs on to T3: compensation cannot matter, and the
+    two variants come out the same; both commands say so before anything runs."""
+    base = copy.deepcopy(SMALL)
+    base["align"] |= {"mode": "conventional", "stages": [{}]}
+    p = write_sweep(tmp_path, base=base, grid={"align.compensation": ["none", "continued"]},
+                    seeds=1)
+    line = "align.compensation: 'none' cannot matter in real-time conventional mode"
+    checked = runner.invoke(app, ["validate", str(p), "--json"])
+    assert checked.exit_code == 0 and line in json.loads(checked.stdout)["warnings"][0]
+    res = batch_cli(p, "--workers", 1, "--json", "-o", tmp_path / "w.h5")
+    assert res.exit_code == 0, res.output
+    assert res.stderr.startswith(f"warning: {line}")
+    assert line in json.loads(res.stdout)["warnings"][0]
+    a, b = (v["stats"]["error_t3_deg"] for v in json.loads(res.stdout)["variants"])
+    assert a == b  # what the warning says
 
 
 def test_bad_sweep_keys_and_options(tmp_path):

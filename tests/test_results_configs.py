@@ -98,3 +98,9 @@ def test_results_are_assembled_from_section_files_in_order(tmp_path, monkeypatch
         (tmp_path / name).write_text(f"# {name}\n\n")
     out = mr.assemble()
     assert out.read_text() == "\n\n".join(f"# {n}" for n in mr.SECTIONS[:3]) + "\n"
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in SWEEPS.glob("*.yaml")))
+def test_every_sweep_of_the_results_has_no_key_that_cannot_matter(name):
+    """A grid over a key that cannot matter would give columns that differ only by label."""
+    assert _sweep(name).warnings == ()

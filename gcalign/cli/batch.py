@@ -166,6 +166,8 @@ def batch(
     err = consoles(True)  # notes always on stderr
     for line in notes:
         sys.stderr.write(f"note: {line}\n")
+    for line in sw.warnings:  # before the runs: a grid key that cannot matter wastes them
+        sys.stderr.write(f"warning: {line}\n")
 
     bar = _progress_bar(bar_label(sw))
     task = None
@@ -197,7 +199,7 @@ def batch(
     sys.stderr.write(f"wrote {out}\n")
     consoles(as_json).print(engine.COMMAND.table(summary))
     if as_json:
-        emit_json(summary)
+        emit_json({**summary, "warnings": list(sw.warnings)})
     if summary["failed"]:  # the file records them: a result, but not a success
         sys.stderr.write(f"error: {summary['failed']} of {summary['runs']} run(s) failed "
                          f"(each recorded with its message in {out})\n")

@@ -129,16 +129,21 @@ def show(
 @app.command()
 @user_errors
 def validate(
-    scenario: Path = typer.Argument(..., help="Scenario YAML."),
+    scenario: Path = typer.Argument(..., help="Scenario YAML, or a sweep YAML."),
     as_json: Json = False,
     set_: Sets = None,
 ):
     """Check a scenario and print its resolved values in user units and SI, and the keys
-    that cannot matter (as warnings)."""
+    that cannot matter (as warnings). A sweep file (docs/batch.md): every variant checked
+    as `gcalign batch` checks it, and what the batch would run."""
     from gcalign.app.preflight import preflight
     from gcalign.app.report import kv_table, with_warnings
+    from gcalign.io.scenario.loader import read_yaml
     from gcalign.io.scenario.resolve import resolved_rows
 
+    data = read_yaml(scenario)
+    if isinstance(data, dict) and "base" in data:
+        return _validate_sweep(scenario, set_, as_json)
     sc, _, _ = load_with_overrides(scenario, "", "", {}, sets=set_)
     preflight(sc)  # the checks every command runs first, for every section
     rows = resolved_rows(sc)
@@ -153,4 +158,40 @@ def validate(
     consoles(as_json).print(table if as_json else with_warnings(table, warnings))
     if as_json:
         emit_json({"valid": True, "values": {k: {"value": v, "si": s} for k, v, s in rows},
+                   "warnings": warnings})
+
+
+def _validate_sweep(path: Path, sets: list[str] | None, as_json: bool) -> None:
+    """`gcalign validate` of a sweep file: the checks `gcalign batch` makes before any run
+    (every case, grid value and variant parsed and preflighted; the memory of the runs
+    held at once on this machine's cores), then what it would run."""
+    import os
+
+    from gcalign.app.batch.engine import budget_check
+    from gcalign.app.report import kv_table, with_warnings
+    from gcalign.cli.batch import load_batch
+
+    sw = load_batch([path], None, None, None, None, sets)
+    budget_check(sw, min(os.cpu_count() or 1, len(sw.variants) * sw.seeds))
+    warnings = list(sw.warnings)
+    runs = len(sw.variants) * sw.seeds
+    seeds = (f"seed {sw.seed_start}" if sw.seeds == 1 else
+             f"seeds {sw.seed_start}–{sw.seed_start + sw.seeds - 1}")
+    info = {"sweep": sw.name, "command": sw.command, "base": os.path.normpath(sw.base_source),
+            "variants": len(sw.variants), "seeds": f"{sw.seeds} ({seeds})", "runs": runs,
+            "metrics": ", ".join(sw.metrics)}
+    info |= {f"grid: {k}": ", ".join(map(str, v)) for k, v in sw.grid.items()}
+    warn(warnings, as_json)
+    table = kv_table(f"{path}: valid sweep", [(k, str(v)) for k, v in info.items()],
+                     ("key", "value"), ("left", "left"))
+    for column in table.columns:
+        column.overflow = "fold"
+    consoles(as_json).print(table if as_json else with_warnings(table, warnings))
+    if as_json:
+        emit_json({"valid": True, "sweep": {"name": sw.name, "command": sw.command,
+                                            "base": sw.base_source,
+                                            "variants": [v.label for v in sw.variants],
+                                            "seeds": list(sw.seed_values), "runs": runs,
+                                            "metrics": list(sw.metrics),
+                                            "grid": sw.grid},
                    "warnings": warnings})

@@ -78,6 +78,9 @@ class Sweep:
     seed_start: int
     metrics: tuple[str, ...]
     variants: tuple[Variant, ...]
+    #: keys that cannot matter to the command, over the variants, one line each (a grid key
+    #: among them makes variants that differ only by it): warnings of batch and validate
+    warnings: tuple[str, ...] = ()
 
     @property
     def seed_values(self) -> range:
@@ -326,9 +329,10 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     total_runs(math.prod(len(v) for v in axes.values()) * max(1, len(cases)), spec.seeds,
                source)
 
-    def variant(applied, where: str, name_key: bool = False) -> dict:
-        """The base with `applied` (key, value) overrides, parsed and preflighted; a bad
-        override is reported at `where` (and by its key and value with `name_key`)."""
+    def variant(applied, where: str, name_key: bool = False) -> tuple[dict, list[str]]:
+        """The base with `applied` (key, value) overrides, parsed and preflighted, and its
+        keys that cannot matter; a bad override is reported at `where` (and by its key and
+        value with `name_key`)."""
         scenario = copy.deepcopy(base_data)
         for key, value in applied:
             try:
@@ -336,8 +340,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
             except ScenarioError as err:
                 at = f"{where}: {key} = {_cut(value)}" if name_key else where
                 raise ScenarioError(f"{at}: {err}") from None
-        _check_section(parse_scenario(scenario, where), command, where)
-        return scenario
+        return scenario, _check_section(parse_scenario(scenario, where), command, where)
 
     # Each case alone, then each grid key and value alone against the base: a message that
     # names exactly that case or pair.
@@ -352,23 +355,25 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     if cases:
         axes = {CASE_KEY: list(cases), **axes}
     keys = list(axes)
-    variants = []
+    variants, unused = [], {}
     for i, combo in enumerate(itertools.product(*(axes[k] for k in keys))):
         overrides = dict(zip(keys, combo, strict=True))
         label = ", ".join(f"{k} = {_cut(v)}" for k, v in overrides.items())
         applied = [*cases.get(str(overrides.get(CASE_KEY)), {}).items(),
                    *((k, v) for k, v in overrides.items() if k != CASE_KEY)]
-        scenario = variant(applied, f"{source}: grid: variant {label}")
+        scenario, lines = variant(applied, f"{source}: grid: variant {label}")
+        unused.update(dict.fromkeys(lines))
         variants.append(Variant(i, overrides, scenario, _hash(command, list(metrics), scenario)))
     return Sweep(name=spec.name or default_name, command=command, source=source, text=text,
                  base_source=base_source, base_text=base_text, grid=axes, cases=cases,
                  seeds=spec.seeds, seed_start=spec.seed_start, metrics=tuple(metrics),
-                 variants=tuple(variants))
+                 variants=tuple(variants), warnings=tuple(unused))
 
 
-def _check_section(sc, command: str, where: str) -> None:
+def _check_section(sc, command: str, where: str) -> list[str]:
     """The checks a run of the command makes first (:func:`gcalign.app.preflight.preflight`:
-    the section's own ``check``, times against the data, the cost of one run)."""
+    the section's own ``check``, times against the data, the cost of one run); the keys
+    that cannot matter to it (``Scenario.unused``)."""
     from gcalign.app.preflight import preflight
 
     section = getattr(sc, command, None)
@@ -379,6 +384,7 @@ def _check_section(sc, command: str, where: str) -> None:
         preflight(sc, command, read_recorded=False)
     except ScenarioError as err:
         raise ScenarioError(f"{where}: {err}") from None
+    return sc.unused(command)
 
 
 def apply_sets(data: dict, sets: Sequence[tuple[str, Any]], base_model: Any = None,
@@ -454,10 +460,13 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
     sweep = sweep_from_mapping({"name": name, "base": copy.deepcopy(datas[0]),
                                 "command": command, "seeds": seeds, "seed_start": seed_start,
                                 "metrics": spec["metrics"]}, "batch")
-    variants = []
+    variants, unused = [], {}
     for i, (label, data) in enumerate(zip(labels, datas, strict=True)):
         where = f"{paths[i]}"
-        _check_section(parse_scenario(copy.deepcopy(data), where), command, where)
+        unused.update(dict.fromkeys(
+            f"{where}: {line}"
+            for line in _check_section(parse_scenario(copy.deepcopy(data), where), command,
+                                       where)))
         variants.append(Variant(i, {FILE_KEY: label}, data,
                                 _hash(command, list(sweep.metrics), data)))
     base_text = "".join(f"# --- {p}\n{t}\n" for p, t in zip(paths, texts, strict=True))
@@ -465,4 +474,4 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
                  text=yaml.safe_dump(spec, sort_keys=False), base_source=", ".join(
                      map(str, paths)), base_text=base_text, grid={FILE_KEY: labels}, cases={},
                  seeds=sweep.seeds, seed_start=sweep.seed_start, metrics=sweep.metrics,
-                 variants=tuple(variants))
+                 variants=tuple(variants), warnings=tuple(unused))
