@@ -214,7 +214,8 @@ def test_progress_bar_when_a_terminal_is_forced(tmp_path, monkeypatch):
         assert other.exit_code == 0, other.output
         bar = unstyled(other.stderr)
         assert line in bar and "100%" in bar, bar
-        assert all(len(x) <= 80 for x in bar.replace("\r", "\n").splitlines())  # one line
+        drawn = [x for x in bar.replace("\r", "\n").splitlines() if not x.startswith("wrote ")]
+        assert all(len(x) <= 80 for x in drawn)  # one line (the path written may be longer)
     monkeypatch.setenv("GCALIGN_PROGRESS", "auto")  # not a terminal: nothing
     res = runner.invoke(app, ["navigate", str(p), "-o", str(tmp_path / "n.h5")])
     assert res.exit_code == 0 and "navigating" not in res.stderr

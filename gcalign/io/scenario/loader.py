@@ -239,16 +239,18 @@ def loads(text: str, source: str):
 
 def parse_override(item: str, option: str = "--set") -> tuple[str, object]:
     """``KEY=VALUE`` -> (key, value), VALUE read as a scenario file is (:func:`loads`: YAML
-    1.2 numbers, no key twice, nesting limited); ScenarioError names the option and key."""
+    1.2 numbers, no key twice, nesting limited); ScenarioError names the option and key.
+    ``KEY=null`` is the key written ``null`` in the file (an optional key's default); an
+    empty VALUE is refused, being more likely a slip than a null."""
     key, sep, text = item.partition("=")
     key = key.strip()
     if not sep or not key:
         raise ScenarioError(f"{option}: expected KEY=VALUE (e.g. align.mode=conventional), "
                             f"got {_cut(item)}")
-    value = loads(text, f"{option} {key}") if text.strip() else None
-    if value is None:
-        raise ScenarioError(f"{option} {key}: give a value (KEY=VALUE)")
-    return key, value
+    if not text.strip():
+        raise ScenarioError(f"{option} {key}: give a value (KEY=VALUE; KEY=null for the "
+                            "key's default where it has one)")
+    return key, loads(text, f"{option} {key}")
 
 
 def read_yaml(path: Path) -> dict:
