@@ -151,6 +151,9 @@ def test_validate_of_a_sweep_says_what_the_batch_would_run(tmp_path):
                                                                        METRICS)
     assert sw["variants"][:2] == ["align.mode=conventional, align.stages.0.t_z_s=40",
                                   "align.mode=conventional, align.stages.0.t_z_s=60"]
+    ran = runner.invoke(app, ["align", str(tmp_path / "sweep.yaml")])
+    assert ran.exit_code == 2 and "a sweep file (it has 'base'): run it with gcalign batch" \
+        in ran.stderr
     shown = runner.invoke(app, ["validate", str(tmp_path / "sweep.yaml")])
     assert shown.exit_code == 0 and "valid" in shown.stdout
     assert [ln.split()[1:4] for ln in shown.stdout.splitlines() if "│ runs" in ln] == [

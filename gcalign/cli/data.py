@@ -177,7 +177,8 @@ def _validate_sweep(path: Path, sets: list[str] | None, as_json: bool) -> None:
     runs = len(sw.variants) * sw.seeds
     seeds = (f"seed {sw.seed_start}" if sw.seeds == 1 else
              f"seeds {sw.seed_start}–{sw.seed_start + sw.seeds - 1}")
-    info = {"sweep": sw.name, "command": sw.command, "base": os.path.normpath(sw.base_source),
+    base = os.path.normpath(sw.base_source)
+    info = {"sweep": sw.name, "command": sw.command, "base": base,
             "variants": len(sw.variants), "seeds": f"{sw.seeds} ({seeds})", "runs": runs,
             "metrics": ", ".join(sw.metrics)}
     info |= {f"grid: {k}": ", ".join(map(str, v)) for k, v in sw.grid.items()}
@@ -189,7 +190,7 @@ def _validate_sweep(path: Path, sets: list[str] | None, as_json: bool) -> None:
     consoles(as_json).print(table if as_json else with_warnings(table, warnings))
     if as_json:
         emit_json({"valid": True, "sweep": {"name": sw.name, "command": sw.command,
-                                            "base": sw.base_source,
+                                            "base": base,
                                             "variants": [v.label for v in sw.variants],
                                             "seeds": list(sw.seed_values), "runs": runs,
                                             "metrics": list(sw.metrics),

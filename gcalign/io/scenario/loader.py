@@ -98,6 +98,9 @@ def parse_scenario(data: dict, source: str = "scenario") -> Scenario:
         raise ScenarioError(
             f"{source}: the scenario must be a YAML mapping, got {type(data).__name__}"
         )
+    if "base" in data:  # no scenario key: a sweep's
+        raise ScenarioError(f"{source}: a sweep file (it has 'base'): run it with gcalign "
+                            "batch (gcalign validate checks it)")
     try:
         return Scenario.model_validate(data)
     except ValidationError as err:
