@@ -148,7 +148,7 @@ def test_a_sigterm_lost_in_a_finaliser_still_keeps_the_file_from_its_name(tmp_pa
     try:
         with pytest.raises(errors.Terminated), results.atomic_h5(tmp_path / "o.h5") as f:
             f.attrs["x"] = 1
-            _RaisesOnFinalise()  # freed at once: its exception is lost
+            _lose_a_sigterm()
     finally:
         errors.TERMINATE_REQUESTED[0] = False
     assert list(tmp_path.iterdir()) == []
@@ -209,10 +209,10 @@ def test_a_sigterm_lost_in_a_finaliser_is_exit_143_one_line():
     143, the one error line and no "Exception ignored" traceback."""
     code = """if True:
         import sys, typer
-        from test_faults import _RaisesOnFinalise
+        from test_faults import _lose_a_sigterm
         from gcalign.cli import user_errors
         try:
-            user_errors(lambda: _RaisesOnFinalise() and None)()
+            user_errors(_lose_a_sigterm)()
         except typer.Exit as e:
             sys.exit(e.exit_code)
     """

@@ -167,14 +167,14 @@ def _validate_sweep(path: Path, sets: list[str] | None, as_json: bool) -> None:
     held at once on this machine's cores), then what it would run."""
     import os
 
-    from gcalign.app.batch.engine import budget_check
+    from gcalign.app.batch.engine import budget_check, worker_count
     from gcalign.app.report import kv_table, with_warnings
     from gcalign.cli.batch import load_batch
 
     sw = load_batch([path], None, None, None, None, sets)
-    budget_check(sw, min(os.cpu_count() or 1, len(sw.variants) * sw.seeds))
-    warnings = list(sw.warnings)
     runs = len(sw.variants) * sw.seeds
+    budget_check(sw, worker_count(None, None, runs))
+    warnings = list(sw.warnings)
     seeds = (f"seed {sw.seed_start}" if sw.seeds == 1 else
              f"seeds {sw.seed_start}–{sw.seed_start + sw.seeds - 1}")
     base = os.path.normpath(sw.base_source)

@@ -92,7 +92,7 @@ def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
     log = log or (lambda msg: None)
     t_start = time.perf_counter()
     keys = sweep.run_keys()
-    n_workers = _workers(workers, scheduler, len(keys))
+    n_workers = worker_count(workers, scheduler, len(keys))
     with OutputLock(output):
         clean_stale_temps(output.parent)
         records: dict[tuple[int, int], dict] = {}
@@ -124,7 +124,8 @@ def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
                     chunk_size, rebuild_every_s, t_start, resume)
 
 
-def _workers(workers: int | None, scheduler: str | None, runs: int) -> int:
+def worker_count(workers: int | None, scheduler: str | None, runs: int) -> int:
+    """The local worker processes a batch of `runs` starts (1 on a scheduler)."""
     from gcalign import limits
 
     if scheduler:

@@ -78,11 +78,10 @@ class Journal:
             check_terminated()
             os.replace(tmp, self.path)
             self._f = open(self.path, "a", encoding="utf-8")  # noqa: SIM115
-        except OSError as err:
+        except BaseException as err:  # a SIGTERM too: no temporary file left
             tmp.unlink(missing_ok=True)
-            raise _journal_error(self.path, err) from None
-        except BaseException:
-            tmp.unlink(missing_ok=True)
+            if isinstance(err, OSError):
+                raise _journal_error(self.path, err) from None
             raise
 
     @property
