@@ -1,14 +1,25 @@
 """The IMU error model, applied to ideal increments block by block (in the sensor frame).
 
 Per axis: constant bias, white noise (ARW/VRW), scale factor (optionally different for
-positive and negative input: asymmetric), non-orthogonality/misalignment, quantisation.
-The measured increment is ``(I + diag(k) + M) Δ_ideal + b T + n`` with ``k = scale`` or,
-with an asymmetric part, ``scale + asym·sign(Δ_ideal)``; a quantiser keeps its remainder.
+positive and negative input: asymmetric), non-orthogonality/misalignment, quantisation,
+and the time-varying sensor processes of KF-GINS and PSINS: a bias that is a first-order
+Gauss–Markov process (stationary std σ, correlation time τ) and/or a random walk (density
+q), a scale factor that is a Gauss–Markov process. The measured increment is
+``(I + diag(k) + M) Δ_ideal + b T + n`` with ``k = scale (+ scale process)`` or, with an
+asymmetric part, ``+ asym·sign(Δ_ideal)``, ``b = bias (+ bias processes)``; a quantiser
+keeps its remainder.
+
+The processes are discretised exactly at the sample interval T: ``x_k = a x_{k−1} + s w_k``
+with ``a = e^{−T/τ}``, ``s = σ √(1 − a²)`` (Gauss–Markov; started from its stationary
+distribution N(0, σ²)) or ``a = 1``, ``s = q √T`` (random walk, started at zero); x_k is
+the value during increment k.
 
 Random numbers: one seeded ``numpy.random.Generator`` per run. The gyro noise of all N
 samples comes first in its stream, then the accelerometer noise (the layout of the
 whole-run draw ``g = rng.normal((N, 3)); a = rng.normal((N, 3))``), so a run gives the
-same numbers whatever its block size, and the same as before streaming existed.
+same numbers whatever its block size, and the same as before streaming existed. Each
+sensor process draws from a child generator of its own (``rng.spawn``, which leaves `rng`
+where it was): adding a process changes no other number of the run.
 """
 
 from __future__ import annotations
@@ -33,6 +44,12 @@ class SensorErrors:
         subtracted for negative input.
     misalignment : (3, 3) small-angle non-orthogonality; zero diagonal.
     quantum : increment quantisation step (rad or m/s); 0 disables it.
+    bias_gm_std, bias_gm_tau : (3,) first-order Gauss–Markov bias: stationary std (rad/s or
+        m/s²) and correlation time (s); std 0: none.
+    bias_rw : (3,) bias random walk density (rad/s/√s or m/s²/√s): rate (acceleration)
+        random walk; the bias's std grows as ``bias_rw · √t``.
+    scale_gm_std, scale_gm_tau : (3,) Gauss–Markov scale-factor error (fraction) and its
+        correlation time (s); std 0: none.
     """
 
     bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -41,6 +58,11 @@ class SensorErrors:
     misalignment: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
     quantum: float = 0.0
     asym: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    bias_gm_std: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    bias_gm_tau: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
+    bias_rw: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    scale_gm_std: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    scale_gm_tau: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
 
     def matrix(self) -> np.ndarray:
         """``I + diag(scale) + misalignment``, shape (3, 3)."""
@@ -49,6 +71,68 @@ class SensorErrors:
     @property
     def noisy(self) -> bool:
         return bool(np.any(np.asarray(self.noise) != 0))
+
+    @property
+    def varying(self) -> bool:
+        """Whether a bias or scale-factor process is set (the errors change with time)."""
+        return bool(np.any(np.asarray(self.bias_gm_std) != 0)
+                    or np.any(np.asarray(self.bias_rw) != 0)
+                    or np.any(np.asarray(self.scale_gm_std) != 0))
+
+
+def _coefficients(std: np.ndarray, tau: np.ndarray, ts: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(a, s)`` (3,) of the exact discretisation ``x_k = a x_{k−1} + s w_k`` of a
+    first-order Gauss–Markov process of stationary std `std` and correlation time `tau`."""
+    a = np.exp(-ts / np.asarray(tau, dtype=float))
+    return a, np.asarray(std, dtype=float) * np.sqrt(1.0 - a * a)
+
+
+class _Recursion:
+    """One process ``x_k = a x_{k−1} + s w_k`` per axis across blocks, from its own
+    generator; `x` is the value before the next sample."""
+
+    def __init__(self, a: np.ndarray, s: np.ndarray, x0: np.ndarray,
+                 rng: np.random.Generator):
+        self.a, self.s, self.x, self.rng = a, s, x0, rng
+
+    def next(self, n: int) -> np.ndarray:
+        """The values during the next `n` samples (n, 3)."""
+        from scipy.signal import lfilter  # only where a process runs (start-up)
+
+        drive = self.rng.standard_normal((n, 3)) * self.s
+        out = np.empty((n, 3))
+        for i in range(3):
+            out[:, i], zf = lfilter([1.0], [1.0, -self.a[i]], drive[:, i],
+                                    zi=[self.a[i] * self.x[i]])
+        self.x = out[-1].copy() if n else self.x
+        return out
+
+
+class _Processes:
+    """The time-varying bias and scale factor of one triad (module docstring)."""
+
+    def __init__(self, err: SensorErrors, ts: float, rng: np.random.Generator):
+        g_bias, g_rw, g_scale = rng.spawn(3)
+        self.parts: list[tuple[str, _Recursion]] = []
+        if np.any(np.asarray(err.bias_gm_std) != 0):
+            a, s = _coefficients(err.bias_gm_std, err.bias_gm_tau, ts)
+            x0 = np.asarray(err.bias_gm_std, float) * g_bias.standard_normal(3)
+            self.parts.append(("bias", _Recursion(a, s, x0, g_bias)))
+        if np.any(np.asarray(err.bias_rw) != 0):
+            self.parts.append(("bias", _Recursion(np.ones(3), np.asarray(err.bias_rw, float)
+                                                  * np.sqrt(ts), np.zeros(3), g_rw)))
+        if np.any(np.asarray(err.scale_gm_std) != 0):
+            a, s = _coefficients(err.scale_gm_std, err.scale_gm_tau, ts)
+            x0 = np.asarray(err.scale_gm_std, float) * g_scale.standard_normal(3)
+            self.parts.append(("scale", _Recursion(a, s, x0, g_scale)))
+
+    def next(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """Bias (n, 3) and scale-factor error (n, 3) of the processes during the next n
+        samples (without the constant parts)."""
+        bias, scale = np.zeros((n, 3)), np.zeros((n, 3))
+        for kind, rec in self.parts:
+            (bias if kind == "bias" else scale)[:] += rec.next(n)
+        return bias, scale
 
 
 @dataclass(frozen=True)
@@ -60,7 +144,8 @@ class ImuErrors:
 class _Channel:
     """One triad's error state across blocks: its noise stream and quantiser remainder."""
 
-    def __init__(self, err: SensorErrors, ts: float, rng: np.random.Generator | None):
+    def __init__(self, err: SensorErrors, ts: float, rng: np.random.Generator | None,
+                 process_rng: np.random.Generator | None = None):
         self.err, self.ts, self.rng = err, ts, rng
         self.M = err.matrix().T
         self.unit = bool(np.all(self.M == np.eye(3)))  # no scale factor or misalignment
@@ -70,12 +155,18 @@ class _Channel:
         self.sigma = np.asarray(err.noise, dtype=float) * np.sqrt(ts)
         self.running = np.zeros(3)  # unquantised running sum
         self.total = np.zeros(3)  # quantised running sum already output
+        self.processes = None if process_rng is None else _Processes(err, ts, process_rng)
+        #: the processes' values of the last block, (bias (n, 3), scale (n, 3)), or None
+        self.last: tuple[np.ndarray, np.ndarray] | None = None
 
     def apply(self, ideal: np.ndarray) -> np.ndarray:
         err = self.err
         out = ideal + self.bias_ts if self.unit else ideal @ self.M + self.bias_ts
         if self.asym is not None:
             out += self.asym * np.abs(ideal)
+        if self.processes is not None:
+            bias, scale = self.last = self.processes.next(len(ideal))
+            out += bias * self.ts + scale * ideal
         if self.rng is not None:
             noise = self.rng.standard_normal(ideal.shape)
             noise *= self.sigma  # in place: one block-sized temporary fewer
@@ -108,8 +199,10 @@ class ErrorStream:
         self._a_start = None if not errors.accel.noisy else (
             copy.deepcopy(rng) if g_rng is not None else rng)
         self._g_drawn = 0  # gyro normals drawn so far
-        self.gyro = _Channel(errors.gyro, ts, g_rng)
-        self.accel = _Channel(errors.accel, ts, None)
+        varying = errors.gyro.varying or errors.accel.varying
+        g_proc, a_proc = rng.spawn(2) if varying else (None, None)
+        self.gyro = _Channel(errors.gyro, ts, g_rng, g_proc if errors.gyro.varying else None)
+        self.accel = _Channel(errors.accel, ts, None, a_proc if errors.accel.varying else None)
 
     def _accel_rng(self) -> np.random.Generator:
         """The accelerometer's generator, 3N normals after the start of the run."""

@@ -86,6 +86,12 @@ ARW_DPRH = Bound(0.0, 10.0, "°/√h", "more than the angle random walk of any g
                  "(consumer MEMS 0.1 … 1 °/√h)")
 VRW_UGRHZ = Bound(0.0, 1e4, "µg/√Hz", "more than the noise of any accelerometer "
                   "(consumer MEMS 100 … 300 µg/√Hz)")
+GYRO_BIAS_RW_DPHRH = Bound(0.0, 3.6e4, "°/h/√h", "a bias wandering by 10 °/s in an hour, "
+                           "beyond any gyro's rate random walk")
+ACCEL_BIAS_RW_UGRH = Bound(0.0, 1e5, "µg/√h", "a bias wandering by 0.1 g in an hour, beyond "
+                           "any accelerometer's random walk")
+CORRELATION_TIME_S = Bound(1e-3, 1e9, "s", "from a millisecond (white noise at any IMU rate) to "
+                           "30 years (a constant)")
 SENSOR_RATE_HZ = Bound(0.0, 1e6, "Hz", "1 MHz, beyond the output rate of any IMU")
 
 # ----------------------------------------------------------------------- filters

@@ -83,6 +83,37 @@ class Site(Model):
         return np.array([self.lat_deg * u.DEG, self.lon_deg * u.DEG, self.height_m])
 
 
+def _gm(std, tau, unit: float) -> tuple[np.ndarray, np.ndarray]:
+    """(std SI, τ s) of a Gauss–Markov section, or (zeros, inf) without one."""
+    if std is None:
+        return np.zeros(3), np.full(3, np.inf)
+    return _vec(std) * unit, _vec(tau)
+
+
+Tau = Annotated[PerAxis, B.CORRELATION_TIME_S]
+
+
+class GyroGaussMarkov(Model):
+    """A first-order Gauss–Markov gyro bias: stationary std and correlation time."""
+
+    std_dph: Annotated[Noise, B.GYRO_BIAS_DPH] = Field(description="stationary std, °/h")
+    tau_s: Tau = Field(description="correlation time, s")
+
+
+class AccelGaussMarkov(Model):
+    """A first-order Gauss–Markov accelerometer bias: stationary std and correlation time."""
+
+    std_ug: Annotated[Noise, B.ACCEL_BIAS_UG] = Field(description="stationary std, µg")
+    tau_s: Tau = Field(description="correlation time, s")
+
+
+class ScaleGaussMarkov(Model):
+    """A first-order Gauss–Markov scale-factor error: stationary std and correlation time."""
+
+    std_ppm: Annotated[Noise, B.SCALE_PPM] = Field(description="stationary std, ppm")
+    tau_s: Tau = Field(description="correlation time, s")
+
+
 class Gyro(Model):
     bias_dph: Annotated[PerAxis, B.GYRO_BIAS_DPH] = Field(
         default_factory=lambda: [0.0, 0.0, 0.0], description=B.GYRO_BIAS_DPH.range())
@@ -95,10 +126,24 @@ class Gyro(Model):
     asym_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
         default_factory=lambda: [0.0, 0.0, 0.0],
         description="asymmetric scale factor: + for positive input, − negative")
+    bias_gm: GyroGaussMarkov | None = Field(
+        None, description="a bias that wanders: first-order Gauss–Markov (added to bias_dph)")
+    bias_rw_dphrh: Annotated[Noise, B.GYRO_BIAS_RW_DPHRH] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description=f"rate random walk, the bias's std after t hours is this · √t; "
+                    f"{B.GYRO_BIAS_RW_DPHRH.range()}")
+    scale_gm: ScaleGaussMarkov | None = Field(
+        None, description="a scale-factor error that wanders (added to scale_ppm)")
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
     def to_si(self) -> SensorErrors:
+        gm = self.bias_gm
+        bias_std, bias_tau = _gm(None if gm is None else gm.std_dph,
+                                 None if gm is None else gm.tau_s, u.DPH)
+        sg = self.scale_gm
+        scale_std, scale_tau = _gm(None if sg is None else sg.std_ppm,
+                                   None if sg is None else sg.tau_s, u.PPM)
         return SensorErrors(
             bias=_vec(self.bias_dph) * u.DPH,
             noise=_vec(self.arw_dprh) * u.DPSH,
@@ -106,6 +151,9 @@ class Gyro(Model):
             misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
             quantum=self.quantum_arcsec * u.ARCSEC,
             asym=_vec(self.asym_ppm) * u.PPM,
+            bias_gm_std=bias_std, bias_gm_tau=bias_tau,
+            bias_rw=_vec(self.bias_rw_dphrh) * u.DPH / math.sqrt(u.HOUR),
+            scale_gm_std=scale_std, scale_gm_tau=scale_tau,
         )
 
 
@@ -121,10 +169,24 @@ class Accel(Model):
     asym_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
         default_factory=lambda: [0.0, 0.0, 0.0],
         description="asymmetric scale factor: + for positive input, − negative")
+    bias_gm: AccelGaussMarkov | None = Field(
+        None, description="a bias that wanders: first-order Gauss–Markov (added to bias_ug)")
+    bias_rw_ughrh: Annotated[Noise, B.ACCEL_BIAS_RW_UGRH] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description=f"acceleration random walk, the bias's std after t hours is this · √t; "
+                    f"{B.ACCEL_BIAS_RW_UGRH.range()}")
+    scale_gm: ScaleGaussMarkov | None = Field(
+        None, description="a scale-factor error that wanders (added to scale_ppm)")
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
     def to_si(self) -> SensorErrors:
+        gm = self.bias_gm
+        bias_std, bias_tau = _gm(None if gm is None else gm.std_ug,
+                                 None if gm is None else gm.tau_s, u.UG)
+        sg = self.scale_gm
+        scale_std, scale_tau = _gm(None if sg is None else sg.std_ppm,
+                                   None if sg is None else sg.tau_s, u.PPM)
         return SensorErrors(
             bias=_vec(self.bias_ug) * u.UG,
             noise=_vec(self.vrw_ugrhz) * u.UGPSHZ,
@@ -132,6 +194,9 @@ class Accel(Model):
             misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
             quantum=self.quantum_ugs * u.UG,
             asym=_vec(self.asym_ppm) * u.PPM,
+            bias_gm_std=bias_std, bias_gm_tau=bias_tau,
+            bias_rw=_vec(self.bias_rw_ughrh) * u.UG / math.sqrt(u.HOUR),
+            scale_gm_std=scale_std, scale_gm_tau=scale_tau,
         )
 
 
