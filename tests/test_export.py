@@ -164,3 +164,32 @@ def test_export_json(nav, tmp_path):
                               str(tmp_path / "a.csv"), "--json"])
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout)["output"] == str(tmp_path / "a.csv")
+
+
+@pytest.mark.parametrize("fmt", ["mat", "psins-avp"])
+def test_a_mat_export_is_the_same_bytes_on_another_day(nav, tmp_path, monkeypatch, fmt):
+    """scipy writes the date into a MAT file's header: two exports of one results file
+    differed. The header names gcalign and the source file instead."""
+    import time
+
+    outs = []
+    for day in ("Mon Jan  5 10:00:00 2026", "Tue Jan  6 11:11:11 2026"):
+        monkeypatch.setattr(time, "asctime", lambda *a, day=day: day)
+        outs.append(tmp_path / f"{len(outs)}.mat")
+        res = runner.invoke(app, ["export", str(nav), "--format", fmt, "-o", str(outs[-1])])
+        assert res.exit_code == 0, res.output
+    assert outs[0].read_bytes() == outs[1].read_bytes()
+    assert outs[0].read_bytes()[:116].rstrip() == b"MATLAB 5.0 MAT-file, written by gcalign " + \
+        __import__("gcalign").__version__.encode() + b" from nav.h5"
+    assert scipy.io.loadmat(outs[0])  # still a MAT file
+
+
+@pytest.mark.parametrize("fmt", ["csv", "mat", "i2nav-nav", "psins-avp"])
+def test_an_export_past_the_output_limit_is_refused_before_writing(nav, tmp_path, fmt,
+                                                                   monkeypatch):
+    """GCALIGN_MAX_OUTPUT_MB holds for export too (it wrote whatever the series made)."""
+    monkeypatch.setenv("GCALIGN_MAX_OUTPUT_MB", "0.001")
+    out = tmp_path / "x.out"
+    res = runner.invoke(app, ["export", str(nav), "--format", fmt, "-o", str(out)])
+    assert_bad_input(res, out, "GCALIGN_MAX_OUTPUT_MB", f"as {fmt}", "more than the limit")
+    assert not list(tmp_path.iterdir())

@@ -179,8 +179,8 @@ def test_a_sigterm_lost_in_a_finaliser_keeps_every_other_commit_from_its_name(
     from gcalign.app import export, plots
     from gcalign.app.batch.store import Journal
 
-    def csv_then_lost(tmp, *a):
-        Path(tmp).write_text("t\n0\n")
+    def csv_then_lost(fh, *a):
+        fh.write("t\n0\n")
         _lose_a_sigterm()
 
     def savefig_then_lost(self, p, **kw):
@@ -247,10 +247,9 @@ def test_the_guard_is_silent_once_a_failed_run_closed_its_file(tmp_path):
     run closed and deleted its temporary file; freeing them writes and truncates through the
     guard, which must then do nothing instead of raising (printed as "Exception ignored", a
     traceback on stderr: seen once in the SIGTERM test above)."""
-    raw = open(tmp_path / "t", "w+b")
-    guard = results._GuardedFile(raw)
+    guard = results._GuardedFile(os.open(tmp_path / "t", os.O_RDWR | os.O_CREAT))
     guard.write(b"abc")
-    raw.close()
+    guard.close()
     assert guard.write(b"more") == 4 and guard.truncate(10) == 10
     guard.flush()
     assert (guard.read(), guard.readinto(bytearray(2)), guard.seek(5), guard.tell()) == (

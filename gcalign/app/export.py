@@ -18,17 +18,21 @@ and KF-GINS's FRD/NED ``[roll, pitch, yaw]`` (z-y-x) are the same rotations abou
 physical axes, down being minus up: roll and pitch are equal and the NED yaw is the
 heading, ``−yaw`` (tested against the matrices). The week of the i2nav-nav file is 0
 unless given: gcalign's time is the recording's own (GNSS seconds of week for i2nav input).
-Files are written under a temporary name and renamed: nothing half-written is left.
+Files are written under a temporary name and renamed (:func:`gcalign.io.results.atomic_file`):
+nothing half-written is left, and a full disk is one line. The export's size is held against
+``GCALIGN_MAX_OUTPUT_MB`` before anything is written. A MAT file's header names gcalign and
+the source file where scipy would write the date, so one results file always exports to the
+same bytes.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 
-from gcalign.errors import ScenarioError, check_terminated
+from gcalign import __version__, limits
+from gcalign.errors import ScenarioError
 from gcalign.io import results
 
 FORMATS = {"csv": ".csv", "mat": ".mat", "i2nav-nav": ".nav", "psins-avp": ".avp.mat"}
@@ -63,37 +67,51 @@ def export(path, fmt: str, out=None, group: str | None = None, week: int = 0) ->
     out = results.check_output(default_output(path, fmt) if out is None else out)
     if out.resolve() == path.resolve():
         raise ScenarioError(f"--output: {out} is the results file itself; give another name")
+    cols = results.columns(path, group) if fmt == "csv" else None
+    _check_size(fmt, data, path, group)
     writer = {"csv": _csv, "mat": _mat, "i2nav-nav": _i2nav_nav, "psins-avp": _psins_avp}[fmt]
-    fd, tmp = results.make_temp(out)
-    os.close(fd)
-    try:
-        writer(tmp, path, group, data, week)
-        check_terminated()  # a SIGTERM whose exception a finaliser swallowed
-        os.replace(tmp, out)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    with results.atomic_file(out, "w" if fmt in ("csv", "i2nav-nav") else "wb") as fh:
+        writer(fh, path, group, data if cols is None else cols, week)
     return out
 
 
-def _csv(tmp: Path, path: Path, group: str, data, week: int) -> None:
-    cols = results.columns(path, group)
+#: Bytes per value as written: 17 significant digits and a separator in text, float64 in MAT
+_VALUE_BYTES = {"csv": 25, "i2nav-nav": 25, "mat": 8, "psins-avp": 8}
+
+
+def _check_size(fmt: str, data, path: Path, group: str) -> None:
+    """The export's size against ``GCALIGN_MAX_OUTPUT_MB`` before anything is written
+    (uncompressed: a MAT file's compression is not known before it is done)."""
+    values = (11 * len(data["t"][0]) if fmt == "i2nav-nav" else
+              sum(int(np.asarray(a).size) for a, _ in data.values()))
+    limits.MAX_OUTPUT_MB.check(values * _VALUE_BYTES[fmt] / 2**20,
+                               f"export of {path} /{group} as {fmt}")
+
+
+def _csv(fh, path: Path, group: str, cols, week: int) -> None:
     header = ",".join(f"{name} ({units})" for name, _, units in cols)
-    with open(tmp, "w", encoding="utf-8") as fh:
-        fh.write(f"# gcalign export of {path}, group /{group}; SI as stored, unit of each "
-                 "column in its name\n")
-        fh.write(header + "\n")
-        np.savetxt(fh, np.column_stack([a for _, a, _ in cols]), fmt="%.17g", delimiter=",")
+    fh.write(f"# gcalign export of {path}, group /{group}; SI as stored, unit of each "
+             "column in its name\n")
+    fh.write(header + "\n")
+    np.savetxt(fh, np.column_stack([a for _, a, _ in cols]), fmt="%.17g", delimiter=",")
 
 
-def _mat(tmp: Path, path: Path, group: str, data, week: int) -> None:
+def _savemat(fh, variables: dict, source: Path) -> None:
+    """``scipy.io.savemat`` with a header that says what wrote the file, in place of the
+    date scipy writes there: the same results file exports to the same bytes."""
     import scipy.io
 
+    scipy.io.savemat(fh, variables, do_compression=True)
+    text = f"MATLAB 5.0 MAT-file, written by gcalign {__version__} from {source.name}"
+    header = text.encode("ascii", "replace")[:116].ljust(116, b" ")
+    fh.seek(0)
+    fh.write(header)  # the first 116 bytes are free text (MAT-file format, level 5)
+
+
+def _mat(fh, path: Path, group: str, data, week: int) -> None:
     arrays = {name: a for name, (a, _) in data.items()}
     units = {name: u for name, (_, u) in data.items()}
-    with open(tmp, "wb") as fh:
-        scipy.io.savemat(fh, {**arrays, "units": units, "source": str(path), "group": group},
-                         do_compression=True)
+    _savemat(fh, {**arrays, "units": units, "source": str(path), "group": group}, path)
 
 
 def _nav(data, group: str, path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -105,19 +123,16 @@ def _nav(data, group: str, path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return data["t"][0], data["att"][0], data["v_n"][0], data["pos"][0]
 
 
-def _i2nav_nav(tmp: Path, path: Path, group: str, data, week: int) -> None:
+def _i2nav_nav(fh, path: Path, group: str, data, week: int) -> None:
     t, att, v, pos = _nav(data, group, path)
     heading = np.degrees(-att[:, 2])
     heading = (heading + 180.0) % 360.0 - 180.0
     rows = np.column_stack([np.full(len(t), week), t, np.degrees(pos[:, 0]),
                             np.degrees(pos[:, 1]), pos[:, 2], v[:, 1], v[:, 0], 0.0 - v[:, 2],
                             np.degrees(att[:, 1]), np.degrees(att[:, 0]), heading])
-    np.savetxt(tmp, rows, fmt=["%d"] + ["%.17g"] * 10)
+    np.savetxt(fh, rows, fmt=["%d"] + ["%.17g"] * 10)
 
 
-def _psins_avp(tmp: Path, path: Path, group: str, data, week: int) -> None:
-    import scipy.io
-
+def _psins_avp(fh, path: Path, group: str, data, week: int) -> None:
     t, att, v, pos = _nav(data, group, path)
-    with open(tmp, "wb") as fh:
-        scipy.io.savemat(fh, {"avp": np.column_stack([att, v, pos, t])}, do_compression=True)
+    _savemat(fh, {"avp": np.column_stack([att, v, pos, t])}, path)

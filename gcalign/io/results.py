@@ -161,87 +161,183 @@ def write_error(path: Path, err: BaseException) -> GcalignError:
     return ScenarioError(f"--output: cannot write {path}: {reason}")
 
 
-def _from_h5py(err: BaseException) -> bool:
-    """Whether `err` was raised inside h5py (a write that the file system refused)."""
-    tb = err.__traceback__
-    last = None
-    while tb is not None:
-        last = tb.tb_frame.f_code.co_filename
-        tb = tb.tb_next
-    return last is not None and f"{os.sep}h5py{os.sep}" in last
-
-
 class _GuardedFile:
-    """The temporary file as HDF5 sees it (h5py's ``fileobj`` driver): a refused write
-    (full disk, ``ulimit -f``) is recorded and reported as success, so HDF5 never meets an
-    error halfway, which it reports only while freeing objects, or by crashing when the file
-    is closed. :func:`atomic_h5` raises the recorded error once HDF5 is done. Writing through
-    the descriptor that mkstemp created also means no other file can be written instead."""
+    """The temporary file as HDF5 sees it (h5py's ``fileobj`` driver), written with
+    ``pwrite``/``pread`` through the descriptor that mkstemp created (so no other file can be
+    written instead).
 
-    def __init__(self, raw):
-        self.raw = raw
+    A write the file system refuses (full disk, ``ulimit -f``) is recorded and reported to
+    HDF5 as success: HDF5 reports an error met halfway only while freeing objects, or by
+    crashing. From then on the file as HDF5 sees it is the part on disk overlaid by the
+    pages written since (held in memory), so that what HDF5 reads back is what it wrote: it
+    read zero bytes of metadata it believed written and crashed (``observability`` under
+    ``ulimit -f 256``: a segmentation fault). :func:`atomic_h5` raises the recorded error
+    once HDF5 is done, and :func:`check_writes`, called by every writer of this module
+    (:func:`put`, :class:`Series`, :func:`write_header`), stops the run at its next write,
+    so that the pages held stay about one dataset. Reads past the end are zeros, as HDF5's
+    own POSIX driver gives them."""
+
+    PAGE = 1 << 16
+
+    def __init__(self, fd: int):
+        self.fd = fd
+        self.pos = 0
         self.error: OSError | None = None
+        self.closed = False
+        self._pages: dict[int, bytearray] = {}
+        self._size = 0  # the file's size as HDF5 sees it, once a write was refused
 
-    # Once a failed run has closed (and deleted) the file, HDF5 may still free objects
-    # that write or truncate through here (a SIGTERM landing inside h5py): nothing to do
-    # then, and an exception would only be printed as "Exception ignored".
+    # Once a failed run has closed (and deleted) the file, HDF5 may still free objects that
+    # write or truncate through here (a SIGTERM landing inside h5py): nothing to do then,
+    # and an exception would only be printed as "Exception ignored".
+
+    def close(self) -> None:
+        if not self.closed:
+            self.closed = True
+            os.close(self.fd)
+
+    def _refuse(self, err: OSError) -> None:
+        if self.error is None:
+            self.error = err
+            self._size = os.fstat(self.fd).st_size
 
     def write(self, b) -> int:
-        if self.error is None and not self.raw.closed:
+        data = memoryview(b).cast("B")
+        n = len(data)
+        if self.closed:
+            return n
+        done = 0
+        while self.error is None and done < n:
             try:
-                return self.raw.write(b)
+                k = os.pwrite(self.fd, data[done:], self.pos + done)
             except OSError as err:
-                self.error = err
-        return len(b)
+                self._refuse(err)
+                break
+            if k <= 0:
+                self._refuse(OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)))
+                break
+            done += k
+        if done < n:
+            self._hold(self.pos + done, data[done:])
+        self.pos += n
+        return n
+
+    def _page(self, k: int) -> bytearray:
+        page = self._pages.get(k)
+        if page is None:
+            page = bytearray(self.PAGE)
+            self._from_disk(k * self.PAGE, memoryview(page))
+            self._pages[k] = page
+        return page
+
+    def _from_disk(self, offset: int, out: memoryview) -> int:
+        """Read into `out` from the disk at `offset`; zeros past the end (or if the disk
+        refuses). Returns len(out)."""
+        done = 0
+        while done < len(out):
+            try:
+                k = os.preadv(self.fd, [out[done:]], offset + done)
+            except OSError:
+                k = 0
+            if k <= 0:
+                out[done:] = bytes(len(out) - done)
+                break
+            done += k
+        return len(out)
+
+    def _hold(self, offset: int, data: memoryview) -> None:
+        end = offset + len(data)
+        while offset < end:
+            k, at = divmod(offset, self.PAGE)
+            m = min(self.PAGE - at, end - offset)
+            self._page(k)[at:at + m] = data[:m]
+            data = data[m:]
+            offset += m
+        self._size = max(self._size, end)
+
+    def readinto(self, b) -> int:
+        out = memoryview(b).cast("B")
+        if self.closed:
+            return 0
+        n = len(out)
+        if self.error is None:
+            self._from_disk(self.pos, out)
+        else:
+            offset, done = self.pos, 0
+            while done < n:
+                k, at = divmod(offset + done, self.PAGE)
+                m = min(self.PAGE - at, n - done)
+                page = self._pages.get(k)
+                if page is None:
+                    self._from_disk(offset + done, out[done:done + m])
+                else:
+                    out[done:done + m] = page[at:at + m]
+                done += m
+            past = min(max(self._size - offset, 0), n)  # what lies past the end is zeros
+            out[past:] = bytes(n - past)
+        self.pos += n
+        return n
+
+    def read(self, n=-1) -> bytes:
+        if self.closed:
+            return b""
+        if n is None or n < 0:
+            n = max(self._end() - self.pos, 0)
+        buf = bytearray(n)
+        self.readinto(buf)
+        return bytes(buf)
+
+    def _end(self) -> int:
+        return self._size if self.error is not None else os.fstat(self.fd).st_size
+
+    def seek(self, offset, whence=0) -> int:
+        if self.closed:
+            return 0
+        base = {0: 0, 1: self.pos, 2: self._end()}[whence]
+        self.pos = base + offset
+        return self.pos
+
+    def tell(self) -> int:
+        return 0 if self.closed else self.pos
 
     def truncate(self, size=None):
-        if self.raw.closed:
+        size = self.pos if size is None else size
+        if self.closed:
             return size
-        try:
-            return self.raw.truncate(size)
-        except OSError as err:
-            self.error = self.error or err
-            return size
+        if self.error is None:
+            try:
+                os.ftruncate(self.fd, size)
+                return size
+            except OSError as err:
+                self._refuse(err)
+        self._size = size
+        for k in [k for k in self._pages if k * self.PAGE >= size]:
+            del self._pages[k]
+        k, at = divmod(size, self.PAGE)
+        if k in self._pages:  # a later write past a gap must find zeros there
+            self._pages[k][at:] = bytes(self.PAGE - at)
+        return size
 
     def flush(self) -> None:
-        if self.raw.closed:
-            return
-        try:
-            self.raw.flush()
-        except OSError as err:
-            self.error = self.error or err
+        """Nothing is buffered here (``pwrite``)."""
 
-    # A buffered file flushes what it holds before it seeks, reads or tells, so a refused
-    # write can surface in any of them (seen with modulate's many small writes under
-    # ``ulimit -f``: HDF5 met the error in a seek and crashed): each records it too.
+    @property
+    def held_bytes(self) -> int:
+        """Memory held for HDF5 since a write was refused."""
+        return len(self._pages) * self.PAGE
 
-    def read(self, n=-1):
-        try:
-            return b"" if self.raw.closed else self.raw.read(n)
-        except OSError as err:
-            self.error = self.error or err
-            return b""
 
-    def readinto(self, b):
-        try:
-            return 0 if self.raw.closed else self.raw.readinto(b)
-        except OSError as err:
-            self.error = self.error or err
-            return 0
+#: (path, guard) of the results files open for writing in this process (atomic_h5)
+_WRITING: list[tuple[Path, _GuardedFile]] = []
 
-    def seek(self, offset, whence=0):
-        try:
-            return 0 if self.raw.closed else self.raw.seek(offset, whence)
-        except OSError as err:
-            self.error = self.error or err
-            return offset if whence == 0 else 0
 
-    def tell(self):
-        try:
-            return 0 if self.raw.closed else self.raw.tell()
-        except OSError as err:
-            self.error = self.error or err
-            return 0
+def check_writes() -> None:
+    """Stop a run whose results file the file system refused: the write error (one line,
+    exit 1) if a file open by :func:`atomic_h5` met one. Every writer of this module asks
+    before it writes, so that a full disk ends the run at its next dataset, not after it."""
+    for path, guard in _WRITING:
+        if guard.error is not None:
+            raise write_error(path, guard.error)
 
 
 @contextmanager
@@ -251,41 +347,111 @@ def atomic_h5(path: Path) -> Iterator[h5py.File]:
     An interrupted or failed run therefore never leaves a truncated file under the final
     name, and never a temporary file either (a SIGKILL's is removed by the next run into
     that folder). The temporary file is created exclusively (:func:`make_temp`) and written
-    through its own descriptor; a write refused by the file system (full disk, ``ulimit
-    -f``) becomes one line (:func:`write_error`).
+    through its own descriptor (:class:`_GuardedFile`); a write refused by the file system
+    (full disk, ``ulimit -f``) becomes one line (:func:`write_error`), whatever HDF5 was
+    doing when it met it.
     """
     path = check_output(path)
     fd, tmp = make_temp(path)
-    raw = guard = f = None
+    guard: _GuardedFile | None = None
+    f = None
     try:  # everything after the file exists, so that a SIGTERM anywhere removes it
-        raw = os.fdopen(fd, "w+b")
-        guard = _GuardedFile(raw)
+        guard = _GuardedFile(fd)
+        _WRITING.append((path, guard))
         f = h5py.File(guard, "w")
         yield f
         f.close()
         f = None
-        guard.flush()
-        raw.close()
+        guard.close()
         if guard.error is not None:
             raise guard.error
         check_terminated()  # a SIGTERM whose exception a finaliser swallowed
         os.replace(tmp, path)
     except BaseException as err:
-        if raw is None:
+        try:
+            if f is not None:
+                f.close()  # HDF5 flushes into the guard: consistent even after a refusal
+        except Exception:  # noqa: BLE001 - the file is deleted anyway
+            pass
+        if guard is None:
             os.close(fd)
-        for closing in (f, raw):
-            try:
-                if closing is not None:
-                    closing.close()
-            except Exception:  # noqa: BLE001 - the file is deleted anyway
-                pass
+        else:
+            guard.close()
         tmp.unlink(missing_ok=True)
-        guard_error = guard.error if guard is not None else None
-        refused = guard_error if guard_error is not None else err
-        if guard_error is not None or (isinstance(err, OSError) and (
-                _from_h5py(err) or err.errno in _WRITE_ERRNOS)):
-            if not isinstance(err, (KeyboardInterrupt, SystemExit)):
-                raise write_error(path, refused) from None
+        refused = guard.error if guard is not None else None
+        if isinstance(err, (GcalignError, KeyboardInterrupt, SystemExit)):
+            raise
+        if refused is not None:
+            raise write_error(path, refused) from None
+        if isinstance(err, OSError) and err.errno in _WRITE_ERRNOS:
+            raise write_error(path, err) from None
+        raise
+    finally:
+        if guard is not None:
+            _WRITING.remove((path, guard))
+
+
+class _RefusableStream:
+    """A file of :func:`atomic_file` as its writers see it: a write, flush or close that the
+    file system refuses raises :func:`write_error` (one line), not an OSError that would
+    read as a bug."""
+
+    def __init__(self, fh, path: Path):
+        self._fh = fh
+        self._path = path
+
+    def _call(self, name: str, *args):
+        try:
+            return getattr(self._fh, name)(*args)
+        except OSError as err:
+            raise write_error(self._path, err) from None
+
+    def write(self, data):
+        return self._call("write", data)
+
+    def flush(self) -> None:
+        self._call("flush")
+
+    def close(self) -> None:
+        self._call("close")
+
+    def seek(self, *args):
+        return self._call("seek", *args)
+
+    def tell(self):
+        return self._call("tell")
+
+    def __getattr__(self, name: str):
+        return getattr(self._fh, name)
+
+
+@contextmanager
+def atomic_file(path, mode: str = "wb") -> Iterator:
+    """A results file other than HDF5 (export's CSV, MAT and text files), written as
+    :func:`atomic_h5` writes HDF5: under a temporary name made by :func:`make_temp`, through
+    its descriptor, renamed on success and removed on any failure; a write the file system
+    refuses (full disk, ``ulimit -f``) is one line (:func:`write_error`). `mode` is ``wb``
+    or ``w`` (UTF-8 text)."""
+    path = check_output(path)
+    fd, tmp = make_temp(path)
+    try:
+        fh = os.fdopen(fd, mode, encoding=None if "b" in mode else "utf-8")
+    except BaseException:
+        os.close(fd)
+        tmp.unlink(missing_ok=True)
+        raise
+    stream = _RefusableStream(fh, path)
+    try:
+        yield stream
+        stream.close()
+        check_terminated()  # a SIGTERM whose exception a finaliser swallowed
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            fh.close()
+        except OSError:
+            pass
+        tmp.unlink(missing_ok=True)
         raise
 
 
@@ -308,6 +474,7 @@ def finite_summary(summary, where: str) -> None:
 
 def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None, **attrs):
     """Write one dataset with its units (and frame) attributes."""
+    check_writes()
     ds = group.create_dataset(name, data=np.asarray(data))
     ds.attrs["units"] = units
     if frame:
@@ -367,6 +534,7 @@ class Series:
         held = self._held[name]
         if not held:
             return
+        check_writes()
         rows = np.concatenate(held) if len(held) > 1 else held[0]
         n = len(rows) - len(rows) % self.chunk_rows if whole_chunks else len(rows)
         ds = self._datasets[name]
@@ -379,6 +547,7 @@ class Series:
 
 def write_header(f: h5py.File, kind: str, scenario_yaml: str, seed: int | None, summary: dict):
     """Root attributes; GcalignError if the summary holds a number that is not finite."""
+    check_writes()
     finite_summary(summary, kind)
     if seed is not None and not 0 <= int(seed) <= SEED_MAX:
         raise ScenarioError(f"seed: must be within [0, 2^63), got {_short(seed)}")

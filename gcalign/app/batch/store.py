@@ -183,8 +183,15 @@ class OutputLock:
             except FileNotFoundError:
                 same = False
             if same:
-                os.ftruncate(fd, 0)
-                os.write(fd, f"{os.getpid()}\n".encode())
+                try:  # the holder's pid, for the message of a second batch
+                    os.ftruncate(fd, 0)
+                    os.write(fd, f"{os.getpid()}\n".encode())
+                except OSError as err:  # a full disk: no lock file left either
+                    self.path.unlink(missing_ok=True)
+                    os.close(fd)
+                    from gcalign.io.results import write_error
+
+                    raise write_error(self.output, err) from None
                 self.fd = fd
                 _HELD_LOCKS[fd] = self.path.resolve()
                 return self
