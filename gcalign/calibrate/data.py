@@ -282,7 +282,23 @@ def flight_from_ideal(truth: Truth, ideal: ImuData, x_true: np.ndarray, errors: 
     start = NavState.from_euler(traj.att[0], traj.v_n[0], traj.pos[0])
     return FlightData(t=traj.t, dtheta=dtheta, dv=dv, start=perturb(start, x_true),
                       ref_v_n=traj.v_n, ref_pos=traj.pos, segments=segments, truth=traj,
-                      x_true=np.array(x_true, dtype=float), earth=earth)
+                      x_true=np.array(x_true, dtype=float), earth=earth,
+                      sensor_truth=_sensor_truth(stream, x_true, len(dtheta), subsamples))
+
+
+def _sensor_truth(stream, x_true: np.ndarray, steps: int, n: int) -> np.ndarray | None:
+    """(steps+1, 12) the true sensor errors during the last IMU increment of each navigation
+    step (row 0: the first increment) when a process makes them vary, else None."""
+    g, a = stream.gyro.last, stream.accel.last
+    if g is None and a is None:
+        return None
+    rows = np.concatenate([[0], np.arange(1, steps + 1) * n - 1])
+    out = np.tile(np.asarray(x_true, float)[9:21], (steps + 1, 1))
+    for part, cols in ((g, (slice(0, 3), slice(6, 9))), (a, (slice(3, 6), slice(9, 12)))):
+        if part is not None:
+            out[:, cols[0]] += part[0][rows]
+            out[:, cols[1]] += part[1][rows]
+    return out
 
 
 def motion_spans(motion: MotionType, t_end: float | None = None) -> tuple[Span, ...]:
