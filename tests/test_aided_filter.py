@@ -11,7 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from aided_cases import LEVER, settings, vehicle
+from aided_cases import settings, vehicle
 from scipy.stats import chi2
 
 from gcalign.calibrate import calibrate

@@ -29,7 +29,7 @@ from gcalign.nav.rotation import (
     rotvec_to_quat,
 )
 from gcalign.nav.strapdown import NavState
-from gcalign.sim.errors import ImuErrors, SensorErrors
+from gcalign.sim.errors import ErrorStream, ImuErrors, SensorErrors
 from gcalign.sim.imu import ImuData
 from gcalign.sim.motions import MotionType, Truth
 from gcalign.units import ARCMIN, ARCSEC, DPH, PPM, UG
@@ -273,8 +273,6 @@ def flight_from_ideal(truth: Truth, ideal: ImuData, x_true: np.ndarray, errors: 
     increments are combined `subsamples` to a navigation step, and the INS starts from the
     truth perturbed by ``x_true[:9]``. The Monte Carlo path: simulate once, corrupt per run.
     """
-    from gcalign.sim.errors import ErrorStream
-
     stream = ErrorStream(imu_errors(x_true, errors), ideal.ts, rng, len(ideal.dtheta))
     dtheta, dv = combine_increments(*stream.apply(ideal.dtheta, ideal.dv), subsamples)
     traj = trajectory(truth.t, truth.att, truth.v_n, truth.pos, ideal.dtheta, ideal.dv,
@@ -286,7 +284,8 @@ def flight_from_ideal(truth: Truth, ideal: ImuData, x_true: np.ndarray, errors: 
                       sensor_truth=_sensor_truth(stream, x_true, len(dtheta), subsamples))
 
 
-def _sensor_truth(stream, x_true: np.ndarray, steps: int, n: int) -> np.ndarray | None:
+def _sensor_truth(stream: ErrorStream, x_true: np.ndarray, steps: int,
+                  n: int) -> np.ndarray | None:
     """(steps+1, 12) the true sensor errors during the last IMU increment of each navigation
     step (row 0: the first increment) when a process makes them vary, else None."""
     g, a = stream.gyro.last, stream.accel.last
