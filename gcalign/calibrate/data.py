@@ -18,6 +18,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from gcalign.calibrate.fixes import Fixes
 from gcalign.estimation.ins_error import DB, DKA, DKG, DP, DV, EB, N_STATES, PHI
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import (
@@ -28,7 +29,7 @@ from gcalign.nav.rotation import (
     rotvec_to_quat,
 )
 from gcalign.nav.strapdown import NavState
-from gcalign.sim.errors import ImuErrors, SensorErrors
+from gcalign.sim.errors import ErrorStream, ImuErrors, SensorErrors
 from gcalign.sim.imu import ImuData
 from gcalign.sim.motions import MotionType, Truth
 from gcalign.units import ARCMIN, ARCSEC, DPH, PPM, UG
@@ -94,8 +95,12 @@ class FlightData:
 
     t : (N+1,) navigation times, s. dtheta, dv : (N, 3) measured increments, rad, m/s.
     start : the INS state at ``t[0]`` (truth plus the initial errors in a simulation).
-    ref_v_n, ref_pos : (N+1, 3) what the aiding source measures without noise: the true
-        velocity and position (simulated DGNSS), or zero velocity and the site (ZUPT).
+    ref_v_n, ref_pos : (N+1, 3) what the aiding source measures without noise at every
+        navigation sample: the true velocity and position (simulated DGNSS), or zero
+        velocity and the site (ZUPT); the filter takes them every filter period. None with
+        `fixes`.
+    fixes : measurements at their own epochs (a recording's GNSS fixes, velocities), or
+        None: the filter updates at each fix and only predicts between them.
     segments : the manoeuvres, for tables.
     truth : the true trajectory (observability, NEES), or None for recorded data.
     x_true : (21,) the true initial navigation errors and IMU errors (state order of
@@ -105,21 +110,26 @@ class FlightData:
         aiding measures (a GNSS antenna), from the IMU in body axes (x right, y forward,
         z up), m; zero: the IMU itself. The filter applies them
         (:func:`gcalign.estimation.ins_error.lever_arm_terms`); ref_v_n, ref_pos are then
-        the antenna's.
+        the antenna's. (Fixes carry their own lever arms.)
+    sensor_truth : (N+1, 12) the true sensor errors during the increment ending at each
+        sample (row 0: at the start) when they vary (Gauss–Markov, random walk), or None
+        (the constants of ``x_true``).
     """
 
     t: np.ndarray
     dtheta: np.ndarray
     dv: np.ndarray
     start: NavState
-    ref_v_n: np.ndarray
-    ref_pos: np.ndarray
+    ref_v_n: np.ndarray | None
+    ref_pos: np.ndarray | None
     segments: tuple[Span, ...] = ()
     truth: Trajectory | None = None
     x_true: np.ndarray | None = None
     earth: EarthModel = field(default=WGS84)
     lever_arm_v_b: np.ndarray = field(default_factory=lambda: np.zeros(3))
     lever_arm_p_b: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    fixes: Fixes | None = None
+    sensor_truth: np.ndarray | None = None
 
     @property
     def ts(self) -> float:
@@ -143,10 +153,15 @@ class FlightData:
         lo, hi = float(self.t[a]), float(self.t[b - 1])
         segs = tuple(Span(s.name, max(s.start, lo), min(s.end, hi))
                      for s in self.segments if s.end > lo + 1e-9 and s.start < hi - 1e-9)
+        if self.fixes is not None:
+            raise ValueError("between: cut the data before making its fixes")
+        assert self.ref_v_n is not None and self.ref_pos is not None
         return replace(self, t=self.t[a:b], dtheta=self.dtheta[a:b - 1], dv=self.dv[a:b - 1],
                        start=start, ref_v_n=self.ref_v_n[a:b], ref_pos=self.ref_pos[a:b],
                        segments=segs,
-                       truth=None if self.truth is None else self.truth.between(lo, hi))
+                       truth=None if self.truth is None else self.truth.between(lo, hi),
+                       sensor_truth=None if self.sensor_truth is None
+                       else self.sensor_truth[a:b])
 
 
 def proposed_truth() -> np.ndarray:
@@ -258,8 +273,6 @@ def flight_from_ideal(truth: Truth, ideal: ImuData, x_true: np.ndarray, errors: 
     increments are combined `subsamples` to a navigation step, and the INS starts from the
     truth perturbed by ``x_true[:9]``. The Monte Carlo path: simulate once, corrupt per run.
     """
-    from gcalign.sim.errors import ErrorStream
-
     stream = ErrorStream(imu_errors(x_true, errors), ideal.ts, rng, len(ideal.dtheta))
     dtheta, dv = combine_increments(*stream.apply(ideal.dtheta, ideal.dv), subsamples)
     traj = trajectory(truth.t, truth.att, truth.v_n, truth.pos, ideal.dtheta, ideal.dv,
@@ -267,7 +280,24 @@ def flight_from_ideal(truth: Truth, ideal: ImuData, x_true: np.ndarray, errors: 
     start = NavState.from_euler(traj.att[0], traj.v_n[0], traj.pos[0])
     return FlightData(t=traj.t, dtheta=dtheta, dv=dv, start=perturb(start, x_true),
                       ref_v_n=traj.v_n, ref_pos=traj.pos, segments=segments, truth=traj,
-                      x_true=np.array(x_true, dtype=float), earth=earth)
+                      x_true=np.array(x_true, dtype=float), earth=earth,
+                      sensor_truth=_sensor_truth(stream, x_true, len(dtheta), subsamples))
+
+
+def _sensor_truth(stream: ErrorStream, x_true: np.ndarray, steps: int,
+                  n: int) -> np.ndarray | None:
+    """(steps+1, 12) the true sensor errors during the last IMU increment of each navigation
+    step (row 0: the first increment) when a process makes them vary, else None."""
+    g, a = stream.gyro.last, stream.accel.last
+    if g is None and a is None:
+        return None
+    rows = np.concatenate([[0], np.arange(1, steps + 1) * n - 1])
+    out = np.tile(np.asarray(x_true, float)[9:21], (steps + 1, 1))
+    for part, cols in ((g, (slice(0, 3), slice(6, 9))), (a, (slice(3, 6), slice(9, 12)))):
+        if part is not None:
+            out[:, cols[0]] += part[0][rows]
+            out[:, cols[1]] += part[1][rows]
+    return out
 
 
 def motion_spans(motion: MotionType, t_end: float | None = None) -> tuple[Span, ...]:

@@ -1,22 +1,32 @@
-"""The 21-state calibration Kalman filter over a navigation run (seed 002 §2, §5.2; spec §2).
+"""The 21-state calibration Kalman filter over a navigation run (seed 002 §2, §5.2; spec §2),
+which is also the loosely coupled GNSS/INS filter of a recording with aiding files.
 
 Navigation runs at the data rate (25 Hz in the seed) with the sensors compensated by the
-current estimates; the filter predicts and updates at ``filter_rate`` (1 Hz), which must
-divide the navigation rate. Per filter step of S navigation steps:
+current estimates. The filter steps from one epoch to the next: on the seed's schedule
+every ``1/filter_rate`` (1 Hz, dividing the navigation rate) with the reference at that
+sample; with measured fixes (:class:`gcalign.calibrate.fixes.Fixes`), to the navigation
+sample that closes each fix's time, and where no fix comes within a filter period (an
+outage), predict-only steps of one filter period. Per step:
 
 1. compensate the increments (PSINS ``ω = Kg ω̃ − ε``, per axis, written in the sensor
    model's own parameters): ``Δθ = (Δθ̃ − ε̂ ts)/(1 + δK̂g)``, ``Δv = (Δṽ − ∇̂ ts)/(1 + δK̂a)``;
-2. navigate the S steps with :func:`gcalign.nav.strapdown.navigate` from the corrected state;
+2. navigate the step with :func:`gcalign.nav.strapdown.navigate` from the corrected state;
 3. Φ, Q_d from F (:func:`gcalign.estimation.ins_error.error_matrix`) at the middle of each
    navigation step, either accumulated step by step (default) or by Van Loan on the mean F
    over the step (spec §2 [X] offers both; on a 9°/s turn the accumulated Φ matches the
    nonlinear mechanisation to 1e-4 of the one-second change and Van Loan on the mean F
-   to 1e-2, ``tests/test_ins_error.py``);
-4. predict, and update in Joseph form (:func:`gcalign.estimation.kalman.update`) with
-   z = INS − reference (+ noise): horizontal velocity, horizontal position in metres, or both;
-   an aiding antenna at a lever arm (``FlightData.lever_arm_v_b``, ``lever_arm_p_b``) adds
-   the INS's prediction of the antenna's offset to z and its φ, ε, δKg columns to H
-   (:func:`gcalign.estimation.ins_error.lever_arm_terms`, where the terms are derived);
+   to 1e-2, ``tests/test_ins_error.py``); sensor states that are Gauss–Markov processes or
+   random walks add their own decay and noise
+   (:func:`gcalign.estimation.ins_error.with_processes`), and in closed loop the
+   parameters in force decay as their model says;
+4. predict, and with a measurement update in Joseph form
+   (:func:`gcalign.estimation.kalman.update`) with z = INS − reference (+ noise in a
+   simulation): velocity, position in metres, or both; horizontal (the seed) or with the
+   vertical components; a fix taken between two navigation samples is compared with the
+   INS interpolated to its time; R from the fix's own σ when it has them; an aiding antenna
+   at a lever arm adds the INS's prediction of the antenna's offset to z and its φ, ε,
+   δKg columns to H (:func:`gcalign.estimation.ins_error.lever_arm_terms`, where the terms
+   are derived);
 5. closed loop (default): feed the estimate back and reset it, ``C_nb ← exp([φ̂×]) C_nb``,
    ``v −= δv̂``, ``p −= δp̂``, and for the sensors the exact composition
    ``ε̂ += (1 + δK̂g) x_ε``, ``1 + δK̂g ← (1 + δK̂g)(1 + x_δKg)`` (likewise ∇, δKa), so that
@@ -25,19 +35,35 @@ divide the navigation rate. Per filter step of S navigation steps:
    Feed-forward: the INS runs free and the state is not reset.
 
 The filter's state is then always the error of the current INS solution and of the
-compensation in force; with the truth known, the same quantity gives NEES.
+compensation in force; with the truth known, the same quantity gives NEES. The solution at
+every navigation sample goes out as the run goes (``on_rows``); the run keeps only what
+each epoch needs.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from gcalign.calibrate.data import FlightData, Trajectory
+from gcalign.calibrate.fixes import Fixes
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
-from gcalign.estimation.ins_error import DB, DKA, DKG, DP, DV, EB, IMU, N_STATES, NAV, PHI
+from gcalign.estimation.ins_error import (
+    DB,
+    DKA,
+    DKG,
+    DP,
+    DV,
+    EB,
+    IMU,
+    N_STATES,
+    NAV,
+    PHI,
+    SensorProcesses,
+)
 from gcalign.estimation.kalman import nees as nees_of
 from gcalign.estimation.kalman import predict, rts, update, van_loan
 from gcalign.nav.earth import WGS84, EarthModel
@@ -69,6 +95,10 @@ class Settings:
     feedback : closed loop (True) or feed-forward (False).
     gnss_noise : add measurement noise of σ (sigma_v, sigma_p) to the reference.
     smoother : also run the RTS smoother (keeps Φ and P of every filter step).
+    components : "horizontal" (the seed's eqs. 5–7) or "3d" (with the vertical velocity
+        and height: the aiding holds the vertical channel).
+    processes : the sensor states' dynamics (:class:`~gcalign.estimation.ins_error.
+        SensorProcesses`); None: random constants (the seed).
     """
 
     measure: str = "velocity"
@@ -83,10 +113,12 @@ class Settings:
     feedback: bool = True
     gnss_noise: bool = True
     smoother: bool = False
+    components: str = "horizontal"
+    processes: SensorProcesses | None = None
 
     def steps_per_update(self, ts: float) -> int:
         """Navigation steps per filter step; checks every setting (ScenarioError, one line)."""
-        ie.measurement_noise(self.measure, self.sigma_v, self.sigma_p)
+        ie.measurement_noise(self.measure, self.sigma_v, self.sigma_p, self.components)
         ie.process_noise_density(self.arw, self.vrw)
         if self.discretization not in DISCRETIZATIONS:
             raise ScenarioError(f"discretization: got {self.discretization!r}, allowed: "
@@ -109,17 +141,21 @@ class Settings:
         sigma = None if self.p0_sigma is None else np.asarray(self.p0_sigma, dtype=float)
         return (ie.initial_covariance(pos, self.p0_scale, sigma, earth),
                 ie.process_noise_density(self.arw, self.vrw),
-                ie.measurement_noise(self.measure, self.sigma_v, self.sigma_p))
+                ie.measurement_noise(self.measure, self.sigma_v, self.sigma_p, self.components))
 
 
 @dataclass(frozen=True)
 class Smoothed:
     """RTS-smoothed estimates at the filter epochs: estimate and sigma (K+1, 21), as in
     :class:`CalibrationResult` (IMU part: the sensor parameters, navigation part: the error
-    of the INS solution before the update at that epoch)."""
+    of the INS solution before the update at that epoch); att, v_n, pos (K+1, 3) the
+    smoothed navigation solution (that INS solution less its smoothed error)."""
 
     estimate: np.ndarray
     sigma: np.ndarray
+    att: np.ndarray
+    v_n: np.ndarray
+    pos: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -132,10 +168,16 @@ class CalibrationResult:
         before the correction. σ: posterior standard deviation of the filter state.
     truth : (K+1, 21) the same quantities from the truth (None for recorded data).
     nees : (K+1,) NEES of the filter state against the truth (None without truth).
-    innovation, standardized : (K, m) z − H x⁻ and its whitened form (~ N(0, 1)).
-    nis : (K,) normalised innovation squared (~ χ²_m).
+    innovation, standardized : (U, m) z − H x⁻ and its whitened form (~ N(0, 1)) at the
+        U epochs with a measurement (``updated``; every epoch but the first on the seed's
+        schedule). nis : (U,) normalised innovation squared (~ χ²_m). sigma_z : (U, m) the
+        measurement σ used (R = diag σ²: the fix's own, or the settings').
     att, v_n, pos : (K+1, 3) the corrected INS solution at the epochs.
     measure_names : names of the m measurement components.
+    index : (K+1,) the navigation sample of each epoch (into the data's t).
+    updated : (K+1,) whether a measurement updated the filter at the epoch (in an outage
+        the filter only predicts, every filter period).
+    fixes_unused : fixes outside the run, or a second one within one navigation step.
     """
 
     t: np.ndarray
@@ -153,6 +195,15 @@ class CalibrationResult:
     settings: Settings
     smoothed: Smoothed | None = None
     names: tuple[str, ...] = field(default=ie.STATE_NAMES)
+    index: np.ndarray | None = None
+    updated: np.ndarray | None = None
+    sigma_z: np.ndarray | None = None
+    fixes_unused: int = 0
+
+    @property
+    def update_t(self) -> np.ndarray:
+        """(U,) the epochs with a measurement."""
+        return self.t[1:] if self.updated is None else self.t[self.updated]
 
     @property
     def error(self) -> np.ndarray | None:
@@ -162,18 +213,24 @@ class CalibrationResult:
 
 def _transition(q_nb: np.ndarray, v_n: np.ndarray, pos: np.ndarray, dtheta: np.ndarray,
                 dv: np.ndarray, ts: float, Qc: np.ndarray, method: str,
-                E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                E: np.ndarray, processes: SensorProcesses | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
     """Φ, Q_d over one filter step from the navigation states (S+1, …) and the compensated
     increments (S, 3) (numba kernel; the NumPy route is ``ins_error.accumulate``); `E` is
-    ``EarthModel.params()``."""
+    ``EarthModel.params()``; `processes` the sensor states' dynamics (None: constants)."""
     from gcalign.estimation._ins_kernel import transition_block
 
     Phi, Qd = np.empty((N_STATES, N_STATES)), np.empty((N_STATES, N_STATES))
     F_mean, G_mean = np.empty((N_STATES, N_STATES)), np.empty((N_STATES, 6))
     transition_block(q_nb, v_n, pos, dtheta, dv, ts, np.ascontiguousarray(np.diag(Qc)),
                      E, Phi, Qd, F_mean, G_mean)
+    dt = len(dtheta) * ts
     if method == "van_loan":
-        return van_loan(F_mean, G_mean, Qc, len(dtheta) * ts)
+        if processes is not None:
+            return van_loan(*processes.augment(F_mean, G_mean, Qc), dt)
+        return van_loan(F_mean, G_mean, Qc, dt)
+    if processes is not None:
+        return ie.with_processes(Phi, Qd, processes, dt)
     return Phi, Qd
 
 
@@ -189,14 +246,14 @@ def warm_up() -> None:
 
 def _imu_residual(x_true: np.ndarray, imu: np.ndarray) -> np.ndarray:
     """Error of the compensation in force (IMU part of the state, (..., 12) for `imu`
-    (..., 21)): with ``ω̃ = (1 + δKg) ω + ε`` and ``ω_c = (ω̃ − ε̂)/(1 + δK̂g)``,
-    ``ω_c = (1 + x_δKg) ω + x_ε`` holds exactly for ``x_ε = (ε − ε̂)/(1 + δK̂g)``,
-    ``x_δKg = (1 + δKg)/(1 + δK̂g) − 1``."""
+    (..., 21) and the true sensor errors `x_true` (..., 21) or (21,)): with
+    ``ω̃ = (1 + δKg) ω + ε`` and ``ω_c = (ω̃ − ε̂)/(1 + δK̂g)``, ``ω_c = (1 + x_δKg) ω + x_ε``
+    holds exactly for ``x_ε = (ε − ε̂)/(1 + δK̂g)``, ``x_δKg = (1 + δKg)/(1 + δK̂g) − 1``."""
     r = np.zeros(np.shape(imu))
-    r[..., EB] = (x_true[EB] - imu[..., EB]) / (1.0 + imu[..., DKG])
-    r[..., DB] = (x_true[DB] - imu[..., DB]) / (1.0 + imu[..., DKA])
-    r[..., DKG] = (1.0 + x_true[DKG]) / (1.0 + imu[..., DKG]) - 1.0
-    r[..., DKA] = (1.0 + x_true[DKA]) / (1.0 + imu[..., DKA]) - 1.0
+    r[..., EB] = (x_true[..., EB] - imu[..., EB]) / (1.0 + imu[..., DKG])
+    r[..., DB] = (x_true[..., DB] - imu[..., DB]) / (1.0 + imu[..., DKA])
+    r[..., DKG] = (1.0 + x_true[..., DKG]) / (1.0 + imu[..., DKG]) - 1.0
+    r[..., DKA] = (1.0 + x_true[..., DKA]) / (1.0 + imu[..., DKA]) - 1.0
     return r[..., IMU]
 
 
@@ -216,16 +273,20 @@ def _phi(q_est: np.ndarray, q_true: np.ndarray) -> np.ndarray:
     return quat_to_rotvec(quat_mult(q_true, quat_conj(q_est)))
 
 
-def _measurement(measure: str, v_n: np.ndarray, pos: np.ndarray, ref_v: np.ndarray,
-                 ref_pos: np.ndarray, noise: np.ndarray, earth: EarthModel) -> np.ndarray:
-    """z = INS − reference − noise (seed eqs. 5–7); position in metres north, east."""
-    dv = v_n[:2] - ref_v[:2]
+def _measurement(measure: str, components: str, v_n: np.ndarray, pos: np.ndarray,
+                 ref_v: np.ndarray, ref_pos: np.ndarray, earth: EarthModel) -> np.ndarray:
+    """z = INS − reference (seed eqs. 5–7, with the vertical components for "3d"):
+    velocity east, north (up); position north, east (up) in metres."""
+    n = 3 if components == "3d" else 2
+    dv = v_n[:n] - ref_v[:n]
     if measure == "velocity":
-        return dv - noise
+        return dv
     r_m, r_n = earth.radii(pos[0])
-    dp = np.array([(pos[0] - ref_pos[0]) * (r_m + pos[2]),
-                   (pos[1] - ref_pos[1]) * (r_n + pos[2]) * np.cos(pos[0])])
-    return (dp if measure == "position" else np.concatenate([dv, dp])) - noise
+    dp = [(pos[0] - ref_pos[0]) * (r_m + pos[2]),
+          (pos[1] - ref_pos[1]) * (r_n + pos[2]) * np.cos(pos[0])]
+    if n == 3:
+        dp.append(pos[2] - ref_pos[2])
+    return np.array(dp) if measure == "position" else np.concatenate([dv, dp])
 
 
 def _lever_arm(value: np.ndarray, which: str) -> np.ndarray:
@@ -238,47 +299,107 @@ def _lever_arm(value: np.ndarray, which: str) -> np.ndarray:
 
 
 def _noise_sigma(s: Settings) -> np.ndarray:
-    return np.array({"velocity": [s.sigma_v] * 2, "position": [s.sigma_p] * 2,
-                     "both": [s.sigma_v] * 2 + [s.sigma_p] * 2}[s.measure])
+    n = 3 if s.components == "3d" else 2
+    return np.array({"velocity": [s.sigma_v] * n, "position": [s.sigma_p] * n,
+                     "both": [s.sigma_v] * n + [s.sigma_p] * n}[s.measure])
+
+
+@dataclass(frozen=True)
+class _Stop:
+    """The end of one filter step: navigation sample `end` (index into ``data.t``); with a
+    measurement, its fix (index into the fixes, or -1 for the reference at `end`) and where
+    its time lies in the last navigation step (``frac`` 1: at the sample itself)."""
+
+    end: int
+    fix: int | None = None
+    frac: float = 1.0
+
+
+def _grid_stops(N: int, S: int) -> list[_Stop]:
+    """The seed's schedule: an update with the reference every S navigation steps (a tail
+    shorter than S is not used)."""
+    return [_Stop((k + 1) * S, -1) for k in range(N // S)]
+
+
+def _fix_stops(t: np.ndarray, fixes: Fixes, S: int) -> tuple[list[_Stop], int]:
+    """Steps ending at the navigation sample that closes each fix's time, and, where no fix
+    comes within S steps, predict-only steps of S (outages keep their filter epochs); a
+    last step to the end of the data. Returns the stops and the number of fixes left out
+    (outside the run, or a second fix within one navigation step: the later one is used)."""
+    ts = float(t[1] - t[0])
+    N = len(t) - 1
+    pos = (np.asarray(fixes.t, float) - t[0]) / ts
+    end = np.ceil(pos - 1e-9).astype(np.int64)
+    ok = (end >= 1) & (end <= N)
+    idx = np.flatnonzero(ok)
+    # one fix per navigation step: the latest
+    keep = idx[np.append(end[idx][1:] != end[idx][:-1], True)] if len(idx) else idx
+    stops: list[_Stop] = []
+    k = 0
+    for j in keep:
+        e = int(end[j])
+        while e - k > S:
+            k += S
+            stops.append(_Stop(k))
+        frac = float(pos[j] - (e - 1))
+        stops.append(_Stop(e, int(j), 1.0 if frac > 1.0 - 1e-9 else frac))
+        k = e
+    while N - k > 0:
+        k = min(k + S, N)
+        stops.append(_Stop(k))
+    return stops, len(fixes.t) - len(keep)
 
 
 @dataclass
 class _History:
     """What the RTS smoother needs from the filter (kept only when it is asked for)."""
 
-    Phi: np.ndarray  # (K, n, n) transition k → k+1
-    P_prior: np.ndarray  # (K, n, n) prediction at k+1
-    x_prior: np.ndarray  # (K, n)
-    P_post: np.ndarray  # (K+1, n, n) posterior at k (k = 0: P0)
-    x_post: np.ndarray  # (K+1, n)
-    imu_pre: np.ndarray  # (K+1, n) sensor parameters in force during the step ending at k
+    Phi: list[np.ndarray] = field(default_factory=list)  # transition k → k+1
+    P_prior: list[np.ndarray] = field(default_factory=list)  # prediction at k+1
+    x_prior: list[np.ndarray] = field(default_factory=list)
+    P_post: list[np.ndarray] = field(default_factory=list)  # posterior at k (k = 0: P0)
+    x_post: list[np.ndarray] = field(default_factory=list)
+    imu_pre: list[np.ndarray] = field(default_factory=list)  # in force in the step ending at k
 
-    @classmethod
-    def empty(cls, K: int, P0: np.ndarray) -> _History:
-        n = N_STATES
-        h = cls(np.zeros((K, n, n)), np.zeros((K, n, n)), np.zeros((K, n)),
-                np.zeros((K + 1, n, n)), np.zeros((K + 1, n)), np.zeros((K + 1, n)))
-        h.P_post[0] = P0
-        return h
+
+Rows = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], None]
+"""``on_rows(t (n,), q_nb (n, 4), v_n (n, 3), pos (n, 3))``: the navigation solution at
+every navigation sample, as the run goes (at an epoch: after its correction)."""
 
 
 def calibrate(data: FlightData, settings: Settings | None = None,
-              rng: np.random.Generator | None = None) -> CalibrationResult:
+              rng: np.random.Generator | None = None, on_rows: Rows | None = None
+              ) -> CalibrationResult:
     """Run the calibration filter over `data` (see the module docstring for the steps).
 
-    `rng` draws the measurement noise (needed when ``settings.gnss_noise``).
+    `rng` draws the measurement noise (needed when ``settings.gnss_noise``). `on_rows`, if
+    given, receives the navigation solution at every navigation sample (:data:`Rows`), the
+    start included, so a caller can store it as it comes without the run holding it.
     """
     s = settings or Settings()
     ts = data.ts
     S = s.steps_per_update(ts)
-    K = len(data.dtheta) // S
-    if K < 1:
-        raise ScenarioError(f"data: {len(data.dtheta)} navigation steps are fewer than one "
+    N = len(data.dtheta)
+    fixes = data.fixes
+    if fixes is None:
+        if data.ref_v_n is None or data.ref_pos is None:
+            raise ValueError("calibrate: data need fixes or ref_v_n and ref_pos")
+        stops, dropped = _grid_stops(N, S), 0
+    else:
+        if s.gnss_noise:
+            raise ScenarioError("calibrate.gnss_noise: adds simulated noise to a reference; "
+                                "measured fixes carry their own (set it false)")
+        stops, dropped = _fix_stops(data.t, fixes, S)
+    K = len(stops)
+    if K < 1 or (fixes is None and K < 1):
+        raise ScenarioError(f"data: {N} navigation steps are fewer than one "
                             f"filter step ({S})")
     earth = data.earth
     E = earth.params()
-    P0, Qc, R = s.covariances(data.start.pos, earth)
-    m = R.shape[0]
+    P0, Qc, R_fixed = s.covariances(data.start.pos, earth)
+    names = ie.measurement_names(s.measure, s.components)
+    m = len(names)
+    procs = s.processes if s.processes is not None and not s.processes.constant else None
     noise = np.zeros((K, m))
     if s.gnss_noise:
         if rng is None:
@@ -287,18 +408,31 @@ def calibrate(data: FlightData, settings: Settings | None = None,
     truth, x_true = data.truth, data.x_true
     if truth is None or x_true is None:
         truth = x_true = None
-    lever_v, lever_p = _lever_arm(data.lever_arm_v_b, "v"), _lever_arm(data.lever_arm_p_b, "p")
+    if fixes is None:
+        lever_v = _lever_arm(data.lever_arm_v_b, "v")
+        lever_p = _lever_arm(data.lever_arm_p_b, "p")
+    else:
+        lever_v = _lever_arm(fixes.lever_arm_v_b, "v")
+        lever_p = _lever_arm(fixes.lever_arm_p_b, "p")
     levered = bool(lever_v.any() or lever_p.any())
+    need_v, need_p = s.measure != "position", s.measure != "velocity"
+    if fixes is not None and ((need_v and fixes.v_n is None) or (need_p and fixes.pos is None)):
+        raise ScenarioError(f"calibrate.measure: {s.measure!r} needs "
+                            f"{'velocities' if need_v and fixes.v_n is None else 'positions'}"
+                            " the aiding does not have")
 
+    index = np.zeros(K + 1, np.int64)
+    updated = np.zeros(K + 1, dtype=bool)
     est, sig = np.zeros((K + 1, N_STATES)), np.zeros((K + 1, N_STATES))
-    innov, stdz, nis = np.zeros((K, m)), np.zeros((K, m)), np.zeros(K)
+    innov, stdz, nis, r_sig = [], [], [], []
     quat, vel, posn = np.zeros((K + 1, 4)), np.zeros((K + 1, 3)), np.zeros((K + 1, 3))
     # what the errors against the truth need, evaluated after the loop in whole arrays:
-    # the INS solution before each correction, the compensation in force, x⁺ and P⁺
+    # the INS solution before each correction, the compensation in force, x⁺ and, as
+    # they come, the NEES terms (P is not kept per epoch)
     pre_q, pre_v, pre_p = np.zeros((K + 1, 4)), np.zeros((K + 1, 3)), np.zeros((K + 1, 3))
     in_force, x_all = np.zeros((K + 1, N_STATES)), np.zeros((K + 1, N_STATES))
-    P_all = np.zeros((K + 1, N_STATES, N_STATES))
-    hist = _History.empty(K, P0) if s.smoother else None
+    P_all = np.zeros((K + 1, N_STATES, N_STATES)) if truth is not None else None
+    hist = _History() if s.smoother else None
 
     q, v, p = (np.asarray(data.start.q_nb, float), np.asarray(data.start.v_n, float),
                np.asarray(data.start.pos, float))
@@ -306,76 +440,157 @@ def calibrate(data: FlightData, settings: Settings | None = None,
     imu = np.zeros(N_STATES)  # sensor parameters in force (closed loop), states 9–20
     sig[0] = np.sqrt(np.diag(P0))
     quat[0], vel[0], posn[0] = pre_q[0], pre_v[0], pre_p[0] = q, v, p
-    P_all[0] = P0
+    if P_all is not None:
+        P_all[0] = P0
+    if hist is not None:
+        hist.P_post.append(P0)
+        hist.x_post.append(np.zeros(N_STATES))
+        hist.imu_pre.append(np.zeros(N_STATES))
+    if on_rows is not None:
+        on_rows(data.t[:1], q[None], v[None], p[None])
 
-    for k in range(K):
-        blk = slice(k * S, (k + 1) * S)
-        j = (k + 1) * S
-        # 1–2. compensate with the parameters in force, navigate S steps
+    b = 0
+    for k, stop in enumerate(stops):
+        e = stop.end
+        blk = slice(b, e)
+        # 1–2. compensate with the parameters in force, navigate to the stop
         dth = (data.dtheta[blk] - imu[EB] * ts) / (1.0 + imu[DKG])
         dvb = (data.dv[blk] - imu[DB] * ts) / (1.0 + imu[DKA])
-        sol = navigate(data.t[blk.start + 1: j + 1], dth, dvb, ts, NavState(q, v, p),
-                       earth=earth)
+        sol = navigate(data.t[b + 1: e + 1], dth, dvb, ts, NavState(q, v, p), earth=earth)
         q, v, p = sol.q_nb[-1], sol.v_n[-1], sol.pos[-1]
-        # 3–4. Φ, Q_d along the navigation; predict; Joseph update
+        # 3–4. Φ, Q_d along the navigation (and the sensors' own processes); predict
         Phi, Qd = _transition(sol.q_nb, sol.v_n, sol.pos, dth, dvb, ts, Qc, s.discretization,
-                              E)
+                              E, procs)
         x_prior, P_prior = predict(x, P, Phi, Qd)
-        z = _measurement(s.measure, v, p, data.ref_v_n[j], data.ref_pos[j], noise[k], earth)
-        H = ie.measurement_matrix(s.measure, p, earth)
-        if levered:  # the fixes are the antenna's: z and H of the INS's antenna
-            off, H_l = ie.lever_arm_terms(s.measure, quat_to_dcm(q), dth[-1] / ts,
-                                          earth.omega_ie_n(p[0]), lever_v, lever_p)
-            z, H = z + off, H + H_l
-        u = update(x_prior, P_prior, z, H, R)
-        innov[k], stdz[k], nis[k] = u.innovation, u.standardized, u.nis
-        sig[k + 1], P = np.sqrt(np.diag(u.P)), u.P
-        est[k + 1, NAV] = u.x[NAV]
-        pre_q[k + 1], pre_v[k + 1], pre_p[k + 1] = q, v, p
-        in_force[k + 1], x_all[k + 1], P_all[k + 1] = imu, u.x, u.P
+        if procs is not None and s.feedback:  # the parameters in force follow their model
+            imu = imu.copy()
+            imu[IMU] *= procs.discrete((e - b) * ts)[0]
+        imu_step = imu  # the compensation the state x⁻ is the error of
+        index[k + 1], pre_q[k + 1], pre_v[k + 1], pre_p[k + 1] = e, q, v, p
+        x_post, P = x_prior, P_prior
+        if stop.fix is not None:
+            # the INS at the fix's time: inside the last navigation step, linearly (a few ms;
+            # the error state is the same at both ends to far below its σ)
+            if stop.frac == 1.0:
+                v_f, p_f = v, p
+            else:
+                w = stop.frac
+                v_f = sol.v_n[-2] + w * (v - sol.v_n[-2])
+                p_f = sol.pos[-2] + w * (p - sol.pos[-2])
+            if stop.fix < 0:
+                assert data.ref_v_n is not None and data.ref_pos is not None
+                ref_v, ref_p = data.ref_v_n[e], data.ref_pos[e]
+                R = R_fixed
+            else:
+                assert fixes is not None
+                j = stop.fix
+                ref_v = None if fixes.v_n is None else fixes.v_n[j]
+                ref_p = None if fixes.pos is None else fixes.pos[j]
+                R = _fix_noise(s, fixes, j, R_fixed)
+            z = _measurement(s.measure, s.components, v_f, p_f,
+                             np.zeros(3) if ref_v is None else ref_v,
+                             np.zeros(3) if ref_p is None else ref_p, earth) - noise[k]
+            H = ie.measurement_matrix(s.measure, p, earth, s.components)
+            if levered:  # the fixes are the antenna's: z and H of the INS's antenna
+                off, H_l = ie.lever_arm_terms(s.measure, quat_to_dcm(q), dth[-1] / ts,
+                                              earth.omega_ie_n(p[0]), lever_v, lever_p,
+                                              s.components)
+                z, H = z + off, H + H_l
+            u = update(x_prior, P_prior, z, H, R)
+            innov.append(u.innovation)
+            stdz.append(u.standardized)
+            nis.append(u.nis)
+            r_sig.append(np.sqrt(np.diag(R)))
+            updated[k + 1] = True
+            x_post, P = u.x, u.P
+        sig[k + 1] = np.sqrt(np.diag(P))
+        est[k + 1, NAV] = x_post[NAV]
+        in_force[k + 1], x_all[k + 1] = imu_step, x_post
+        if P_all is not None:
+            P_all[k + 1] = P
         if hist is not None:
-            hist.Phi[k], hist.P_prior[k], hist.x_prior[k] = Phi, P_prior, x_prior
-            hist.P_post[k + 1], hist.x_post[k + 1], hist.imu_pre[k + 1] = u.P, u.x, imu
+            hist.Phi.append(Phi)
+            hist.P_prior.append(P_prior)
+            hist.x_prior.append(x_prior)
+            hist.P_post.append(P)
+            hist.x_post.append(x_post)
+            hist.imu_pre.append(imu_step)
         # 5. closed loop: correct the INS and the sensors, reset; feed-forward: keep x
-        q_c = quat_mult(rotvec_to_quat(u.x[PHI]), q)
-        v_c, p_c = v - u.x[DV], p - u.x[DP]
+        q_c = quat_mult(rotvec_to_quat(x_post[PHI]), q)
+        v_c, p_c = v - x_post[DV], p - x_post[DP]
         if s.feedback:
             q, v, p = q_c, v_c, p_c
-            imu = _compose(imu, u.x)
+            imu = _compose(imu, x_post)
             est[k + 1, IMU] = imu[IMU]
             x = np.zeros(N_STATES)
         else:
-            est[k + 1, IMU] = u.x[IMU]
-            x = u.x
+            est[k + 1, IMU] = x_post[IMU]
+            x = x_post
         quat[k + 1], vel[k + 1], posn[k + 1] = q_c, v_c, p_c
+        if on_rows is not None:
+            rq, rv, rp = sol.q_nb[1:].copy(), sol.v_n[1:].copy(), sol.pos[1:].copy()
+            rq[-1], rv[-1], rp[-1] = q_c, v_c, p_c
+            on_rows(data.t[b + 1: e + 1], rq, rv, rp)
+        b = e
 
-    smoothed = None if hist is None else _smooth(hist, s.feedback)
+    smoothed = None if hist is None else _smooth(hist, s.feedback, pre_q, pre_v, pre_p)
     tru = nees = None
-    if truth is not None and x_true is not None:
+    if truth is not None and x_true is not None and P_all is not None:
         # the true filter state at every epoch: the error of the INS solution before the
         # correction and of the compensation in force; epoch 0 is x_true itself
+        sensors = (np.broadcast_to(x_true, (K + 1, N_STATES)) if data.sensor_truth is None
+                   else _with_sensors(x_true, data.sensor_truth[index]))
         tru = np.empty((K + 1, N_STATES))
-        tru[:, PHI] = _phi(pre_q, euler_to_quat(truth.att[::S][: K + 1]))
-        tru[:, DV] = pre_v - truth.v_n[::S][: K + 1]
-        tru[:, DP] = pre_p - truth.pos[::S][: K + 1]
-        tru[:, IMU] = _imu_residual(x_true, in_force)
-        tru[0] = x_true
+        tru[:, PHI] = _phi(pre_q, euler_to_quat(truth.att[index]))
+        tru[:, DV] = pre_v - truth.v_n[index]
+        tru[:, DP] = pre_p - truth.pos[index]
+        tru[:, IMU] = _imu_residual(sensors, in_force)
+        tru[0] = sensors[0]
         nees = nees_of(tru - x_all, P_all)
-        tru[:, IMU] = x_true[IMU]  # reported: the sensor errors themselves
+        tru[:, IMU] = sensors[:, IMU]  # reported: the sensor errors themselves
+    m_rows = (np.array(innov), np.array(stdz)) if innov else (np.zeros((0, m)),) * 2
     return CalibrationResult(
-        t=data.t[::S][: K + 1], estimate=est, sigma=sig, truth=tru,
-        nees=nees, innovation=innov, standardized=stdz, nis=nis,
+        t=data.t[index], estimate=est, sigma=sig, truth=tru,
+        nees=nees, innovation=m_rows[0], standardized=m_rows[1], nis=np.array(nis, float),
         att=quat_to_euler(quat), v_n=vel, pos=posn,
-        measure_names=ie.MEASUREMENT_NAMES[s.measure], settings=s, smoothed=smoothed)
+        measure_names=names, settings=s, smoothed=smoothed, index=index, updated=updated,
+        sigma_z=np.array(r_sig) if r_sig else np.zeros((0, m)), fixes_unused=dropped)
 
 
-def _smooth(h: _History, feedback: bool) -> Smoothed:
-    xs, Ps = rts(h.Phi, h.P_prior, h.x_prior, h.P_post, h.x_post)
+def _fix_noise(s: Settings, fixes: Fixes, j: int, R_fixed: np.ndarray) -> np.ndarray:
+    """R of fix j: the fixes' own σ where they have them (position north, east, up from
+    σ east, north, up), else the settings' σ (``R_fixed``)."""
+    n = 3 if s.components == "3d" else 2
+    parts = []
+    if s.measure != "position":
+        parts.append(R_fixed.diagonal()[:n] if fixes.sigma_v is None
+                     else np.square(fixes.sigma_v[j, :n]))
+    if s.measure != "velocity":
+        parts.append(R_fixed.diagonal()[-n:] if fixes.sigma_pos is None
+                     else np.square(fixes.sigma_pos[j, [1, 0, 2][:n]]))
+    return np.diag(np.concatenate(parts))
+
+
+def _with_sensors(x_true: np.ndarray, sensors: np.ndarray) -> np.ndarray:
+    """(K, 21): the navigation errors of `x_true` and the sensor errors of each row of
+    `sensors` (K, 12)."""
+    out = np.tile(np.asarray(x_true, float), (len(sensors), 1))
+    out[:, IMU] = sensors
+    return out
+
+
+def _smooth(h: _History, feedback: bool, pre_q: np.ndarray, pre_v: np.ndarray,
+            pre_p: np.ndarray) -> Smoothed:
+    xs, Ps = rts(np.array(h.Phi), np.array(h.P_prior), np.array(h.x_prior),
+                 np.array(h.P_post), np.array(h.x_post))
     est = xs.copy()
     if feedback:  # sensor parameters: the compensation in force, corrected by the smoothed error
         for k in range(len(xs)):
             est[k, IMU] = _compose(h.imu_pre[k], xs[k])[IMU]
-    return Smoothed(estimate=est, sigma=np.sqrt(np.diagonal(Ps, axis1=1, axis2=2)))
+    # the smoothed solution: the INS before each correction, less the smoothed error
+    q = quat_mult(rotvec_to_quat(xs[:, PHI]), pre_q)
+    return Smoothed(estimate=est, sigma=np.sqrt(np.diagonal(Ps, axis1=1, axis2=2)),
+                    att=quat_to_euler(q), v_n=pre_v - xs[:, DV], pos=pre_p - xs[:, DP])
 
 
 @dataclass(frozen=True)

@@ -19,8 +19,15 @@ scale-factor columns of PSINS ``kffk`` case 34::
 
 The δλ column is identically zero (nothing depends on longitude), and δh feeds δv_U
 positively (≈ +2g/R), so the free vertical channel diverges with time constant
-√(R/2g) ≈ 570 s. Measurements are horizontal (seed §2.4): velocity ``[δvE, δvN]``
-(m/s) and position ``[R_Mh δL, R_Nh cos L δλ]`` (north, east in metres).
+√(R/2g) ≈ 570 s. Measurements are horizontal in the seed (§2.4): velocity ``[δvE, δvN]``
+(m/s) and position ``[R_Mh δL, R_Nh cos L δλ]`` (north, east in metres); with
+``components="3d"`` they add the vertical ``δvU`` and ``δh`` (up, m), which holds the
+vertical channel whenever the aiding source measures height (a GNSS receiver does).
+
+Sensor processes (KF-GINS, PSINS): each sensor state is a random constant (the seed), a
+first-order Gauss–Markov process ``ẋ = −x/τ + w`` with ``E[w²] = 2σ²/τ`` (stationary std
+σ) or a random walk ``ẋ = w`` with ``E[w²] = q²``: :class:`SensorProcesses` holds the
+decay rates β = 1/τ and the driving densities of the 12 sensor states.
 
 >>> import numpy as np
 >>> F = error_matrix(np.eye(3), [0.0, 0.0, 9.8], [0.0, 0.0, 0.0], np.zeros(3),
@@ -30,6 +37,9 @@ positively (≈ +2g/R), so the free vertical channel diverges with time constant
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -68,6 +78,21 @@ MEASUREMENT_NAMES = {
     "position": ("dpN", "dpE"),
     "both": ("dvE", "dvN", "dpN", "dpE"),
 }
+COMPONENTS = ("horizontal", "3d")
+"""The seed's horizontal measurements (eqs. 5–7), or with their vertical components."""
+MEASUREMENT_NAMES_3D = {
+    "velocity": ("dvE", "dvN", "dvU"),
+    "position": ("dpN", "dpE", "dpU"),
+    "both": ("dvE", "dvN", "dvU", "dpN", "dpE", "dpU"),
+}
+
+
+def measurement_names(measure: str, components: str = "horizontal") -> tuple[str, ...]:
+    """Names of the measurement components: velocity east, north (up); position north,
+    east (up) in metres."""
+    _check_measure(measure)
+    _check_components(components)
+    return (MEASUREMENT_NAMES_3D if components == "3d" else MEASUREMENT_NAMES)[measure]
 
 # Seed 002 §5.2 P0 list in display units (before the ×10); position in metres.
 _P0_LISTED_DISPLAY = np.array(
@@ -227,18 +252,35 @@ def _check_measure(measure: str) -> None:
         raise ScenarioError(f"measure: got {measure!r}, allowed: {', '.join(MEASUREMENTS)}")
 
 
-def measurement_matrix(measure: str, pos: np.ndarray, earth: EarthModel = WGS84) -> np.ndarray:
-    """H (m, 21) of seed eqs. (5)–(7): ``velocity`` [δvE, δvN]; ``position`` [north, east] in
-    metres, ``R_Mh δL`` and ``R_Nh cos L δλ`` at `pos` ``[L, λ, h]``; ``both`` stacks them."""
+def _check_components(components: str) -> None:
+    if components not in COMPONENTS:
+        raise ScenarioError(f"components: got {components!r}, allowed: {', '.join(COMPONENTS)}")
+
+
+def _rows(measure: str, components: str) -> tuple[list[int], list[int]]:
+    """Rows of the full 3-D velocity [E, N, U] and position [N, E, U] blocks kept."""
     _check_measure(measure)
-    H_v = np.zeros((2, N_STATES))
-    H_v[0, IDX["dvE"]] = H_v[1, IDX["dvN"]] = 1.0
+    _check_components(components)
+    keep = [0, 1, 2] if components == "3d" else [0, 1]
+    return (keep if measure != "position" else []), (keep if measure != "velocity" else [])
+
+
+def measurement_matrix(measure: str, pos: np.ndarray, earth: EarthModel = WGS84,
+                       components: str = "horizontal") -> np.ndarray:
+    """H (m, 21) of seed eqs. (5)–(7): ``velocity`` [δvE, δvN]; ``position`` [north, east] in
+    metres, ``R_Mh δL`` and ``R_Nh cos L δλ`` at `pos` ``[L, λ, h]``; ``both`` stacks them.
+    ``components="3d"`` adds δvU after the horizontal velocity and δh (up, m) after the
+    horizontal position."""
+    rv, rp = _rows(measure, components)
+    H_v = np.zeros((3, N_STATES))
+    H_v[0, IDX["dvE"]] = H_v[1, IDX["dvN"]] = H_v[2, IDX["dvU"]] = 1.0
     lat, h = float(pos[0]), float(pos[2])
     r_m, r_n = earth.radii(lat)
-    H_p = np.zeros((2, N_STATES))
+    H_p = np.zeros((3, N_STATES))
     H_p[0, IDX["dL"]] = r_m + h
     H_p[1, IDX["dlam"]] = (r_n + h) * np.cos(lat)
-    return {"velocity": H_v, "position": H_p, "both": np.vstack([H_v, H_p])}[measure]
+    H_p[2, IDX["dh"]] = 1.0
+    return np.vstack([H_v[rv], H_p[rp]])
 
 
 def antenna_offset(C_nb: ArrayLike, omega_ib_b: ArrayLike, omega_ie_n: ArrayLike,
@@ -254,7 +296,8 @@ def antenna_offset(C_nb: ArrayLike, omega_ib_b: ArrayLike, omega_ie_n: ArrayLike
 
 def lever_arm_terms(measure: str, C_nb: ArrayLike, omega_ib_b: ArrayLike,
                     omega_ie_n: ArrayLike, lever_v_b: ArrayLike | None = None,
-                    lever_p_b: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+                    lever_p_b: ArrayLike | None = None,
+                    components: str = "horizontal") -> tuple[np.ndarray, np.ndarray]:
     """What an aiding antenna at a lever arm adds to the measurement: ``(offset (m,), H_l
     (m, 21))`` with ``z = INS + offset − fix`` and ``H = measurement_matrix + H_l``.
 
@@ -262,7 +305,8 @@ def lever_arm_terms(measure: str, C_nb: ArrayLike, omega_ib_b: ArrayLike,
     each measures, from the IMU in body axes x right, y forward, z up; m; None: the IMU).
     `C_nb` (3, 3) and `omega_ib_b` (3,) rad/s are the INS's attitude and compensated rate
     at the epoch, `omega_ie_n` (3,) the earth rate. Components in the order of
-    :data:`MEASUREMENT_NAMES` (velocity east, north; position north, east in metres).
+    :func:`measurement_names` (velocity east, north (up); position north, east (up) in
+    metres).
 
     Derivation (φ convention ``Ĉ = (I − [φ×]) C``, so ``(Ĉ − C) u = −φ × C u = [(C u)×] φ``;
     l taken as exactly known, products of errors dropped):
@@ -287,7 +331,7 @@ def lever_arm_terms(measure: str, C_nb: ArrayLike, omega_ib_b: ArrayLike,
     ([2.0, 0.0], [[0.0, 0.0, 0.0], [0.0, 0.0, 2.0]])
     >>> # right by φU) puts the antenna east by 2 m · φU
     """
-    _check_measure(measure)
+    rv, rp = _rows(measure, components)
     C = np.asarray(C_nb, dtype=float)
     w = np.asarray(omega_ib_b, dtype=float)
     w_ie = np.asarray(omega_ie_n, dtype=float)
@@ -300,25 +344,118 @@ def lever_arm_terms(measure: str, C_nb: ArrayLike, omega_ib_b: ArrayLike,
     H_v[:, PHI] = _skew(u) - _skew(w_ie) @ _skew(Cl)
     H_v[:, EB] = -ClX
     H_v[:, DKG] = -ClX * w[None, :]  # −C [l×] diag(ω)
-    off_v = off_v[:2]
     Cl_p = C @ l_p
     H_p = np.zeros((3, N_STATES))
     H_p[:, PHI] = _skew(Cl_p)
-    off_p, H_p = Cl_p[[1, 0]], H_p[[1, 0]]  # north, east
-    H_v = H_v[:2]
-    return {"velocity": (off_v, H_v), "position": (off_p, H_p),
-            "both": (np.concatenate([off_v, off_p]), np.vstack([H_v, H_p]))}[measure]
+    off_p, H_p = Cl_p[[1, 0, 2]], H_p[[1, 0, 2]]  # north, east, up
+    return (np.concatenate([off_v[rv], off_p[rp]]), np.vstack([H_v[rv], H_p[rp]]))
 
 
-def measurement_noise(measure: str, sigma_v: float = 0.2, sigma_p: float = 1.0) -> np.ndarray:
+def measurement_noise(measure: str, sigma_v: float = 0.2, sigma_p: float = 1.0,
+                      components: str = "horizontal") -> np.ndarray:
     """R (m, m) from the seed's standard deviations (spec 002 §2): R = diag(σ²)."""
-    _check_measure(measure)
+    rv, rp = _rows(measure, components)
     for name, value in (("sigma_v", sigma_v), ("sigma_p", sigma_p)):
         if not np.isfinite(value) or value <= 0:
             raise ScenarioError(f"{name}: R needs a positive standard deviation, got {value!r}")
-    sig = {"velocity": [sigma_v] * 2, "position": [sigma_p] * 2,
-           "both": [sigma_v] * 2 + [sigma_p] * 2}[measure]
-    return np.diag(np.square(sig))
+    return np.diag(np.square([sigma_v] * len(rv) + [sigma_p] * len(rp)))
+
+
+PROCESS_KINDS = ("constant", "gauss-markov", "random-walk")
+"""How a sensor state evolves: random constant, first-order Gauss–Markov, random walk."""
+
+
+@dataclass(frozen=True)
+class SensorProcesses:
+    """Dynamics of the 12 sensor states (ε, ∇, δKg, δKa in the state order):
+    ``ẋ_i = −β_i x_i + w_i``, ``E[w wᵀ] = diag(q) δ(t − s)``.
+
+    beta : (12,) decay rates 1/τ (1/s); 0 for a constant or a random walk.
+    q : (12,) driving-noise densities (state unit² per s): ``2σ²/τ`` for a Gauss–Markov
+        process of stationary std σ, the squared density for a random walk, 0 for a
+        constant.
+    """
+
+    beta: np.ndarray
+    q: np.ndarray
+
+    @classmethod
+    def of(cls, kinds: Sequence[str], std: ArrayLike, tau: ArrayLike,
+           density: ArrayLike) -> SensorProcesses:
+        """From one kind per state (:data:`PROCESS_KINDS`), the stationary std and τ of the
+        Gauss–Markov states and the density of the random walks (each (12,), SI)."""
+        std, tau, dens = (np.broadcast_to(np.asarray(a, dtype=float), (12,))
+                          for a in (std, tau, density))
+        beta, q = np.zeros(12), np.zeros(12)
+        for i, kind in enumerate(kinds):
+            if kind == "gauss-markov":
+                if not (np.isfinite(tau[i]) and tau[i] > 0 and np.isfinite(std[i])
+                        and std[i] >= 0):
+                    raise ScenarioError(f"{STATE_NAMES[9 + i]}: a Gauss–Markov process needs "
+                                        f"std ≥ 0 and τ > 0, got std {std[i]!r}, τ {tau[i]!r}")
+                beta[i], q[i] = 1.0 / tau[i], 2.0 * std[i] ** 2 / tau[i]
+            elif kind == "random-walk":
+                if not (np.isfinite(dens[i]) and dens[i] >= 0):
+                    raise ScenarioError(f"{STATE_NAMES[9 + i]}: a random walk needs a "
+                                        f"density ≥ 0, got {dens[i]!r}")
+                q[i] = dens[i] ** 2
+            elif kind != "constant":
+                raise ScenarioError(f"{STATE_NAMES[9 + i]}: process {kind!r}; allowed: "
+                                    f"{', '.join(PROCESS_KINDS)}")
+        return cls(beta, q)
+
+    @property
+    def constant(self) -> bool:
+        """Every sensor state a random constant (the seed's model)."""
+        return not (self.beta.any() or self.q.any())
+
+    def discrete(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """``(a, Q)`` (12,) over `dt`: ``a = e^{−β dt}`` and the variance the driving noise
+        adds, ``q (1 − e^{−2β dt})/(2β)`` (``q dt`` for β = 0): exact."""
+        a = np.exp(-self.beta * dt)
+        bt = 2.0 * self.beta * dt
+        # (1 − e^{−x})/x → 1 as x → 0: expm1 keeps it exact for small β dt
+        frac = np.where(bt > 0, -np.expm1(-bt) / np.where(bt > 0, bt, 1.0), 1.0)
+        return a, self.q * dt * frac
+
+    def augment(self, F: np.ndarray, G: np.ndarray,
+                Qc: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """F (21, 21), G (21, 6 + 12), Qc (18, 18) of the whole model with the processes
+        (for Van Loan): ``−β`` on the sensor diagonal, the driving noise on new columns."""
+        F = F.copy()
+        F[IMU, IMU] -= np.diag(self.beta)
+        G2 = np.zeros((N_STATES, G.shape[1] + 12))
+        G2[:, : G.shape[1]] = G
+        G2[IMU, G.shape[1]:] = np.eye(12)
+        Q2 = np.zeros((G2.shape[1],) * 2)
+        Q2[: Qc.shape[0], : Qc.shape[0]] = Qc
+        Q2[Qc.shape[0]:, Qc.shape[0]:] = np.diag(self.q)
+        return F, G2, Q2
+
+
+def with_processes(Phi: np.ndarray, Qd: np.ndarray, processes: SensorProcesses,
+                   dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Φ, Q_d over `dt` of the model with sensor processes, from Φ_c, Q_d,c of the model
+    with constant sensors (the navigation steps' accumulation) by a symmetric splitting:
+    half the sensors' own dynamics, the coupled step, the other half,
+    ``Φ = D Φ_c D`` and ``Q_d = D (Φ_c Q_s Φ_cᵀ + Q_d,c) D + Q_s`` with
+    ``D = diag(1, e^{−β dt/2})`` and Q_s the variance the driving noise adds in dt/2.
+
+    The splitting leaves the navigation block's accumulation as it was and errs by terms of
+    third order in dt, β dt³ in the coupling of the sensors into velocity: about a sixth of
+    what the decay changes there. Against Van Loan on the whole model over dt = 1 s: 1.4e-4
+    of the coupling block of Φ and 5e-4 of Q_d at τ = 600 s, 2.3e-5 and 9e-5 at τ = 1 h
+    (``tests/test_aided_filter.py``), far below the model's own approximations.
+    """
+    a, Qs = processes.discrete(0.5 * dt)
+    d = np.ones(N_STATES)
+    d[IMU] = a
+    Q_half = np.zeros((N_STATES, N_STATES))
+    Q_half[IMU, IMU] = np.diag(Qs)
+    Phi_out = d[:, None] * Phi * d[None, :]
+    inner = Phi @ Q_half @ Phi.T + Qd
+    Q_out = d[:, None] * inner * d[None, :] + Q_half
+    return Phi_out, 0.5 * (Q_out + Q_out.T)
 
 
 def accumulate(F_steps: np.ndarray, G_steps: np.ndarray, Qc: np.ndarray,
