@@ -12,6 +12,7 @@ from pydantic import BeforeValidator, Field, field_validator, model_serializer, 
 from gcalign import units as u
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.align import AlignConfig
+from gcalign.io.scenario.allan import AllanConfig
 from gcalign.io.scenario.base import Model, NonNegVec3, Vec3
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 from gcalign.io.scenario.modulate import ModulateConfig
@@ -216,7 +217,8 @@ class Imu(Model):
 
 #: The commands that use the recorded-data keys ``reference`` and ``initial``.
 #: (align and calibrate: the site when the file has none, and whether the base is at rest.)
-USED_BY: dict[str, tuple[str, ...]] = {"reference": ("navigation", "align", "calibrate"),
+USED_BY: dict[str, tuple[str, ...]] = {"reference": ("navigation", "align", "calibrate",
+                                                     "allan"),
                                        "initial": ("navigation",)}
 
 
@@ -242,6 +244,7 @@ class Scenario(Model):
     observability: ObservabilityConfig | None = None
     realtime: RealtimeConfig | None = None
     modulate: ModulateConfig | None = None
+    allan: AllanConfig | None = None
 
     @property
     def earth_model(self) -> EarthModel:

@@ -1,0 +1,40 @@
+"""IMU noise from a recording: the overlapping Allan deviation of each gyro and
+accelerometer axis (:func:`allan_deviation`, allantools underneath) with its interval from
+the number of clusters, and the IEEE Std 952 terms fitted to it (:func:`fit_terms`):
+quantization, white noise (ARW/VRW), bias instability (flat part / 0.664) and rate random
+walk, each with its τ range and interval. :func:`analyse` does both for a triad pair.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gcalign.allan.curve import AllanCurve, allan_deviation, cluster_sizes
+from gcalign.allan.fit import FLAT, TERMS, NoiseFit, TermFit, fit_terms
+
+__all__ = ["FLAT", "TERMS", "AllanCurve", "AllanResult", "NoiseFit", "TermFit",
+           "allan_deviation", "analyse", "cluster_sizes", "fit_terms"]
+
+
+@dataclass(frozen=True)
+class AllanResult:
+    """Curves and fits of the gyros (rad/s) and the accelerometers (m/s²), and the mean
+    rate and specific force of the window (rad/s, m/s²)."""
+
+    gyro: AllanCurve
+    accel: AllanCurve
+    gyro_fit: NoiseFit
+    accel_fit: NoiseFit
+    mean_rate: np.ndarray
+    mean_force: np.ndarray
+
+
+def analyse(dtheta: np.ndarray, dv: np.ndarray, ts: float, per_decade: int = 10,
+            min_clusters: int = 4) -> AllanResult:
+    """Allan deviation and noise terms of increments dtheta, dv (N, 3) sampled every `ts`."""
+    g = allan_deviation(dtheta, ts, per_decade, min_clusters)
+    a = allan_deviation(dv, ts, per_decade, min_clusters)
+    return AllanResult(g, a, fit_terms(g), fit_terms(a), np.mean(dtheta, axis=0) / ts,
+                       np.mean(dv, axis=0) / ts)
