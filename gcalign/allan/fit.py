@@ -17,7 +17,9 @@ How they are fitted. First all four together, by non-negative least squares on �
 the weights of the points' relative 1σ errors (:attr:`~gcalign.allan.curve.AllanCurve.error`),
 iterated twice with the model's σ² in the weights (a low point must not weigh more than a
 high one). A term's τ range is the longest run of points where it is the largest of the
-four and at least half of σ² (:data:`MIN_SHARE`): where the log-log plot shows its slope.
+four, at least half of σ² (:data:`MIN_SHARE`) and more than the 1σ of σ² there (2δ, so
+that a fluctuation of a few long clusters is no term): where the log-log plot shows its
+slope.
 Its value is read on that range alone: each point gives c_i² = (σ_i² − rest_i)/f(τ_i), the
 other terms of the whole-curve model taken off (so a term read on a bend, ARW beside the
 flicker floor, is not biased by its neighbour, as a line of fixed slope through the points
@@ -143,7 +145,10 @@ def fit_terms(curve: AllanCurve) -> NoiseFit:
         share = basis * c2 / np.maximum(basis @ c2, np.finfo(float).tiny)[:, None]
         largest = np.argmax(share, axis=1)
         for t, (name, _, _) in enumerate(TERMS):
-            run = _longest_run((largest == t) & (share[:, t] >= MIN_SHARE))
+            # where it is the largest, half of σ² at least, and more than σ²'s own 1σ
+            # (2δ): a fluctuation of a few clusters at long τ is no term
+            shows = (largest == t) & (share[:, t] >= np.maximum(MIN_SHARE, 2.0 * rel))
+            run = _longest_run(shows)
             o = out[name]
             if run is None or c2[t] <= 0:
                 # what the curve allows: below its upper 1σ end at every τ
