@@ -12,9 +12,9 @@ import h5py
 import numpy as np
 import pytest
 import yaml
+from cli_checks import assert_bad_run
 from typer.testing import CliRunner
 
-from cli_checks import assert_bad_run
 from gcalign import units as u
 from gcalign.allan import FLAT, allan_deviation, fit_terms
 from gcalign.allan.curve import AllanCurve

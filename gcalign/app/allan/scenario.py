@@ -18,6 +18,7 @@ def scenario_mapping(summary: dict) -> dict:
         "motion": {"kind": "static", "attitude_deg": [0.0, 0.0, 0.0],
                    "duration_s": float(summary["duration_s"])},
         "imu": {**summary["imu"], "seed": 1},
+        "output": {"rate_hz": "full"},  # every increment: what `allan` of it reads
         "allan": {"per_decade": summary["per_decade"],
                   "min_clusters": summary["min_clusters"]},
     }

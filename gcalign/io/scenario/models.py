@@ -7,7 +7,14 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BeforeValidator, Field, field_validator, model_serializer, model_validator
+from pydantic import (
+    AfterValidator,
+    BeforeValidator,
+    Field,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from gcalign import units as u
 from gcalign.io.scenario import bounds as B
@@ -115,6 +122,21 @@ class ScaleGaussMarkov(Model):
     tau_s: Tau = Field(description="correlation time, s")
 
 
+def _tau_range(v):
+    if v is None:
+        return v
+    if len(v) != 2 or not 0 < v[0] < v[1]:
+        raise ValueError(f"must be [lo, hi] in s with 0 < lo < hi, got {v}")
+    return v
+
+
+TauRange = Annotated[list[Annotated[float, B.CORRELATION_TIME_S]] | None,
+                     AfterValidator(_tau_range)]
+INSTABILITY_TAU = ("τ range (s) over which the bias instability's Allan deviation is flat "
+                   "(its Gauss–Markov sum, gcalign.sim.errors); default 1 s to the run's "
+                   "duration")
+
+
 class Gyro(Model):
     bias_dph: Annotated[PerAxis, B.GYRO_BIAS_DPH] = Field(
         default_factory=lambda: [0.0, 0.0, 0.0], description=B.GYRO_BIAS_DPH.range())
@@ -135,6 +157,11 @@ class Gyro(Model):
                     f"{B.GYRO_BIAS_RW_DPHRH.range()}")
     scale_gm: ScaleGaussMarkov | None = Field(
         None, description="a scale-factor error that wanders (added to scale_ppm)")
+    bias_instability_dph: Annotated[Noise, B.GYRO_BIAS_DPH] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description="bias instability B, °/h: the flat part of the Allan deviation / 0.664 "
+                    "(flicker noise, simulated as a sum of Gauss–Markov processes)")
+    bias_instability_tau_s: TauRange = Field(None, description=INSTABILITY_TAU)
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
@@ -155,6 +182,9 @@ class Gyro(Model):
             bias_gm_std=bias_std, bias_gm_tau=bias_tau,
             bias_rw=_vec(self.bias_rw_dphrh) * u.DPH / math.sqrt(u.HOUR),
             scale_gm_std=scale_std, scale_gm_tau=scale_tau,
+            instability=_vec(self.bias_instability_dph) * u.DPH,
+            instability_tau=None if self.bias_instability_tau_s is None
+            else tuple(self.bias_instability_tau_s),
         )
 
 
@@ -178,6 +208,11 @@ class Accel(Model):
                     f"{B.ACCEL_BIAS_RW_UGRH.range()}")
     scale_gm: ScaleGaussMarkov | None = Field(
         None, description="a scale-factor error that wanders (added to scale_ppm)")
+    bias_instability_ug: Annotated[Noise, B.ACCEL_BIAS_UG] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description="bias instability B, µg: the flat part of the Allan deviation / 0.664 "
+                    "(flicker noise, simulated as a sum of Gauss–Markov processes)")
+    bias_instability_tau_s: TauRange = Field(None, description=INSTABILITY_TAU)
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
@@ -198,6 +233,9 @@ class Accel(Model):
             bias_gm_std=bias_std, bias_gm_tau=bias_tau,
             bias_rw=_vec(self.bias_rw_ughrh) * u.UG / math.sqrt(u.HOUR),
             scale_gm_std=scale_std, scale_gm_tau=scale_tau,
+            instability=_vec(self.bias_instability_ug) * u.UG,
+            instability_tau=None if self.bias_instability_tau_s is None
+            else tuple(self.bias_instability_tau_s),
         )
 
 
