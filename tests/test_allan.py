@@ -82,7 +82,8 @@ def _exact_curve(Q, N, B, K, ts=0.01, n=2_000_000) -> AllanCurve:
 def test_fit_reads_exact_curves():
     """On σ(τ) computed from the closed forms (IEEE Std 952 C.1) every term comes back to
     1e-6, each over the τ range where it is the largest, and the model lies on the curve."""
-    Q, N, B, K = 2e-6, 3e-5, 4e-6, 1e-7
+    # crossings at 0.05 s (Q, N), 5 s (N, B) and 300 s (B, K) of a 20000 s run
+    Q, N, B, K = 1.92e-6, 1.485e-5, 1e-5, 6.64e-7
     curve = _exact_curve(Q, N, B, K)
     fit = fit_terms(curve)
     for name, true in (("quantization", Q), ("white", N), ("instability", B), ("rate_rw", K)):

@@ -26,8 +26,11 @@ flicker floor, is not biased by its neighbour, as a line of fixed slope through 
 is), and the value is their mean weighted by 1/h_i².
 
 Its interval: the curve's 1σ from the number of clusters (IEEE Std 952 C.3),
-δ_i = 1/√(2(K_i − 1)), widened by the term's share s_i of σ² at that point (σ² = c²f + rest
-gives dc/c = (dσ/σ)/s): h_i = δ_i/s_i. The points of a range share their data (overlapping
+δ_i = 1/√(2(K_i − 1)), plus what the rest taken off is uncertain by (the other terms' shares
+s_l times their own relative half-widths h_l; a term in the model but resolved nowhere
+counts as unknown to 100 %), over the term's share s_i of σ² at that point (σ² = c²f + rest
+gives dc/c = (dσ/σ)/s): h_i = (δ_i + Σ s_l h_l)/s_i, computed twice so that each term
+sees the others' widths. The points of a range share their data (overlapping
 clusters), so they are not combined as independent: the half-width is the weighted mean of
 the h_i, the largest the sd of a mean of correlated estimates can be. Monte Carlo over seeds
 (``tests/test_allan_closed_loop.py``) holds the fitted values to these intervals.
@@ -135,44 +138,66 @@ def fit_terms(curve: AllanCurve) -> NoiseFit:
            for name, _, _ in TERMS}
     for j in range(k):
         var = curve.adev[:, j] ** 2
+        if not (var > 0).any():  # no noise at all (ideal increments): nothing to fit
+            for name, _, _ in TERMS:
+                out[name]["bound"][j] = 0.0
+            continue
+        floor = var[var > 0].min()  # a point of exactly zero must not take all the weight
         # σ² of a point has the relative 1σ error 2·rel; weights from the points first,
         # then twice from the model (a point that fell low must not weigh more)
-        c2 = _nnls(basis, var, var * rel)
+        c2 = _nnls(basis, var, np.maximum(var, floor) * rel)
         for _ in range(2):
             model = basis @ c2
-            c2 = _nnls(basis, var, np.where(model > 0, model, var) * rel)
+            c2 = _nnls(basis, var, np.maximum(np.where(model > 0, model, var), floor) * rel)
         coef[j] = np.sqrt(c2)
         share = basis * c2 / np.maximum(basis @ c2, np.finfo(float).tiny)[:, None]
         largest = np.argmax(share, axis=1)
+        runs: dict[int, tuple[int, int]] = {}
         for t, (name, _, _) in enumerate(TERMS):
             # where it is the largest, half of σ² at least, and more than σ²'s own 1σ
             # (2δ): a fluctuation of a few clusters at long τ is no term
             shows = (largest == t) & (share[:, t] >= np.maximum(MIN_SHARE, 2.0 * rel))
             run = _longest_run(shows)
-            o = out[name]
             if run is None or c2[t] <= 0:
                 # what the curve allows: below its upper 1σ end at every τ
-                o["bound"][j] = float(np.min(curve.hi[:, j] ** 2 / basis[:, t])) ** 0.5
-                continue
-            a, b = run
-            sl = slice(a, b + 1)
-            # each point of the range read alone, the other terms of the whole-curve
-            # model taken off: c_i² = (σ_i² − rest_i)/f(τ_i), 1σ relative h_i = δ_i/s_i
-            rest = basis[sl] @ c2 - basis[sl, t] * c2[t]
-            c_i = np.sqrt(np.clip(var[sl] - rest, 0.0, None) / basis[sl, t])
-            h = rel[sl] / share[sl, t]
-            wgt = 1.0 / h**2
-            value = float(np.sum(wgt * c_i) / np.sum(wgt))
-            half = float(np.sum(wgt * h) / np.sum(wgt))  # the sd of a mean of correlated
-            # estimates is at most the mean of their sd (equal when fully correlated)
-            o["value"][j] = value
-            o["lo"][j] = value * max(1.0 - half, 0.0)
-            o["hi"][j] = value * (1.0 + half)
-            o["tau_range"][j] = (tau[a], tau[b])
-            o["tau_best"][j] = tau[a + int(np.argmin(h))]
+                out[name]["bound"][j] = float(np.min(curve.hi[:, j] ** 2
+                                                     / basis[:, t])) ** 0.5
+            else:
+                runs[t] = run
+        # twice: the rest taken off a point is known as well as the other terms are (a term
+        # in the model but resolved nowhere is taken as unknown to 100 %)
+        known = np.where(c2 > 0, 1.0, 0.0)
+        known[list(runs)] = 0.0  # first pass: δ/s alone
+        for _ in range(2):
+            half_of = known.copy()
+            for t, (a, b) in runs.items():
+                sl = slice(a, b + 1)
+                # each point read alone, the other terms of the whole-curve model taken
+                # off: c_i² = (σ_i² − rest_i)/f(τ_i); its relative 1σ
+                # h_i = (δ_i + Σ_other s_l h_l) / s_i
+                rest = basis[sl] @ c2 - basis[sl, t] * c2[t]
+                c_i = np.sqrt(np.clip(var[sl] - rest, 0.0, None) / basis[sl, t])
+                others = (share[sl] ** 2) @ (known**2) - (share[sl, t] * known[t]) ** 2
+                h = np.sqrt(rel[sl] ** 2 + others) / share[sl, t]
+                wgt = 1.0 / h**2
+                value = float(np.sum(wgt * c_i) / np.sum(wgt))
+                # the sd of a mean of correlated estimates is at most the mean of their
+                # sd (equal when fully correlated)
+                half = float(np.sum(wgt * h) / np.sum(wgt))
+                half_of[t] = half
+                o = out[TERMS[t][0]]
+                o["value"][j] = value
+                o["lo"][j] = value * max(1.0 - half, 0.0)
+                o["hi"][j] = value * (1.0 + half)
+                o["tau_range"][j] = (tau[a], tau[b])
+                o["tau_best"][j] = tau[a + int(np.argmin(h))]
+            known = half_of
     terms = {name: TermFit(name=name, slope=slope, **out[name]) for name, slope, _ in TERMS}
     model = np.sqrt(np.maximum(basis @ (coef**2).T, np.finfo(float).tiny))
-    misfit = np.sqrt(np.mean((np.log(curve.adev / model) / rel[:, None]) ** 2, axis=0))
+    with np.errstate(divide="ignore"):
+        ratio = np.log(np.maximum(curve.adev, np.finfo(float).tiny) / model)
+    misfit = np.where((curve.adev > 0).any(axis=0),
+                      np.sqrt(np.mean((ratio / rel[:, None]) ** 2, axis=0)), 0.0)
     return NoiseFit(terms=terms, coef=coef, misfit=misfit)
 
 

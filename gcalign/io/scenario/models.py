@@ -130,11 +130,15 @@ def _tau_range(v):
     return v
 
 
+def _span(v: list[float] | None) -> tuple[float, float] | None:
+    return None if v is None else (float(v[0]), float(v[1]))
+
+
 TauRange = Annotated[list[Annotated[float, B.CORRELATION_TIME_S]] | None,
                      AfterValidator(_tau_range)]
 INSTABILITY_TAU = ("τ range (s) over which the bias instability's Allan deviation is flat "
-                   "(its Gauss–Markov sum, gcalign.sim.errors); default 1 s to the run's "
-                   "duration")
+                   "(its Gauss–Markov sum, gcalign.sim.errors), from 10 samples on; default 1 s "
+                   "(or 10 samples) to the run's duration")
 
 
 class Gyro(Model):
@@ -183,8 +187,7 @@ class Gyro(Model):
             bias_rw=_vec(self.bias_rw_dphrh) * u.DPH / math.sqrt(u.HOUR),
             scale_gm_std=scale_std, scale_gm_tau=scale_tau,
             instability=_vec(self.bias_instability_dph) * u.DPH,
-            instability_tau=None if self.bias_instability_tau_s is None
-            else tuple(self.bias_instability_tau_s),
+            instability_tau=_span(self.bias_instability_tau_s),
         )
 
 
@@ -234,8 +237,7 @@ class Accel(Model):
             bias_rw=_vec(self.bias_rw_ughrh) * u.UG / math.sqrt(u.HOUR),
             scale_gm_std=scale_std, scale_gm_tau=scale_tau,
             instability=_vec(self.bias_instability_ug) * u.UG,
-            instability_tau=None if self.bias_instability_tau_s is None
-            else tuple(self.bias_instability_tau_s),
+            instability_tau=_span(self.bias_instability_tau_s),
         )
 
 
@@ -248,6 +250,17 @@ class Imu(Model):
     @property
     def ts(self) -> float:
         return 1.0 / self.rate_hz
+
+    @model_validator(mode="after")
+    def _instability_after_ten_samples(self):
+        for name, sensor in (("gyro", self.gyro), ("accel", self.accel)):
+            span = sensor.bias_instability_tau_s
+            if span is not None and span[0] < 10.0 / self.rate_hz * (1 - 1e-9):
+                raise ValueError(
+                    f"{name}.bias_instability_tau_s: starts at {span[0]:g} s, under 10 samples "
+                    f"at {self.rate_hz:g} Hz ({10.0 / self.rate_hz:g} s): faster than that the "
+                    "Gauss–Markov sum is white noise, not a flat Allan deviation")
+        return self
 
     def errors(self) -> ImuErrors:
         return ImuErrors(gyro=self.gyro.to_si(), accel=self.accel.to_si())
