@@ -32,9 +32,13 @@ class AllanResult:
 
 
 def analyse(dtheta: np.ndarray, dv: np.ndarray, ts: float, per_decade: int = 10,
-            min_clusters: int = 4) -> AllanResult:
-    """Allan deviation and noise terms of increments dtheta, dv (N, 3) sampled every `ts`."""
+            min_clusters: int = 4, fit_tau: tuple[float, float] | None = None
+            ) -> AllanResult:
+    """Allan deviation and noise terms of increments dtheta, dv (N, 3) sampled every `ts`;
+    the terms fitted on the points with τ in `fit_tau` (s) only, if given (a base that sways
+    shapes the short τ of a recording; the sensor shows beyond)."""
     g = allan_deviation(dtheta, ts, per_decade, min_clusters)
     a = allan_deviation(dv, ts, per_decade, min_clusters)
-    return AllanResult(g, a, fit_terms(g), fit_terms(a), np.mean(dtheta, axis=0) / ts,
+    gf, af = (g, a) if fit_tau is None else (g.between(*fit_tau), a.between(*fit_tau))
+    return AllanResult(g, a, fit_terms(gf), fit_terms(af), np.mean(dtheta, axis=0) / ts,
                        np.mean(dv, axis=0) / ts)

@@ -59,6 +59,16 @@ class AllanCurve:
         """(M, k) upper end of the 1σ interval."""
         return self.adev * (1.0 + self.error)[:, None]
 
+    def between(self, lo: float, hi: float) -> AllanCurve:
+        """The points with lo ≤ τ ≤ hi (InputError when fewer than two)."""
+        keep = (self.tau >= lo * (1 - 1e-9)) & (self.tau <= hi * (1 + 1e-9))
+        if keep.sum() < 2:
+            raise InputError("tau", f"[{lo:g}, {hi:g}] s holds {int(keep.sum())} of the "
+                             f"curve's cluster times ({self.tau[0]:g} … {self.tau[-1]:g} s); "
+                             "it needs two")
+        return AllanCurve(self.tau[keep], self.adev[keep], self.clusters[keep], self.samples,
+                          self.ts)
+
     def at(self, tau: float) -> np.ndarray:
         """(k,) σ at `tau` (s), interpolated log-log between the computed points; NaN
         outside them."""

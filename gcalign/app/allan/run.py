@@ -172,8 +172,11 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     if progress is not None:
         progress(0.0, 1.0, "Allan deviation")
     try:
-        res = analyse(dtheta, dv, ts, cfg.per_decade, cfg.min_clusters)
+        res = analyse(dtheta, dv, ts, cfg.per_decade, cfg.min_clusters,
+                      None if cfg.fit_tau_s is None else (cfg.fit_tau_s[0], cfg.fit_tau_s[1]))
     except InputError as err:
+        if err.field == "tau":
+            raise ScenarioError(f"allan.fit_tau_s: {err.message}") from None
         raise ScenarioError(f"allan: the window holds {k1 - k0} samples: {err.message}; "
                             "give a longer window (allan.duration_s) or fewer clusters "
                             "(allan.min_clusters)") from None
@@ -189,8 +192,10 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
         "start_s": k0 * ts,
         "duration_s": (k1 - k0) * ts,
         "site_deg_m": [*np.degrees(data.site[:2]).tolist(), float(data.site[2])],
+        "header_attitude_deg": None if imu.att0 is None else np.degrees(imu.att0).tolist(),
         "per_decade": cfg.per_decade,
         "min_clusters": cfg.min_clusters,
+        "fit_tau_s": cfg.fit_tau_s,
         "mean_rate_dph": (res.mean_rate / u.DPH).tolist(),
         "mean_force_ug": (res.mean_force / u.UG).tolist(),
         "at_rest": rest,
