@@ -183,3 +183,32 @@ def test_cli_bad_window(tmp_path):
                    "allan.start_s", "past the end")
     assert_bad_run(cli, tmp_path, ["allan", DATA / "lasergyro.imu.xz", "--duration", 0.03],
                    "allan", "samples")
+
+
+def test_filter_model_from_the_fits():
+    """Bias instability → one Gauss–Markov process whose Allan deviation peaks at the flat
+    level, in the middle of the flicker's τ range; a rate random walk alone → a random
+    walk of density K; nothing → a random constant; white noise → the filter's Q."""
+    from gcalign.allan.processes import filter_model
+    from gcalign.sim.errors import gm_allan_variance
+
+    Q, N, B, K = 1.92e-6, 1.485e-5, 1e-5, 6.64e-7
+    full = _exact_curve(Q, N, B, K)
+    no_flicker = _exact_curve(Q, N, 0.0, 2e-6)
+    three = AllanCurve(full.tau, np.hstack([full.adev, no_flicker.adev, full.adev * 0]),
+                       full.clusters, full.samples, full.ts)
+    fit = fit_terms(three)
+    m = filter_model(fit, fit)
+    assert m.kinds[:3] == ("gauss-markov", "random-walk", "constant")
+    assert m.kinds[6:] == ("constant",) * 6
+    lo, hi = fit.terms["instability"].tau_range[0]
+    mid = math.sqrt(lo * hi)
+    peak = math.sqrt(gm_allan_variance(np.array([mid]), m.std[0], m.tau[0])[0])
+    assert peak == pytest.approx(FLAT * B, rel=1e-3)
+    assert m.density[1] == pytest.approx(2e-6, rel=1e-6)
+    assert m.arw == pytest.approx(N, rel=1e-6)
+    from gcalign.estimation.ins_error import SensorProcesses
+
+    p = SensorProcesses.of(m.kinds, np.nan_to_num(m.std), np.nan_to_num(m.tau, nan=1.0),
+                           np.nan_to_num(m.density))
+    assert p.beta[0] == pytest.approx(1 / m.tau[0]) and p.q[1] == pytest.approx(4e-12)

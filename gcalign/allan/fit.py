@@ -186,7 +186,13 @@ def fit_terms(curve: AllanCurve) -> NoiseFit:
                 half = float(np.sum(wgt * h) / np.sum(wgt))
                 half_of[t] = half
                 o = out[TERMS[t][0]]
-                o["value"][j] = value
+                if not value > 0:  # the other terms explain the whole range: no term
+                    o["bound"][j] = float(np.min(curve.hi[:, j] ** 2 / basis[:, t])) ** 0.5
+                    o["value"][j] = o["lo"][j] = o["hi"][j] = o["tau_best"][j] = np.nan
+                    o["tau_range"][j] = np.nan
+                    half_of[t] = 1.0
+                    continue
+                o["value"][j], o["bound"][j] = value, np.nan
                 o["lo"][j] = value * max(1.0 - half, 0.0)
                 o["hi"][j] = value * (1.0 + half)
                 o["tau_range"][j] = (tau[a], tau[b])

@@ -49,7 +49,7 @@ def _panel(ax, g, triad: str) -> None:
             if not np.isfinite(value) or value <= 0:
                 continue
             line = value * BASIS[name](t_line)
-            keep = (line > ymin / 3) & (line < ymax * 3)
+            keep = (line > ymin / 2) & (line < ymax * 2)  # inside the axes: the label shows
             if not keep.any():
                 continue
             ax.loglog(t_line[keep], line[keep], ":", color=color, lw=0.9, label="_term")
