@@ -29,6 +29,7 @@ class AllanResult:
     accel_fit: NoiseFit
     mean_rate: np.ndarray
     mean_force: np.ndarray
+    fit_tau: tuple[float, float] | None = None  #: the τ range the terms were fitted on
 
 
 def analyse(dtheta: np.ndarray, dv: np.ndarray, ts: float, per_decade: int = 10,
@@ -41,4 +42,4 @@ def analyse(dtheta: np.ndarray, dv: np.ndarray, ts: float, per_decade: int = 10,
     a = allan_deviation(dv, ts, per_decade, min_clusters)
     gf, af = (g, a) if fit_tau is None else (g.between(*fit_tau), a.between(*fit_tau))
     return AllanResult(g, a, fit_terms(gf), fit_terms(af), np.mean(dtheta, axis=0) / ts,
-                       np.mean(dv, axis=0) / ts)
+                       np.mean(dv, axis=0) / ts, fit_tau)

@@ -22,19 +22,25 @@ SCALE = {"gyro": (1.0 / (np.pi / 180 / 3600), "σ(τ) (°/h)", "gyros"),
 def figures(f, name: str) -> dict:
     """``{stem: Figure}`` of a results file holding ``/allan``."""
     fig, axes = new_figure(1, 2, width=13.0, height=5.6, sharex=False)
+    span = f["allan"].attrs.get("fit_tau_s")
     for ax, triad in zip(axes, ("gyro", "accel"), strict=True):
-        _panel(ax, f[f"allan/{triad}"], triad)
+        _panel(ax, f[f"allan/{triad}"], triad, None if span is None else tuple(span))
     fig.suptitle(f"{name}: Allan deviation and fitted noise terms (1σ bands dashed)",
                  fontsize="medium")
     return {f"{name}-allan": fig}
 
 
-def _panel(ax, g, triad: str) -> None:
+def _panel(ax, g, triad: str, span: tuple | None) -> None:
     scale, ylabel, title = SCALE[triad]
     tau = g["tau"][()]
     adev = g["adev"][()] * scale
     lo, hi = g["adev_lo"][()] * scale, g["adev_hi"][()] * scale
     model = g["model"][()] * scale
+    if span is not None:  # the terms were fitted on span only: their sum is drawn there
+        model[(tau < span[0] * (1 - 1e-9)) | (tau > span[1] * (1 + 1e-9))] = np.nan
+        for a, b in ((tau[0], span[0]), (span[1], tau[-1])):
+            if b > a:
+                ax.axvspan(a, b, color="0.9", zorder=0, label="_not fitted")
     t_line = np.geomspace(tau[0], tau[-1], 200)
     ymin, ymax = np.nanmin(lo[lo > 0]) if (lo > 0).any() else adev.min(), np.nanmax(hi)
     for i, (axis, color) in enumerate(zip(AXES, COLORS, strict=True)):
@@ -63,6 +69,7 @@ def _panel(ax, g, triad: str) -> None:
     ax.set_ylim(ymin / 2, ymax * 2)
     ax.set_xlabel("τ (s)")
     ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize="medium")
+    ax.set_title(title if span is None else f"{title} (terms fitted on τ {span[0]:g}–"
+                 f"{span[1]:g} s, unshaded)", fontsize="medium")
     ax.grid(True, which="both", lw=0.3, alpha=0.5)
     ax.legend(fontsize="x-small", ncols=2, loc="best")

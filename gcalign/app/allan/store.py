@@ -51,5 +51,7 @@ def write_allan(f, res: AllanResult) -> None:
     g = f.create_group("allan")
     g.attrs["samples"] = res.gyro.samples
     g.attrs["ts"] = res.gyro.ts
+    if res.fit_tau is not None:
+        g.attrs["fit_tau_s"] = np.asarray(res.fit_tau, float)
     _triad(g.create_group("gyro"), res.gyro, res.gyro_fit, UNITS["gyro"])
     _triad(g.create_group("accel"), res.accel, res.accel_fit, UNITS["accel"])
