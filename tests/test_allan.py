@@ -212,3 +212,17 @@ def test_filter_model_from_the_fits():
     p = SensorProcesses.of(m.kinds, np.nan_to_num(m.std), np.nan_to_num(m.tau, nan=1.0),
                            np.nan_to_num(m.density))
     assert p.beta[0] == pytest.approx(1 / m.tau[0]) and p.q[1] == pytest.approx(4e-12)
+
+
+def test_cli_scenario_on_stdout(tmp_path):
+    """`--scenario -`: the scenario alone on stdout (the table on stderr), a static base at
+    the recording's site and header attitude; with --json it is refused (one stdout)."""
+    res = runner.invoke(app, ["allan", str(DATA / "lasergyro.imu.xz"), "-o",
+                              str(tmp_path / "a.h5"), "--scenario", "-"])
+    assert res.exit_code == 0, res.output
+    sc = yaml.safe_load(res.stdout)
+    assert sc["motion"]["attitude_deg"][2] == pytest.approx(-90.6, abs=0.01)
+    assert sc["site"]["lat_deg"] == pytest.approx(34.246048)
+    assert set(sc["imu"]) >= {"rate_hz", "gyro", "accel"}
+    assert_bad_run(cli, tmp_path, ["allan", DATA / "lasergyro.imu.xz", "--json",
+                                   "--scenario", "-"], "--scenario")
