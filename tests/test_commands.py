@@ -151,7 +151,7 @@ def test_a_limit_that_is_not_a_number_is_refused_everywhere(name, tmp_path, monk
                                                             no_work):
     monkeypatch.setenv("GCALIGN_MAX_MEMORY_MB", "abc")
     out = tmp_path / "out.h5"
-    args = [str(builtin("align", tmp_path))] if name in ("simulate", "navigate") else []
+    args = [str(builtin("align", tmp_path))] if name in ("simulate", "navigate", "allan") else []
     res = runner.invoke(app, [name, *args, "-o", str(out)])
     assert_bad_input(res, out, "GCALIGN_MAX_MEMORY_MB: must be a number, got 'abc'")
 

@@ -34,6 +34,7 @@ WRITERS: dict[str, list[str]] = {
     "northfind": ["northfind", "NF.yaml"], "calibrate": ["calibrate", "CAL.yaml"],
     "observability": ["observability", "CAL.yaml"], "realtime": ["realtime", "RT.yaml"],
     "modulate": ["modulate", "MO.yaml"], "batch": ["batch", "SW.yaml", "-w", "1"],
+    "allan": ["allan", "S.yaml"],
     **{f"export-{fmt}": ["export", "nav.h5", "--format", fmt]
        for fmt in ("csv", "mat", "i2nav-nav", "psins-avp")},
     "plot": ["plot", "nav.h5"],

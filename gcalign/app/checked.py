@@ -170,6 +170,12 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
         "linear/t?": times("L"), "linear/north?": num(("L",)), "linear/east?": num(("L",)),
         "linear/horizontal?": num(("L",)), "linear/sigma_horizontal?": num(("L",)),
         "linear/phi?": num(("L", 3)), "linear/component*?": INDEX}),),
+    "allan": (Block("allan/*", {
+        "tau": times("M"), "adev": num(("M", 3)), "adev_lo": num(("M", 3)),
+        "adev_hi": num(("M", 3)), "clusters": num(("M",), whole=True), "model": num(("M", 3)),
+        "terms/*/value": num((3,), finite=False), "terms/*/interval": num((3, 2), finite=False),
+        "terms/*/bound": num((3,), finite=False),
+        "terms/*/tau_range": num((3, 2), finite=False)}),),
     "batch": (
         Block("batch/runs", {
             "variant": num(("R",), whole=True), "seed": num(("R",), whole=True),

@@ -37,6 +37,7 @@ class Outcome:
 
 def _registered() -> dict[str, Command]:
     from gcalign.app.align import COMMAND as align
+    from gcalign.app.allan import COMMAND as allan
     from gcalign.app.batch import COMMAND as batch
     from gcalign.app.calibrate import COMMAND as calibrate
     from gcalign.app.modulate import COMMAND as modulate
@@ -47,7 +48,7 @@ def _registered() -> dict[str, Command]:
     from gcalign.app.simulate import COMMAND as simulate
 
     commands = (simulate, navigate, align, northfind, calibrate, observability, realtime,
-                modulate, batch)
+                modulate, allan, batch)
     return {c.name: c for c in commands}
 
 

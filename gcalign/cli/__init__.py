@@ -293,6 +293,7 @@ def main() -> None:
 
 # Commands register themselves on `app`.
 from gcalign.cli import align as _align  # noqa: E402,F401
+from gcalign.cli import allan as _allan  # noqa: E402,F401
 from gcalign.cli import batch as _batch  # noqa: E402,F401
 from gcalign.cli import calibrate as _calibrate  # noqa: E402,F401
 from gcalign.cli import data as _data  # noqa: E402,F401

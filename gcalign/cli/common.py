@@ -494,13 +494,16 @@ def _time_column():
 
 
 def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: Path | None,
-                 as_json: bool, **options) -> None:
+                 as_json: bool, on_summary: Callable[[dict], None] | None = None,
+                 stdout_free: bool = False, **options) -> None:
     """Run command `name` on a loaded scenario (its preflight, then its execute), write the
     results file and show its table. Default file name: :func:`output_name` with the
     overrides of the command line (and `options`, e.g. ``--init``). A streaming command
     writes its series into the (temporary) file while it runs; `options` go to its
     ``execute``, a progress bar to a command that reports progress
-    (:func:`gcalign.app.runner.run_command`). Keys that cannot matter become warnings."""
+    (:func:`gcalign.app.runner.run_command`). Keys that cannot matter become warnings.
+    `on_summary` hears of the summary stored; `stdout_free` keeps stdout for the command's
+    own output (the table goes to stderr, as under --json, without the JSON)."""
     from gcalign.app.runner import run_command
 
     inv = _INVOCATION.get() or Invocation()
@@ -519,9 +522,11 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
     with ProgressBar(name) as bar:  # the scenario's name heads the table
         summary = run_command(name, sc, text, seed, out, progress=bar, notes=notes,
                               before_write=bar.close, **options)
-    warn(summary["warnings"], as_json)
+    if on_summary is not None:
+        on_summary(summary)
+    warn(summary["warnings"], as_json or stdout_free)
     sys.stderr.write(f"wrote {out}\n")  # where the file went, also under --json
-    show(name, summary, as_json)
+    show(name, summary, as_json, stdout_free)
 
 
 def warn(warnings: Sequence[str], as_json: bool) -> None:
@@ -534,12 +539,14 @@ def warn(warnings: Sequence[str], as_json: bool) -> None:
         sys.stderr.write(f"warning: {line}\n")
 
 
-def show(kind: str, summary: dict, as_json: bool) -> None:
+def show(kind: str, summary: dict, as_json: bool, stdout_free: bool = False) -> None:
     """Print a command's table with its warnings under it and, under --json, the table on
-    stderr without the warnings (one line each beside it: :func:`warn`) and the summary."""
+    stderr without the warnings (one line each beside it: :func:`warn`) and the summary;
+    `stdout_free`: the table on stderr as under --json, and no JSON."""
     from gcalign.app.report import summary_table
 
-    shown = {**summary, "warnings": []} if as_json else summary  # said above (warn)
-    consoles(as_json).print(summary_table(kind, shown))
+    aside = as_json or stdout_free
+    shown = {**summary, "warnings": []} if aside else summary  # said above (warn)
+    consoles(aside).print(summary_table(kind, shown))
     if as_json:
         emit_json(summary)

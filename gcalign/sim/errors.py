@@ -14,6 +14,17 @@ with ``a = e^{−T/τ}``, ``s = σ √(1 − a²)`` (Gauss–Markov; started fro
 distribution N(0, σ²)) or ``a = 1``, ``s = q √T`` (random walk, started at zero); x_k is
 the value during increment k.
 
+Bias instability (flicker noise, PSD B²/(2πf), whose Allan deviation is flat at 0.664·B)
+has no finite-state form; it is approximated by a sum of first-order Gauss–Markov processes
+of equal std whose correlation times are spread over the decades of τ it must cover
+(:func:`flicker_components`: two a decade, from two decades below the range to a decade
+above it). The sum's Allan variance is the sum of theirs (:func:`gm_allan_variance`, closed
+form, sampled as the simulator runs it); the common std puts the middle of its extremes
+over the range at 0.664·B, and it stays within ±:data:`FLICKER_TOLERANCE` (in σ) of it
+over the whole range. The range is ``instability_tau`` or, by default, 1 s (10 samples, if
+longer) to the run's duration. Each process starts at zero: the turn-on bias is
+``bias``'s, and the flicker wanders from it.
+
 Random numbers: one seeded ``numpy.random.Generator`` per run. The gyro noise of all N
 samples comes first in its stream, then the accelerometer noise (the layout of the
 whole-run draw ``g = rng.normal((N, 3)); a = rng.normal((N, 3))``), so a run gives the
@@ -50,6 +61,10 @@ class SensorErrors:
         random walk; the bias's std grows as ``bias_rw · √t``.
     scale_gm_std, scale_gm_tau : (3,) Gauss–Markov scale-factor error (fraction) and its
         correlation time (s); std 0: none.
+    instability : (3,) bias instability B (rad/s or m/s²): a flicker bias whose Allan
+        deviation is flat at 0.664·B (module docstring); 0: none.
+    instability_tau : (lo, hi) s, the τ range over which it is flat (lo ≥ 10 samples); None:
+        :func:`default_instability_tau`.
     """
 
     bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -63,6 +78,8 @@ class SensorErrors:
     bias_rw: np.ndarray = field(default_factory=lambda: np.zeros(3))
     scale_gm_std: np.ndarray = field(default_factory=lambda: np.zeros(3))
     scale_gm_tau: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
+    instability: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    instability_tau: tuple[float, float] | None = None
 
     def matrix(self) -> np.ndarray:
         """``I + diag(scale) + misalignment``, shape (3, 3)."""
@@ -77,7 +94,8 @@ class SensorErrors:
         """Whether a bias or scale-factor process is set (the errors change with time)."""
         return bool(np.any(np.asarray(self.bias_gm_std) != 0)
                     or np.any(np.asarray(self.bias_rw) != 0)
-                    or np.any(np.asarray(self.scale_gm_std) != 0))
+                    or np.any(np.asarray(self.scale_gm_std) != 0)
+                    or np.any(np.asarray(self.instability) != 0))
 
 
 def _coefficients(std: np.ndarray, tau: np.ndarray, ts: float) -> tuple[np.ndarray, np.ndarray]:
@@ -85,6 +103,78 @@ def _coefficients(std: np.ndarray, tau: np.ndarray, ts: float) -> tuple[np.ndarr
     first-order Gauss–Markov process of stationary std `std` and correlation time `tau`."""
     a = np.exp(-ts / np.asarray(tau, dtype=float))
     return a, np.asarray(std, dtype=float) * np.sqrt(1.0 - a * a)
+
+
+#: √(2 ln2/π): the flat Allan deviation of flicker noise of bias instability B is FLAT·B
+FLAT = float(np.sqrt(2.0 * np.log(2.0) / np.pi))
+#: Correlation times a decade in the Gauss–Markov sum that stands for flicker noise
+FLICKER_PER_DECADE = 2
+#: Largest relative departure of the sum's Allan deviation from 0.664·B over its range
+#: (sampled form: 0.4 % from 100 samples on, 1.2–1.8 % from 10 to 30 samples; tested)
+FLICKER_TOLERANCE = 0.02
+
+
+def default_instability_tau(ts: float, duration: float) -> tuple[float, float]:
+    """The τ range (s) of a bias instability without ``instability_tau``: from 1 s (or 10
+    samples, if longer) to the run's duration (at least ten times the start)."""
+    lo = max(1.0, 10.0 * ts)
+    return lo, max(duration, 10.0 * lo)
+
+
+def gm_allan_variance(tau: np.ndarray, std: float, T: float,
+                      ts: float | None = None) -> np.ndarray:
+    """Allan variance at `tau` of a stationary first-order Gauss–Markov process of std `std`
+    and correlation time `T`.
+
+    Continuous (`ts` None; IEEE Std 952 C.1.6 with q_c² = 2σ²/T)::
+
+        σ²(τ) = (2σ²T/τ) [1 − (T/2τ)(3 − 4e^{−τ/T} + e^{−2τ/T})]
+
+    Sampled (`ts` given): the simulator's process, held during each increment,
+    ``x_k = a x_{k−1} + s w_k`` with a = e^{−ts/T}; for clusters of m = τ/ts samples
+    (S a cluster's sum, autocovariance σ² a^|n|)::
+
+        σ²(τ) = (Var S − Cov(S_1, S_2)) / m²,
+        Var S = σ² [m(1+a)/(1−a) − 2a(1−a^m)/(1−a)²],  Cov = σ² a(1−a^m)²/(1−a)²
+
+    which the continuous form reaches only at τ ≫ ts (at τ = ts it is 1.5 times it for
+    T ≫ ts). Beyond T = 1000·ts the two agree within 0.5 % from τ = 10 ts on, and the
+    continuous one is used (the sampled one cancels there).
+    """
+    tau = np.asarray(tau, dtype=float)
+    if ts is not None and T <= 1e3 * ts:
+        m = np.maximum(np.round(tau / ts), 1.0)
+        d = -np.expm1(-ts / T)  # 1 − a
+        e = -np.expm1(-m * ts / T)  # 1 − a^m
+        a = 1.0 - d
+        v = (m * (1.0 + a) / d - 2.0 * a * e / d**2 - a * e**2 / d**2) / m**2
+        return np.asarray(std**2 * v)
+    x = tau / T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        full = 2.0 / x * (1.0 - (3.0 - 4.0 * np.exp(-x) + np.exp(-2.0 * x)) / (2.0 * x))
+    # τ ≪ T: the bracket cancels; its series 2(x/3 − x²/4 + 7x³/60) (error ~x⁴)
+    series = 2.0 * (x / 3.0 - x**2 / 4.0 + 7.0 * x**3 / 60.0)
+    return np.asarray(std**2 * np.where(x < 1e-2, series, full))
+
+
+def flicker_components(instability: np.ndarray, lo: float, hi: float, ts: float
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Correlation times (n,) s and stds (3, n) of the Gauss–Markov processes, sampled every
+    `ts`, whose sum has an Allan deviation flat at FLAT·`instability` (3,) within
+    ±FLICKER_TOLERANCE over τ in [`lo`, `hi`] (`lo` ≥ 10 `ts`; module docstring): two a
+    decade from two decades below `lo` (the sum sags at its short end without them: 2 % at
+    one decade), but none shorter than `ts` (white noise at the sample rate, not flicker), to
+    a decade above `hi`; the common std sets the middle of the sum's extremes over the range
+    (sampled form of :func:`gm_allan_variance`) at FLAT·B."""
+    decades = np.log10(hi) - np.log10(lo) + 3.0
+    n = int(np.ceil(decades * FLICKER_PER_DECADE - 1e-9)) + 1
+    times = lo / 100.0 * 10.0 ** (np.arange(n) / FLICKER_PER_DECADE)
+    times = times[times >= ts * (1 - 1e-9)]
+    tau = np.geomspace(lo, hi, 256)
+    unit = np.sqrt(sum(gm_allan_variance(tau, 1.0, T, ts) for T in times))  # std 1 each
+    middle = float(np.sqrt(unit.min() * unit.max()))
+    std = FLAT * np.asarray(instability, float)[:, None] / middle
+    return times, np.broadcast_to(std, (3, len(times))).copy()
 
 
 class _Recursion:
@@ -111,8 +201,9 @@ class _Recursion:
 class _Processes:
     """The time-varying bias and scale factor of one triad (module docstring)."""
 
-    def __init__(self, err: SensorErrors, ts: float, rng: np.random.Generator):
-        g_bias, g_rw, g_scale = rng.spawn(3)
+    def __init__(self, err: SensorErrors, ts: float, rng: np.random.Generator,
+                 duration: float = np.inf):
+        g_bias, g_rw, g_scale, g_flicker = rng.spawn(4)  # the first three as spawn(3)
         self.parts: list[tuple[str, _Recursion]] = []
         if np.any(np.asarray(err.bias_gm_std) != 0):
             a, s = _coefficients(err.bias_gm_std, err.bias_gm_tau, ts)
@@ -125,6 +216,12 @@ class _Processes:
             a, s = _coefficients(err.scale_gm_std, err.scale_gm_tau, ts)
             x0 = np.asarray(err.scale_gm_std, float) * g_scale.standard_normal(3)
             self.parts.append(("scale", _Recursion(a, s, x0, g_scale)))
+        if np.any(np.asarray(err.instability) != 0):
+            lo, hi = err.instability_tau or default_instability_tau(ts, duration)
+            times, stds = flicker_components(err.instability, lo, hi, ts)
+            for T, s_T, g in zip(times, stds.T, g_flicker.spawn(len(times)), strict=True):
+                a, s = _coefficients(s_T, np.full(3, T), ts)
+                self.parts.append(("bias", _Recursion(a, s, np.zeros(3), g)))
 
     def next(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """Bias (n, 3) and scale-factor error (n, 3) of the processes during the next n
@@ -145,7 +242,7 @@ class _Channel:
     """One triad's error state across blocks: its noise stream and quantiser remainder."""
 
     def __init__(self, err: SensorErrors, ts: float, rng: np.random.Generator | None,
-                 process_rng: np.random.Generator | None = None):
+                 process_rng: np.random.Generator | None = None, duration: float = np.inf):
         self.err, self.ts, self.rng = err, ts, rng
         self.M = err.matrix().T
         self.unit = bool(np.all(self.M == np.eye(3)))  # no scale factor or misalignment
@@ -155,7 +252,8 @@ class _Channel:
         self.sigma = np.asarray(err.noise, dtype=float) * np.sqrt(ts)
         self.running = np.zeros(3)  # unquantised running sum
         self.total = np.zeros(3)  # quantised running sum already output
-        self.processes = None if process_rng is None else _Processes(err, ts, process_rng)
+        self.processes = None if process_rng is None else _Processes(err, ts, process_rng,
+                                                                      duration)
         #: the processes' values of the last block, (bias (n, 3), scale (n, 3)), or None
         self.last: tuple[np.ndarray, np.ndarray] | None = None
 
@@ -201,8 +299,11 @@ class ErrorStream:
         self._g_drawn = 0  # gyro normals drawn so far
         varying = errors.gyro.varying or errors.accel.varying
         g_proc, a_proc = rng.spawn(2) if varying else (None, None)
-        self.gyro = _Channel(errors.gyro, ts, g_rng, g_proc if errors.gyro.varying else None)
-        self.accel = _Channel(errors.accel, ts, None, a_proc if errors.accel.varying else None)
+        run = samples * ts  # the default τ range of a bias instability ends here
+        self.gyro = _Channel(errors.gyro, ts, g_rng, g_proc if errors.gyro.varying else None,
+                             run)
+        self.accel = _Channel(errors.accel, ts, None, a_proc if errors.accel.varying else None,
+                              run)
 
     def _accel_rng(self) -> np.random.Generator:
         """The accelerometer's generator, 3N normals after the start of the run."""

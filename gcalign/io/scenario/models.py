@@ -7,11 +7,19 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BeforeValidator, Field, field_validator, model_serializer, model_validator
+from pydantic import (
+    AfterValidator,
+    BeforeValidator,
+    Field,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from gcalign import units as u
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.align import AlignConfig
+from gcalign.io.scenario.allan import AllanConfig
 from gcalign.io.scenario.base import Model, NonNegVec3, Vec3
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 from gcalign.io.scenario.modulate import ModulateConfig
@@ -114,6 +122,25 @@ class ScaleGaussMarkov(Model):
     tau_s: Tau = Field(description="correlation time, s")
 
 
+def _tau_range(v):
+    if v is None:
+        return v
+    if len(v) != 2 or not 0 < v[0] < v[1]:
+        raise ValueError(f"must be [lo, hi] in s with 0 < lo < hi, got {v}")
+    return v
+
+
+def _span(v: list[float] | None) -> tuple[float, float] | None:
+    return None if v is None else (float(v[0]), float(v[1]))
+
+
+TauRange = Annotated[list[Annotated[float, B.CORRELATION_TIME_S]] | None,
+                     AfterValidator(_tau_range)]
+INSTABILITY_TAU = ("τ range (s) over which the bias instability's Allan deviation is flat "
+                   "(its Gauss–Markov sum, gcalign.sim.errors), from 10 samples on; default 1 s "
+                   "(or 10 samples) to the run's duration")
+
+
 class Gyro(Model):
     bias_dph: Annotated[PerAxis, B.GYRO_BIAS_DPH] = Field(
         default_factory=lambda: [0.0, 0.0, 0.0], description=B.GYRO_BIAS_DPH.range())
@@ -134,6 +161,11 @@ class Gyro(Model):
                     f"{B.GYRO_BIAS_RW_DPHRH.range()}")
     scale_gm: ScaleGaussMarkov | None = Field(
         None, description="a scale-factor error that wanders (added to scale_ppm)")
+    bias_instability_dph: Annotated[Noise, B.GYRO_BIAS_DPH] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description="bias instability B, °/h: the flat part of the Allan deviation / 0.664 "
+                    "(flicker noise, simulated as a sum of Gauss–Markov processes)")
+    bias_instability_tau_s: TauRange = Field(None, description=INSTABILITY_TAU)
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
@@ -154,6 +186,8 @@ class Gyro(Model):
             bias_gm_std=bias_std, bias_gm_tau=bias_tau,
             bias_rw=_vec(self.bias_rw_dphrh) * u.DPH / math.sqrt(u.HOUR),
             scale_gm_std=scale_std, scale_gm_tau=scale_tau,
+            instability=_vec(self.bias_instability_dph) * u.DPH,
+            instability_tau=_span(self.bias_instability_tau_s),
         )
 
 
@@ -177,6 +211,11 @@ class Accel(Model):
                     f"{B.ACCEL_BIAS_RW_UGRH.range()}")
     scale_gm: ScaleGaussMarkov | None = Field(
         None, description="a scale-factor error that wanders (added to scale_ppm)")
+    bias_instability_ug: Annotated[Noise, B.ACCEL_BIAS_UG] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description="bias instability B, µg: the flat part of the Allan deviation / 0.664 "
+                    "(flicker noise, simulated as a sum of Gauss–Markov processes)")
+    bias_instability_tau_s: TauRange = Field(None, description=INSTABILITY_TAU)
 
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
@@ -197,6 +236,8 @@ class Accel(Model):
             bias_gm_std=bias_std, bias_gm_tau=bias_tau,
             bias_rw=_vec(self.bias_rw_ughrh) * u.UG / math.sqrt(u.HOUR),
             scale_gm_std=scale_std, scale_gm_tau=scale_tau,
+            instability=_vec(self.bias_instability_ug) * u.UG,
+            instability_tau=_span(self.bias_instability_tau_s),
         )
 
 
@@ -210,13 +251,25 @@ class Imu(Model):
     def ts(self) -> float:
         return 1.0 / self.rate_hz
 
+    @model_validator(mode="after")
+    def _instability_after_ten_samples(self):
+        for name, sensor in (("gyro", self.gyro), ("accel", self.accel)):
+            span = sensor.bias_instability_tau_s
+            if span is not None and span[0] < 10.0 / self.rate_hz * (1 - 1e-9):
+                raise ValueError(
+                    f"{name}.bias_instability_tau_s: starts at {span[0]:g} s, under 10 samples "
+                    f"at {self.rate_hz:g} Hz ({10.0 / self.rate_hz:g} s): faster than that the "
+                    "Gauss–Markov sum is white noise, not a flat Allan deviation")
+        return self
+
     def errors(self) -> ImuErrors:
         return ImuErrors(gyro=self.gyro.to_si(), accel=self.accel.to_si())
 
 
 #: The commands that use the recorded-data keys ``reference`` and ``initial``.
 #: (align and calibrate: the site when the file has none, and whether the base is at rest.)
-USED_BY: dict[str, tuple[str, ...]] = {"reference": ("navigation", "align", "calibrate"),
+USED_BY: dict[str, tuple[str, ...]] = {"reference": ("navigation", "align", "calibrate",
+                                                     "allan"),
                                        "initial": ("navigation",)}
 
 
@@ -242,6 +295,7 @@ class Scenario(Model):
     observability: ObservabilityConfig | None = None
     realtime: RealtimeConfig | None = None
     modulate: ModulateConfig | None = None
+    allan: AllanConfig | None = None
 
     @property
     def earth_model(self) -> EarthModel:

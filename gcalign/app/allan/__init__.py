@@ -1,0 +1,40 @@
+"""`gcalign allan`: the Allan deviation of a static recording (or a simulation) and the IMU
+noise terms fitted to it, named as the scenario's ``imu`` keys."""
+
+from __future__ import annotations
+
+from gcalign.app.command import Command, Cost, Extent, Options
+from gcalign.errors import ScenarioError
+
+#: operations per sample and axis: the running sum and allantools' second differences at
+#: every cluster time (about 10 a decade over 5 decades)
+OPS_PER_SAMPLE = 6 * 50.0
+
+
+class Allan(Command):
+    name = "allan"
+    help = ("Allan deviation of IMU data at rest and the noise terms fitted to it (ARW, "
+            "bias instability, ...).")
+    section = "allan"
+    options = Options(recorded=True)
+    layout = ("allan",)
+    run = "gcalign.app.allan.run"
+    table_of = "gcalign.app.allan.tables.allan_table"
+    figures_of = "gcalign.app.allan.plots.figures"
+
+    def check(self, sc, ext: Extent | None) -> None:
+        if ext is None or sc.allan is None:
+            return
+        if int(round(sc.allan.start_s / ext.ts)) >= ext.samples:
+            raise ScenarioError(f"allan.start_s: {sc.allan.start_s:g} s is past the end of the "
+                                f"data ({ext.samples * ext.ts:g} s)")
+
+    def cost(self, sc, ext: Extent | None) -> Cost:
+        if ext is None:
+            return Cost()
+        n = float(ext.samples)
+        return Cost(samples=n, memory_bytes=n * 8 * 10, work=n * OPS_PER_SAMPLE,
+                    work_what="samples × cluster times")
+
+
+COMMAND = Allan()

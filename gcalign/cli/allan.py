@@ -1,0 +1,107 @@
+"""`gcalign allan`: the Allan deviation of IMU data and the noise terms fitted to it."""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+
+import typer
+
+from gcalign.cli import app, user_errors
+from gcalign.cli.common import imu_file_given, load_with_overrides, run_and_show
+from gcalign.cli.options import Json, Output, Seed, Sets
+from gcalign.errors import ScenarioError
+from gcalign.io.paths import not_a_file
+
+SCENARIO_HELP = ("Write a static scenario with the fitted noise as its imu section (site and "
+                 "duration of the data), to run as it is; '-' prints it on stdout (the table "
+                 "then goes to stderr).")
+
+
+@app.command()
+@user_errors
+def allan(
+    source: Path | None = typer.Argument(
+        None, help="A recording (PSINS .imu, CSV/text, PSINS MAT, KF-GINS; .gz/.xz "
+        "compressed too), a `gcalign simulate` results file, or a scenario YAML (simulated "
+        "at rest, or naming its imu_file). Or none, with --imu-file FILE."),
+    start: float | None = typer.Option(None, "--start", help="Data time the window starts at "
+                                       "(s)."),
+    duration: float | None = typer.Option(None, "--duration", help="Window length (s)."),
+    scenario_out: str | None = typer.Option(None, "--scenario", metavar="FILE",
+                                            help=SCENARIO_HELP),
+    output: Output = None,
+    seed: Seed = None,
+    as_json: Json = False,
+    set_: Sets = None,
+):
+    """Overlapping Allan deviation of every gyro and accelerometer axis (allantools), its 1σ
+    interval from the number of clusters, and the IEEE Std 952 terms fitted to it:
+    quantization (slope −1), ARW/VRW (−½), bias instability (flat / 0.664) and rate random
+    walk (+½), each with its τ range and interval, named as the scenario's imu keys."""
+    import yaml
+
+    from gcalign.cli.data import DATA_SUFFIXES, data_suffix
+    from gcalign.io import results
+    from gcalign.io.results import HDF5_SUFFIXES
+
+    if source is not None and not source.is_file():
+        raise ScenarioError(f"{source}: {not_a_file(source)}")
+    if source is None and not imu_file_given():
+        raise ScenarioError("allan: give a recording, a results file or a scenario (SOURCE), "
+                            "or --imu-file FILE")
+    if scenario_out not in (None, "-") and output is not None and \
+            Path(scenario_out).resolve() == Path(output).resolve():
+        raise ScenarioError(f"--scenario: {scenario_out} is also the results file (-o)")
+    if scenario_out not in (None, "-"):
+        results.check_output(scenario_out, "--scenario")
+    suffix = "" if source is None else data_suffix(source)
+    data = text = None
+    if source is not None and suffix in DATA_SUFFIXES | HDF5_SUFFIXES:
+        text = results.read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
+        stored = yaml.safe_load(text) if text else None
+        name = stored.get("name") if isinstance(stored, dict) else None
+        name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.name.split(".")[0]) or "data"
+        data = {"name": name, "imu_file": str(source.resolve())}
+        if isinstance(stored, dict) and "earth" in stored:
+            data["earth"] = stored["earth"]
+        text = yaml.safe_dump(data)
+    overrides = {"start_s": start, "duration_s": duration}
+    sc, text, _ = load_with_overrides(source, "", "allan", overrides, data=data, text=text,
+                                      sets=set_)
+    if as_json and scenario_out == "-":
+        raise ScenarioError("--scenario: '-' prints the scenario on stdout, where --json "
+                            "prints its JSON; give --scenario FILE, or leave out --json")
+    captured: dict = {}
+    run_and_show("allan", sc, text, seed, output, as_json, on_summary=captured.update,
+                 stdout_free=scenario_out == "-")
+    if scenario_out is not None:
+        from gcalign.app.allan.scenario import scenario_text
+
+        out = scenario_text(captured)
+        if scenario_out == "-":
+            sys.stdout.write(out)
+        else:
+            _write_atomically(Path(scenario_out), out)
+            sys.stderr.write(f"wrote {scenario_out}\n")
+
+
+def _write_atomically(path: Path, text: str) -> None:
+    """`text` under `path` whole or not at all (a temporary file beside it, renamed); a
+    refused write is one line (:func:`gcalign.io.results.write_error`)."""
+    import os
+
+    from gcalign.io.results import make_temp, write_error
+
+    fd, tmp = make_temp(path)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except OSError as err:
+        tmp.unlink(missing_ok=True)
+        raise write_error(path, err) from None
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
