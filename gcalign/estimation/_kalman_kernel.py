@@ -59,7 +59,9 @@ def predict_kernel(x: np.ndarray, P: np.ndarray, Phi: np.ndarray,
 
 
 @njit(cache=True, error_model="numpy")
-def update_kernel(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.ndarray):
+def update_kernel(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray,
+                  R: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                          np.ndarray, np.ndarray, float]:
     """Joseph-form update (see :func:`gcalign.estimation.kalman.update`): returns
     ``(ok, x⁺, P⁺, y, S, K, w, nis)`` with w = L⁻¹ y (S = L Lᵀ) and nis = w·w; ok False
     (and the rest unset) when ½(S + Sᵀ) is not positive definite. C-contiguous float64
