@@ -141,3 +141,69 @@ def test_solve_spd_on_a_badly_scaled_covariance():
     ref = np.linalg.solve(C, e / d) / d  # exact: P⁻¹ = D⁻¹ C⁻¹ D⁻¹
     np.testing.assert_allclose(solve_spd(P, e), ref, rtol=1e-12)
     np.testing.assert_allclose(solve_spd(C, e), np.linalg.solve(C, e), rtol=1e-12)
+
+
+def _predict_numpy(x, P, Phi, Qd):
+    """The predict as plain NumPy expressions (the slow reference of the kernel)."""
+    M = Phi @ P @ Phi.T + Qd
+    return Phi @ x, 0.5 * (M + M.T)
+
+
+def _update_numpy(x, P, z, H, R, joseph_r_term=True):
+    """The Joseph-form update as plain NumPy expressions, I − KH formed (the slow reference
+    of the kernel); `joseph_r_term` False drops K R Kᵀ (a one-term change for the test)."""
+    y = z - H @ x
+    S = H @ P @ H.T + R
+    K = P @ H.T @ np.linalg.inv(S)
+    I_KH = np.eye(len(x)) - K @ H
+    Pn = I_KH @ P @ I_KH.T + (K @ R @ K.T if joseph_r_term else 0.0)
+    w = np.linalg.solve(np.linalg.cholesky(0.5 * (S + S.T)), y)
+    return x + K @ y, 0.5 * (Pn + Pn.T), y, S, K, w
+
+
+@pytest.mark.parametrize(("n", "m"), [(21, 2), (21, 3), (21, 6), (4, 1)])
+def test_predict_and_update_kernels_equal_the_numpy_form(n, m):
+    """The numba predict and Joseph update (the O(n² m) evaluation of the product) against
+    the NumPy expressions with I − KH formed: every output to 1e-12 of its largest entry
+    (a covariance on its correlation scale), on a covariance whose standard deviations
+    span six decades, as an INS error state's do."""
+    rng = np.random.default_rng(n * 10 + m)
+    d = np.logspace(-4, 2, n)
+    A = rng.normal(size=(n, n))
+    P = (A @ A.T + n * np.eye(n)) * np.outer(d, d)
+    P = 0.5 * (P + P.T)
+    Phi = np.eye(n) + 0.05 * rng.normal(size=(n, n))
+    Qd = np.diag(rng.uniform(0.1, 1.0, n) * d**2)
+    x, z = rng.normal(size=n) * d, rng.normal(size=m)
+    H = rng.normal(size=(m, n))
+    R = np.diag(rng.uniform(0.1, 1.0, m))
+
+    def close(a, b):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.abs(b).max())
+
+    def scaled(M):  # a covariance on its correlation scale: entries of order one
+        s = np.sqrt(np.diag(M))
+        return M / np.outer(s, s)
+
+    xp, Pp = predict(x, P, Phi, Qd)
+    xr, Pr = _predict_numpy(x, P, Phi, Qd)
+    close(xp, xr)
+    close(scaled(Pp), scaled(Pr))
+    assert np.array_equal(Pp, Pp.T)
+    u = update(xp, Pp, z, H, R)
+    ref = _update_numpy(xp, Pp, z, H, R)
+    for a, b in zip((u.x, u.innovation, u.S, u.standardized), ref[:1] + ref[2:4] + ref[5:],
+                    strict=True):
+        close(a, b)
+    close(scaled(u.P), scaled(ref[1]))
+    close(u.K / d[:, None], ref[4] / d[:, None])
+    assert u.nis == pytest.approx(float(ref[-1] @ ref[-1]), rel=1e-12)
+    assert np.array_equal(u.P, u.P.T)
+    # the check can fail: the same reference without its K R Kᵀ term is far from it
+    assert np.abs(scaled(_update_numpy(xp, Pp, z, H, R, False)[1]) - scaled(u.P)).max() > 1e-6
+
+
+def test_update_refuses_an_innovation_covariance_that_is_not_positive_definite():
+    P, H = np.eye(3), np.array([[1.0, 0.0, 0.0]])
+    with pytest.raises(np.linalg.LinAlgError):
+        update(np.zeros(3), P, np.zeros(1), H, np.array([[-2.0]]))

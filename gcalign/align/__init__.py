@@ -8,6 +8,8 @@ Modules:
 - :mod:`gcalign.align.gains` -- loop gains by pole placement (seed 000 §2, eqs. 5-9).
 - :mod:`gcalign.align.kernel` -- numba kernel of the strapdown gyrocompass loops.
 - :mod:`gcalign.align.cycles` -- conventional, full-cycle and half-cycle passes, stages.
+- :mod:`gcalign.align.lockstep` -- many runs of one variant (Monte Carlo seeds) through
+  the passes together, each run's numbers those of ``align`` to the bit.
 
 Conventions are those of the package (ENU navigation frame, body x right / y forward /
 z up, ``att = [pitch, roll, yaw]`` in radians, ``C_nb = Rz(yaw) Rx(pitch) Ry(roll)``).

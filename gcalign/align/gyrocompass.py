@@ -544,6 +544,37 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
     -------
     Alignment. InputError (a ValueError) names the argument or setting it refuses.
     """
+    prep = _prepare(dtheta, dv, ts, site, settings, earth, att_t1, position_t1, vref,
+                    vref_body, truth_att, t0, stride, first_sample, samples)
+    records, q2, q3, i3, compute = _passes(settings, prep.state0, prep.tl, prep.block, t0,
+                                           prep.ts, earth, prep.stride)
+    return _finish(prep, records, q2, q3, i3, compute)
+
+
+@dataclass(frozen=True)
+class _Prepared:
+    """An alignment's inputs, checked, up to the passes: its settings and timeline, the
+    truth rows, the coarse attitude at T1, the loop state there and its data by range."""
+
+    settings: AlignSettings
+    ts: float
+    t0: float
+    stride: int
+    earth: EarthModel
+    vref_body: bool
+    tl: Timeline
+    truth: TruthRows | None
+    att1: Array
+    state0: Array
+    block: Callable[[int, int], Block]
+
+
+def _prepare(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
+             settings: AlignSettings, earth: EarthModel, att_t1: ArrayLike | None,
+             position_t1: ArrayLike | None, vref: ArrayLike | None, vref_body: bool,
+             truth_att: ArrayLike | TruthRows | None, t0: float, stride: int,
+             first_sample: int, samples: int | None) -> _Prepared:
+    """:func:`align`'s checks, truth, coarse alignment and initial loop state."""
     ts = float(ts)
     if not (math.isfinite(ts) and ts > 0):
         raise InputError("ts", f"must be a finite interval > 0 s, got {ts}")
@@ -558,7 +589,7 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
     tl = _window(settings, ts, n, lo, samples)
     truth = _truth(truth_att, settings, ts, lo + n if samples is None else samples, int(stride),
                    lo, n)
-    i0, i1, i2 = tl.i0, tl.i1, tl.i2
+    i0, i1 = tl.i0, tl.i1
     given = _given(settings, att_t1, truth, i1)
     pos1 = pos0.copy() if position_t1 is None else _array("position_t1", position_t1, (3,))
     att1 = _coarse_attitude(settings, dth[i0 - lo:i1 - lo], dvb[i0 - lo:i1 - lo], ts, pos0,
@@ -572,8 +603,15 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
         i, j = a - lo, b - lo
         return Block(a, t0, dth[i:j], dvb[i:j], ref[i:j + 1], vref_body, ts)
 
-    records, q2, q3, i3, compute = _passes(settings, K.new_state(q1, v1, pos1), tl, block,
-                                           t0, ts, earth, stride)
+    return _Prepared(settings, ts, t0, int(stride), earth, vref_body, tl, truth, att1,
+                     K.new_state(q1, v1, pos1), block)
+
+
+def _finish(prep: _Prepared, records: list[PassRecord], q2: Array, q3: Array, i3: int,
+            compute: float) -> Alignment:
+    """The :class:`Alignment` of prepared inputs, their passes and the attitude at T2, T3."""
+    settings, tl, truth, ts = prep.settings, prep.tl, prep.truth, prep.ts
+    i0, i1, i2 = tl.i0, tl.i1, tl.i2
     if settings.realtime_conventional:
         equivalent = (i3 - i0) * ts
     else:
@@ -584,7 +622,7 @@ def align(dtheta: ArrayLike, dv: ArrayLike, ts: float, site: ArrayLike,
         t2=(i2 - i0) * ts,
         t3=(i3 - i0) * ts,
         t3_source="measured" if settings.t3_s == "measured" else "configured",
-        coarse_att=att1,
+        coarse_att=prep.att1,
         passes=records,
         truth=truth,
         att_t2=quat_to_euler(q2),

@@ -22,16 +22,25 @@ reads the stored block backwards and applies the signs as it reads):
 
 Modes: ``ATTITUDE`` (no loops: the attitude-only strapdown of a half-cycle reverse pass and
 of the T2→T3 update), ``LEVEL`` (both level loops, azimuth free) and ``COMPASS``.
+
+One step (:func:`_loop_step`) serves :func:`gyrocompass_range` (one run) and
+:func:`gyrocompass_range_lanes` (:data:`LANES` runs side by side, vectorised over the runs:
+the seeds of a Monte Carlo variant); ``tests/test_align_lockstep.py`` holds the two to the
+bit and ``tests/test_kernels_bit_identical.py`` the single kernel to its previous form.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numba import njit
 
 from gcalign.nav._kernels import (
+    EarthParams,
     attitude_update,
     earth_at,
+    earth_sc,
     euler_of,
     position_update,
     qrot,
@@ -54,6 +63,123 @@ FLIP = slice(4, 9)
 GAINS_SIZE = 10
 
 
+#: The loop's carried values, in local variables (registers) from step to step: the 12
+#: floats of the state vector in its order, then the reference velocity at the start of
+#: the step (v_R,E, v_R,N, v_R,U) and the control rates ω_cE, ω_cN.
+LoopTuple = tuple[float, float, float, float, float, float, float, float, float, float, float,
+                  float, float, float, float, float, float]
+CARRIED = STATE_SIZE + 5  #: floats of a LoopTuple
+Gains = tuple[float, float, float, float, float, float, float, float, float, float]
+
+
+@njit(cache=True, inline="always")
+def _gains(g: np.ndarray) -> Gains:
+    """The gains vector as locals (loaded once, not at every step)."""
+    return g[0], g[1], g[2], g[3], g[4], g[5], g[6], g[7], g[8], g[9]
+
+
+@njit(cache=True, inline="always")
+def _loop_start(q0: float, q1: float, q2: float, q3: float, ve: float, vn: float, ie: float,
+                inn: float, wcu: float, lat: float, lon: float, h: float, re: float, rn: float,
+                ru: float, vref_body: bool, E: EarthParams, gk: Gains,
+                mode: int) -> LoopTuple:
+    """The carried values at the start of a range: the state, the reference velocity at its
+    first sample (signed, not yet resolved) and the control rates of the incoming state."""
+    if vref_body:
+        re, rn, ru = qrot(q0, q1, q2, q3, re, rn, ru)
+    wce = wcn = 0.0
+    r_m, r_n, g, sl, cl = earth_at(E, lat, h)
+    if mode != ATTITUDE:
+        # Control rates of the incoming state.
+        dve, dvn = ve - re, vn - rn
+        wcn = dve * (1.0 + gk[1]) / (r_n + h) + gk[2] * ie
+        if mode == LEVEL:
+            wce = -dvn * (1.0 + gk[4]) / (r_m + h) - gk[5] * inn
+        else:
+            wce = -dvn * (1.0 + gk[7]) / (r_m + h)
+    return q0, q1, q2, q3, ve, vn, ie, inn, wcu, lat, lon, h, re, rn, ru, wce, wcn
+
+
+@njit(cache=True, inline="always")
+def _loop_step(x: LoopTuple, bx: float, by: float, bz: float, dx: float, dy: float, dz: float,
+               ne: float, nn: float, nu: float, vref_body: bool, ts: float, earth_sign: float,
+               E: EarthParams, gk: Gains, mode: int) -> LoopTuple:
+    """One step of the loops: increments Δθ = (bx, by, bz), Δv = (dx, dy, dz) (signed for the
+    pass direction), reference velocity (ne, nn, nu) at the end of the step (signed, not yet
+    resolved); returns the carried values after it (see the module docstring)."""
+    lat = x[9]
+    return _loop_step_sc(x, math.sin(lat), math.cos(lat), bx, by, bz, dx, dy, dz, ne, nn, nu,
+                         vref_body, ts, earth_sign, E, gk, mode != ATTITUDE, mode == LEVEL,
+                         mode == COMPASS, False)[0]
+
+
+@njit(cache=True, inline="always")
+def _loop_step_sc(x: LoopTuple, sl: float, cl: float, bx: float, by: float, bz: float,
+                  dx: float, dy: float, dz: float, ne: float, nn: float, nu: float,
+                  vref_body: bool, ts: float, earth_sign: float, E: EarthParams, gk: Gains,
+                  loops: bool, level: bool, compass: bool,
+                  series: bool) -> tuple[LoopTuple, float]:
+    """:func:`_loop_step` given sin L and cos L of the latitude at the start of the step and
+    the mode as three flags (loops: not ATTITUDE; LEVEL; COMPASS: independent values, which
+    a compiler cannot fold into a multi-way branch that its vectoriser refuses); also
+    returns the larger squared angle of the step's two rotation vectors (`series`: their
+    quaternions by the series whatever the angle, right below 2.5e-3 rad²)."""
+    q0, q1, q2, q3, ve, vn, ie, inn, wcu, lat, lon, h, re, rn, ru, wce, wcn = x
+    r_m, r_n, g, sl, cl = earth_sc(E, sl, cl, h)
+    rmh, rnh = r_m + h, r_n + h  # radii at the start of the step
+    wie = earth_sign * E[3]
+    wie_n, wie_u = wie * cl, wie * sl
+    te, tn, tu = transport_rate(re, rn, r_m, r_n, h, sl, cl)
+    cu = wcu if compass else 0.0
+    wx = (te + wce) * ts
+    wy = (wie_n + tn + wcn) * ts
+    wz = (wie_u + tu + cu) * ts
+
+    # Specific-force increment at mid-interval, and the attitude update with the
+    # platform rate including the control rates: the pieces of the strapdown step.
+    fx, fy, fz = specific_force_increment(q0, q1, q2, q3, bx, by, bz, dx, dy, dz, wx, wy, wz)
+    q0, q1, q2, q3 = attitude_update(q0, q1, q2, q3, bx, by, bz, wx, wy, wz, series)
+    angle2 = max(bx * bx + by * by + bz * bz, wx * wx + wy * wy + wz * wz)
+
+    # Reference velocity at the end of the step, and position along it.
+    if vref_body:
+        ne, nn, nu = qrot(q0, q1, q2, q3, ne, nn, nu)
+    lat_new, lon, h_new = position_update(
+        E, lat, lon, h, 0.5 * (re + ne), 0.5 * (rn + nn), 0.5 * (ru + nu), ts, r_m, sl, cl
+    )
+
+    if loops:
+        # Coriolis and frame-rate acceleration of the reference velocity (seed §1). With
+        # an odometer the reference is resolved with the computed attitude, so it turns
+        # with every azimuth correction; the loop velocity must turn with the computed
+        # frame too (ω_c in the frame rate), or the compass loop sees a false
+        # δv_N = v_E Δφ_U that detunes it. An ENU (nav) reference does not turn.
+        # Evaluated at the mid-step reference velocity, as the strapdown step does.
+        cc = 1.0 if vref_body else 0.0
+        ce, cn, cu2 = te + cc * wce, 2.0 * wie_n + tn + cc * wcn, 2.0 * wie_u + tu + cc * cu
+        me, mn, mu = 0.5 * (re + ne), 0.5 * (rn + nn), 0.5 * (ru + nu)
+        ae = -(cn * mu - cu2 * mn)
+        an = -(cu2 * me - ce * mu)
+        k1e = gk[0]
+        k1n = gk[3] if level else gk[6]
+        ve = ve + fx + ae * ts - k1e * (ve - re) * ts
+        vn = vn + fy + an * ts - k1n * (vn - rn) * ts
+        dve, dvn = ve - ne, vn - nn
+        ie += dve * ts
+        wcn = dve * (1.0 + gk[1]) / rnh + gk[2] * ie  # eq. 1
+        if level:
+            inn += dvn * ts
+            wce = -dvn * (1.0 + gk[4]) / rmh - gk[5] * inn  # eq. 2
+        else:
+            omega = wie_n  # Ω = ω_ie cos L, signed with the pass direction
+            wcu = (wcu + gk[8] * dvn * ts / omega) / (1.0 + gk[9] * ts)  # eqs. 4, 13
+            wce = -dvn * (1.0 + gk[7]) / rmh  # eq. 3
+    else:
+        ve, vn = ne, nn
+    return (q0, q1, q2, q3, ve, vn, ie, inn, wcu, lat_new, lon, h_new, ne, nn, nu, wce,
+            wcn), angle2
+
+
 @njit(cache=True, error_model="numpy")
 def gyrocompass_range(state: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, vref: np.ndarray,
                       vref_body: bool, ts: float, lo: int, hi: int, reverse: bool,
@@ -74,108 +200,178 @@ def gyrocompass_range(state: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, vre
     (error_model "numpy": a division by zero would give inf instead of raising; none of
     the step's divisors can be zero, and the test before each division is gone.)
     """
-    ke1, ke2, ke3 = gains[0], gains[1], gains[2]
-    kn1, kn2, kn3 = gains[3], gains[4], gains[5]
-    ku1, ku2, ku3, ku4 = gains[6], gains[7], gains[8], gains[9]
-    q0, q1, q2, q3 = state[0], state[1], state[2], state[3]
-    ve, vn = state[4], state[5]
-    ie, inn = state[6], state[7]
-    wcu = state[8]
-    lat, lon, h = state[9], state[10], state[11]
+    gk = _gains(gains)
     n = hi - lo
     # sample j of the range in processing order: forward lo + j, reverse hi − j
     first = hi if reverse else lo
     step = -1 if reverse else 1
+    sg = data_sign
+    x = _loop_start(state[0], state[1], state[2], state[3], state[4], state[5], state[6],
+                    state[7], state[8], state[9], state[10], state[11], sg * vref[first, 0],
+                    sg * vref[first, 1], sg * vref[first, 2], vref_body, E, gk, mode)
     idx_out[0] = first
-    q_out[0, 0], q_out[0, 1], q_out[0, 2], q_out[0, 3] = q0, q1, q2, q3
+    q_out[0, 0], q_out[0, 1], q_out[0, 2], q_out[0, 3] = x[0], x[1], x[2], x[3]
     row = 1
     # the next multiple of the stride after the first sample, in processing order
     keep = (first - 1) // stride * stride if reverse else (first // stride + 1) * stride
-    # Reference velocity at the start of the first step.
-    sg = data_sign
-    re, rn, ru = sg * vref[first, 0], sg * vref[first, 1], sg * vref[first, 2]
-    if vref_body:
-        re, rn, ru = qrot(q0, q1, q2, q3, re, rn, ru)
-    wce = wcn = 0.0
-    r_m, r_n, g, sl, cl = earth_at(E, lat, h)
-    if mode != ATTITUDE:
-        # Control rates of the incoming state.
-        dve, dvn = ve - re, vn - rn
-        wcn = dve * (1.0 + ke2) / (r_n + h) + ke3 * ie
-        if mode == LEVEL:
-            wce = -dvn * (1.0 + kn2) / (r_m + h) - kn3 * inn
-        else:
-            wce = -dvn * (1.0 + ku2) / (r_m + h)
     for k in range(n):
         j = hi - 1 - k if reverse else lo + k  # the increment
         nxt = first + step * (k + 1)  # the sample at the end of the step
-        bx, by, bz = sg * dtheta[j, 0], sg * dtheta[j, 1], sg * dtheta[j, 2]
-        r_m, r_n, g, sl, cl = earth_at(E, lat, h)
-        rmh, rnh = r_m + h, r_n + h  # radii at the start of the step
-        wie = earth_sign * E[3]
-        wie_n, wie_u = wie * cl, wie * sl
-        te, tn, tu = transport_rate(re, rn, r_m, r_n, h, sl, cl)
-        cu = wcu if mode == COMPASS else 0.0
-        wx = (te + wce) * ts
-        wy = (wie_n + tn + wcn) * ts
-        wz = (wie_u + tu + cu) * ts
-
-        # Specific-force increment at mid-interval, and the attitude update with the
-        # platform rate including the control rates: the pieces of the strapdown step.
-        fx, fy, fz = specific_force_increment(
-            q0, q1, q2, q3, bx, by, bz, dv[j, 0], dv[j, 1], dv[j, 2], wx, wy, wz,
-        )
-        q0, q1, q2, q3 = attitude_update(q0, q1, q2, q3, bx, by, bz, wx, wy, wz)
-
-        # Reference velocity at the end of the step, and position along it.
-        ne, nn, nu = sg * vref[nxt, 0], sg * vref[nxt, 1], sg * vref[nxt, 2]
-        if vref_body:
-            ne, nn, nu = qrot(q0, q1, q2, q3, ne, nn, nu)
-        lat_new, lon, h_new = position_update(
-            E, lat, lon, h, 0.5 * (re + ne), 0.5 * (rn + nn), 0.5 * (ru + nu), ts, r_m, sl, cl
-        )
-
-        if mode != ATTITUDE:
-            # Coriolis and frame-rate acceleration of the reference velocity (seed §1). With
-            # an odometer the reference is resolved with the computed attitude, so it turns
-            # with every azimuth correction; the loop velocity must turn with the computed
-            # frame too (ω_c in the frame rate), or the compass loop sees a false
-            # δv_N = v_E Δφ_U that detunes it. An ENU (nav) reference does not turn.
-            # Evaluated at the mid-step reference velocity, as the strapdown step does.
-            cc = 1.0 if vref_body else 0.0
-            ce, cn, cu2 = te + cc * wce, 2.0 * wie_n + tn + cc * wcn, 2.0 * wie_u + tu + cc * cu
-            me, mn, mu = 0.5 * (re + ne), 0.5 * (rn + nn), 0.5 * (ru + nu)
-            ae = -(cn * mu - cu2 * mn)
-            an = -(cu2 * me - ce * mu)
-            k1e = ke1
-            k1n = kn1 if mode == LEVEL else ku1
-            ve = ve + fx + ae * ts - k1e * (ve - re) * ts
-            vn = vn + fy + an * ts - k1n * (vn - rn) * ts
-            dve, dvn = ve - ne, vn - nn
-            ie += dve * ts
-            wcn = dve * (1.0 + ke2) / rnh + ke3 * ie
-            if mode == LEVEL:
-                inn += dvn * ts
-                wce = -dvn * (1.0 + kn2) / rmh - kn3 * inn
-            else:
-                omega = wie_n  # Ω = ω_ie cos L, signed with the pass direction
-                wcu = (wcu + ku3 * dvn * ts / omega) / (1.0 + ku4 * ts)
-                wce = -dvn * (1.0 + ku2) / rmh
-        else:
-            ve, vn = ne, nn
-        lat, h = lat_new, h_new
-        re, rn, ru = ne, nn, nu
+        x = _loop_step(x, sg * dtheta[j, 0], sg * dtheta[j, 1], sg * dtheta[j, 2], dv[j, 0],
+                       dv[j, 1], dv[j, 2], sg * vref[nxt, 0], sg * vref[nxt, 1],
+                       sg * vref[nxt, 2], vref_body, ts, earth_sign, E, gk, mode)
         if nxt == keep or k == n - 1:
             if nxt == keep:
                 keep += step * stride
             idx_out[row] = nxt
-            q_out[row, 0], q_out[row, 1], q_out[row, 2], q_out[row, 3] = q0, q1, q2, q3
+            q_out[row, 0], q_out[row, 1], q_out[row, 2], q_out[row, 3] = x[0], x[1], x[2], x[3]
             row += 1
-
-    state[0], state[1], state[2], state[3] = q0, q1, q2, q3
-    state[4], state[5], state[6], state[7], state[8] = ve, vn, ie, inn, wcu
-    state[9], state[10], state[11] = lat, lon, h
+    for i in range(STATE_SIZE):
+        state[i] = x[i]
     return row
+
+
+#: Runs a lockstep kernel steps side by side: sixteen keep a 4-wide vector unit's loop
+#: above the compiler's "tiny trip count" (below 16 it declines the loop: its check that the
+#: arrays do not overlap would cost more than the loop) and fill an 8-wide one twice.
+LANES = 16
+#: Rows of a sample in the data of :func:`gyrocompass_range_lanes`: Δθ (3), Δv (3), v_R (3),
+#: each row LANES wide.
+DATA_ROWS = 9
+#: Below this squared angle (rad²) both rotation vectors of a step take the series of
+#: :func:`gcalign.nav._kernels.rv2q`; a run whose step is above it has the step redone alone.
+SERIES_ANGLE2 = 2.5e-3
+
+
+@njit(cache=True, error_model="numpy")
+def _lanes_step(X: np.ndarray, Y: np.ndarray, T: np.ndarray, dj: np.ndarray, dn: np.ndarray,
+                sg: float, vref_body: bool, ts: float, earth_sign: float, E: EarthParams,
+                gk: Gains, loops: bool, level: bool, compass: bool) -> None:
+    """One step of LANES runs: carried values X → Y ((CARRIED·LANES,), value i of run s at
+    i·LANES + s), sin L and cos L of each run in T[0:2·LANES] (its squared angle out into
+    T[2·LANES:]), the increments of the step in `dj` and the reference at its end in `dn`
+    (rows of :func:`gyrocompass_range_lanes`'s data). The loop has no call and no branch on
+    the data, and its arrays are few, with constant offsets: the compiler vectorises it."""
+    L = LANES
+    for s in range(L):
+        y, a2 = _loop_step_sc(
+            (X[s], X[L + s], X[2 * L + s], X[3 * L + s], X[4 * L + s], X[5 * L + s],
+             X[6 * L + s], X[7 * L + s], X[8 * L + s], X[9 * L + s], X[10 * L + s],
+             X[11 * L + s], X[12 * L + s], X[13 * L + s], X[14 * L + s], X[15 * L + s],
+             X[16 * L + s]),
+            T[s], T[L + s], sg * dj[s], sg * dj[L + s], sg * dj[2 * L + s], dj[3 * L + s],
+            dj[4 * L + s], dj[5 * L + s], sg * dn[6 * L + s], sg * dn[7 * L + s],
+            sg * dn[8 * L + s], vref_body, ts, earth_sign, E, gk, loops, level, compass, True)
+        Y[s], Y[L + s], Y[2 * L + s], Y[3 * L + s] = y[0], y[1], y[2], y[3]
+        Y[4 * L + s], Y[5 * L + s], Y[6 * L + s], Y[7 * L + s] = y[4], y[5], y[6], y[7]
+        Y[8 * L + s], Y[9 * L + s], Y[10 * L + s], Y[11 * L + s] = y[8], y[9], y[10], y[11]
+        Y[12 * L + s], Y[13 * L + s], Y[14 * L + s] = y[12], y[13], y[14]
+        Y[15 * L + s], Y[16 * L + s] = y[15], y[16]
+        T[2 * L + s] = a2
+
+
+@njit(cache=True, error_model="numpy")
+def gyrocompass_range_lanes(states: np.ndarray, data: np.ndarray, vref_body: bool, ts: float,
+                            lo: int, hi: int, reverse: bool, data_sign: float,
+                            earth_sign: float, E: np.ndarray, gains: np.ndarray, mode: int,
+                            stride: int, row_from: int, idx_out: np.ndarray,
+                            q_out: np.ndarray) -> int:
+    """:func:`gyrocompass_range` for LANES runs in lockstep (the seeds of one Monte Carlo
+    variant: the same block, timeline and gains, their own data). Each run's numbers are
+    those of :func:`gyrocompass_range` on its own data, to the bit: the same step, the
+    same operations in the same order, for all runs at once, so that the processor's
+    vector units take several runs per instruction. The sines and cosines of the
+    latitudes are taken in a loop of their own; a step whose rotation vector is above the
+    series' range (never an IMU increment at a realistic rate) is redone alone by the
+    scalar step, from the values before it.
+
+    states : (LANES, 12), updated in place. data : (N+1, DATA_ROWS·LANES): at sample j,
+    Δθ and Δv of increment j and the reference velocity at sample j, each component a row
+    of LANES runs side by side (what one step of all runs reads is one contiguous piece).
+    Rows are kept as :func:`gyrocompass_range` keeps them, but only those from row
+    `row_from` on are written: block indices into `idx_out` (m,), attitudes into `q_out`
+    (m, 4, LANES), from their row 0 (a Monte Carlo summary needs the end of most passes
+    only). Returns the number of rows the single kernel would have written.
+    """
+    L = LANES
+    gk = _gains(gains)
+    Et = (E[0], E[1], E[2], E[3], E[4], E[5], E[6], E[7])
+    loops, level, compass = mode != ATTITUDE, mode == LEVEL, mode == COMPASS
+    n = hi - lo
+    first = hi if reverse else lo
+    step = -1 if reverse else 1
+    sg = data_sign
+    X, Y = np.empty(CARRIED * L), np.empty(CARRIED * L)
+    T = np.empty(3 * L)
+    d0 = data[first]
+    for s in range(L):
+        x = _loop_start(states[s, 0], states[s, 1], states[s, 2], states[s, 3], states[s, 4],
+                        states[s, 5], states[s, 6], states[s, 7], states[s, 8], states[s, 9],
+                        states[s, 10], states[s, 11], sg * d0[6 * L + s], sg * d0[7 * L + s],
+                        sg * d0[8 * L + s], vref_body, Et, gk, mode)
+        for i in range(CARRIED):
+            X[i * L + s] = x[i]
+    if row_from <= 0:
+        idx_out[0] = first
+        for i in range(4):
+            for s in range(L):
+                q_out[0, i, s] = X[i * L + s]
+    row = 1
+    keep = (first - 1) // stride * stride if reverse else (first // stride + 1) * stride
+    for k in range(n):
+        j = hi - 1 - k if reverse else lo + k  # the increment
+        nxt = first + step * (k + 1)  # the sample at the end of the step
+        dj, dn = data[j], data[nxt]
+        for s in range(L):
+            T[s] = math.sin(X[9 * L + s])
+            T[L + s] = math.cos(X[9 * L + s])
+        _lanes_step(X, Y, T, dj, dn, sg, vref_body, ts, earth_sign, Et, gk, loops, level,
+                    compass)
+        for s in range(L):
+            if not T[2 * L + s] < SERIES_ANGLE2:  # the exact branch of rv2q (NaN too)
+                z = _loop_step(
+                    (X[s], X[L + s], X[2 * L + s], X[3 * L + s], X[4 * L + s], X[5 * L + s],
+                     X[6 * L + s], X[7 * L + s], X[8 * L + s], X[9 * L + s], X[10 * L + s],
+                     X[11 * L + s], X[12 * L + s], X[13 * L + s], X[14 * L + s],
+                     X[15 * L + s], X[16 * L + s]),
+                    sg * dj[s], sg * dj[L + s], sg * dj[2 * L + s], dj[3 * L + s],
+                    dj[4 * L + s], dj[5 * L + s], sg * dn[6 * L + s], sg * dn[7 * L + s],
+                    sg * dn[8 * L + s], vref_body, ts, earth_sign, Et, gk, mode)
+                for i in range(CARRIED):
+                    Y[i * L + s] = z[i]
+        X, Y = Y, X
+        if nxt == keep or k == n - 1:
+            if nxt == keep:
+                keep += step * stride
+            if row >= row_from:
+                w = row - max(row_from, 0)
+                idx_out[w] = nxt
+                for i in range(4):
+                    for s in range(L):
+                        q_out[w, i, s] = X[i * L + s]
+            row += 1
+    for s in range(L):
+        for i in range(STATE_SIZE):
+            states[s, i] = X[i * L + s]
+    return row
+
+
+@njit(cache=True)
+def pack_lanes(dtheta: tuple, dv: tuple, vref: tuple, out: np.ndarray) -> None:
+    """The data of LANES runs as :func:`gyrocompass_range_lanes` reads it: `dtheta`, `dv`
+    (N, 3) and `vref` (N+1, 3) of each run (tuples of LANES arrays) into `out`
+    (N+1, DATA_ROWS·LANES), sample by sample (written in order: a copy run by run into
+    the interleaved layout touches a new page at every few samples and is ten times
+    slower); the increment rows of sample N are zero."""
+    n = dtheta[0].shape[0]
+    L = LANES
+    for j in range(n + 1):
+        for s in range(L):
+            a, b, r = dtheta[s], dv[s], vref[s]
+            for c in range(3):
+                out[j, c * L + s] = a[j, c] if j < n else 0.0
+                out[j, (3 + c) * L + s] = b[j, c] if j < n else 0.0
+                out[j, (6 + c) * L + s] = r[j, c]
 
 
 @njit(cache=True)

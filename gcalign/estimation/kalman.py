@@ -41,11 +41,18 @@ def van_loan(F: np.ndarray, G: np.ndarray, Qc: np.ndarray,
     return Phi, 0.5 * (Qd + Qd.T)
 
 
+def _f64(a: Any) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=float)
+
+
 def predict(x: np.ndarray, P: np.ndarray, Phi: np.ndarray,
             Qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``x⁻ = Φ x``, ``P⁻ = Φ P Φᵀ + Q_d``."""
-    P = Phi @ P @ Phi.T + Qd
-    return Phi @ x, 0.5 * (P + P.T)
+    """``x⁻ = Φ x``, ``P⁻ = Φ P Φᵀ + Q_d`` (symmetrised: ½(P⁻ + P⁻ᵀ)). A numba kernel
+    (:mod:`gcalign.estimation._kalman_kernel`); the NumPy expressions give the same numbers
+    to round-off."""
+    from gcalign.estimation._kalman_kernel import predict_kernel
+
+    return predict_kernel(_f64(x), _f64(P), _f64(Phi), _f64(Qd))
 
 
 @dataclass(frozen=True)
@@ -67,20 +74,18 @@ class Update:
 
 def update(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.ndarray) -> Update:
     """Kalman update in Joseph form: ``P = (I − K H) P⁻ (I − K H)ᵀ + K R Kᵀ`` (stays
-    symmetric positive semi-definite for any gain), ``K = P⁻ Hᵀ S⁻¹``."""
-    y = np.asarray(z, dtype=float) - H @ x
-    PHt = P @ H.T
-    S = H @ PHt + R
-    L = np.linalg.cholesky(0.5 * (S + S.T))
-    # S⁻¹ = L⁻ᵀ L⁻¹ from the inverse of the (m × m, m ≤ a few) Cholesky factor: one small
-    # inversion serves the gain and the whitened innovation
-    Li = np.linalg.inv(L)
-    K = PHt @ (Li.T @ Li)
-    I_KH = np.eye(len(x)) - K @ H
-    P_new = I_KH @ P @ I_KH.T + K @ R @ K.T
-    w = Li @ y
-    return Update(x=x + K @ y, P=0.5 * (P_new + P_new.T), innovation=y, S=S, K=K,
-                  nis=float(w @ w), standardized=w)
+    symmetric positive semi-definite for any gain), ``K = P⁻ Hᵀ S⁻¹``, S⁻¹ = L⁻ᵀ L⁻¹ from
+    the Cholesky factor of ½(S + Sᵀ) (one small inversion serves the gain and the whitened
+    innovation w = L⁻¹ y). A numba kernel (:mod:`gcalign.estimation._kalman_kernel`, which
+    evaluates the Joseph product in O(n² m)); LinAlgError when S is not positive definite.
+    """
+    from gcalign.estimation._kalman_kernel import update_kernel
+
+    ok, x_new, P_new, y, S, K, w, nis = update_kernel(_f64(x), _f64(P), _f64(z), _f64(H),
+                                                      _f64(R))
+    if not ok:
+        raise np.linalg.LinAlgError("Matrix is not positive definite")
+    return Update(x=x_new, P=P_new, innovation=y, S=S, K=K, nis=nis, standardized=w)
 
 
 def solve_spd(P: np.ndarray, B: np.ndarray) -> np.ndarray:

@@ -69,6 +69,10 @@ def _numba_targets_without_scipy() -> None:
 
 _numba_targets_without_scipy()
 
+#: An earth model's float vector (:meth:`gcalign.nav.earth.EarthModel.params`), or the same
+#: numbers as a tuple (a kernel that reads them at every step of a vectorised loop).
+EarthParams = np.ndarray | tuple[float, ...]
+
 Q = slice(0, 4)  #: q_nb in the state vector
 V = slice(4, 7)  #: v_n, ENU, m/s
 P = slice(7, 10)  #: lat, lon (rad), h (m)
@@ -97,10 +101,16 @@ def vertical_gains(tau: float, gravity_gradient: float) -> np.ndarray:
 
 
 @njit(cache=True, inline="always")
-def earth_at(E: np.ndarray, lat: float, h: float) -> tuple[float, float, float, float, float]:
+def earth_at(E: EarthParams, lat: float, h: float) -> tuple[float, float, float, float, float]:
     """R_M, R_N (m), normal gravity g (m/s²), sin L, cos L of earth model `E` at (lat, h)."""
-    sl = math.sin(lat)
-    cl = math.cos(lat)
+    return earth_sc(E, math.sin(lat), math.cos(lat), h)
+
+
+@njit(cache=True, inline="always")
+def earth_sc(E: EarthParams, sl: float, cl: float,
+             h: float) -> tuple[float, float, float, float, float]:
+    """:func:`earth_at` from sin L and cos L (a kernel over many runs takes the sines of
+    all its runs in one loop, and the rest of the step in another, vectorised one)."""
     s2 = sl * sl
     if E[0] == 0.0:  # exact ellipsoid radii
         e2 = E[2]
@@ -116,12 +126,15 @@ def earth_at(E: np.ndarray, lat: float, h: float) -> tuple[float, float, float, 
 
 
 @njit(cache=True, inline="always")
-def rv2q(rx: float, ry: float, rz: float) -> tuple[float, float, float, float]:
+def rv2q(rx: float, ry: float, rz: float,
+         series: bool = False) -> tuple[float, float, float, float]:
     """Quaternion of a rotation vector. Below 0.05 rad the series of cos(θ/2) and
     sin(θ/2)/θ to θ⁸ are exact in float64 (the next terms are below 1e-22) and cost no
-    transcendental function: every IMU increment takes this branch."""
+    transcendental function: every IMU increment takes this branch. `series` (a constant
+    of the caller): the series whatever the angle, no branch (a vectorised kernel checks
+    the angles itself and redoes a step that had a larger one)."""
     t2 = rx * rx + ry * ry + rz * rz
-    if t2 < 2.5e-3:
+    if series or t2 < 2.5e-3:
         c = 1.0 - t2 * (1.0 / 8.0 - t2 * (1.0 / 384.0 - t2 * (1.0 / 46080.0
                                                             - t2 / 10321920.0)))
         s = 0.5 - t2 * (1.0 / 48.0 - t2 * (1.0 / 3840.0 - t2 * (1.0 / 645120.0
@@ -199,11 +212,13 @@ def specific_force_increment(q0: float, q1: float, q2: float, q3: float, bx: flo
 
 @njit(cache=True, inline="always")
 def attitude_update(q0: float, q1: float, q2: float, q3: float, bx: float, by: float, bz: float,
-                    wx: float, wy: float, wz: float) -> tuple[float, float, float, float]:
+                    wx: float, wy: float, wz: float,
+                    series: bool = False) -> tuple[float, float, float, float]:
     """``q ← q(−ω_in T) ⊗ q ⊗ q(Δθ)``, renormalised: body rotation on the right,
-    navigation-frame rotation (wx, wy, wz) = ω_in^n T on the left."""
-    aw, ax, ay, az = rv2q(bx, by, bz)
-    nw, nx, ny, nz = rv2q(-wx, -wy, -wz)
+    navigation-frame rotation (wx, wy, wz) = ω_in^n T on the left (`series`: see
+    :func:`rv2q`)."""
+    aw, ax, ay, az = rv2q(bx, by, bz, series)
+    nw, nx, ny, nz = rv2q(-wx, -wy, -wz, series)
     p0, p1, p2, p3 = qmul(q0, q1, q2, q3, aw, ax, ay, az)
     p0, p1, p2, p3 = qmul(nw, nx, ny, nz, p0, p1, p2, p3)
     # renormalise: |q|² differs from 1 by round-off only, where one Newton step of 1/√x,
@@ -213,7 +228,7 @@ def attitude_update(q0: float, q1: float, q2: float, q3: float, bx: float, by: f
 
 
 @njit(cache=True, inline="always")
-def radii_at(E: np.ndarray, sl: float) -> tuple[float, float]:
+def radii_at(E: EarthParams, sl: float) -> tuple[float, float]:
     """R_M, R_N of earth model `E` where sin L = sl."""
     s2 = sl * sl
     if E[0] == 0.0:
@@ -226,7 +241,7 @@ def radii_at(E: np.ndarray, sl: float) -> tuple[float, float]:
 
 
 @njit(cache=True, inline="always")
-def position_update(E: np.ndarray, lat: float, lon: float, h: float, ue: float, un: float,
+def position_update(E: EarthParams, lat: float, lon: float, h: float, ue: float, un: float,
                     uu: float, ts: float, r_m: float, sl: float,
                     cl: float) -> tuple[float, float, float]:
     """Position after `ts` at mean ENU velocity (ue, un, uu) (trapezoid rule); radii at the

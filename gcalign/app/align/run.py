@@ -274,6 +274,76 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
     return replace(run, warnings=tuple(warnings))
 
 
+def summaries_of_seeds(sc: Scenario, seeds: list[int],
+                       cache_key: str | None) -> list[dict | Exception]:
+    """The summary of each seed's run of a simulated scenario, as :func:`execute` would give
+    it, the seeds aligned in lockstep (:func:`gcalign.align.lockstep.align_runs`: each
+    seed's numbers to the bit those of its own run; ``compute_s`` is the lockstep's time
+    per run). A seed whose run fails has its exception in its place. For a batch: the
+    noise-free simulation is shared through `cache_key`, and the caller has made the
+    preflight (:func:`gcalign.app.preflight.checked_execute`'s) for the variant."""
+    from gcalign.align.lockstep import align_runs
+    from gcalign.io.results import finite_summary
+
+    cfg = sc.align or AlignConfig()
+    kind = sc.motion.kind if sc.motion else None
+    warnings = []
+    if kind == "moving" and cfg.aiding.source == "none":
+        warnings.append("a moving base with align.aiding.source 'none': the loops take the "
+                        "vehicle's accelerations for tilt; expect degrees of error")
+    out: list[dict | Exception] = []
+    runs, streams, notes, where = [], [], [], []
+    for seed in seeds:
+        try:
+            stream = stream_of(scenario_data(sc, seed, cache_key))
+            ts = stream.ts
+            try:
+                stride = sc.output.stride(1.0 / ts, stream.samples * ts)
+            except ValueError as err:
+                raise ScenarioError(str(err)) from None
+            settings = settings_of(cfg, kind)
+            tl = timeline(settings, ts, stream.samples)
+            keep = truth_samples(settings, ts, stream.samples, stride)
+            data = collect(stream, tl, cfg.aiding, None, None, keep)
+            more = list(warnings)
+            if settings.coarse == "analytic":
+                k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
+                more += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
+                                            stream.earth)
+        except (InputError, ScenarioError) as err:
+            out.append(_scenario_error(err) if isinstance(err, InputError) else err)
+            continue
+        except Exception as err:  # noqa: BLE001 - recorded for this seed, as a run would be
+            out.append(err)
+            continue
+        where.append(len(out))
+        out.append(ScenarioError("not aligned"))
+        streams.append(stream)
+        notes.append(tuple(more))
+        runs.append(dict(dtheta=data.dtheta, dv=data.dv, ts=ts, site=stream.site,
+                         settings=settings, earth=stream.earth, position_t1=data.pos_t1,
+                         vref=data.vref, vref_body=cfg.aiding.body, truth_att=data.truth,
+                         t0=stream.t0, stride=stride, first_sample=tl.lo,
+                         samples=stream.samples))
+
+    def summary(i: int, run: Alignment) -> dict:
+        s = alignment_summary(replace(run, warnings=notes[i]), streams[i], sc.name)
+        finite_summary(s, "align")
+        return s
+
+    for i, res in enumerate(align_runs(runs, summary)):
+        out[where[i]] = _scenario_error(res) if isinstance(res, InputError) else res
+    return out
+
+
+def lockstep_ok(sc: Scenario) -> bool:
+    """Can a batch align this variant's seeds in lockstep (:func:`summaries_of_seeds`)? A
+    simulated gyrocompass alignment (not transfer mode), without a recorded reference."""
+    cfg = sc.align or AlignConfig()
+    return (sc.imu_file is None and sc.motion is not None and sc.reference is None
+            and cfg.mode != "transfer" and cfg.aiding.source != "file")
+
+
 def _deg(x):
     return None if x is None else np.degrees(x).tolist()
 

@@ -32,6 +32,9 @@ from gcalign.errors import ScenarioError
 
 MAX_ATTEMPTS = 2  # a run in flight when a worker process died is retried once, alone
 REBUILD_EVERY_S = 2.0  # HDF5 rebuilt from the journal at most this often while running
+#: Runs in a chunk at most: the seeds an align variant steps in lockstep
+#: (:data:`gcalign.align.kernel.LANES`), few enough for progress and resume.
+CHUNK_MAX = 16
 
 
 @dataclass
@@ -60,8 +63,8 @@ def _tasks(sweep: Sweep, keys: list[tuple[int, int]]) -> list[dict]:
 
 
 def _chunks(tasks: list[dict], workers: int, size: int | None) -> list[list[dict]]:
-    if size is None:  # ≥ 4 chunks per worker (load balance), ≤ 8 runs each (progress, resume)
-        size = max(1, min(8, math.ceil(len(tasks) / (4 * workers))))
+    if size is None:  # ≥ 4 chunks per worker (load balance), ≤ CHUNK_MAX runs each
+        size = max(1, min(CHUNK_MAX, math.ceil(len(tasks) / (4 * workers))))
     return [tasks[i:i + size] for i in range(0, len(tasks), size)]
 
 
