@@ -42,6 +42,7 @@ def numpy_oadev(inc: np.ndarray, ts: float, m: int) -> float:
     return float(np.sqrt(0.5 * np.mean(d**2)))
 
 
+@pytest.mark.slow
 def test_lasergyro_against_plain_numpy(lasergyro):
     """σ at τ = 1, 10, 100 s of all six sensors of the real recording: allantools under
     gcalign and the definition in NumPy agree to 1e-9."""
@@ -117,6 +118,7 @@ def test_fit_says_what_it_cannot_resolve():
     assert fit.misfit[0] < 3
 
 
+@pytest.mark.slow
 def test_cli_lasergyro(tmp_path, lasergyro):
     """The real recording (compressed, as it ships): exit 0, the JSON keys named as the
     scenario's imu keys, the curve in /allan with units, and the disturbance said."""
@@ -152,6 +154,7 @@ def test_cli_moving_recording_is_said(tmp_path):
     assert "mg from their median" in line and "velocity change" in line
 
 
+@pytest.mark.slow
 def test_cli_simulate_file_and_scenario(tmp_path):
     """A `gcalign simulate` results file of a static IMU: the ARW and VRW it was given come
     back within their intervals; --scenario writes a scenario that validates as it is."""
@@ -214,6 +217,7 @@ def test_filter_model_from_the_fits():
     assert p.beta[0] == pytest.approx(1 / m.tau[0]) and p.q[1] == pytest.approx(4e-12)
 
 
+@pytest.mark.slow
 def test_cli_scenario_on_stdout(tmp_path):
     """`--scenario -`: the scenario alone on stdout (the table on stderr), a static base at
     the recording's site and header attitude; with --json it is refused (one stdout)."""
