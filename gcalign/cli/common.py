@@ -57,7 +57,7 @@ IMU_FILE_HELP = ("Recorded IMU data (PSINS .imu, CSV/text, gcalign HDF5; .gz/.xz
                  "mechanism, imu and site sections; the site then comes from the file's "
                  "header or --lat/--lon/--height.")
 FORMAT_HELP = ("Layout of the --imu-file (or the scenario's imu_file): psins | psins-mat | "
-               "i2nav | csv | auto (from the suffix); see README 'Your own recording'.")
+               "i2nav | csv | auto (from the suffix); see docs/how-to/file-formats.md.")
 REFERENCE_HELP = ("Reference solution of the recording (a master INS, a post-processed "
                   "trajectory): .mat psins-mat avp, .csv csv, else i2nav-nav (KF-GINS); "
                   "errors against it, and the initial state when the data have none.")

@@ -1,6 +1,6 @@
 """The HDF5 results file: one schema, written atomically, readable without gcalign.
 
-Layout (README "Results file"): root attributes ``gcalign_version``, ``kind`` (the command),
+Layout (docs: Reference, Results file): root attributes ``gcalign_version``, ``kind`` (the command),
 ``command_line``, ``scenario_yaml`` (the scenario text), ``seed``, ``created_utc`` and
 ``summary_json`` (what ``gcalign show`` prints); groups ``/truth``, ``/imu``, ``/navigate``,
 ``/align``, ``/northfind``, ``/batch``. Every dataset carries a ``units`` attribute and,
