@@ -411,6 +411,10 @@ runs both through the command.
 ```sh
 gcalign realtime                           # the first table; runs/seed003-table1-…h5
 gcalign plot runs/seed003-table1-realtime-rng2027.h5
+```
+
+<!-- example: skip: rewrites this section and its figures, then benchmarks for minutes -->
+```sh
 python docs/results_realtime.py --seeds 30 # this section and its three figures
 python benchmarks/bench_realtime.py        # Table 1 end to end, median of 7 warm runs
 ```

@@ -12,7 +12,7 @@ Conventions, fixed once for the whole package (PSINS-compatible; DESIGN.md):
 * Time along axis 0: arrays are ``(N,)``, ``(N, 3)``, ``(N, 3, 3)``; time is a separate
   ``(N,)`` array in seconds. IMU sample k holds the increments over ``(t_k - T, t_k]``.
 
-The Python API (:mod:`gcalign.api`; README "Python"): :func:`load` a scenario (a file, a
+The Python API (:mod:`gcalign.api`; docs/how-to/python.md): :func:`load` a scenario (a file, a
 mapping or recorded data; overrides by dotted key) or take a built-in one
 (:func:`example`), :func:`run` any command on it (``run("align", sc)``, the same run and
 results file as ``gcalign align``), and :func:`read` a results file back into the same

@@ -5,6 +5,8 @@
 writes the same results file and returns a :class:`Result`; :func:`read` gives the same
 object back from the file.
 
+Examples
+--------
 >>> import gcalign
 >>> sc = gcalign.example("northfind", {"northfind.sweep": None, "northfind.azimuth_deg": 48})
 >>> res = gcalign.run("northfind", sc, seed=3)

@@ -1,4 +1,4 @@
-"""Resource limits: what one run may cost before gcalign refuses it (README "Limits").
+"""Resource limits: what one run may cost before gcalign refuses it (docs: Reference, Limits).
 
 Every limit has a default that fits this project's machines and can be raised (or lowered)
 explicitly with an environment variable of the same name, e.g.::

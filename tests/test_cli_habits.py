@@ -447,3 +447,10 @@ def test_batch_over_a_plain_list_of_scenario_files(tmp_path):
     bad = runner.invoke(app, ["batch", str(ROOT / "configs/sweeps/seed000_modes.yaml"),
                               "--command", "calibrate"])  # a sweep says its command
     assert bad.exit_code == 2 and "--command: applies to a list of scenario files" in bad.stderr
+
+
+def test_top_help_names_each_seed_once():
+    """The seeds come from the commands' help lines, whatever follows their '(seed N)'."""
+    res = runner.invoke(app, ["--help"], prog_name="gcalign", env={"COLUMNS": "200"})
+    assert res.exit_code == 0
+    assert "Algorithms of the seed papers 000, 001, 002, 003, 004;" in " ".join(res.output.split())

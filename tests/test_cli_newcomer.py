@@ -315,3 +315,38 @@ def test_batch_figure_of_long_file_names_neither_overlaps_nor_clips():
 
     assert _variant_label({"scenario": "seed000_moving_conventional.yaml"}, ["scenario"]) \
         == "seed000_moving_conventional"
+
+
+@pytest.mark.parametrize("data, where, keys", [
+    ({**STATIC, "initial": {"att_deg": [0, 0, 0], "vel_enu": [0, 0, 0]}}, "initial.vel_enu",
+     "initial has: att_deg, v_enu_mps"),
+    ({**STATIC, "align": {"mdoe": "conventional"}}, "align.mdoe", "align has: coarse, mode,"),
+    ({**STATIC, "motion": {"kind": "moving", "duration_s": 3,
+                           "segments": [{"duration_s": 1, "acel_mps2": 1}]}},
+     "motion.segments.0.acel_mps2", "motion.segments.0 has: duration_s, accel_mps2, rate_dps"),
+])
+def test_unknown_key_lists_the_keys_of_its_mapping(tmp_path, data, where, keys):
+    res = runner.invoke(app, ["validate", str(_write(tmp_path, data, "bad"))])
+    assert res.exit_code == 2, res.output
+    assert f"{where}: unknown key; {keys}" in res.output, res.output
+
+
+@pytest.mark.slow
+def test_a_first_run_says_it_is_compiling(tmp_path):
+    """With an empty numba cache the run says, above its bar, that it compiles the kernels
+    once; the second run loads them and says nothing of it."""
+    import os
+    import subprocess
+    import sys
+
+    from gcalign.cli.common import COMPILING
+
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "GCALIGN_PROGRESS": "always"}
+    args = [sys.executable, "-m", "gcalign", "align", str(small_align(tmp_path)),
+            "-o", str(tmp_path / "a.h5")]
+    first = subprocess.run(args, env=env, capture_output=True, text=True, timeout=600)
+    assert first.returncode == 0, first.stderr
+    assert COMPILING[:60] in first.stderr.replace("\n", " ")
+    second = subprocess.run(args, env=env, capture_output=True, text=True, timeout=600)
+    assert second.returncode == 0, second.stderr
+    assert "compiling" not in second.stderr

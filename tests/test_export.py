@@ -193,3 +193,34 @@ def test_an_export_past_the_output_limit_is_refused_before_writing(nav, tmp_path
     res = runner.invoke(app, ["export", str(nav), "--format", fmt, "-o", str(out)])
     assert_bad_input(res, out, "GCALIGN_MAX_OUTPUT_MB", f"as {fmt}", "more than the limit")
     assert not list(tmp_path.iterdir())
+
+
+def test_align_and_calibrate_export_without_group(tmp_path):
+    """An alignment exports its last pass (the one whose end is the result), a calibration
+    its run, each column named by its component and state with that state's own unit."""
+    sc = tmp_path / "s.yaml"
+    sc.write_text(yaml.safe_dump(SWING))
+    al, cal = tmp_path / "al.h5", tmp_path / "cal.h5"
+    res = runner.invoke(app, ["align", str(sc), "--t1", "2", "--t2", "20", "--t3", "20",
+                              "--passes", "3", "--set", "align.level_s=5", "-o", str(al)])
+    assert res.exit_code == 0, res.output
+    res = runner.invoke(app, ["calibrate", str(sc), "-o", str(cal)])
+    assert res.exit_code == 0, res.output
+    res = runner.invoke(app, ["export", str(al), "--format", "csv", "-o", str(tmp_path / "a.csv")])
+    assert res.exit_code == 0, res.output
+    assert "exported /align/pass_03; --group for another: align/pass_01, align/pass_02" \
+        in res.output
+    lines = (tmp_path / "a.csv").read_text().splitlines()
+    assert "group /align/pass_03" in lines[0]
+    assert lines[1].split(",")[4:7] == ["error_pitch (rad)", "error_roll (rad)",
+                                        "error_yaw (rad)"]
+    with h5py.File(al) as f:
+        np.testing.assert_array_equal(np.loadtxt(lines[2:], delimiter=",")[:, 1:4],
+                                      f["align/pass_03/att"][()])
+    res = runner.invoke(app, ["export", str(cal), "--format", "csv", "-o", str(tmp_path / "c.csv")])
+    assert res.exit_code == 0, res.output
+    header = (tmp_path / "c.csv").read_text().splitlines()[1].split(",")
+    for col in ("estimate_phiU (rad)", "estimate_ebz (rad/s)", "estimate_dbx (m/s^2)",
+                "sigma_dKgz (1)", "truth_dh (m)"):
+        assert col in header
+    assert not any("_0 (" in h or "(SI)" in h for h in header)

@@ -341,3 +341,31 @@ def test_the_imu_file_mapping_survives_a_dump():
     plain = parse_scenario({"name": "x", "imu_file": "/d/a.imu"}, "t")
     assert plain.model_dump(mode="json", exclude_unset=True)["imu_file"] == "/d/a.imu"
     assert plain.recording_layout() == Layout()
+
+
+def _still_csv(path, header, seconds=4.0):
+    """A CSV of a still IMU at 100 Hz (rad and m/s increments, z up) under `header`."""
+    t = np.arange(1, int(seconds * 100) + 1) * 0.01
+    rows = np.column_stack([t, np.zeros((len(t), 5)), np.full(len(t), 0.098)])
+    np.savetxt(path, rows, fmt="%.6g", delimiter=",", comments="", header=header)
+    return path
+
+
+def test_unrecognised_header_is_refused_pointing_to_columns_and_units(tmp_path):
+    """A header row whose names gcalign does not know is never read as rad and m/s in
+    silence: the refusal says how to declare the layout; declared units read it."""
+    f = _still_csv(tmp_path / "own.csv", "stamp,rx,ry,rz,sx,sy,sz")
+    out = tmp_path / "out.h5"
+    res = runner.invoke(app, ["align", "--imu-file", str(f), *SITE, "-o", str(out)])
+    assert_bad_input(res, out, "imu_file", "'stamp,rx,ry,rz,sx,sy,sz'", "columns: [t, gx",
+                     "units: {gyro: rad | deg", "accel: m/s | m/s^2 | g}")
+    imu = read_recording(f, Layout(format="csv", gyro_units="rad", accel_units="m/s"))
+    np.testing.assert_allclose(imu.dv[:, 2], 0.098)
+
+
+def test_recording_too_short_names_the_times_not_the_motion(tmp_path):
+    f = _still_csv(tmp_path / "short.csv", "t,gx,gy,gz,ax,ay,az")
+    out = tmp_path / "out.h5"
+    res = runner.invoke(app, ["align", "--imu-file", str(f), *SITE, "-o", str(out)])
+    assert_bad_input(res, out, "align.t1_s", "past the end of the data (4.00 s)", "--t1")
+    assert "motion.duration_s" not in res.output

@@ -45,23 +45,35 @@ def default_output(path: Path, fmt: str) -> Path:
 
 def default_group(path: Path) -> str:
     """The group of the command that wrote the file (``navigate``, ``simulate``'s
-    ``truth``, ...); :func:`gcalign.io.results.series` says which groups hold series when
-    it has none."""
+    ``truth``, ...); where that group keeps its series in subgroups, the one holding the
+    result: an alignment's last pass (``align/pass_05``: it ends at T2, whence T3), a
+    calibration's first run (``calibrate/runs/00``). :func:`gcalign.io.results.series`
+    says which groups hold series when there is none."""
     from gcalign.app.checked import read_checked
 
     kind = read_checked(path)[0]
-    return {"simulate": "truth"}.get(kind, kind)
+    group = {"simulate": "truth"}.get(kind, kind)
+    timed = results.timed_groups(path, group)
+    if not timed or group in timed:
+        return group
+    return timed[-1] if kind == "align" else timed[0]
 
 
-def export(path, fmt: str, out=None, group: str | None = None, week: int = 0) -> Path:
+def export(path, fmt: str, out=None, group: str | None = None, week: int = 0,
+           note=None) -> Path:
     """Write the series of `group` of the results file `path` in format `fmt` to `out`
     (default :func:`default_output`); ScenarioError (one line) on a bad format, file or
-    group. Returns the path written."""
+    group. `note(text)`, when given, is told which group a default chose if it is not the
+    command's own (an alignment's last pass). Returns the path written."""
     path = Path(path)
     if fmt not in FORMATS:
         raise ScenarioError(f"--format: {fmt!r} is not an export format; allowed: "
                             f"{', '.join(FORMATS)}")
     own = default_group(path)  # reads the file through its kind's checks (app.checked)
+    if group is None and note is not None and "/" in own:
+        others = [g for g in results.timed_groups(path, own.split("/")[0]) if g != own]
+        note(f"exported /{own}" + (f"; --group for another: {', '.join(others)}"
+                                    if others else ""))
     group = group or own
     data = results.series(path, group)
     out = results.check_output(default_output(path, fmt) if out is None else out)

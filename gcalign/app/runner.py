@@ -74,7 +74,7 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
 
 
 OUT_OF_MEMORY = ("out of memory; a smaller run, or lower GCALIGN_MAX_MEMORY_MB so that gcalign "
-                 "refuses it up front (README 'Limits')")
+                 "refuses it up front (docs/reference: Limits)")
 
 
 def out_of_memory(err: BaseException) -> bool:

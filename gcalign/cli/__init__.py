@@ -45,8 +45,9 @@ if TYPE_CHECKING:
 def _top_help() -> str:
     """What gcalign does, from the registry (so it never promises a command that is not
     there); the command list below it takes each command's line from the registry too."""
-    seeds = sorted({c.help.rsplit("(seed ", 1)[1].rstrip(").") for c in COMMANDS.values()
-                    if "(seed " in c.help})
+    import re
+
+    seeds = sorted({m for c in COMMANDS.values() for m in re.findall(r"\(seed (\d+)\)", c.help)})
     return ("Strapdown INS laboratory: write a scenario (YAML), run a command, read its "
             "table and its results file (HDF5). Algorithms of the seed papers "
             f"{', '.join(seeds)}; `gcalign example` lists the built-in scenarios. Exit "

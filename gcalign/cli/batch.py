@@ -152,7 +152,7 @@ def batch(
 ):
     """Run a sweep (variants × seeds), or the same seeds on several scenario files; aggregate
     each metric per variant into one HDF5 file. One batch starts Python once: far cheaper
-    than a shell loop over `gcalign align` (README "Many runs")."""
+    than a shell loop over `gcalign align` (docs/batch.md)."""
     if workers is not None and workers < 1:
         raise ScenarioError(f"--workers: must be at least 1, got {workers}")
     if workers is not None and scheduler:

@@ -24,6 +24,7 @@ calls those two functions.
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 import copy
 import functools
@@ -56,7 +57,7 @@ IMU_FILE_HELP = ("Recorded IMU data (PSINS .imu, CSV/text, gcalign HDF5; .gz/.xz
                  "mechanism, imu and site sections; the site then comes from the file's "
                  "header or --lat/--lon/--height.")
 FORMAT_HELP = ("Layout of the --imu-file (or the scenario's imu_file): psins | psins-mat | "
-               "i2nav | csv | auto (from the suffix); see README 'Your own recording'.")
+               "i2nav | csv | auto (from the suffix); see docs/how-to/file-formats.md.")
 REFERENCE_HELP = ("Reference solution of the recording (a master INS, a post-processed "
                   "trajectory): .mat psins-mat avp, .csv csv, else i2nav-nav (KF-GINS); "
                   "errors against it, and the initial state when the data have none.")
@@ -401,6 +402,7 @@ class ProgressBar:
         self.pending: tuple[float, float, str] | None = None
         self.timer: threading.Timer | None = None
         self.closed = False
+        self.notes: list[str] = []
 
     def _start(self):
         from rich.console import Console
@@ -417,6 +419,8 @@ class ProgressBar:
             # (colorama's init) must not keep rich's wrapper of them
             redirect_stdout=False, redirect_stderr=False)
         self.bar.start()
+        for text in self.notes:
+            self.bar.console.print(text, highlight=False)
 
     def __call__(self, done: float, total: float, what: str = "") -> None:
         import threading
@@ -437,6 +441,16 @@ class ProgressBar:
                     return
                 self._start()
             self._update(done, total, what)
+
+    def note(self, text: str) -> None:
+        """A line above the bar (it stays when the bar goes), where the bar is shown."""
+        if not self.enabled:
+            return
+        with self.lock:
+            if self.bar is not None:
+                self.bar.console.print(text, highlight=False)
+            elif not self.closed:
+                self.notes.append(text)
 
     def _late_start(self) -> None:
         with self.lock:
@@ -467,6 +481,39 @@ class ProgressBar:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+COMPILING = ("compiling gcalign's numerical kernels (numba): once, on a first run or after "
+             "an upgrade; later runs load them from the cache")
+
+
+@contextlib.contextmanager
+def compile_note(bar: ProgressBar):
+    """While a command runs with a progress bar, say once above it (:data:`COMPILING`)
+    when numba compiles a kernel instead of loading it from its cache: a first run takes
+    tens of seconds more, which the bar alone would leave unexplained."""
+    if not bar.enabled:
+        yield
+        return
+    from numba.core import event
+
+    class _Note(event.Listener):
+        said = False
+
+        def on_start(self, ev) -> None:
+            if not self.said:
+                self.said = True
+                bar.note(COMPILING)
+
+        def on_end(self, ev) -> None:
+            pass
+
+    listener = _Note()
+    event.register("numba:compile", listener)
+    try:
+        yield
+    finally:
+        event.unregister("numba:compile", listener)
 
 
 def _time_column():
@@ -519,7 +566,7 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
         replaced = _replaced_other(out, name, text, run_seed)
         if replaced:
             notes.append(replaced)
-    with ProgressBar(name) as bar:  # the scenario's name heads the table
+    with ProgressBar(name) as bar, compile_note(bar):  # the scenario's name heads the table
         summary = run_command(name, sc, text, seed, out, progress=bar, notes=notes,
                               before_write=bar.close, **options)
     if on_summary is not None:

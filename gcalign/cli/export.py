@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import typer
@@ -20,7 +21,8 @@ def export(
         None, "-o", "--output", help="File to write; default FILE with the format's suffix "
         "(.csv, .mat, .nav, .avp.mat)."),
     group: str | None = typer.Option(
-        None, "--group", help="Group of the series (default: the command's, e.g. navigate)."),
+        None, "--group", help="Group of the series (default: the command's, e.g. navigate; "
+        "an alignment's last pass, a calibration's first run)."),
     week: int = typer.Option(0, "--week", help="GNSS week written by i2nav-nav (the results "
                              "keep seconds only).", min=0, max=9999),
     as_json: Json = False,
@@ -30,7 +32,8 @@ def export(
     psins-avp (PSINS avp array in a MAT file)."""
     from gcalign.app.export import export as run
 
-    out = run(file, fmt, output, group, week)
+    out = run(file, fmt, output, group, week,
+              note=lambda text: sys.stderr.write(text + "\n"))
     consoles(as_json).print(str(out), highlight=False, soft_wrap=True)
     if as_json:
         emit_json({"file": str(file), "format": fmt, "output": str(out)})

@@ -1,6 +1,6 @@
 """The HDF5 results file: one schema, written atomically, readable without gcalign.
 
-Layout (README "Results file"): root attributes ``gcalign_version``, ``kind`` (the command),
+Layout (docs: Reference, Results file): root attributes ``gcalign_version``, ``kind`` (the command),
 ``command_line``, ``scenario_yaml`` (the scenario text), ``seed``, ``created_utc`` and
 ``summary_json`` (what ``gcalign show`` prints); groups ``/truth``, ``/imu``, ``/navigate``,
 ``/align``, ``/northfind``, ``/batch``. Every dataset carries a ``units`` attribute and,
@@ -903,8 +903,22 @@ def _index_scale(g: h5py.Group, name: str, size: int) -> h5py.Dataset:
 
 #: Component names of a series by its frame attribute (first match).
 _COMPONENTS = (("[pitch, roll, yaw]", ("pitch", "roll", "yaw")),
+               ("Euler differences", ("pitch", "roll", "yaw")),
                ("[latitude, longitude, height]", ("lat", "lon", "h")),
                ("ENU", ("e", "n", "u")), ("body", ("x", "y", "z")))
+
+
+def timed_groups(path: Path, under: str = "") -> list[str]:
+    """The groups at or below `under` that hold time series (a 1-D float ``t``), in the
+    file's order (``align/pass_01``, …, ``align/pass_05``)."""
+    with open_results(path) as f:
+        top = f.get(under.strip("/")) if under.strip("/") else f
+        if not isinstance(top, h5py.Group):
+            return []
+        found = [top.name.strip("/")] if _is_time(top.get("t")) else []
+        top.visititems(lambda n, o: found.append(o.name.strip("/"))
+                       if isinstance(o, h5py.Group) and _is_time(o.get("t")) else None)
+        return found
 
 
 def series(path: Path, group: str = "navigate") -> dict[str, tuple[np.ndarray, str]]:
@@ -946,30 +960,63 @@ def _time_datasets(g: h5py.Group, n: int, prefix: str = ""):
 
 def series_components(path: Path, group: str = "navigate") -> dict[str, tuple[str, ...]]:
     """Column labels of each (N, k) series: ``att -> (pitch, roll, yaw)``, ``v_n -> (e, n,
-    u)``, ``pos -> (lat, lon, h)``, otherwise ``0, 1, ...``."""
+    u)``, ``pos -> (lat, lon, h)``; a series with a ``names`` attribute by those names
+    (``innovation -> (dvE, dvN)``), one in the order of its group's ``states`` attribute
+    by the states (``estimate -> (phiE, …, dKaz)``), otherwise ``0, 1, ...``."""
+    return {name: labels for name, (labels, _) in _component_meta(path, group).items()}
+
+
+def _component_meta(path: Path, group: str) -> dict[str, tuple[tuple[str, ...], list[str]]]:
+    """``{name: (labels, units per component or [])}`` of the (N, k) series of a group."""
     with open_results(path) as f:
         g = f[group.strip("/")]
         out = {}
         for name, ds in _time_datasets(g, len(g["t"])):
             if ds.ndim == 2:
-                frame = str(ds.attrs.get("frame", ""))
-                labels = next((c for key, c in _COMPONENTS if key in frame
-                               and len(c) == ds.shape[1]), None)
-                out[name] = labels or tuple(str(i) for i in range(ds.shape[1]))
+                out[name] = _components(ds)
         return out
+
+
+def _list_attr(obj, name: str) -> list[str]:
+    v = obj.attrs.get(name, "")
+    v = v.decode() if isinstance(v, bytes) else str(v)
+    return [p.strip() for p in v.split(",")] if v else []
+
+
+def _components(ds: h5py.Dataset) -> tuple[tuple[str, ...], list[str]]:
+    k = ds.shape[1]
+    names = _list_attr(ds, "names")
+    if len(names) == k:
+        return tuple(names), []
+    frame = str(ds.attrs.get("frame", ""))
+    labels = next((c for key, c in _COMPONENTS if key in frame and len(c) == k), None)
+    if labels is not None:
+        return labels, []
+    parent = ds.parent
+    while parent.name != "/":  # the 'states' of the nearest group that lists them
+        states = _list_attr(parent, "states")
+        if states:
+            if len(states) == k:
+                units = _list_attr(parent, "state_units")
+                return tuple(states), units if len(units) == k else []
+            break
+        parent = parent.parent
+    return tuple(str(i) for i in range(k)), []
 
 
 def columns(path: Path, group: str = "navigate") -> list[tuple[str, np.ndarray, str]]:
     """The group's series as flat columns ``(name, values (N,), units)``: ``t``, then each
-    vector series by component (``att_pitch``, ``v_n_e``, ``pos_lat``, ...)."""
-    labels = series_components(path, group)
+    vector series by component (``att_pitch``, ``v_n_e``, ``pos_lat``, ``estimate_ebx``,
+    ...), each with its own unit where the file gives one per component."""
+    meta = _component_meta(path, group)
     out = []
     for name, (a, units) in series(path, group).items():
         if a.ndim == 1:
             out.append((name, a, units))
             continue
-        parts = [p.strip() for p in units.split(",")]
-        for j, label in enumerate(labels[name]):
+        labels, own = meta[name]
+        parts = own or [p.strip() for p in units.split(",")]
+        for j, label in enumerate(labels):
             out.append((f"{name}_{label}", a[:, j], parts[j] if len(parts) == a.shape[1]
                         else units))
     return out

@@ -51,10 +51,12 @@ def window(sc, ext: Extent) -> tuple[int, int]:
             continue
         k = int(round((cfg.start_s + t) / ext.ts))
         if k > ext.samples:
+            fix = ("the recording is that long: choose earlier times (--t1, --t2, --t3)"
+                   if getattr(sc, "imu_file", None) is not None
+                   else "lengthen motion.duration_s or choose an earlier time")
             raise ScenarioError(
                 f"align.{field}: {t} s (+ start_s {cfg.start_s} s) is past the end of the data "
-                f"({ext.samples * ext.ts:.2f} s); lengthen motion.duration_s or choose an "
-                "earlier time")
+                f"({ext.samples * ext.ts:.2f} s); {fix}")
         his.append(k)
     return int(round(cfg.start_s / ext.ts)), max(his)
 

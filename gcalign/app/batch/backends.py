@@ -16,7 +16,7 @@ import time
 from gcalign.app.batch.runs import run_chunk, warm_up
 from gcalign.errors import GcalignError
 
-SCHEDULER_TIMEOUT_S = 4.0  # each step of connecting to a Dask scheduler (README: ≤ 15 s)
+SCHEDULER_TIMEOUT_S = 4.0  # each step of connecting to a Dask scheduler (≤ 15 s in all)
 WORKERS_TIMEOUT_S = 4.0  # waiting for a scheduler's first worker
 
 

@@ -7,42 +7,18 @@ or a missing list index is an error that names what exists.
 
 from __future__ import annotations
 
-import types
-from typing import Annotated, Any, Union, get_args, get_origin
+from typing import Any, get_args, get_origin
 
 from gcalign.errors import ScenarioError
-
-
-def _unwrap(tp):
-    """Strip Annotated[...] and Optional[...] from a pydantic field annotation."""
-    while True:
-        origin = get_origin(tp)
-        if origin is Annotated:
-            tp = get_args(tp)[0]
-        elif origin in (Union, types.UnionType):
-            args = [a for a in get_args(tp) if a is not type(None)]
-            if len(args) != 1:
-                return tp  # e.g. float | Literal["measured"]: a single value
-            tp = args[0]
-        else:
-            return tp
-
-
-def _is_model(tp) -> bool:
-    from pydantic import BaseModel
-
-    return isinstance(tp, type) and issubclass(tp, BaseModel)
+from gcalign.io.scenario.walk import is_model as _is_model
+from gcalign.io.scenario.walk import kind_arm
+from gcalign.io.scenario.walk import unwrap as _unwrap
 
 
 def _arm(tp, node):
     """The member of a union of models (the motion kinds) that `node`'s ``kind`` names."""
-    if get_origin(tp) not in (Union, types.UnionType) or not isinstance(node, dict):
-        return tp
-    for arm in get_args(tp):
-        field = getattr(arm, "model_fields", {}).get("kind")
-        if field is not None and node.get("kind") in get_args(field.annotation):
-            return arm
-    return tp
+    arm = kind_arm(tp, node.get("kind")) if isinstance(node, dict) else None
+    return tp if arm is None else arm
 
 
 def _dump(value):

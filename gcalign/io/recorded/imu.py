@@ -331,6 +331,10 @@ def _header_layout(header: list[str] | None) -> tuple[tuple[str, ...], dict] | N
     return tuple(cols), {k: v.pop() for k, v in units.items()}
 
 
+def _clip(text: str, n: int = 60) -> str:
+    return text if len(text) <= n else text[:n - 3] + "..."
+
+
 def _read_csv(name: str, data: bytes, layout: Layout) -> _Raw:
     lines = _text_lines(name, data)
     cols = _columns(layout)
@@ -344,6 +348,14 @@ def _read_csv(name: str, data: bytes, layout: Layout) -> _Raw:
             raise ImuFileError(f"{name}: {err}") from None
         if named is not None:
             cols = named[0]
+        elif layout.gyro_units is None and layout.accel_units is None:
+            # an unrecognised header row would otherwise be read as rad and m/s increments
+            raise ImuFileError(
+                f"{name}: header row {_clip(first)!r} does not name the columns as gcalign "
+                "knows them (time, gyro_x (deg/s), ..., accel_z (m/s^2)); declare the "
+                "layout in a scenario: imu_file: {path: ..., columns: [t, gx, gy, gz, ax, "
+                "ay, az], units: {gyro: "
+                f"{' | '.join(GYRO_UNITS)}, accel: {' | '.join(ACCEL_UNITS)}}}}}")
     rows, (header, where) = _table(name, lines, len(cols), cols)
     idx = {c: i for i, c in enumerate(cols)}
     pick = [idx[c] for c in ("gx", "gy", "gz")], [idx[c] for c in ("ax", "ay", "az")]

@@ -1,6 +1,6 @@
 """Scenario files: YAML -> validated pydantic models -> SI values for the core.
 
-The YAML schema is the public contract (README "Scenario format"): units in key names,
+The YAML schema is the public contract (docs: Reference, Scenario keys): units in key names,
 ``extra="forbid"`` so that a misspelt key is an error. Conversion to SI happens here once.
 """
 

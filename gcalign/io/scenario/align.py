@@ -1,4 +1,4 @@
-"""The `align` section of a scenario (seed 000; README "Scenario format").
+"""The `align` section of a scenario (seed 000; docs: Reference, Scenario keys).
 
 One key per quantity: the coarse window is ``[start_s, t1_s]`` (no separate duration), the
 method ``given`` takes ``error_deg`` and the measuring methods ``offset_deg``, and the pass

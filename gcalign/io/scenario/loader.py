@@ -68,7 +68,12 @@ def scenario_errors(err: ValidationError, source: str = "") -> str:
             msg = msg[m.end() :]
         where = ".".join(loc) or "scenario"
         if e["type"] == "extra_forbidden":
-            msg = "unknown key (check the spelling; see README 'Scenario format')"
+            from gcalign.io.scenario.walk import keys_at
+
+            keys = keys_at(e["loc"][:-1])
+            here = ".".join(loc[:-1]) or "the scenario"
+            msg = ("unknown key" + (f"; {here} has: {', '.join(keys)}" if keys else
+                                    " (check the spelling)"))
         elif e["type"] in ("union_tag_invalid", "union_tag_not_found"):
             ctx = e.get("ctx", {})
             key = str(ctx.get("discriminator", "kind")).strip("'")
