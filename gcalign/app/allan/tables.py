@@ -72,7 +72,7 @@ def allan_table(s: dict) -> Table:
                                         for v in s["misfit"][t]) for t in ("gyro", "accel"))
     table.caption = (f"model misfit (RMS in 1σ, x y z): {mis}\n"
                      f"mean rate (°/h): {mean}; mean specific force (µg): {force}; "
-                     f"1-s |f| spread {s['at_rest']['force_spread_mg']:.3g} mg\n"
+                     f"1-s specific force spread {s['at_rest']['force_spread_mg']:.3g} mg\n"
                      "intervals 1σ from the number of clusters (IEEE Std 952 C.3); bias "
                      "instability = flat σ / 0.664; quantum q = √12·Q\n"
                      + run_line(s, "compute (Allan deviation and fits)"))
