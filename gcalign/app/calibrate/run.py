@@ -442,10 +442,13 @@ def reference_series(sc: Scenario, run: Run, t0: float = 0.0) -> dict[str, np.nd
     the reference covers (SI): ``t`` (the run's epochs, s from sample 0), ``att`` (Euler
     differences est − reference, roll and yaw wrapped; the reference's attitude by slerp),
     ``v_n`` (ENU), ``pos`` (m ENU), the reference taken at the recording's time ``t + t0``
-    (:attr:`Case.t0`); None without a reference, with truth, or with no epoch inside it."""
+    (:attr:`Case.t0`), none inside the reference's gaps; None without a reference, with
+    truth, or with no epoch inside it."""
     r = run.result
     if sc.reference is None or r.truth is not None:
         return None
+    from gcalign.app.calibrate.solution import reference_gaps
+    from gcalign.calibrate.fixes import inside as in_gaps
     from gcalign.io.recorded.reference import reference_at
     from gcalign.nav.navigate import position_error_enu
     from gcalign.nav.rotation import attitude_error
@@ -453,6 +456,7 @@ def reference_series(sc: Scenario, run: Run, t0: float = 0.0) -> dict[str, np.nd
     ref = sc.reference.read()
     t_data = r.t + t0
     inside = (t_data >= ref.t[0] - 1e-6) & (t_data <= ref.t[-1] + 1e-6)
+    inside &= ~in_gaps(t_data, reference_gaps(ref, sc.reference.max_gap_s))  # not in its gaps
     if not inside.any():
         return None
     t = r.t[inside]

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gcalign.calibrate.fixes import Outage, find_outages, inside
-from gcalign.io.recorded.reference import Reference, reference_at
+from gcalign.io.recorded.reference import Reference, reference_at, reference_window
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.navigate import position_error_enu
 from gcalign.nav.rotation import attitude_error, quat_to_euler
@@ -103,7 +103,9 @@ class Errors:
         ok = (t_data >= ref.t[0] - 1e-9) & (t_data <= ref.t[-1] + 1e-9)
         ok &= ~inside(t_data, self.ref_gaps)
         if ok.any():
-            r_att, r_v, r_pos = reference_at(ref, t_data[ok], tol=1e-6)
+            tq = t_data[ok]
+            r_att, r_v, r_pos = reference_at(reference_window(ref, tq[0], tq[-1]), tq,
+                                             tol=1e-6)
             out["position"][ok] = position_error_enu(pos[ok], r_pos, self.earth)
             out["velocity"][ok] = v[ok] - r_v
             if r_att is not None:
@@ -132,8 +134,9 @@ class SolutionSink:
                     "att": (3, "rad", ATT_FRAME), "v_n": (3, "m/s", "ENU"),
                     "pos": (3, "rad, rad, m", "[latitude, longitude, height]")}
             if errors.against is not None:
-                spec |= {"error/att": (3, "rad", f"Euler differences est - {errors.against}"
-                                                 ", roll and yaw wrapped; NaN: not compared"),
+                spec |= {"error/t": (None, "s", None),
+                         "error/att": (3, "rad", f"Euler differences est - {errors.against}"
+                                                 ", roll and yaw wrapped"),
                          "error/v_n": (3, "m/s", "ENU"),
                          "error/pos": (3, "m", "ENU (east, north, up)")}
             self.series = Series(group, spec, stride=stride, rate_hz=rate_hz / stride,
@@ -158,9 +161,10 @@ class SolutionSink:
             keep = (self.k + np.arange(n)) % self.stride == 0
             rows = {"t": t_data[keep], "t_run": t[keep], "att": att[keep], "v_n": v_n[keep],
                     "pos": pos[keep]}
-            if self.errors.against is not None:
-                rows |= {"error/att": err["attitude"][keep], "error/v_n": err["velocity"][keep],
-                         "error/pos": err["position"][keep]}
+            if self.errors.against is not None:  # where compared: not in a reference's gaps
+                sel = keep & ok
+                rows |= {"error/t": t_data[sel], "error/att": err["attitude"][sel],
+                         "error/v_n": err["velocity"][sel], "error/pos": err["position"][sel]}
             self.series.append(**rows)
         self.k += n
 

@@ -36,8 +36,8 @@ from gcalign.io.recorded.rows import _check_rows, _columns, _finite
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
 from gcalign.units import DEG
 
-__all__ = ["Reference", "read_reference", "reference_at", "initial_state", "REFERENCE_FORMATS",
-           "reference_format_of"]
+__all__ = ["Reference", "read_reference", "reference_at", "reference_window", "initial_state",
+           "REFERENCE_FORMATS", "reference_format_of"]
 
 REFERENCE_FORMATS = ("psins-mat", "i2nav-nav", "csv")
 _CSV_COLUMNS = ("t", "pitch", "roll", "yaw", "ve", "vn", "vu", "lat", "lon", "h")
@@ -147,6 +147,16 @@ def _covers(ref: Reference, t: np.ndarray, tol: float) -> None:
             f"{hi:.3f} s, the run needs {float(t[0]):.3f} .. {float(t[-1]):.3f} s: a "
             "reference must cover the whole run (start later, stop earlier, or give a "
             "longer reference)")
+
+
+def reference_window(ref: Reference, t_lo: float, t_hi: float) -> Reference:
+    """The part of `ref` that interpolates within ``[t_lo, t_hi]``: its epochs there and
+    one beyond each end (a run compared block by block interpolates each block in the
+    reference's few epochs around it, not in all of them)."""
+    a = min(max(int(np.searchsorted(ref.t, t_lo, side="right")) - 1, 0), len(ref.t) - 2)
+    b = max(min(int(np.searchsorted(ref.t, t_hi, side="left")) + 1, len(ref.t)), a + 2)
+    return Reference(ref.t[a:b], None if ref.att is None else ref.att[a:b], ref.v_n[a:b],
+                     ref.pos[a:b], ref.record)
 
 
 def reference_at(ref: Reference, t, tol: float = 1e-9) -> tuple[np.ndarray, np.ndarray,
