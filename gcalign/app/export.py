@@ -47,8 +47,9 @@ def default_group(path: Path) -> str:
     """The group of the command that wrote the file (``navigate``, ``simulate``'s
     ``truth``, ...); where that group keeps its series in subgroups, the one holding the
     result: an alignment's last pass (``align/pass_05``: it ends at T2, whence T3), a
-    calibration's first run (``calibrate/runs/00``). :func:`gcalign.io.results.series`
-    says which groups hold series when there is none."""
+    calibration's first run's solution at every navigation sample
+    (``calibrate/runs/00/navigation``; files without it: ``calibrate/runs/00``).
+    :func:`gcalign.io.results.series` says which groups hold series when there is none."""
     from gcalign.app.checked import read_checked
 
     kind = read_checked(path)[0]
@@ -56,6 +57,8 @@ def default_group(path: Path) -> str:
     timed = results.timed_groups(path, group)
     if not timed or group in timed:
         return group
+    if kind == "calibrate" and "calibrate/runs/00/navigation" in timed:
+        return "calibrate/runs/00/navigation"
     return timed[-1] if kind == "align" else timed[0]
 
 

@@ -14,7 +14,8 @@ Layout::
         updated (K+1,) 1 where a measurement updated the filter; update_t (U,) those
         epochs; innovation, standardized (U, m); nis (U,); sigma_z (U, m) the σ of R;
         att, v_n, pos (K+1, 3) the corrected INS solution; smoothed/estimate,
-        smoothed/sigma (K+1, 21), smoothed/att, v_n, pos (K+1, 3) with the RTS smoother;
+        smoothed/sigma (K+1, 21), smoothed/att, v_n, pos (K+1, 3) with the RTS smoother,
+        smoothed/error/t, att, v_n, pos its errors at the epochs compared;
         navigation/ the solution at every navigation sample (or the output rate): t (the
         recording's time), t_run, att, v_n, pos, and error/t, att, v_n, pos against the
         truth or the reference where they are compared
@@ -122,3 +123,12 @@ def _write_run(g: h5py.Group, run) -> None:
         put(s, "att", r.smoothed.att, "rad", ATT_FRAME, description="the smoothed solution")
         put(s, "v_n", r.smoothed.v_n, "m/s", "ENU")
         put(s, "pos", r.smoothed.pos, "rad, rad, m", "[latitude, longitude, height]")
+        e = (run.epoch_errors or {}).get("smoothed_series")
+        if e is not None:
+            se = s.create_group("error")
+            se.attrs["description"] = "the smoothed solution - the truth or the reference"
+            put(se, "t", e["t"], "s")
+            put(se, "att", e["attitude"], "rad", description="Euler differences, roll and "
+                "yaw wrapped: pitch, roll, yaw")
+            put(se, "v_n", e["velocity"], "m/s", "ENU")
+            put(se, "pos", e["position"], "m", "ENU")

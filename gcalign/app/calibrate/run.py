@@ -254,17 +254,18 @@ def run_filter(case: Case, measure: str | None = None, data: FlightData | None =
 
 def _epoch_errors(case: Case, r: CalibrationResult, errors) -> dict:
     """The forward filter's and (with it) the smoother's solutions at the filter epochs
-    against the truth or the reference, inside and outside the outages."""
+    against the truth or the reference, inside and outside the outages (the smoothed
+    errors themselves under ``smoothed_series``, for the file)."""
     from gcalign.app.calibrate.solution import epoch_errors
 
     assert r.index is not None
     outages = () if case.aid is None else case.aid.outages
-    out = {"forward": epoch_errors(errors, r.t, case.t0, r.index, r.att, r.v_n, r.pos,
-                                   outages)}
+    out: dict = {"forward": epoch_errors(errors, r.t, case.t0, r.index, r.att, r.v_n, r.pos,
+                                         outages)[0]}
     if r.smoothed is not None:
         sm = r.smoothed
-        out["smoothed"] = epoch_errors(errors, r.t, case.t0, r.index, sm.att, sm.v_n, sm.pos,
-                                       outages)
+        out["smoothed"], out["smoothed_series"] = epoch_errors(
+            errors, r.t, case.t0, r.index, sm.att, sm.v_n, sm.pos, outages)
     return out
 
 
@@ -345,7 +346,8 @@ def run_summary(run: Run) -> dict:
     if run.errors is not None:
         out["solution_errors"] = run.errors
     if run.epoch_errors is not None:
-        out["epoch_errors"] = run.epoch_errors
+        out["epoch_errors"] = {k: v for k, v in run.epoch_errors.items()
+                               if k != "smoothed_series"}
     if r.nees is not None:
         lo, hi = _chi2_band(ie.N_STATES)
         out["nees"] = {"final": float(r.nees[-1]), "mean": float(r.nees.mean()),

@@ -179,11 +179,11 @@ class SolutionSink:
 
 
 def epoch_errors(errors: Errors, t: np.ndarray, t0: float, index: np.ndarray, att: np.ndarray,
-                 v_n: np.ndarray, pos: np.ndarray,
-                 outages: tuple[Outage, ...]) -> dict[str, dict | None]:
-    """Statistics of a solution at the filter epochs (the forward filter's or the
-    smoother's), inside and outside the outages."""
-    stats = {"outside_outages": ErrorStats(), "in_outages": ErrorStats()}
+                 v_n: np.ndarray, pos: np.ndarray, outages: tuple[Outage, ...]
+                 ) -> tuple[dict[str, dict | None], dict[str, np.ndarray]]:
+    """A solution at the filter epochs (the forward filter's or the smoother's) against
+    the truth or the reference: its statistics inside and outside the outages, and the
+    errors themselves (``t`` and position, velocity, attitude at the epochs compared)."""
     if errors.truth is not None:
         tr = errors.truth
         err = {"position": position_error_enu(pos, tr.pos[index], errors.earth),
@@ -192,6 +192,8 @@ def epoch_errors(errors: Errors, t: np.ndarray, t0: float, index: np.ndarray, at
     else:
         ok, err = errors.of(0, t + t0, att, v_n, pos)
     out = inside(t, outages)
+    stats = {"outside_outages": ErrorStats(), "in_outages": ErrorStats()}
     stats["in_outages"].add({q: e[ok & out] for q, e in err.items()})
     stats["outside_outages"].add({q: e[ok & ~out] for q, e in err.items()})
-    return {k: s.summary() for k, s in stats.items()}
+    return ({k: s.summary() for k, s in stats.items()},
+            {"t": t[ok], **{q: e[ok] for q, e in err.items()}})
