@@ -166,10 +166,10 @@ def aided_notes(s: dict) -> list[str]:
                                       sm["in_outages"]))
             fw = s["epoch_errors"]["forward"]["in_outages"]
             lines.append(_errors_line("in the outages, forward (filter epochs)", fw))
-        lines = [x for x in lines if x]
-        if lines:
+        shown = [x for x in lines if x is not None]
+        if shown:
             notes.append(f"solution against the {e['against']} at every navigation sample:")
-            notes += lines
+            notes += shown
     return notes
 
 
