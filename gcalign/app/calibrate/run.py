@@ -210,7 +210,8 @@ def solution_errors(sc: Scenario, case: Case, data: FlightData):
     """What the solution is compared with: the simulation's truth, else the scenario's
     reference (its gaps left out), else nothing (:class:`gcalign.app.calibrate.solution.
     Errors`)."""
-    from gcalign.app.calibrate.solution import Errors, reference_gaps
+    from gcalign.app.calibrate.solution import Errors
+    from gcalign.io.recorded.reference import reference_gaps
 
     if data.truth is not None:
         return Errors(data.earth, truth=data.truth)
@@ -449,9 +450,8 @@ def reference_series(sc: Scenario, run: Run, t0: float = 0.0) -> dict[str, np.nd
     r = run.result
     if sc.reference is None or r.truth is not None:
         return None
-    from gcalign.app.calibrate.solution import reference_gaps
     from gcalign.calibrate.fixes import inside as in_gaps
-    from gcalign.io.recorded.reference import reference_at
+    from gcalign.io.recorded.reference import reference_at, reference_gaps
     from gcalign.nav.navigate import position_error_enu
     from gcalign.nav.rotation import attitude_error
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gcalign.calibrate.fixes import Outage, find_outages, inside
+from gcalign.calibrate.fixes import Outage, inside
 from gcalign.io.recorded.reference import Reference, reference_at, reference_window
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.navigate import position_error_enu
@@ -62,15 +62,6 @@ class ErrorStats:
         out["horizontal_rms_m"] = float(np.sqrt(self.h_sq / self.n))
         out["horizontal_max_m"] = self.h_peak
         return out
-
-
-def reference_gaps(ref: Reference, max_gap: float | None) -> tuple[Outage, ...]:
-    """The stretches of a reference longer than `max_gap` (default twice its median
-    interval) without an epoch: no error is reported inside them."""
-    from gcalign.calibrate.fixes import default_max_gap
-
-    gap = default_max_gap(ref.t) if max_gap is None else max_gap
-    return find_outages(ref.t, float(ref.t[0]), float(ref.t[-1]), gap)
 
 
 class Errors:

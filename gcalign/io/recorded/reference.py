@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gcalign.errors import ScenarioError
+from gcalign.gaps import Outage, default_max_gap, find_outages
 from gcalign.io.imu_files import ImuFileError, read_bytes
 from gcalign.io.recorded import mat
 from gcalign.io.recorded.imu import _table, _text_lines
@@ -36,8 +37,8 @@ from gcalign.io.recorded.rows import _check_rows, _columns, _finite
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
 from gcalign.units import DEG
 
-__all__ = ["Reference", "read_reference", "reference_at", "reference_window", "initial_state",
-           "REFERENCE_FORMATS", "reference_format_of"]
+__all__ = ["Reference", "read_reference", "reference_at", "reference_window", "reference_gaps",
+           "initial_state", "REFERENCE_FORMATS", "reference_format_of"]
 
 REFERENCE_FORMATS = ("psins-mat", "i2nav-nav", "csv")
 _CSV_COLUMNS = ("t", "pitch", "roll", "yaw", "ve", "vn", "vu", "lat", "lon", "h")
@@ -147,6 +148,14 @@ def _covers(ref: Reference, t: np.ndarray, tol: float) -> None:
             f"{hi:.3f} s, the run needs {float(t[0]):.3f} .. {float(t[-1]):.3f} s: a "
             "reference must cover the whole run (start later, stop earlier, or give a "
             "longer reference)")
+
+
+def reference_gaps(ref: Reference, max_gap: float | None = None) -> tuple[Outage, ...]:
+    """The stretches of a reference longer than `max_gap` (s; default twice its median
+    interval) without an epoch: no error is given against it there (an interpolation
+    across a gap is not a measurement)."""
+    gap = default_max_gap(ref.t) if max_gap is None else max_gap
+    return find_outages(ref.t, float(ref.t[0]), float(ref.t[-1]), gap)
 
 
 def reference_window(ref: Reference, t_lo: float, t_hi: float) -> Reference:
