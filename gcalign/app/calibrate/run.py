@@ -180,7 +180,7 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
             att = quat_to_euler(state.q_nb)
         data = parked_data(imu.dtheta[i1:i2], imu.dv[i1:i2], ts, att, site, t0=coarse_end,
                            subsamples=n, earth=earth)
-    start_att = quat_to_euler(data.start.q_nb)
+    start_att = att if att is not None else quat_to_euler(data.start.q_nb)
     return Case(data, cfg.settings(site, earth, sc=sc), imu.source, aiding, n, rate, None,
                 None, start_att, (start, coarse_end, end), t0, aid, source,
                 cfg.output_stride(rate / n))
