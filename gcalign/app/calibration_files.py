@@ -189,14 +189,14 @@ def _at_start(ep: Fixes, values: np.ndarray | None, t_start: float,
 def start_state(sc: Scenario, cfg: CalibrateConfig, t_start: float, t0: float,
                 site: np.ndarray, earth: EarthModel, w0: np.ndarray,
                 fixes: Fixes | None = None, coarse_att: np.ndarray | None = None,
-                header=None) -> tuple[NavState, str]:
+                header=None, reference=None) -> tuple[NavState, str]:
     """The INS state at run time `t_start` (s from sample 0; data time ``t_start + t0``)
     and where it came from (module docstring). `w0` the first body rate (rad/s, for an
-    antenna's velocity); `coarse_att` the coarse alignment's attitude when one ran."""
+    antenna's velocity); `coarse_att` the coarse alignment's attitude when one ran;
+    `reference` the scenario's reference as read."""
     from gcalign.io.recorded.reference import initial_state, reference_at
 
     t_data = t_start + t0
-    reference = sc.reference.read() if sc.reference is not None else None
     ini = sc.initial
     if coarse_att is not None:
         att, v0, source = coarse_att, np.zeros(3), "the coarse alignment (a parked start)"
@@ -231,14 +231,14 @@ def start_state(sc: Scenario, cfg: CalibrateConfig, t_start: float, t0: float,
 
 def file_data(sc: Scenario, cfg: CalibrateConfig, t: np.ndarray, dtheta: np.ndarray,
               dv: np.ndarray, site: np.ndarray, earth: EarthModel, t0: float,
-              coarse_att: np.ndarray | None = None, header=None
+              coarse_att: np.ndarray | None = None, header=None, reference=None
               ) -> tuple[FlightData, AidingInput, str]:
     """The filter's data at the navigation times `t` (N+1,) (from sample 0; `t0` the data
     time of sample 0): the fixes, the start state; and where the start came from."""
     aid = aiding_input(cfg, t0, np.asarray(t, float))
     w0 = dtheta[0] / (t[1] - t[0])
     start, source = start_state(sc, cfg, float(t[0]), t0, site, earth, w0, aid.fixes,
-                                coarse_att, header)
+                                coarse_att, header, reference)
     data = FlightData(t=np.asarray(t, float), dtheta=dtheta, dv=dv, start=start,
                       ref_v_n=None, ref_pos=None,
                       segments=(Span("recorded", float(t[0]), float(t[-1])),), earth=earth,

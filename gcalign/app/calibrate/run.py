@@ -39,6 +39,7 @@ from gcalign.calibrate import (
 from gcalign.calibrate.filter import warm_up
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
+from gcalign.io.recorded.reference import Reference
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig
 from gcalign.nav.earth import EarthModel
@@ -62,7 +63,8 @@ class Case:
     simulation): ``data.t + t0`` is the time of the recording's files and reference.
     aid : the aiding files' fixes and what to report of them (``aiding: file``).
     start_source : where the start state came from. output_stride : navigation steps per
-    stored row of the solution.
+    stored row of the solution. reference : the scenario's reference solution, read once
+    (recorded data), or None.
     """
 
     data: FlightData
@@ -79,6 +81,7 @@ class Case:
     aid: AidingInput | None = None
     start_source: str = ""
     output_stride: int = 1
+    reference: Reference | None = None
 
     @property
     def navigation_rate(self) -> float:
@@ -167,23 +170,25 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
         except ValueError as err:
             raise ScenarioError(f"calibrate.coarse.duration_s: {err}") from None
     aiding = cfg.aiding_for(sc)
+    reference = sc.reference.read() if sc.reference is not None else None  # read once
     t0 = float(imu.t[0] - ts)  # the recording's time of sample 0
     dth, dv = combine_increments(imu.dtheta[i1:i2], imu.dv[i1:i2], n)
     t = coarse_end + np.arange(len(dth) + 1) * n * ts
     aid, source = None, "the coarse alignment (a parked start)"
     if aiding == "file":  # measured velocity / position at their epochs
-        data, aid, source = file_data(sc, cfg, t, dth, dv, site, earth, t0, att, imu)
+        data, aid, source = file_data(sc, cfg, t, dth, dv, site, earth, t0, att, imu,
+                                      reference)
     else:
         if att is None:
             state, source = start_state(sc, cfg, float(t[0]), t0, site, earth,
-                                        dth[0] / (n * ts), header=imu)
+                                        dth[0] / (n * ts), header=imu, reference=reference)
             att = quat_to_euler(state.q_nb)
         data = parked_data(imu.dtheta[i1:i2], imu.dv[i1:i2], ts, att, site, t0=coarse_end,
                            subsamples=n, earth=earth)
     start_att = att if att is not None else quat_to_euler(data.start.q_nb)
     return Case(data, cfg.settings(site, earth, sc=sc), imu.source, aiding, n, rate, None,
                 None, start_att, (start, coarse_end, end), t0, aid, source,
-                cfg.output_stride(rate / n))
+                cfg.output_stride(rate / n), reference)
 
 
 def scenario_case(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Case:
@@ -215,9 +220,9 @@ def solution_errors(sc: Scenario, case: Case, data: FlightData):
 
     if data.truth is not None:
         return Errors(data.earth, truth=data.truth)
-    if sc.reference is None:
+    ref = case.reference
+    if ref is None or sc.reference is None:
         return Errors(data.earth)
-    ref = sc.reference.read()
     return Errors(data.earth, reference=ref, ref_gaps=reference_gaps(ref, sc.reference.max_gap_s))
 
 
@@ -440,7 +445,8 @@ def aiding_files(cfg: CalibrateConfig) -> dict | None:
             if f is not None}
 
 
-def reference_series(sc: Scenario, run: Run, t0: float = 0.0) -> dict[str, np.ndarray] | None:
+def reference_series(sc: Scenario, run: Run, t0: float = 0.0,
+                     reference: Reference | None = None) -> dict[str, np.ndarray] | None:
     """A recording's INS solution against the scenario's reference at every filter epoch
     the reference covers (SI): ``t`` (the run's epochs, s from sample 0), ``att`` (Euler
     differences est − reference, roll and yaw wrapped; the reference's attitude by slerp),
@@ -455,7 +461,7 @@ def reference_series(sc: Scenario, run: Run, t0: float = 0.0) -> dict[str, np.nd
     from gcalign.nav.navigate import position_error_enu
     from gcalign.nav.rotation import attitude_error
 
-    ref = sc.reference.read()
+    ref = reference if reference is not None else sc.reference.read()
     t_data = r.t + t0
     inside = (t_data >= ref.t[0] - 1e-6) & (t_data <= ref.t[-1] + 1e-6)
     inside &= ~in_gaps(t_data, reference_gaps(ref, sc.reference.max_gap_s))  # not in its gaps
@@ -503,7 +509,7 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             else [run_filter(case, group=group_of(0), errors=errors_of(case.data))])
     if progress is not None and not compare:
         progress(1, 1, "filter run")
-    against = [reference_series(sc, r, case.t0) for r in runs]  # read and interpolated once
+    against = [reference_series(sc, r, case.t0, case.reference) for r in runs]
     out = summary(sc, case, runs, compare, against)
     from gcalign.app.at_rest import zero_velocity_warnings  # a moving recording under ZUPT
 

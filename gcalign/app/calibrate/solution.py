@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gcalign.calibrate.fixes import Outage, inside
-from gcalign.io.recorded.reference import Reference, reference_at, reference_window
+from gcalign.io.recorded.reference import Reference, reference_at
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.navigate import position_error_enu
 from gcalign.nav.rotation import attitude_error, quat_to_euler
@@ -94,9 +94,7 @@ class Errors:
         ok = (t_data >= ref.t[0] - 1e-9) & (t_data <= ref.t[-1] + 1e-9)
         ok &= ~inside(t_data, self.ref_gaps)
         if ok.any():
-            tq = t_data[ok]
-            r_att, r_v, r_pos = reference_at(reference_window(ref, tq[0], tq[-1]), tq,
-                                             tol=1e-6)
+            r_att, r_v, r_pos = reference_at(ref, t_data[ok], tol=1e-6)
             out["position"][ok] = position_error_enu(pos[ok], r_pos, self.earth)
             out["velocity"][ok] = v[ok] - r_v
             if r_att is not None:

@@ -33,7 +33,7 @@ from gcalign.errors import ScenarioError
 from gcalign.gaps import default_max_gap
 from gcalign.io.imu_files import ImuFileError, read_bytes
 from gcalign.io.recorded.axes import _DIRECTIONS
-from gcalign.io.recorded.imu import _table, _text_lines
+from gcalign.io.recorded.imu import _table, _table_of, _text_lines
 from gcalign.io.recorded.rows import _check_rows, _columns, _finite
 from gcalign.units import DEG
 
@@ -93,7 +93,7 @@ def read_gnss(path, format: str = "i2nav-gnss", columns=None, lever_arm_b=(0.0, 
         t, lat, lon, h, s_enu, origin = _rtklib(name, data)
     else:
         cols = _GNSS_COLUMNS if format == "i2nav-gnss" else _columns(columns, _GNSS_COLUMNS)
-        rows, (_, where) = _table(name, _text_lines(name, data), len(cols), cols)
+        rows, (_, where) = _table_of(name, data, len(cols), cols)
         _finite(name, rows, cols, where)
         c = {k: rows[:, cols.index(k)] for k in _GNSS_COLUMNS}
         _check_rows(name, c["t"], where)
