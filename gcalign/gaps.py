@@ -45,10 +45,11 @@ def find_outages(t_fix: np.ndarray, t_start: float, t_end: float,
                  for i in np.flatnonzero(gaps > max_gap))
 
 
-def inside(t: np.ndarray, outages: tuple[Outage, ...]) -> np.ndarray:
-    """Boolean mask (N,): which times lie strictly inside an outage."""
+def inside(t: np.ndarray, outages: tuple[Outage, ...], tol: float = 1e-6) -> np.ndarray:
+    """Boolean mask (N,): which times lie inside an outage, more than `tol` (s) from its
+    ends (an epoch that ends a gap, computed as ``t0 + k·ts``, is not in it)."""
     t = np.asarray(t, dtype=float)
     mask = np.zeros(t.shape, dtype=bool)
     for o in outages:
-        mask |= (t > o.start) & (t < o.end)
+        mask |= (t > o.start + tol) & (t < o.end - tol)
     return mask

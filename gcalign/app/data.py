@@ -162,8 +162,8 @@ def _recorded(scenario: Scenario) -> RunData:
         site = scenario.site.to_si()
     elif imu.site is not None:
         site = np.asarray(imu.site, float)
-    elif scenario.initial is not None and scenario.initial.position() is not None:
-        site = scenario.initial.position()  # where the run starts
+    elif scenario.initial is not None and (start := scenario.initial.position()) is not None:
+        site = start  # where the run starts
     elif scenario.reference is not None:  # where the reference solution starts
         site = np.asarray(scenario.reference.read().pos[0], float)
     else:
