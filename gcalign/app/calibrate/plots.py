@@ -193,7 +193,7 @@ def navigation_figure(run, attrs, title: str) -> Figure:
     return _finish(fig, axes, xlabel, title)
 
 
-def innovations_figure(run, title: str) -> Figure:
+def innovations_figure(run, title: str, outages=()) -> Figure:
     """Standardized innovations (each ~ N(0, 1)) with ±3, NEES with the χ²₂₁ 95 % band, NIS."""
     from scipy.stats import chi2
 
@@ -211,6 +211,8 @@ def innovations_figure(run, title: str) -> Figure:
     m = z.shape[1]
     lo, hi = chi2.ppf([0.025, 0.975], m)
     axes[1].semilogy(tu, np.maximum(run["nis"], 1e-6), ".", markersize=2, label="NIS")
+    for ax in axes:
+        shade_outages(ax, outages, xlabel.endswith("(min)"))
     axes[1].axhspan(lo, hi, color="tab:green", alpha=0.15, label=f"χ²({m}) 95 %")
     axes[1].set_ylabel("NIS")
     if has_nees:
@@ -399,7 +401,8 @@ def figures(f, name: str) -> dict[str, Figure]:
             first["reference_error"], f"{name}: INS solution against the reference "
             f"(est − reference; {AIDED[first['measure']]} aiding)")
     figs["innovations"] = innovations_figure(
-        first, f"{name}: standardized innovations, NIS and NEES ({first['measure']})")
+        first, f"{name}: standardized innovations, NIS and NEES ({first['measure']})",
+        attrs["outages"])
     if first["navigation"] is not None and len(first["navigation"]["t"]):
         against = "truth" if first["truth"] is not None else "reference"
         figs["solution_errors"] = solution_figure(

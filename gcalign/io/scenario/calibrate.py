@@ -448,7 +448,18 @@ class CalibrateConfig(Model):
              else "feed-forward"),
             ("calibrate.discretization", self.discretization, ""),
             ("calibrate.smoother", str(self.smoother), ""),
+            ("calibrate.components", self.components_for(sc), "horizontal: the seed's eqs. "
+             "5-7; 3d: with the vertical velocity and height"),
         ]
+        procs = [k for k in ("gyro_bias_gm", "gyro_bias_rw_dphrh", "accel_bias_gm",
+                             "accel_bias_rw_ughrh", "gyro_scale_gm", "accel_scale_gm")
+                 if getattr(self.q, k) is not None]
+        rows.append(("calibrate.q processes", ", ".join(procs) or "none",
+                     "the other sensor states are random constants"))
+        if self.files is not None:
+            rows.append(("calibrate.max_gap_s", "twice the file's median interval"
+                         if self.max_gap_s is None else f"{self.max_gap_s:g} s",
+                         "fixes further apart are an outage"))
         if not self.recorded(sc):
             rate = sc.imu.rate_hz
             n = self.subsamples(rate)

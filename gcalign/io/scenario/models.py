@@ -336,6 +336,10 @@ class Scenario(Model):
                     and getattr(self, section, None) is not None:  # a section of the file
                 out.append(f"{key}: read and checked (gcalign validate shows it), but "
                            f"{section} does not use it yet")
+        if self.initial is not None and self.initial.sigma is not None \
+                and section == "navigation":
+            out.append("initial.sigma: cannot matter to navigate (no filter); it is the P0 "
+                       "of calibrate")
         model = getattr(self, section, None) if section else None
         if model is not None and hasattr(model, "unused"):
             out += model.unused(self)
