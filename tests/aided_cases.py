@@ -43,19 +43,17 @@ GYRO = {"arw_dprh": 0.003, "bias_gm": {"std_dph": 1.0, "tau_s": 600.0}}
 ACCEL = {"vrw_ugrhz": 30.0, "bias_gm": {"std_ug": 200.0, "tau_s": 600.0}}
 
 
-def scenario(duration: float | None = None, rate: float = 100.0):
+def scenario(rate: float = 100.0):
     motion = {"kind": "flight", "attitude_deg": [0, 0, 30], "segments": SEGMENTS}
-    if duration is not None:
-        motion["duration_s"] = duration
     return parse_scenario({"name": "vehicle", "site": {"lat_deg": 30.5, "lon_deg": 114.3,
                                                        "height_m": 20},
                            "imu": {"rate_hz": rate, "gyro": GYRO, "accel": ACCEL},
                            "motion": motion})
 
 
-@lru_cache(maxsize=2)
-def _raw(duration: float | None):
-    return noise_free(scenario(duration))
+@lru_cache(maxsize=1)
+def _raw():
+    return noise_free(scenario())
 
 
 def p0_sigma() -> np.ndarray:
@@ -94,9 +92,10 @@ def vehicle(seed: int, duration: float | None = None, offset: float = 0.373,
     """``(FlightData with fixes, Fixes, x_true)``: the vehicle with its sensor errors drawn
     with `seed` (initial errors from the filter's P0, processes from the IMU model), 1 Hz
     fixes `offset` s after each whole second of run time, their σ varying slowly between
-    `sigma_range`, minus the fixes inside `outages`."""
-    raw = _raw(duration)
-    sc = scenario(duration)
+    `sigma_range`, minus the fixes inside `outages`; the first `duration` s (default all
+    of the 295.5 s)."""
+    raw = _raw()
+    sc = scenario()
     rng = np.random.default_rng([seed, 7])
     x_true = np.zeros(21)
     x_true[:9] = p0_sigma()[:9] * rng.standard_normal(9)
@@ -105,6 +104,8 @@ def vehicle(seed: int, duration: float | None = None, offset: float = 0.373,
     data = flight_from_ideal(raw.truth, raw.imu, x_true, sc.imu.errors(),
                              np.random.default_rng(seed),
                              motion_spans(sc.motion.to_motion(), float(raw.truth.t[-1])))
+    if duration is not None:
+        data = data.between(0.0, duration)
     fixes = gnss(data, rng, offset, outages, sigma_range)
     return replace(data, fixes=fixes, ref_v_n=None, ref_pos=None), fixes, x_true
 

@@ -138,7 +138,7 @@ def test_noise_free_fixes_between_samples_agree_with_the_ins_to_a_millimetre():
     from gcalign.calibrate import flight_from_ideal, white_noise
     from gcalign.nav.navigate import position_error_enu
 
-    raw = _raw(None)
+    raw = _raw()
     clean = flight_from_ideal(raw.truth, raw.imu, np.zeros(21), white_noise(0.0, 0.0),
                               np.random.default_rng(0))
     fx = gnss(clean, np.random.default_rng(1), 0.373, (), (1e-9, 1e-9))

@@ -142,7 +142,8 @@ def test_mems_aided_by_the_fog_velocity(tmp_path):
 
 def test_aiding_file_refusals(tmp_path):
     """One line, exit 2, no file: a velocity file with no common time, one that does not
-    cover the alignment window, the file keys with another source."""
+    cover the alignment window, one with a gap inside it (accepted when max_gap_s says the
+    gap is harmless), the file keys with another source."""
     def run(*args):
         return runner.invoke(app, ["align", *map(str, args)])
 
@@ -156,10 +157,43 @@ def test_aiding_file_refusals(tmp_path):
     assert_bad_run(run, tmp_path, [_mems_scenario(tmp_path, MAT, {
         "source": "file", "path": short, "format": "velocity-enu"})], "align.aiding:",
         "covers 0.000 .. 49.000 s")
+    # a gap of 20 s in a 1 Hz file inside the window: no velocity drawn across it
+    t = np.concatenate([np.arange(0.0, 40.0), np.arange(60.0, 101.0)])
+    gap = _write(tmp_path / "gap.csv", "t,ve,vn,vu", t, [np.zeros(len(t))] * 3)
+    assert_bad_run(run, tmp_path, [_mems_scenario(tmp_path, MAT, {
+        "source": "file", "path": gap, "format": "velocity-enu"})], "align.aiding:",
+        "no epoch for 21.000 s after 39.000 s", "longer than max_gap_s 2 s")
+    res = runner.invoke(app, ["align", _mems_scenario(tmp_path, MAT, {
+        "source": "file", "path": gap, "format": "velocity-enu", "max_gap_s": 30}),
+        "-o", str(tmp_path / "gap.h5")])
+    assert res.exit_code == 0, res.output  # a gap the user says is harmless
     assert_bad_run(run, tmp_path, [_mems_scenario(tmp_path, MAT, {
         "source": "none", "path": short})], "path", "applies to source 'file' only")
     assert_bad_run(run, tmp_path, [_mems_scenario(tmp_path, MAT, {
         "source": "file", "path": short})], "format", "missing")
+
+
+def test_no_error_against_a_reference_across_its_gap(tmp_path):
+    """A reference with 12 s cut out inside the alignment: refused naming the gap (an error
+    against a line drawn across it is not a measurement); reference.max_gap_s accepts it."""
+    m = scipy.io.loadmat(MAT)
+    fog = m["fogavp"]
+    keep = (fog[:, 9] < 50.0) | (fog[:, 9] > 62.0)
+    cut = tmp_path / "cut.mat"
+    scipy.io.savemat(cut, {"fogavp": fog[keep]})
+    sc = yaml.safe_load(open(_mems_scenario(tmp_path, MAT, {"source": "none"})))
+    sc["reference"] = {"path": str(cut), "format": "psins-mat"}
+    path = tmp_path / "ref.yaml"
+    path.write_text(yaml.safe_dump(sc))
+
+    def run(*args):
+        return runner.invoke(app, ["align", *map(str, args)])
+
+    assert_bad_run(run, tmp_path, [path], "reference:", "no epoch for 12.100 s after 49.900 s",
+                   "reference.max_gap_s")
+    sc["reference"]["max_gap_s"] = 20
+    path.write_text(yaml.safe_dump(sc))
+    assert run(path, "-o", tmp_path / "ok.h5").exit_code == 0
 
 
 def test_align_errors_against_the_reference(tmp_path):

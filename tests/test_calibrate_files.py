@@ -77,8 +77,8 @@ def _velocity_csv(path, fog: np.ndarray) -> str:
 def _scenario(tmp_path, files: dict, **calibrate) -> str:
     sc = {"name": "mems-files", "imu_file": str(MAT), "reference": {"path": str(MAT)},
           "calibrate": {"aiding": "file", "files": files, "measure": "both",
-                        "sigma_v_mps": 0.1, "sigma_p_m": 0.5,
-                        "coarse": {"method": "inertial", "duration_s": 1}, "start_s": 0.11,
+                        "sigma_v_mps": 0.1,
+                        "start_s": 1.01,  # data time 1.00 s (sample 0 is -0.01 s)
                         "gnss_noise": False, "filter_rate_hz": 10, "p0_scale": 1,
                         "p0": MEMS_P0, "q": {"arw_dprh": 0.5, "vrw_ugrhz": 300}, **calibrate}}
     path = tmp_path / "cal.yaml"
@@ -102,12 +102,13 @@ def test_mems_gyro_biases_from_the_fog_solution(tmp_path):
     assert res.exit_code == 0, res.output
     s = json.loads(res.stdout.strip().splitlines()[-1])
     assert s["aiding"] == "file"
-    # the seed's filter measures horizontal velocity and position only (seed eqs. 5-7): the
-    # height is unaided, and R (0.1 m/s, 0.5 m) is wider than the FOG solution's noise; the
-    # health checks say both, nothing else warns (the vehicle is not taken as parked)
-    assert len(s["warnings"]) == 3, s["warnings"]
+    # files are measured in 3-D (velocity with its vertical, position with its height):
+    # nothing grows unheld; R (0.1 m/s, the CSV's 0.1 m, 0.2 m up) is wider than the FOG
+    # solution's noise: the health check says so, nothing else warns (the vehicle is not
+    # taken as parked)
+    assert s["components"] == "3d"
+    assert len(s["warnings"]) == 1, s["warnings"]
     assert "below its 95 % band" in s["warnings"][0]
-    assert s["warnings"][1].startswith("dvU: σ") and s["warnings"][2].startswith("dh: σ")
     est = {k: (v["estimate"], v["sigma"]) for k, v in s["states"].items()}
     eb = np.array([est[k][0] for k in ("ebx", "eby", "ebz")])
     sb = np.array([est[k][1] for k in ("ebx", "eby", "ebz")])
@@ -186,12 +187,20 @@ def test_calibrate_files_refusals(tmp_path):
         (tmp_path / "cal.yaml").write_text(text)
         assert_bad_run(run, tmp_path, [tmp_path / "cal.yaml"],
                        f"calibrate.files.{key}.lever_arm_m", why)
-    # a file that ends before the run does (the FOG's positions to 60 s only)
+    # a file that ends before the run does (the FOG's positions to 60 s only): the run goes
+    # on unaided to the end and says so; the rest is an outage in the JSON
     short = {"path": _gnss_csv(tmp_path / "short.csv", fog[fog[:, 9] < 60.05]),
              "format": "csv"}
-    assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel, "position": short})],
-                   "calibrate.files.position:", "covers 0.100 .. 60.000 s", "the run needs",
-                   "move calibrate.start_s or set calibrate.duration_s")
+    res = runner.invoke(app, ["calibrate", _scenario(tmp_path, {"velocity": vel,
+                                                                 "position": short}),
+                              "-o", str(tmp_path / "short.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout.strip().splitlines()[-1])
+    assert any("short.csv ends at 60.000 s, 40.0 s before the end of the run: the rest ran "
+               "unaided" in w for w in s["warnings"]), s["warnings"]
+    last = s["fixes"]["outages"][-1]
+    assert last["start_data_s"] == pytest.approx(60.0) and last["end_data_s"] == \
+        pytest.approx(100.0, abs=0.011)
     assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel}, measure="velocity",
                                              gnss_noise=True)], "calibrate.gnss_noise")
     assert_bad_run(run, tmp_path, [_scenario(tmp_path, {"velocity": vel}, measure="velocity",
@@ -211,11 +220,11 @@ def test_validate_shows_the_files(tmp_path):
 
 
 def _one_hz(tmp_path, files: dict, measure: str, **calibrate) -> str:
-    """The 1 Hz GNSS-like runs: filter epochs on the FOG's whole seconds (start at data
-    time 1.00 s: sample 11 is 0.10 s, the coarse window 0.9 s), σ of the fixtures."""
+    """The 1 Hz GNSS-like runs: the start (from the reference) at data time 1.00 s, fixes
+    on the FOG's whole seconds, σ of the fixtures, horizontal as the seed measures (as
+    docs/results_transfer.md tabulates them)."""
     return _scenario(tmp_path, files, measure=measure, filter_rate_hz=1, sigma_p_m=SIGMA_P_M,
-                     sigma_v_mps=SIGMA_V_MPS, coarse={"method": "inertial", "duration_s": 0.9},
-                     **calibrate)
+                     sigma_v_mps=SIGMA_V_MPS, **({"components": "horizontal"} | calibrate))
 
 
 def test_lever_arms_reach_the_filter_and_the_start(tmp_path):
@@ -235,7 +244,7 @@ def test_lever_arms_reach_the_filter_and_the_start(tmp_path):
                          "lever_arm_m": l_p}}
     a = recorded_case(load_scenario(_one_hz(tmp_path, gnss, "both"))[0])
     d = a.data
-    assert d.lever_arm_v_b.tolist() == l_v and d.lever_arm_p_b.tolist() == l_p
+    assert d.fixes.lever_arm_v_b.tolist() == l_v and d.fixes.lever_arm_p_b.tolist() == l_p
     k = np.argmin(np.abs(fog[:, 9] - 1.0))  # the start: the FOG at 1.0 s
     C = euler_to_dcm(fog[k, :3])
     assert d.t[0] + a.t0 == pytest.approx(1.0)
@@ -250,12 +259,13 @@ def test_lever_arms_reach_the_filter_and_the_start(tmp_path):
     v_ant = C @ np.cross(w, l_v) - np.cross(w_ie, C @ l_v)
     np.testing.assert_allclose(d.start.v_n, fog[k, 3:6] - v_ant, atol=1e-9)
 
-    mat = {"position": {"path": str(MAT), "format": "psins-mat"}}
+    mat = {"position": {"path": str(MAT), "format": "psins-mat", "interval_s": 1.0}}
     b = recorded_case(load_scenario(_one_hz(tmp_path, mat, "position"))[0]).data
-    epochs = np.arange(0, len(b.t), 100)  # 100 Hz navigation, 1 Hz filter
-    assert np.abs(b.t[epochs] + a.t0 - np.round(b.t[epochs] + a.t0)).max() < 1e-6
-    np.testing.assert_allclose(b.ref_pos[epochs, :2], d.ref_pos[epochs, :2], rtol=0, atol=1e-12)
-    np.testing.assert_allclose(b.ref_pos[epochs, 2], d.ref_pos[epochs, 2], rtol=0, atol=1e-8)
+    # the MAT file's 10 Hz solution on its whole seconds: the 1 Hz fixes written from it
+    assert b.fixes.t.tolist() == pytest.approx(d.fixes.t.tolist(), abs=1e-9)
+    np.testing.assert_allclose(b.fixes.pos[:, :2], d.fixes.pos[:, :2], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(b.fixes.pos[:, 2], d.fixes.pos[:, 2], rtol=0, atol=1e-8)
+    assert np.abs(b.fixes.t + a.t0 - np.round(b.fixes.t + a.t0)).max() < 1e-6
 
 
 def test_smoother_on_a_recording(tmp_path):
@@ -276,7 +286,7 @@ def test_smoother_on_a_recording(tmp_path):
         g = f["calibrate/runs/00"]
         est, sig = g["estimate"][()], g["sigma"][()]
         s_est, s_sig = g["smoothed/estimate"][()], g["smoothed/sigma"][()]
-    assert len(sig) == 30  # the start (data time 1 s) and 29 updates, 2 ... 30 s
+    assert len(sig) == 31  # the start (data time 1 s) and 30 updates, 2 ... 31 s
     assert np.all(s_sig <= sig * (1 + 1e-9))
     np.testing.assert_allclose(s_sig[-1], sig[-1], rtol=1e-12)
     np.testing.assert_allclose(s_est[-1], est[-1], rtol=1e-12, atol=0)

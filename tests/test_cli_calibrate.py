@@ -337,10 +337,28 @@ def test_bad_options_exit_2(tmp_path, args, field):
     _bad(tmp_path, args, field)
 
 
-def test_recorded_data_need_a_coarse_alignment(tmp_path):
+def test_recorded_data_start_where_the_user_says(tmp_path):
+    """Without a coarse alignment the start is the user's: a recording whose file has no
+    header, with no initial keys and no reference, is refused naming the ways to give one;
+    PSINS's header gives one (said in the JSON); a coarse alignment beside initial keys
+    cannot matter and is refused."""
+    mat = {"name": "rec", "imu_file": str(ROOT / "tests/data/transfer_align_fog_mems.mat"),
+           "site": {"lat_deg": 34.0, "lon_deg": 108.0},
+           "calibrate": {"coarse": {"method": "none"}}}
+    _bad(tmp_path, [_write(tmp_path, mat)], "initial:", "gives no initial attitude",
+         "initial: {att_deg")
     d = {"name": "rec", "imu_file": str(ROOT / "tests/data/lasergyro.imu.xz"),
-         "calibrate": {"coarse": {"method": "none"}}}
-    _bad(tmp_path, [_write(tmp_path, d)], "calibrate.coarse.method", "analytic or inertial")
+         "calibrate": {"duration_s": 30}}
+    res = runner.invoke(app, ["calibrate", str(_write(tmp_path, d)), "-o",
+                              str(tmp_path / "h.h5"), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout.strip().splitlines()[-1])
+    assert s["start"]["source"] == "the file's header"
+    assert s["coarse_attitude_deg"][2] == pytest.approx(-90.6, abs=0.01)  # the header's yaw
+    both = dict(d, initial={"att_deg": [0, 0, -90]},
+                calibrate={"coarse": {"method": "inertial"}})
+    _bad(tmp_path, [_write(tmp_path, both)], "calibrate.coarse.method", "cannot matter",
+         "the start comes from initial")
 
 
 def test_compare_needs_more_segments_than_the_conventional_take_off(tmp_path):

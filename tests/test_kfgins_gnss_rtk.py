@@ -58,3 +58,27 @@ def test_the_files_span_spacing_and_sigma_ranges(rows):
     east = np.ptp(lon) * 6.4e6 * np.cos(lat.mean())
     assert 1.2e3 < north < 1.3e3 and 1.0e3 < east < 1.2e3
     assert (round(h.min(), 3), round(h.max(), 3)) == (18.657, 35.359)
+
+
+def test_the_filter_takes_each_fixs_sigma_as_its_R(rows):
+    """As calibrate's aiding (``files.position``), every epoch becomes a fix at its own
+    time with R = diag(σN², σE², σD²) of its own row: the filter's noise of fix j is the
+    file's row j (north, east, up), not one σ for all."""
+    from gcalign.app.calibration_files import aiding_input
+    from gcalign.calibrate.filter import Settings, _fix_noise
+    from gcalign.io.scenario.calibrate import CalibrateConfig
+
+    cfg = CalibrateConfig.model_validate({
+        "aiding": "file", "measure": "position",
+        "files": {"position": {"path": str(GNSS_RTK_XZ), "format": "i2nav-gnss"}}})
+    t0 = float(rows[0, 0]) - 1.0
+    t_run = np.arange(0.0, float(rows[-1, 0] - t0) + 1.0, 0.01)
+    aid = aiding_input(cfg, t0, t_run)
+    assert len(aid.fixes) == len(rows) and aid.info["sigma"] == "the file's, per fix"
+    np.testing.assert_allclose(aid.fixes.t + t0, rows[:, 0], rtol=0, atol=1e-6)
+    s = Settings(measure="position", components="3d", gnss_noise=False)
+    R_fixed = np.eye(3)
+    for j in (0, 1000, len(rows) - 1):
+        R = _fix_noise(s, aid.fixes, j, R_fixed)
+        np.testing.assert_array_equal(np.sqrt(np.diag(R)), rows[j, [4, 5, 6]])  # N, E, D
+    assert aid.outages == () and aid.info["max_gap_s"] == 2.0

@@ -199,3 +199,27 @@ def test_command_route_is_the_arrays_route(tmp_path, mems):
     e = position_error_enu(nav.final.pos[None], reference_at(ref, [100.0])[2])[0]
     assert s["vertical"] == "free"
     np.testing.assert_allclose(s["final_error"]["position_m"], e, atol=1e-6)
+
+
+def test_no_error_inside_a_gap_of_the_reference(tmp_path):
+    """A reference with 12 s cut out: the stored errors are NaN inside the gap (not a line
+    drawn across it), the maxima come from the compared samples only, and outside the gap
+    every error is the full reference's."""
+    m = scipy.io.loadmat(MAT)
+    fog = m["fogavp"]
+    cut = tmp_path / "cut.mat"
+    scipy.io.savemat(cut, {"fogavp": fog[(fog[:, 9] < 50.0) | (fog[:, 9] > 62.0)]})
+    full = run(MAT, "--reference", MAT, "--start", START, "-o", tmp_path / "full.h5", "--json")
+    gap = run(MAT, "--reference", cut, "--start", START, "-o", tmp_path / "gap.h5", "--json")
+    assert full.exit_code == 0 and gap.exit_code == 0, gap.output
+    with h5py.File(tmp_path / "full.h5") as f, h5py.File(tmp_path / "gap.h5") as g:
+        t = f["navigate/t"][()]
+        e_full, e_gap = f["navigate/error/pos"][()], g["navigate/error/pos"][()]
+    inside = (t > 49.9 + 1e-6) & (t < 62.0 - 1e-6)
+    assert np.isnan(e_gap[inside]).all() and np.isfinite(e_gap[~inside]).all()
+    np.testing.assert_allclose(e_gap[~inside & (np.abs(t - 56) > 7)],
+                               e_full[~inside & (np.abs(t - 56) > 7)], atol=1e-9)
+    s = json.loads(gap.stdout.strip().splitlines()[-1])
+    peak = s["max_error"]["position_m"]
+    assert np.isfinite(peak).all()
+    assert np.allclose(peak, np.nanmax(np.abs(e_gap), axis=0))

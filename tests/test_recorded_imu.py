@@ -369,3 +369,27 @@ def test_recording_too_short_names_the_times_not_the_motion(tmp_path):
     res = runner.invoke(app, ["align", "--imu-file", str(f), *SITE, "-o", str(out)])
     assert_bad_input(res, out, "align.t1_s", "past the end of the data (4.00 s)", "--t1")
     assert "motion.duration_s" not in res.output
+
+
+def test_block_parse_gives_the_line_by_line_rows(monkeypatch):
+    """A table parsed a block of lines at a time (without a list of its lines) gives the
+    rows of the line-by-line parse to the bit, across block edges, with a header, comments,
+    blank lines and CRLF; a bad field goes to the line-by-line parse and its message."""
+    from gcalign.io.imu_files import ImuFileError
+    from gcalign.io.recorded import imu as rec
+
+    rng = np.random.default_rng(3)
+    rows = rng.standard_normal((500, 7)) * [1e5, 1e-6, 1e-6, 1e-6, 1e-3, 1e-3, 1e-1]
+    lines = ["# a comment", "t gx gy gz ax ay az", ""]
+    for i, r in enumerate(rows):
+        lines.append(" ".join(repr(float(x)) for x in r) + ("  % tail" if i % 97 == 0 else ""))
+        if i % 131 == 0:
+            lines.append("")
+    data = "\r\n".join(lines).encode()
+    monkeypatch.setattr(rec, "_BLOCK_BYTES", 777)  # many blocks, cut inside lines
+    fast, (head, _) = rec._table_of("f.txt", data, 7, tuple("abcdefg"))
+    slow, (head2, _) = rec._table("f.txt", rec._text_lines("f.txt", data), 7, tuple("abcdefg"))
+    assert np.array_equal(fast, slow) and fast.shape == (500, 7) and head == head2
+    bad = data.replace(repr(float(rows[250, 3])).encode(), b"nan", 1)
+    with pytest.raises(ImuFileError, match=r"f\.txt:\d+: field 4 \(d\) must be finite"):
+        rec._table_of("f.txt", bad, 7, tuple("abcdefg"))

@@ -162,13 +162,15 @@ def _recorded(scenario: Scenario) -> RunData:
         site = scenario.site.to_si()
     elif imu.site is not None:
         site = np.asarray(imu.site, float)
+    elif scenario.initial is not None and (start := scenario.initial.position()) is not None:
+        site = start  # where the run starts
     elif scenario.reference is not None:  # where the reference solution starts
         site = np.asarray(scenario.reference.read().pos[0], float)
     else:
         raise ScenarioError(
             f"site: missing: {scenario.imu_file} does not give the site (a CSV file has no "
-            "header); give --lat/--lon/--height, a site section in the scenario, or a "
-            "reference (--reference)"
+            "header); give --lat/--lon/--height, a site section in the scenario, "
+            "initial: {lat_deg, lon_deg, height_m}, or a reference (--reference)"
         )
     return RunData(imu=imu, truth=truth, site=site, seed=None, earth=scenario.earth_model)
 

@@ -43,12 +43,19 @@ def default_output(path: Path, fmt: str) -> Path:
     return path.with_name(path.name.split(".")[0] + FORMATS[fmt])
 
 
-def default_group(path: Path) -> str:
+#: formats that hold a navigation solution (attitude, velocity, position): a calibration
+#: exports its solution at every navigation sample to them, its estimates to the others
+NAVIGATION_FORMATS = ("i2nav-nav", "psins-avp")
+
+
+def default_group(path: Path, fmt: str = "csv") -> str:
     """The group of the command that wrote the file (``navigate``, ``simulate``'s
     ``truth``, ...); where that group keeps its series in subgroups, the one holding the
     result: an alignment's last pass (``align/pass_05``: it ends at T2, whence T3), a
-    calibration's first run (``calibrate/runs/00``). :func:`gcalign.io.results.series`
-    says which groups hold series when there is none."""
+    calibration's first run (``calibrate/runs/00``: its estimates and σ), or to a
+    navigation format (:data:`NAVIGATION_FORMATS`) its solution at every navigation sample
+    (``calibrate/runs/00/navigation``). :func:`gcalign.io.results.series` says which groups
+    hold series when there is none."""
     from gcalign.app.checked import read_checked
 
     kind = read_checked(path)[0]
@@ -56,6 +63,9 @@ def default_group(path: Path) -> str:
     timed = results.timed_groups(path, group)
     if not timed or group in timed:
         return group
+    if kind == "calibrate" and fmt in NAVIGATION_FORMATS \
+            and "calibrate/runs/00/navigation" in timed:
+        return "calibrate/runs/00/navigation"
     return timed[-1] if kind == "align" else timed[0]
 
 
@@ -69,7 +79,7 @@ def export(path, fmt: str, out=None, group: str | None = None, week: int = 0,
     if fmt not in FORMATS:
         raise ScenarioError(f"--format: {fmt!r} is not an export format; allowed: "
                             f"{', '.join(FORMATS)}")
-    own = default_group(path)  # reads the file through its kind's checks (app.checked)
+    own = default_group(path, fmt)  # reads the file through its kind's checks (app.checked)
     if group is None and note is not None and "/" in own:
         others = [g for g in results.timed_groups(path, own.split("/")[0]) if g != own]
         note(f"exported /{own}" + (f"; --group for another: {', '.join(others)}"

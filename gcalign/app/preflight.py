@@ -42,11 +42,12 @@ def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
                 raise ScenarioError(f"imu_file: {sc.imu_file}: {not_a_file(sc.imu_file)}")
             return None
         ext = _recorded_extent(Path(sc.imu_file), sc.recording_layout())
-        if sc.site is None and ext.lat is None and sc.reference is None:
+        start_pos = sc.initial is not None and sc.initial.position() is not None
+        if sc.site is None and ext.lat is None and sc.reference is None and not start_pos:
             raise ScenarioError(
                 f"site: missing: {sc.imu_file} does not give the site (a CSV file has no "
-                "header); give --lat/--lon/--height, a site section in the scenario, or a "
-                "reference)")
+                "header); give --lat/--lon/--height, a site section in the scenario, "
+                "initial: {lat_deg, lon_deg, height_m}, or a reference)")
         return ext
     if sc.motion is None:
         return None

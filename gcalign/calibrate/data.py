@@ -235,10 +235,10 @@ def combine_increments(dtheta: np.ndarray, dv: np.ndarray,
     if n < 1:
         raise ValueError(f"subsamples: at least 1 IMU increment per navigation step, got {n}")
     k = len(dtheta) // n
+    if n == 1:  # the increments themselves (views: a long recording is not copied)
+        return np.asarray(dtheta, float)[:k], np.asarray(dv, float)[:k]
     w = np.asarray(dtheta, float)[: k * n].reshape(k, n, 3)
     v = np.asarray(dv, float)[: k * n].reshape(k, n, 3)
-    if n == 1:
-        return w[:, 0].copy(), v[:, 0].copy()
     q = np.zeros((k, 4))
     q[:, 0] = 1.0
     V = np.zeros((k, 3))

@@ -89,7 +89,7 @@ def _reference(aiding: Aiding, att, v_n, rng: np.random.Generator, body: bool,
 
 def collect(stream: Stream, tl: Timeline, aiding: Aiding,
             progress: Progress | None = None, reference=None,
-            keep: np.ndarray | None = None) -> Window:
+            keep: np.ndarray | None = None, ref_gap: float | None = None) -> Window:
     """One pass over the stream for the samples tl.lo .. tl.hi; the rest of the run is
     never held (nor, simulated, generated). `progress(done_s, total_s, what)` hears of
     every block (the simulation, if it is one, is most of an alignment's time). A
@@ -110,12 +110,13 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
         from gcalign.io.recorded.aiding import velocity_at
 
         t_samples = stream.t0 + np.arange(lo, hi + 1) * stream.ts
-        vref, _ = velocity_at(aiding.read(), t_samples, "align.aiding")
+        vref, _ = velocity_at(aiding.read(), t_samples, "align.aiding",
+                              max_gap=aiding.max_gap_s)
         source = "none"  # nothing more to take from the truth
     truth_att = np.empty((len(samples), 3)) if has_truth else None
     pos_t1 = stream.site.copy()
     if reference is not None and not has_truth:
-        truth_att = _reference_attitude(reference, stream, lo, hi, samples)
+        truth_att = _reference_attitude(reference, stream, lo, hi, samples, ref_gap)
 
     def take(k0: int, att, v_n, pos) -> None:
         """Truth rows of samples k0 .. k0+len-1: reference velocity, attitude, pos at T1."""
@@ -156,7 +157,7 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
 
 
 def _reference_attitude(reference, stream: Stream, lo: int, hi: int,
-                        samples: np.ndarray) -> np.ndarray:
+                        samples: np.ndarray, max_gap: float | None = None) -> np.ndarray:
     """The reference's attitude at record `samples` (slerp); ScenarioError naming
     align.start_s when it does not cover the samples lo .. hi the alignment reads."""
     from gcalign.io.recorded import reference_at
@@ -168,7 +169,25 @@ def _reference_attitude(reference, stream: Stream, lo: int, hi: int,
             f"reference: {reference.record.get('path', 'the reference')} covers {lo_t:.3f} .. "
             f"{hi_t:.3f} s, the alignment reads {t_lo:.3f} .. {t_hi:.3f} s (data time): "
             "move align.start_s or shorten align.t2_s / t3_s, or remove the reference")
+    _no_gap(reference, t_lo, t_hi, max_gap)
     return reference_at(reference, stream.t0 + samples * stream.ts, tol=1e-6)[0]
+
+
+def _no_gap(reference, t_lo: float, t_hi: float, max_gap: float | None) -> None:
+    """ScenarioError when the reference has a gap longer than `max_gap` (default twice its
+    median interval) inside [t_lo, t_hi]: an error against a line drawn across a gap is not
+    a measurement."""
+    from gcalign.io.recorded.reference import reference_gaps
+
+    inside = [g for g in reference_gaps(reference, max_gap) if g.end > t_lo and g.start < t_hi]
+    if inside:
+        g = inside[0]
+        raise ScenarioError(
+            f"reference: {reference.record.get('path', 'the reference')} has no epoch for "
+            f"{g.length:.3f} s after {g.start:.3f} s (data time), inside the alignment "
+            f"{t_lo:.3f} .. {t_hi:.3f} s: no error against it can be given there (move "
+            "align.start_s or shorten align.t2_s / t3_s, or set reference.max_gap_s if the "
+            "gap is harmless)")
 
 
 #: The share of the signal an excursion of the base may reach before the analytic coarse
@@ -258,7 +277,8 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
         tl = timeline(settings, ts, stream.samples)
         reference = sc.reference.read() if sc.reference is not None else None
         keep = truth_samples(settings, ts, stream.samples, stride)
-        data = collect(stream, tl, cfg.aiding, progress, reference, keep)
+        data = collect(stream, tl, cfg.aiding, progress, reference, keep,
+                       None if sc.reference is None else sc.reference.max_gap_s)
         if settings.coarse == "analytic":
             k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
             warnings += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],

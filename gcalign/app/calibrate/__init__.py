@@ -22,6 +22,7 @@ SIMULATION_DOUBLES = 24  #: per IMU sample of the noise-free simulation held (tr
 RECORDED_DOUBLES = 7  #: per sample of recorded data (t, increments)
 STEP_DOUBLES = 16  #: per navigation step of the flight data (increments, truth)
 EPOCH_DOUBLES = 100  #: per filter epoch: estimate, σ, truth, error, state, NIS, NEES
+ROW_DOUBLES = 23  #: per stored navigation row: t, t_run, att, v_n, pos and their errors
 SMOOTHER_DOUBLES = 2 * 21 * 21  #: per epoch kept for the smoother: P and Φ
 
 WARM_SCENARIO = {  # a tiny flight: every kernel of a calibration, in milliseconds
@@ -71,7 +72,8 @@ class Calibrate(Command):
     help = "In-flight calibration, 21-state Kalman filter (seed 002)."
     section = "calibrate"
     builtin = "seed002_designed.yaml"
-    options = Options(recorded=True, batch_metrics=("nees.final", "normalized_error"))
+    options = Options(recorded=True, streams=True,
+                      batch_metrics=("nees.final", "normalized_error"))
     layout = ("calibrate",)
     run = "gcalign.app.calibrate.run"
     table_of = "gcalign.app.calibrate.tables.calibrate_table"
@@ -91,8 +93,11 @@ class Calibrate(Command):
             nav * STEP_DOUBLES + epochs * per_epoch)
         work = (0.0 if recorded else n * SIMULATE_OPS) + nav * STRAPDOWN_OPS + (
             epochs * KALMAN_OPS * (2 if cfg.smoother else 1))
+        rows = nav / max(1, cfg.output_stride(1.0 / ext.ts / cfg.subsamples(1.0 / ext.ts))
+                         if ext is not None else 1)
         return Cost(samples=n, memory_bytes=memory * DOUBLE,
-                    output_bytes=epochs * EPOCH_DOUBLES * DOUBLE, work=work,
+                    output_bytes=(epochs * EPOCH_DOUBLES + rows * ROW_DOUBLES) * DOUBLE,
+                    work=work,
                     work_what="navigation steps and 21-state filter epochs",
                     memory_what="the simulation and the filter's epochs")
 

@@ -7,10 +7,18 @@ Layout::
                                       states (names), state_units, display_units,
                                       display_scale (SI -> display factors)
     /calibrate/segments        name (strings), t0, t1 (s)
+    /calibrate/outages         start, end, length (s, the run's time base; attribute t0: the
+                               recording's time of its 0), with aiding files
     /calibrate/runs/NN         attrs: label (designed | conventional | ""), measure
         t (K+1,) s; estimate, sigma, truth (K+1, 21) SI in the state order; nees (K+1,);
-        innovation, standardized (K, m); nis (K,); att, v_n, pos (K+1, 3) the corrected
-        INS solution; smoothed/estimate, smoothed/sigma (K+1, 21) with the RTS smoother
+        updated (K+1,) 1 where a measurement updated the filter; update_t (U,) those
+        epochs; innovation, standardized (U, m); nis (U,); sigma_z (U, m) the σ of R;
+        att, v_n, pos (K+1, 3) the corrected INS solution; smoothed/estimate,
+        smoothed/sigma (K+1, 21), smoothed/att, v_n, pos (K+1, 3) with the RTS smoother,
+        smoothed/error/t, att, v_n, pos its errors at the epochs compared;
+        navigation/ the solution at every navigation sample (or the output rate): t (the
+        recording's time), t_run, att, v_n, pos, and error/t, att, v_n, pos against the
+        truth or the reference where they are compared
 """
 
 from __future__ import annotations
@@ -40,7 +48,7 @@ def write_calibration(f: h5py.File, case, runs, compare: bool, against=None) -> 
     reference (:func:`gcalign.app.calibrate.run.reference_series`)."""
     d = case.data
     write_segments(f, case.truth(), d.segments)
-    g = f.create_group("calibrate")
+    g = f.require_group("calibrate")
     g.attrs["aiding"] = case.aiding
     g.attrs["navigation_rate_hz"] = case.navigation_rate
     g.attrs["filter_rate_hz"] = case.settings.filter_rate
@@ -55,9 +63,19 @@ def write_calibration(f: h5py.File, case, runs, compare: bool, against=None) -> 
                                              dtype=h5py.string_dtype()))
     put(seg, "t0", [s.start for s in d.segments], "s")
     put(seg, "t1", [s.end for s in d.segments], "s")
-    rg = g.create_group("runs")
+    if case.aid is not None:
+        og = g.create_group("outages")
+        og.attrs["t0"] = case.t0
+        og.attrs["max_gap_s"] = case.aid.info["max_gap_s"]
+        og.attrs["description"] = ("stretches without a fix longer than max_gap_s (s from the "
+                                   "run's sample 0; + t0: the recording's time)")
+        outs = case.aid.outages
+        put(og, "start", [o.start for o in outs], "s")
+        put(og, "end", [o.end for o in outs], "s")
+        put(og, "length", [o.length for o in outs], "s")
+    rg = g.require_group("runs")
     for i, run in enumerate(runs):
-        _write_run(rg.create_group(f"{i:02d}"), run)
+        _write_run(rg.require_group(f"{i:02d}"), run)
         e = None if against is None else against[i]
         if e is not None:
             ref = rg[f"{i:02d}"].create_group("reference_error")
@@ -84,10 +102,17 @@ def _write_run(g: h5py.Group, run) -> None:
         put(g, "nees", r.nees, "1", description="chi-square, 21 degrees of freedom")
     units = "m/s" if r.settings.measure == "velocity" else (
         "m" if r.settings.measure == "position" else "m/s, m/s, m, m")
+    if r.updated is not None:
+        put(g, "updated", r.updated.astype(np.int8), "1",
+            description="1: a measurement updated the filter at the epoch, 0: predict only")
+        put(g, "update_t", r.update_t, "s", description="the epochs with a measurement")
     put(g, "innovation", r.innovation, units, names=",".join(r.measure_names),
         description="z - H x-, z = INS - reference")
     put(g, "standardized", r.standardized, "1", description="L^-1 innovation, S = L L^T")
     put(g, "nis", r.nis, "1", description=f"chi-square, {r.standardized.shape[1]} dof")
+    if r.sigma_z is not None:
+        put(g, "sigma_z", r.sigma_z, units, names=",".join(r.measure_names),
+            description="the measurement sigma of each update (R = diag sigma^2)")
     put(g, "att", r.att, "rad", ATT_FRAME)
     put(g, "v_n", r.v_n, "m/s", "ENU")
     put(g, "pos", r.pos, "rad, rad, m", "[latitude, longitude, height]")
@@ -95,3 +120,15 @@ def _write_run(g: h5py.Group, run) -> None:
         s = g.create_group("smoothed")
         put(s, "estimate", r.smoothed.estimate, "SI", shape=STATE_SHAPE)
         put(s, "sigma", r.smoothed.sigma, "SI", shape=STATE_SHAPE)
+        put(s, "att", r.smoothed.att, "rad", ATT_FRAME, description="the smoothed solution")
+        put(s, "v_n", r.smoothed.v_n, "m/s", "ENU")
+        put(s, "pos", r.smoothed.pos, "rad, rad, m", "[latitude, longitude, height]")
+        e = (run.epoch_errors or {}).get("smoothed_series")
+        if e is not None:
+            se = s.create_group("error")
+            se.attrs["description"] = "the smoothed solution - the truth or the reference"
+            put(se, "t", e["t"], "s")
+            put(se, "att", e["attitude"], "rad", description="Euler differences, roll and "
+                "yaw wrapped: pitch, roll, yaw")
+            put(se, "v_n", e["velocity"], "m/s", "ENU")
+            put(se, "pos", e["position"], "m", "ENU")

@@ -8,7 +8,10 @@
 * ``sigma`` -- σ/σ0 of the twelve sensor errors, log scale (they span decades);
 * ``navigation_errors`` -- φ, δv of the corrected INS (estimate − truth) with ±3σ;
 * ``innovations`` -- standardized innovations with ±3, NEES with its χ²₂₁ band, NIS;
-* ``attitude`` -- recorded data (no truth): the INS attitude with ±3σ of φ.
+* ``attitude`` -- recorded data (no truth): the INS attitude with ±3σ of φ;
+* ``solution_errors`` -- the solution at every navigation sample against the truth or the
+  reference (position, velocity, attitude) with the filter's ±3σ, the smoothed solution at
+  the filter epochs, and the outages of the aiding shaded.
 """
 
 from __future__ import annotations
@@ -35,8 +38,18 @@ def read_runs(f) -> tuple[list[dict], dict]:
         r = g["runs"][key]
         run: dict = {"label": _s(r.attrs.get("label", "")), "measure": _s(r.attrs["measure"]),
                "measure_names": _s(r.attrs.get("measure_names", "")).split(",")}
-        for name in ("t", "estimate", "sigma", "truth", "nees", "standardized", "nis", "att"):
+        for name in ("t", "estimate", "sigma", "truth", "nees", "standardized", "nis", "att",
+                     "update_t"):
             run[name] = r[name][()] if name in r else None
+        if run["update_t"] is None:  # the seed's schedule: an update at every epoch but 0
+            run["update_t"] = run["t"][1:]
+        nav = r.get("navigation")
+        run["navigation"] = None if nav is None or "error" not in nav else {
+            k: nav["error"][k][()] for k in ("t", "att", "v_n", "pos")} | {
+            "t0": float(nav["t"][0] - nav["t_run"][0]) if len(nav["t"]) else 0.0}
+        sm = r.get("smoothed/error")
+        run["smoothed"] = None if sm is None else {k: sm[k][()] for k in
+                                                   ("t", "att", "v_n", "pos")}
         e = r.get("reference_error")
         run["reference_error"] = None if e is None else {k: e[k][()] for k in
                                                          ("t", "att", "v_n", "pos")}
@@ -44,7 +57,18 @@ def read_runs(f) -> tuple[list[dict], dict]:
     seg = g["segments"]
     attrs["segments"] = [(_s(n), float(a), float(b)) for n, a, b in
                          zip(seg["name"][()], seg["t0"][()], seg["t1"][()], strict=True)]
+    o = g.get("outages")
+    attrs["outages"] = [] if o is None else list(zip(o["start"][()].tolist(),
+                                                     o["end"][()].tolist(), strict=True))
     return runs, attrs
+
+
+def shade_outages(ax, outages, minutes: bool) -> None:
+    """Grey bands over the outages of the aiding (run time, s)."""
+    k = 60.0 if minutes else 1.0
+    for i, (a, b) in enumerate(outages):
+        ax.axvspan(a / k, b / k, color="0.5", alpha=0.18, linewidth=0,
+                   label="outage (no fix)" if i == 0 else "_outage")
 
 
 def _time_axis(t: np.ndarray) -> tuple[np.ndarray, str]:
@@ -169,7 +193,7 @@ def navigation_figure(run, attrs, title: str) -> Figure:
     return _finish(fig, axes, xlabel, title)
 
 
-def innovations_figure(run, title: str) -> Figure:
+def innovations_figure(run, title: str, outages=()) -> Figure:
     """Standardized innovations (each ~ N(0, 1)) with ±3, NEES with the χ²₂₁ 95 % band, NIS."""
     from scipy.stats import chi2
 
@@ -178,14 +202,17 @@ def innovations_figure(run, title: str) -> Figure:
     t = run["t"]
     tx, xlabel = _time_axis(t)
     z = run["standardized"]
+    tu = _time_axis(np.concatenate([t[:1], run["update_t"]]))[0][1:]  # the epochs with a fix
     for j, name in enumerate(run["measure_names"]):
-        axes[0].plot(tx[1:], z[:, j], ".", markersize=2, label=name)
+        axes[0].plot(tu, z[:, j], ".", markersize=2, label=name)
     for y in (-3, 3):
         axes[0].axhline(y, color="black", linewidth=0.7, linestyle="--", label="_3")
     axes[0].set_ylabel("standardized\ninnovation")
     m = z.shape[1]
     lo, hi = chi2.ppf([0.025, 0.975], m)
-    axes[1].semilogy(tx[1:], np.maximum(run["nis"], 1e-6), ".", markersize=2, label="NIS")
+    axes[1].semilogy(tu, np.maximum(run["nis"], 1e-6), ".", markersize=2, label="NIS")
+    for ax in axes:
+        shade_outages(ax, outages, xlabel.endswith("(min)"))
     axes[1].axhspan(lo, hi, color="tab:green", alpha=0.15, label=f"χ²({m}) 95 %")
     axes[1].set_ylabel("NIS")
     if has_nees:
@@ -229,6 +256,54 @@ def reference_figure(e: dict, title: str) -> Figure:
             ax.plot(tx, values[:, j], linewidth=0.9, label=n)
     return finish(fig, axes, xlabel, title, [f"attitude ({unit})", "velocity (m/s)",
                                               "position (m)"])
+
+
+def solution_figure(run, attrs, title: str) -> Figure:
+    """The solution at every navigation sample minus the truth or the reference: position
+    and velocity east, north, up and the attitude, with the filter's ±3σ at its epochs (φ
+    for the attitude), the smoothed solution at the epochs where there is one, and the
+    outages shaded."""
+    e = run["navigation"]
+    scale = np.asarray(attrs["display_scale"])
+    t_run = e["t"] - e["t0"]
+    tx, xlabel = _time_axis(t_run)
+    minutes = xlabel.endswith("(min)")
+    te = _time_axis(run["t"])[0] if not minutes else run["t"] / 60.0
+    unit = angle_unit(float(np.max(np.abs(e["att"]))))
+    k_att = 1.0 / ANGLE_UNITS[unit][0]
+    fig, axes = new_figure(3, 3, width=13.0, height=8.5, sharex=True)
+    sig_pos = run["sigma"][:, [7, 6, 8]] * scale[[7, 6, 8]]  # east, north, up in metres
+    sig_v = run["sigma"][:, 3:6]
+    sig_att = run["sigma"][:, 0:3] * k_att
+    rows = (("position", e["pos"], sig_pos, ("east", "north", "up"), "m"),
+            ("velocity", e["v_n"], sig_v, ("east", "north", "up"), "m/s"),
+            ("attitude", e["att"] * k_att, sig_att, ("pitch", "roll", "yaw"),
+             UNIT_WORD.get(unit, unit)))
+    sm = run.get("smoothed")
+    sm_rows = None if sm is None else (sm["pos"], sm["v_n"], sm["att"] * k_att)
+    ts = None if sm is None else (sm["t"] / 60.0 if minutes else sm["t"])
+    for r, (what, err, sig, labels, u) in enumerate(rows):
+        for c in range(3):
+            ax = axes[3 * r + c]
+            ax.plot(tx, err[:, c], color="black", linewidth=0.6, label="forward filter")
+            ax.fill_between(te, -3 * sig[:, c], 3 * sig[:, c], step="post", color="tab:blue",
+                            alpha=0.15, linewidth=0, label="±3σ (filter)")
+            if sm_rows is not None:
+                ax.plot(ts, sm_rows[r][:, c], color="tab:red", linewidth=1.0,
+                        label="smoothed (filter epochs)")
+            shade_outages(ax, attrs["outages"], minutes)
+            half = np.abs(err[:, c])
+            lim = 1.2 * float(max(np.percentile(half, 99.5), 3 * np.median(sig[:, c])))
+            ax.set_ylim(-lim, lim)
+            ax.set_title(f"{what} {labels[c]}", fontsize="medium")
+            if c == 0:
+                ax.set_ylabel(u)
+            ax.grid(True, alpha=0.3)
+    for ax in axes[6:]:
+        ax.set_xlabel(xlabel)
+    legend_below(fig, axes[0])
+    suptitle(fig, title)
+    return fig
 
 
 def enu_track(pos: np.ndarray) -> np.ndarray:
@@ -326,5 +401,11 @@ def figures(f, name: str) -> dict[str, Figure]:
             first["reference_error"], f"{name}: INS solution against the reference "
             f"(est − reference; {AIDED[first['measure']]} aiding)")
     figs["innovations"] = innovations_figure(
-        first, f"{name}: standardized innovations, NIS and NEES ({first['measure']})")
+        first, f"{name}: standardized innovations, NIS and NEES ({first['measure']})",
+        attrs["outages"])
+    if first["navigation"] is not None and len(first["navigation"]["t"]):
+        against = "truth" if first["truth"] is not None else "reference"
+        figs["solution_errors"] = solution_figure(
+            first, attrs, f"{name}: solution − {against} at every navigation sample "
+            f"({AIDED[first['measure']]} aiding)")
     return figs

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gcalign.app.calibration_files import AidingInput
 from gcalign.app.registry import Outcome
 from gcalign.calibrate import (
     CalibrationResult,
@@ -38,9 +39,11 @@ from gcalign.calibrate import (
 from gcalign.calibrate.filter import warm_up
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
+from gcalign.io.recorded.reference import Reference
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig
 from gcalign.nav.earth import EarthModel
+from gcalign.nav.rotation import quat_to_euler
 from gcalign.sim.motions import Truth
 
 MEASURES = ie.MEASUREMENTS
@@ -54,10 +57,14 @@ class Case:
     data : the filter's input. settings : the filter settings (SI). source : "simulated"
     or the recorded file. aiding : "dgnss" | "zero-velocity". subsamples : IMU increments
     per navigation step. imu_rate : Hz. seed : the run's seed (None for recorded data).
-    truth_source : "scenario" | "draw" | None. coarse_att : the coarse attitude (rad) of
-    recorded data. window : (start, coarse end, end), s from sample 0 as ``data.t``.
-    t0 : the recording's own time of sample 0 (s; 0 for a simulation): ``data.t + t0`` is
-    the time of the recording's files and reference.
+    truth_source : "scenario" | "draw" | None. coarse_att : the start attitude (rad) of
+    recorded data (a coarse alignment's, or the user's). window : (start, coarse end, end),
+    s from sample 0 as ``data.t``. t0 : the recording's own time of sample 0 (s; 0 for a
+    simulation): ``data.t + t0`` is the time of the recording's files and reference.
+    aid : the aiding files' fixes and what to report of them (``aiding: file``).
+    start_source : where the start state came from. output_stride : navigation steps per
+    stored row of the solution. reference : the scenario's reference solution, read once
+    (recorded data), or None.
     """
 
     data: FlightData
@@ -71,6 +78,10 @@ class Case:
     coarse_att: np.ndarray | None
     window: tuple[float, float, float]
     t0: float = 0.0
+    aid: AidingInput | None = None
+    start_source: str = ""
+    output_stride: int = 1
+    reference: Reference | None = None
 
     @property
     def navigation_rate(self) -> float:
@@ -114,7 +125,7 @@ def simulated_case(sc: Scenario, seed: int | None = None, cache_key: str | None 
     seed = sc.imu.seed if seed is None else seed
     earth, site = sc.earth_model, raw.site
     n = cfg.subsamples(sc.imu.rate_hz)
-    settings = cfg.settings(site, earth)
+    settings = cfg.settings(site, earth, sc=sc)
     x = injected_truth(sc, cfg, settings, site, earth, seed)
     data = flight_from_ideal(raw.truth, raw.imu, x, sc.imu.errors(), np.random.default_rng(seed),
                              motion_spans(sc.motion.to_motion(), float(raw.truth.t[-1])), n,
@@ -125,13 +136,17 @@ def simulated_case(sc: Scenario, seed: int | None = None, cache_key: str | None 
     if cfg.aiding_for(sc) == "zero-velocity":
         data = zero_velocity_aiding(data)
     return Case(data, settings, "simulated", cfg.aiding_for(sc), n, sc.imu.rate_hz, seed,
-                cfg.truth, None, window)
+                cfg.truth, None, window, output_stride=cfg.output_stride(sc.imu.rate_hz / n))
 
 
 def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
-    """Recorded data on a parked vehicle: coarse alignment over the start of the window,
-    then zero-velocity updates at the site to the end of the window."""
+    """Recorded data: a coarse alignment over the start of the window when
+    ``calibrate.coarse.method`` asks for one, then the filter to the end of the window,
+    aided by the files at their own epochs (``aiding: file``) or by zero velocity at the
+    site. Without a coarse alignment the start is the user's (``initial``, the reference,
+    the file's header: :func:`gcalign.app.calibration_files.start_state`)."""
     from gcalign.align import coarse as coarse_mod
+    from gcalign.app.calibration_files import file_data, start_state
     from gcalign.app.data import scenario_data
 
     cfg = cfg or config_of(sc)
@@ -143,28 +158,37 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
     cfg.steps_per_update(rate)
     start, coarse_end, end = cfg.window(len(imu) * ts, ts)
     i0, i1, i2 = (int(round(t / ts)) for t in (start, coarse_end, end))
-    dth, dv = imu.dtheta[i0:i1], imu.dv[i0:i1]
-    try:
-        if cfg.coarse.method == "analytic":
-            att = coarse_mod.analytic_coarse(dth, dv, ts, site[0], earth)
-        else:
-            att = coarse_mod.inertial_frame_coarse(dth, dv, ts, site[0], site[1], site[2],
-                                                   earth=earth)
-    except ValueError as err:
-        raise ScenarioError(f"calibrate.coarse.duration_s: {err}") from None
+    att = None
+    if cfg.coarse.method != "none":
+        dth, dv = imu.dtheta[i0:i1], imu.dv[i0:i1]
+        try:
+            if cfg.coarse.method == "analytic":
+                att = coarse_mod.analytic_coarse(dth, dv, ts, site[0], earth)
+            else:
+                att = coarse_mod.inertial_frame_coarse(dth, dv, ts, site[0], site[1], site[2],
+                                                       earth=earth)
+        except ValueError as err:
+            raise ScenarioError(f"calibrate.coarse.duration_s: {err}") from None
     aiding = cfg.aiding_for(sc)
+    reference = sc.reference.read() if sc.reference is not None else None  # read once
     t0 = float(imu.t[0] - ts)  # the recording's time of sample 0
-    if aiding == "file":  # measured velocity / position (gcalign.app.calibration_files)
-        from gcalign.app.calibration_files import file_data
-
-        dth, dv = combine_increments(imu.dtheta[i1:i2], imu.dv[i1:i2], n)
-        t = coarse_end + np.arange(len(dth) + 1) * n * ts
-        data, att, _ = file_data(sc, cfg, t, dth, dv, att, site, earth, t0, imu.att0)
+    dth, dv = combine_increments(imu.dtheta[i1:i2], imu.dv[i1:i2], n)
+    t = coarse_end + np.arange(len(dth) + 1) * n * ts
+    aid, source = None, "the coarse alignment (a parked start)"
+    if aiding == "file":  # measured velocity / position at their epochs
+        data, aid, source = file_data(sc, cfg, t, dth, dv, site, earth, t0, att, imu,
+                                      reference)
     else:
+        if att is None:
+            state, source = start_state(sc, cfg, float(t[0]), t0, site, earth,
+                                        dth[0] / (n * ts), header=imu, reference=reference)
+            att = quat_to_euler(state.q_nb)
         data = parked_data(imu.dtheta[i1:i2], imu.dv[i1:i2], ts, att, site, t0=coarse_end,
                            subsamples=n, earth=earth)
-    return Case(data, cfg.settings(site, earth), imu.source, aiding, n, rate, None,
-                None, att, (start, coarse_end, end), t0)
+    start_att = att if att is not None else quat_to_euler(data.start.q_nb)
+    return Case(data, cfg.settings(site, earth, sc=sc), imu.source, aiding, n, rate, None,
+                None, start_att, (start, coarse_end, end), t0, aid, source,
+                cfg.output_stride(rate / n), reference)
 
 
 def scenario_case(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Case:
@@ -175,42 +199,100 @@ def scenario_case(sc: Scenario, seed: int | None = None, cache_key: str | None =
 
 @dataclass(frozen=True)
 class Run:
-    """One filter run on a case: its label, the result, and its compute time (s)."""
+    """One filter run on a case: its label, the result, its compute time (s) and the
+    statistics of its solution's errors at every navigation sample (None without truth or
+    reference)."""
 
     label: str
     data: FlightData
     result: CalibrationResult
     compute_s: float
+    errors: dict | None = None
+    epoch_errors: dict | None = None
+
+
+def solution_errors(sc: Scenario, case: Case, data: FlightData):
+    """What the solution is compared with: the simulation's truth, else the scenario's
+    reference (its gaps left out), else nothing (:class:`gcalign.app.calibrate.solution.
+    Errors`)."""
+    from gcalign.app.calibrate.solution import Errors
+    from gcalign.io.recorded.reference import reference_gaps
+
+    if data.truth is not None:
+        return Errors(data.earth, truth=data.truth)
+    ref = case.reference
+    if ref is None or sc.reference is None:
+        return Errors(data.earth)
+    return Errors(data.earth, reference=ref, ref_gaps=reference_gaps(ref, sc.reference.max_gap_s))
 
 
 def run_filter(case: Case, measure: str | None = None, data: FlightData | None = None,
-               label: str = "") -> Run:
-    """The calibration filter on the case's data (or `data`, a part of it)."""
+               label: str = "", group=None, errors=None) -> Run:
+    """The calibration filter on the case's data (or `data`, a part of it). With `group`
+    (an h5py group) the solution at the output rate goes into it as the run goes; with
+    `errors` (:class:`gcalign.app.calibrate.solution.Errors`) its errors at every sample
+    are summed inside and outside the outages."""
     from dataclasses import replace
+
+    from gcalign.app.calibrate.solution import SolutionSink
 
     s = case.settings if measure is None else replace(case.settings, measure=measure)
     data = case.data if data is None else data
     rng = np.random.default_rng([0 if case.seed is None else case.seed, 3])
+    sink = None
+    if group is not None or errors is not None:
+        from gcalign.app.calibrate.solution import Errors
+
+        outages = () if case.aid is None else case.aid.outages
+        origin = "" if case.aid is None else case.aid.info["time_origin"]
+        sink = SolutionSink(group, case.output_stride, case.t0, errors or Errors(data.earth),
+                            outages, case.navigation_rate, origin)
     warm_up()
     t0 = time.perf_counter()
-    result = calibrate(data, s, rng)
-    return Run(label, data, result, time.perf_counter() - t0)
+    result = calibrate(data, s, rng, on_rows=sink)
+    compute = time.perf_counter() - t0
+    stats = None if sink is None else sink.close()
+    at_epochs = None
+    if errors is not None and errors.against is not None:
+        at_epochs = _epoch_errors(case, result, errors)
+    return Run(label, data, result, compute, stats, at_epochs)
 
 
-def compare_runs(case: Case, segments: int, progress: Progress | None = None) -> list[Run]:
+def _epoch_errors(case: Case, r: CalibrationResult, errors) -> dict:
+    """The forward filter's and (with it) the smoother's solutions at the filter epochs
+    against the truth or the reference, inside and outside the outages (the smoothed
+    errors themselves under ``smoothed_series``, for the file)."""
+    from gcalign.app.calibrate.solution import epoch_errors
+
+    assert r.index is not None
+    outages = () if case.aid is None else case.aid.outages
+    out: dict = {"forward": epoch_errors(errors, r.t, case.t0, r.index, r.att, r.v_n, r.pos,
+                                         outages)[0]}
+    if r.smoothed is not None:
+        sm = r.smoothed
+        out["smoothed"], out["smoothed_series"] = epoch_errors(
+            errors, r.t, case.t0, r.index, sm.att, sm.v_n, sm.pos, outages)
+    return out
+
+
+def compare_runs(case: Case, segments: int, progress: Progress | None = None,
+                 group_of=None, errors_of=None) -> list[Run]:
     """The seed's Table 3: velocity, position and both on the whole flight ("designed")
     and on its first `segments` segments ("conventional"), on the same data and noise;
-    `progress(done, total, what)` hears of each of the six filter runs."""
+    `progress(done, total, what)` hears of each of the six filter runs; `group_of(i)` and
+    `errors_of(data)` give run i's solution group and what its errors are taken against."""
     spans = case.data.segments
     if case.data.truth is None or len(spans) <= segments:
         raise ScenarioError(f"calibrate.conventional_segments: --compare needs a simulated "
                             f"flight with more than {segments} segments (the conventional "
                             f"take-off is its first {segments}); this one has {len(spans)}")
     short = case.data.between(float(case.data.t[0]), spans[segments - 1].end)
-    runs = []
+    runs: list[Run] = []
     for label, data in (("designed", case.data), ("conventional", short)):
         for measure in MEASURES:
-            runs.append(run_filter(case, measure, data, label))
+            runs.append(run_filter(case, measure, data, label,
+                                   None if group_of is None else group_of(len(runs)),
+                                   None if errors_of is None else errors_of(data)))
             if progress is not None:
                 progress(len(runs), 2 * len(MEASURES), "filter runs")
     return runs
@@ -263,6 +345,15 @@ def run_summary(run: Run) -> dict:
         "position_deg_m": [*np.degrees(r.pos[-1, :2]).tolist(), float(r.pos[-1, 2])],
         "compute_s": run.compute_s,
     }
+    if r.updated is not None and not r.updated[1:].all():
+        out["updates"] = int(r.updated.sum())
+        out["predict_only_epochs"] = int(len(r.t) - 1 - r.updated.sum())
+        out["fixes_unused"] = r.fixes_unused
+    if run.errors is not None:
+        out["solution_errors"] = run.errors
+    if run.epoch_errors is not None:
+        out["epoch_errors"] = {k: v for k, v in run.epoch_errors.items()
+                               if k != "smoothed_series"}
     if r.nees is not None:
         lo, hi = _chi2_band(ie.N_STATES)
         out["nees"] = {"final": float(r.nees[-1]), "mean": float(r.nees.mean()),
@@ -313,7 +404,16 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
         else np.degrees(case.coarse_att).tolist(),
         "aiding_files": aiding_files(config_of(sc)),
         "compare": compare,
+        "components": s.components,
+        "processes": processes_summary(config_of(sc)),
     }
+    if case.source != "simulated":
+        out["start"] = {"source": case.start_source, "t_s": float(d.t[0]),
+                        "t_data_s": float(d.t[0] + case.t0)}
+        out["time"] = {"t0_s": case.t0, "origin": "the recording's time base (t_data = t + "
+                       "t0)" if case.aid is None else case.aid.info["time_origin"]}
+    if case.aid is not None:
+        out["fixes"] = case.aid.info
     if compare:
         out["runs"] = [run_summary(r) | reference_errors(e)
                        for r, e in zip(runs, against, strict=True)]
@@ -321,6 +421,18 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
     else:
         out |= run_summary(runs[0]) | reference_errors(against[0])
     return out
+
+
+def processes_summary(cfg: CalibrateConfig) -> dict | None:
+    """The filter's sensor processes as the scenario gives them (user units), or None when
+    every sensor state is a random constant."""
+    keys = [k for k in ("gyro_bias_gm", "gyro_bias_rw_dphrh", "accel_bias_gm",
+                        "accel_bias_rw_ughrh", "gyro_scale_gm", "accel_scale_gm")
+            if getattr(cfg.q, k) is not None]
+    if not keys:
+        return None
+    return {k: getattr(cfg.q, k).model_dump() if hasattr(getattr(cfg.q, k), "model_dump")
+            else list(getattr(cfg.q, k)) for k in keys}
 
 
 def aiding_files(cfg: CalibrateConfig) -> dict | None:
@@ -333,22 +445,26 @@ def aiding_files(cfg: CalibrateConfig) -> dict | None:
             if f is not None}
 
 
-def reference_series(sc: Scenario, run: Run, t0: float = 0.0) -> dict[str, np.ndarray] | None:
+def reference_series(sc: Scenario, run: Run, t0: float = 0.0,
+                     reference: Reference | None = None) -> dict[str, np.ndarray] | None:
     """A recording's INS solution against the scenario's reference at every filter epoch
     the reference covers (SI): ``t`` (the run's epochs, s from sample 0), ``att`` (Euler
     differences est − reference, roll and yaw wrapped; the reference's attitude by slerp),
     ``v_n`` (ENU), ``pos`` (m ENU), the reference taken at the recording's time ``t + t0``
-    (:attr:`Case.t0`); None without a reference, with truth, or with no epoch inside it."""
+    (:attr:`Case.t0`), none inside the reference's gaps; None without a reference, with
+    truth, or with no epoch inside it."""
     r = run.result
     if sc.reference is None or r.truth is not None:
         return None
-    from gcalign.io.recorded.reference import reference_at
+    from gcalign.calibrate.fixes import inside as in_gaps
+    from gcalign.io.recorded.reference import reference_at, reference_gaps
     from gcalign.nav.navigate import position_error_enu
     from gcalign.nav.rotation import attitude_error
 
-    ref = sc.reference.read()
+    ref = reference if reference is not None else sc.reference.read()
     t_data = r.t + t0
     inside = (t_data >= ref.t[0] - 1e-6) & (t_data <= ref.t[-1] + 1e-6)
+    inside &= ~in_gaps(t_data, reference_gaps(ref, sc.reference.max_gap_s))  # not in its gaps
     if not inside.any():
         return None
     t = r.t[inside]
@@ -369,10 +485,11 @@ def reference_errors(e: dict[str, np.ndarray] | None) -> dict:
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            compare: bool = False, progress: Progress | None = None) -> Outcome:
+            compare: bool = False, progress: Progress | None = None, sink=None) -> Outcome:
     """Build the case, run the filter (or the six runs of `compare`), summarise; the
     Outcome's result is the :class:`~gcalign.calibrate.CalibrationResult` (with `compare`: the
-    six, in the summary's order)."""
+    six, in the summary's order). With `sink` (an open results file) each run's solution at
+    the output rate goes into ``/calibrate/runs/NN/navigation`` as it is computed."""
     from gcalign.app.calibrate.hdf5 import write_calibration
 
     if progress is not None:
@@ -380,18 +497,37 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     case = scenario_case(sc, seed, cache_key)
     if progress is not None and not compare:
         progress(0, 1, "filter run")
-    runs = (compare_runs(case, config_of(sc).conventional_segments, progress) if compare
-            else [run_filter(case)])
+
+    def group_of(i: int):
+        return None if sink is None else sink.require_group(f"calibrate/runs/{i:02d}/navigation")
+
+    def errors_of(data: FlightData):  # a batch run (no file) sums no solution errors
+        return None if sink is None and case.aid is None else solution_errors(sc, case, data)
+
+    runs = (compare_runs(case, config_of(sc).conventional_segments, progress, group_of,
+                         errors_of) if compare
+            else [run_filter(case, group=group_of(0), errors=errors_of(case.data))])
     if progress is not None and not compare:
         progress(1, 1, "filter run")
-    against = [reference_series(sc, r, case.t0) for r in runs]  # read and interpolated once
+    against = [reference_series(sc, r, case.t0, case.reference) for r in runs]
     out = summary(sc, case, runs, compare, against)
     from gcalign.app.at_rest import zero_velocity_warnings  # a moving recording under ZUPT
 
     result = tuple(r.result for r in runs) if compare else runs[0].result
-    warnings = (*zero_velocity_warnings(sc, case, out), *filter_warnings(runs, compare))
+    warnings = (*zero_velocity_warnings(sc, case, out), *filter_warnings(runs, compare),
+                *(() if case.aid is None else case.aid.warnings), *sigma_warnings(sc, case))
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare, against),
                    case.truth(), case.seed, warnings, result=result)
+
+
+def sigma_warnings(sc: Scenario, case: Case) -> tuple[str, ...]:
+    """``calibrate.sigma_p_m`` set while every fix has its own σ: it cannot matter."""
+    cfg = config_of(sc)
+    if case.aid is None or case.aid.fixes.sigma_pos is None or \
+            "sigma_p_m" not in cfg.model_fields_set:
+        return ()
+    return (f"calibrate.sigma_p_m: {cfg.sigma_p_m:g} m cannot matter: every fix of "
+            f"{case.aid.info['path']} has its own σ, which the filter uses",)
 
 
 def filter_warnings(runs: list[Run], compare: bool) -> tuple[str, ...]:

@@ -5,6 +5,7 @@ six runs of ``--compare`` (the seed's Table 3 analogue). Display units are the s
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 from rich import box
 from rich.table import Table
@@ -87,6 +88,7 @@ def run_table(s: dict) -> Table:
                  f"{att[2]:.4f}°" + (
                      f"; coarse {'  '.join(numbers(s['coarse_attitude_deg'], most=4))}°"
                      if s.get("coarse_attitude_deg") else ""))
+    notes += aided_notes(s)
     for key, f in (s.get("aiding_files") or {}).items():
         lever = f["lever_arm_m"]
         notes.append(f"{key} from {f['path'].rsplit('/', 1)[-1]} ({f['format']}), measured at "
@@ -115,6 +117,60 @@ def run_table(s: dict) -> Table:
     return _captioned(table, notes)
 
 
+
+
+def _outage_text(o: dict) -> str:
+    return f"{o['start_data_s']:.2f}–{o['end_data_s']:.2f} s ({o['length_s']:.1f} s)"
+
+
+def _errors_line(label: str, e: dict | None) -> str | None:
+    """One line of a solution's errors: horizontal and vertical position, velocity and
+    heading RMS / max."""
+    if e is None:
+        return None
+    pos_rms, pos_max = e["position_rms_m"], e["position_max_m"]
+    v_rms = math.sqrt(sum(x * x for x in e["velocity_rms_mps"]))
+    yaw = angle_text(math.radians(e["attitude_rms_deg"][2]))
+    return (f"  {label}: horizontal {e['horizontal_rms_m']:.3f} / {e['horizontal_max_m']:.3f} m,"
+            f" up {pos_rms[2]:.3f} / {pos_max[2]:.3f} m, velocity {v_rms:.3f} m/s, yaw {yaw}"
+            f" (RMS / max, {e['samples']} samples)")
+
+
+def aided_notes(s: dict) -> list[str]:
+    """What a run on aiding files adds: the fixes and their σ, the outages, where the start
+    came from, and the solution's errors inside and outside the outages."""
+    notes = []
+    start = s.get("start")
+    if start:
+        notes.append(f"start at {start['t_data_s']:.3f} s (the recording's time): "
+                     f"{start['source']}")
+    fx = s.get("fixes")
+    if fx:
+        sig = ("σ per fix " + "–".join(f"{x:.3g}" for x in fx["sigma_enu_range_m"]) + " m"
+               if fx["sigma_enu_range_m"] else fx["sigma"])
+        outs = fx["outages"]
+        notes.append(f"fixes: {fx['epochs']} of {Path(fx['path']).name} "
+                     f"({fx['first_s']:.2f}–{fx['last_s']:.2f} s, every "
+                     f"{fx['median_interval_s']:.3g} s), {sig}; {s['components']}; "
+                     f"{len(outs)} outage{'s' if len(outs) != 1 else ''} longer than "
+                     f"{fx['max_gap_s']:.3g} s" + (": " + ", ".join(
+                         _outage_text(o) for o in outs[:6]) + (" …" if len(outs) > 6 else "")
+                         if outs else ""))
+    e = s.get("solution_errors")
+    if e:
+        lines = [_errors_line("outside the outages", e["outside_outages"]),
+                 _errors_line("in the outages", e["in_outages"])]
+        sm = (s.get("epoch_errors") or {}).get("smoothed")
+        if sm:
+            lines.append(_errors_line("in the outages, smoothed (filter epochs)",
+                                      sm["in_outages"]))
+            fw = s["epoch_errors"]["forward"]["in_outages"]
+            lines.append(_errors_line("in the outages, forward (filter epochs)", fw))
+        shown = [x for x in lines if x is not None]
+        if shown:
+            notes.append(f"solution against the {e['against']} at every navigation sample:")
+            notes += shown
+    return notes
 
 
 def _tag(run: dict) -> str:

@@ -29,7 +29,7 @@ import numpy as np
 from gcalign.app.data import DataBlock, Stream, scenario_stream
 from gcalign.app.registry import Outcome
 from gcalign.errors import InputError, ScenarioError
-from gcalign.io.recorded.reference import Reference, initial_state, reference_at
+from gcalign.io.recorded.reference import Reference, initial_state, reference_at, reference_gaps
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.navigation import NavigationConfig
 from gcalign.nav.navigate import Navigation, NavRows, NavTruth, navigate_blocks
@@ -103,14 +103,22 @@ def reference_window(ref: Reference, stream: Stream, k_start: int, k_end: int) -
     return t_a, t_b
 
 
-def against_reference(blocks: Iterator[DataBlock], ref: Reference, t_a: float, t_b: float
-                      ) -> Iterator[DataBlock]:
+def against_reference(blocks: Iterator[DataBlock], ref: Reference, t_a: float, t_b: float,
+                      gaps: tuple = ()) -> Iterator[DataBlock]:
     """The blocks with the reference at their end times as their 'truth' (times outside
-    [t_a, t_b], which the navigation skips, take the nearest end)."""
+    [t_a, t_b], which the navigation skips, take the nearest end); NaN inside the
+    reference's `gaps` (:func:`gcalign.io.recorded.reference.reference_gaps`): no error
+    there, and none in the maxima."""
+    from gcalign.gaps import inside
+
     for b in blocks:
         if b.t[0] > t_b:
             return
         att, v, pos = reference_at(ref, np.clip(b.t, t_a, t_b), tol=1e-6)
+        hole = inside(b.t, gaps)
+        if hole.any():
+            att, v, pos = att.copy(), v.copy(), pos.copy()
+            att[hole] = v[hole] = pos[hole] = np.nan
         yield replace(b, truth=NavTruth(att, v, pos))  # type: ignore[arg-type]
 
 
@@ -135,7 +143,8 @@ def _as_dict(rows: NavRows) -> dict[str, np.ndarray]:
 
 def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
                     duration_s: float | None = None, sink=None, on_rows=None,
-                    progress=None, reference: Reference | None = None) -> dict:
+                    progress=None, reference: Reference | None = None,
+                    ref_gaps: tuple = ()) -> dict:
     """Navigate from `start` to the end of the data (or for `duration_s`) by
     :func:`gcalign.nav.navigate.navigate_blocks`, write every `stride`-th row to `sink` (an
     h5py group) and hand it to `on_rows` (called with the dict of arrays appended to the
@@ -151,7 +160,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
     blocks = stream.blocks()
     if reference is not None:
         t_a, t_b = reference_window(reference, stream, start.k, k_end)
-        blocks = against_reference(blocks, reference, t_a, t_b)
+        blocks = against_reference(blocks, reference, t_a, t_b, ref_gaps)
     has_truth = stream.truth0 is not None or reference is not None
     against = "reference" if reference is not None else "true"
     series = None
@@ -247,8 +256,10 @@ def _run(sc: Scenario, seed: int | None, init: str | Path | None, sink, on_rows,
         else:
             state, source = _recorded_start(sc, stream, k, ref, init == "header")
         start = Start(k, state, source)
+    gaps = () if ref is None or sc.reference is None else reference_gaps(
+        ref, sc.reference.max_gap_s)
     part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink, on_rows,
-                           progress, ref)
+                           progress, ref, gaps)
     return _summary(sc, stream, start, vertical, stride, part), stream, part["result"]
 
 
@@ -322,7 +333,9 @@ def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, str
     if part["peak"] is not None:
         scale = np.array([[math.degrees(1.0)], [1.0], [1.0], [math.degrees(1.0)]])
         names = ("attitude_deg", "velocity_mps", "position_m", "misalignment_deg")
-        out["final_error"] = dict(zip(names, (part["final_error"] * scale).tolist(), strict=True))
+        if np.isfinite(part["final_error"]).all():  # else the run ends in a reference gap
+            out["final_error"] = dict(zip(names, (part["final_error"] * scale).tolist(),
+                                          strict=True))
         out["max_error"] = dict(zip(names, (part["peak"] * scale).tolist(), strict=True))
         out["max_horizontal_error_m"] = part["max_horizontal_error"]
     return out

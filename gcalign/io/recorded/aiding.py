@@ -30,9 +30,10 @@ from datetime import datetime, timezone
 import numpy as np
 
 from gcalign.errors import ScenarioError
+from gcalign.gaps import default_max_gap
 from gcalign.io.imu_files import ImuFileError, read_bytes
 from gcalign.io.recorded.axes import _DIRECTIONS
-from gcalign.io.recorded.imu import _table, _text_lines
+from gcalign.io.recorded.imu import _table, _table_of, _text_lines
 from gcalign.io.recorded.rows import _check_rows, _columns, _finite
 from gcalign.units import DEG
 
@@ -92,7 +93,7 @@ def read_gnss(path, format: str = "i2nav-gnss", columns=None, lever_arm_b=(0.0, 
         t, lat, lon, h, s_enu, origin = _rtklib(name, data)
     else:
         cols = _GNSS_COLUMNS if format == "i2nav-gnss" else _columns(columns, _GNSS_COLUMNS)
-        rows, (_, where) = _table(name, _text_lines(name, data), len(cols), cols)
+        rows, (_, where) = _table_of(name, data, len(cols), cols)
         _finite(name, rows, cols, where)
         c = {k: rows[:, cols.index(k)] for k in _GNSS_COLUMNS}
         _check_rows(name, c["t"], where)
@@ -250,13 +251,14 @@ def read_velocity_aiding(path, format: str, columns=None, variable: str | None =
 
 
 def velocity_at(vel: Velocities, t, what: str = "aiding",
-                hint: str = "move align.start_s, shorten align.t2_s / t3_s"
-                ) -> tuple[np.ndarray, bool]:
+                hint: str = "move align.start_s, shorten align.t2_s / t3_s",
+                max_gap: float | None = None) -> tuple[np.ndarray, bool]:
     """The aiding velocity at times `t` (M,), linearly interpolated between its epochs:
     ``(v (M, 3), body)``, ENU m/s, or (``body`` True) the odometer's speed times its body
     axis. ScenarioError (one line) when the file shares no time with `t`
-    (:func:`overlap`) or does not cover all of it, naming both spans and, in `hint`, the
-    keys that move the run."""
+    (:func:`overlap`), does not cover all of it, or has a gap longer than `max_gap` (s;
+    default twice its median interval) inside it: no line is drawn across a gap, naming
+    both spans or the gap and, in `hint`, the keys that move the run."""
     t = np.asarray(t, dtype=float)
     name = vel.record.get("path", "the aiding file")
     overlap(vel.t, t, name, what)
@@ -267,6 +269,19 @@ def velocity_at(vel: Velocities, t, what: str = "aiding",
             f"{what}: {name} covers {lo:.3f} .. {hi:.3f} s, the run needs "
             f"{float(t[0]):.3f} .. {float(t[-1]):.3f} s (data time): every sample it aids "
             f"must lie inside the file ({hint})")
+    if len(vel.t) > 1:
+        gap = default_max_gap(vel.t) if max_gap is None else float(max_gap)
+        a = max(int(np.searchsorted(vel.t, t[0], side="right")) - 1, 0)
+        b = min(int(np.searchsorted(vel.t, t[-1], side="left")) + 1, len(vel.t))
+        span = vel.t[a:b]
+        d = np.diff(span)
+        if len(d) and d.max() > gap + tol:
+            k = int(np.argmax(d))
+            raise ScenarioError(
+                f"{what}: {name} has no epoch for {d[k]:.3f} s after {span[k]:.3f} s (data "
+                f"time), longer than max_gap_s {gap:g} s: the run would aid its samples "
+                f"there with a velocity drawn across the gap ({hint}, or set "
+                f"{what}.max_gap_s if the gap is harmless)")
     tq = np.clip(t, lo, hi)
     if vel.speed is not None:
         assert vel.axis_b is not None

@@ -29,15 +29,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gcalign.errors import ScenarioError
+from gcalign.gaps import Outage, default_max_gap, find_outages
 from gcalign.io.imu_files import ImuFileError, read_bytes
 from gcalign.io.recorded import mat
-from gcalign.io.recorded.imu import _table, _text_lines
+from gcalign.io.recorded.imu import _table_of
 from gcalign.io.recorded.rows import _check_rows, _columns, _finite
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
 from gcalign.units import DEG
 
-__all__ = ["Reference", "read_reference", "reference_at", "initial_state", "REFERENCE_FORMATS",
-           "reference_format_of"]
+__all__ = ["Reference", "read_reference", "reference_at", "reference_gaps",
+           "initial_state", "REFERENCE_FORMATS", "reference_format_of"]
 
 REFERENCE_FORMATS = ("psins-mat", "i2nav-nav", "csv")
 _CSV_COLUMNS = ("t", "pitch", "roll", "yaw", "ve", "vn", "vu", "lat", "lon", "h")
@@ -87,7 +88,7 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
         notes["variable"] = key
         origin = "seconds, the avp array's last column"
     elif format == "i2nav-nav":
-        rows, (_, where) = _table(name, _text_lines(name, data), 11, _NAV_LABELS)
+        rows, (_, where) = _table_of(name, data, 11, _NAV_LABELS)
         _finite(name, rows, _NAV_LABELS, where)
         t = rows[:, 1]
         att = np.column_stack([rows[:, 9], rows[:, 8], -rows[:, 10]]) * DEG  # yaw = -heading
@@ -97,7 +98,7 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
         notes["week"] = int(rows[0, 0])
     else:
         cols = _columns(columns, _CSV_COLUMNS)
-        rows, (_, where) = _table(name, _text_lines(name, data), len(cols), cols)
+        rows, (_, where) = _table_of(name, data, len(cols), cols)
         _finite(name, rows, cols, where)
         c = {k: rows[:, cols.index(k)] for k in _CSV_COLUMNS}
         t = c["t"]
@@ -149,6 +150,14 @@ def _covers(ref: Reference, t: np.ndarray, tol: float) -> None:
             "longer reference)")
 
 
+def reference_gaps(ref: Reference, max_gap: float | None = None) -> tuple[Outage, ...]:
+    """The stretches of a reference longer than `max_gap` (s; default twice its median
+    interval) without an epoch: no error is given against it there (an interpolation
+    across a gap is not a measurement)."""
+    gap = default_max_gap(ref.t) if max_gap is None else max_gap
+    return find_outages(ref.t, float(ref.t[0]), float(ref.t[-1]), gap)
+
+
 def reference_at(ref: Reference, t, tol: float = 1e-9) -> tuple[np.ndarray, np.ndarray,
                                                                  np.ndarray]:
     """``(att, v_n, pos)`` of `ref` at times `t` (M,): attitude by slerp of q_nb between
@@ -163,12 +172,17 @@ def reference_at(ref: Reference, t, tol: float = 1e-9) -> tuple[np.ndarray, np.n
                             "[att v lat lon h t] is needed here")
     _covers(ref, t, tol)
     tq = np.clip(t, ref.t[0], ref.t[-1])
-    slerp = Slerp(ref.t, Rotation.from_matrix(euler_to_dcm(ref.att)))
+    # only the epochs that bracket a query: each is interpolated between its two
+    # neighbours, so the rest cannot matter (and a long reference costs nothing more)
+    j = np.clip(np.searchsorted(ref.t, tq, side="right"), 1, len(ref.t) - 1)
+    rows = np.unique(np.concatenate([j - 1, j]))
+    rt, ratt = ref.t[rows], ref.att[rows]
+    slerp = Slerp(rt, Rotation.from_matrix(euler_to_dcm(ratt)))
     att = dcm_to_euler(slerp(tq).as_matrix())
-    v = np.column_stack([np.interp(tq, ref.t, ref.v_n[:, i]) for i in range(3)])
-    lon = np.unwrap(ref.pos[:, 1])
-    pos = np.column_stack([np.interp(tq, ref.t, ref.pos[:, 0]), np.interp(tq, ref.t, lon),
-                           np.interp(tq, ref.t, ref.pos[:, 2])])
+    v = np.column_stack([np.interp(tq, rt, ref.v_n[rows, i]) for i in range(3)])
+    lon = np.unwrap(ref.pos[rows, 1])
+    pos = np.column_stack([np.interp(tq, rt, ref.pos[rows, 0]), np.interp(tq, rt, lon),
+                           np.interp(tq, rt, ref.pos[rows, 2])])
     pos[:, 1] = (pos[:, 1] + np.pi) % (2 * np.pi) - np.pi
     return att, v, pos
 

@@ -87,11 +87,14 @@ class Aiding(Model):
     columns: list[str] | None = None
     variable: str | None = Field(None, description="psins-mat: the avp array to read")
     axis: str = Field("F", description="odometer: the body axis of its speed (F, B, R, L, U, D)")
+    max_gap_s: float | None = Field(None, gt=0, description="source file: epochs further "
+                                    "apart are a gap the window may not contain; default "
+                                    "twice the file's median interval")
 
     @model_validator(mode="after")
     def _file_keys(self):
-        keys = [k for k in ("path", "format", "columns", "variable") if getattr(self, k)
-                is not None]
+        keys = [k for k in ("path", "format", "columns", "variable", "max_gap_s")
+                if getattr(self, k) is not None]
         if self.source == "file":
             missing = [k for k in ("path", "format") if getattr(self, k) is None]
             if missing:

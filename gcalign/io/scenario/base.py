@@ -7,11 +7,21 @@ import typing
 from pathlib import PurePath
 from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 NonNegVec3 = Annotated[list[Annotated[float, Field(ge=0)]], Field(min_length=3, max_length=3)]
 PosVec3 = Annotated[list[Annotated[float, Field(gt=0)]], Field(min_length=3, max_length=3)]
+
+
+def three(x: Any) -> Any:
+    """One number stands for all three axes."""
+    if isinstance(x, (int, float)) and not isinstance(x, bool):
+        return [x, x, x]
+    return x
+
+
+Pos3 = Annotated[PosVec3, BeforeValidator(three)]  #: positive, one number or three
 
 
 def _takes_bool(annotation: Any) -> bool:

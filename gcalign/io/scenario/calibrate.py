@@ -8,7 +8,11 @@
       sigma_p_m: 1.0             # DGNSS position σ, metres north and east
       p0_scale: 10               # P0 = (p0_scale · listed σ)², the seed's "×10"
       # p0: {attitude_arcsec: [20, 20, 1800], velocity_enu_mps: 0.2, ...}  # the listed σ
-      q: {arw_dprh: 0.001, vrw_ugrhz: 10}   # the filter's white-noise densities (Q)
+      q: {arw_dprh: 0.001, vrw_ugrhz: 10}   # the filter's white-noise densities (Q), and
+                                 # the sensor states' processes (random constants without):
+                                 # gyro_bias_gm: {std_dph, tau_s}, gyro_bias_rw_dphrh,
+                                 # gyro_scale_gm: {std_ppm, tau_s}, accel_bias_gm: {std_ug,
+                                 # tau_s}, accel_bias_rw_ughrh, accel_scale_gm (the imu keys)
       navigation_rate_hz: 25     # the IMU rate / a whole n (n increments per step)
       filter_rate_hz: 1          # navigation rate / a whole number
       feedback: true             # closed loop; false: feed-forward (linearised KF)
@@ -21,7 +25,15 @@
       aiding: auto               # dgnss (simulated truth) | zero-velocity (a parked vehicle)
                                  # | file (recorded: files: {velocity: {path, format,
                                  #   lever_arm_m}, position: {path, format, lever_arm_m}})
-      coarse: {method: none}     # none (start from truth + initial_error) | analytic | inertial
+      components: auto           # horizontal (the seed's eqs. 5-7) | 3d (with the vertical);
+                                 # auto: 3d for files, horizontal otherwise
+      max_gap_s: null            # fixes further apart are an outage (listed, drawn); default
+                                 # twice the file's median interval
+      output_rate_hz: null       # the solution stored at this rate; default every navigation
+                                 # step
+      coarse: {method: none}     # none (start from truth + initial_error; on recorded data
+                                 # from initial:, the reference or the file's header)
+                                 # | analytic | inertial
       start_s: 0                 # data time at which the calibration (or coarse) window opens
       # duration_s: 400          # default: to the end of the data
       conventional_segments: 6   # --compare: the conventional take-off = the first n segments
@@ -40,28 +52,22 @@ converts them once to the SI :class:`gcalign.calibrate.Settings`.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BeforeValidator, Field
+from pydantic import BeforeValidator, Field, model_validator
 
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, PosVec3, Vec3
+from gcalign.io.scenario.base import Model, NonNegVec3, Pos3, Vec3, three
+from gcalign.io.scenario.sensors import AccelGaussMarkov, GyroGaussMarkov, ScaleGaussMarkov
 from gcalign.nav.earth import EarthModel
 
-
-def _three(x):
-    """One number stands for all three axes."""
-    if isinstance(x, (int, float)) and not isinstance(x, bool):
-        return [x, x, x]
-    return x
-
-
-Pos3 = Annotated[PosVec3, BeforeValidator(_three)]
-Any3 = Annotated[Vec3, BeforeValidator(_three)]
+Pos3Zero = Annotated[NonNegVec3, BeforeValidator(three)]
+Any3 = Annotated[Vec3, BeforeValidator(three)]
 
 
 def _enu_m_to_si(enu, lat: float, h: float, earth: EarthModel) -> np.ndarray:
@@ -100,12 +106,70 @@ class P0Sigma(Model):
 
 
 class ProcessNoise(Model):
-    """White-noise densities of the filter's Q (spec 002 §2 [X]: the seed lost its Q)."""
+    """The filter's Q: white-noise densities (spec 002 §2 [X]: the seed lost its Q) and the
+    sensor states' processes, in the keys of the ``imu`` section (KF-GINS's ``imunoise``:
+    arw, vrw, gbstd, abstd, gsstd, asstd, corrtime). A sensor state without a process is a
+    random constant (the seed)."""
 
     arw_dprh: Annotated[float, B.ARW_DPRH] = Field(
         0.001, ge=0, description=f"gyro angle random walk, {B.ARW_DPRH.range()}")
     vrw_ugrhz: Annotated[float, B.VRW_UGRHZ] = Field(
         10.0, ge=0, description=f"accelerometer velocity random walk, {B.VRW_UGRHZ.range()}")
+    gyro_bias_gm: GyroGaussMarkov | None = Field(
+        None, description="gyro biases as first-order Gauss–Markov processes")
+    gyro_bias_rw_dphrh: Annotated[Pos3Zero, B.GYRO_BIAS_RW_DPHRH] | None = Field(
+        None, description="gyro biases as random walks (rate random walk, °/h/√h)")
+    accel_bias_gm: AccelGaussMarkov | None = Field(
+        None, description="accelerometer biases as first-order Gauss–Markov processes")
+    accel_bias_rw_ughrh: Annotated[Pos3Zero, B.ACCEL_BIAS_RW_UGRH] | None = Field(
+        None, description="accelerometer biases as random walks (µg/√h)")
+    gyro_scale_gm: ScaleGaussMarkov | None = Field(
+        None, description="gyro scale factors as first-order Gauss–Markov processes")
+    accel_scale_gm: ScaleGaussMarkov | None = Field(
+        None, description="accelerometer scale factors as first-order Gauss–Markov processes")
+
+    @model_validator(mode="after")
+    def _one_process_per_state(self):
+        for what in ("gyro", "accel"):
+            if getattr(self, f"{what}_bias_gm") is not None and \
+                    getattr(self, f"{what}_bias_rw_{'dphrh' if what == 'gyro' else 'ughrh'}") \
+                    is not None:
+                raise ValueError(f"{what}_bias_gm: a bias is one process; give "
+                                 f"{what}_bias_gm or the random walk, not both")
+        return self
+
+    def processes(self):
+        """The SI :class:`gcalign.estimation.ins_error.SensorProcesses` of the 12 sensor
+        states, or None when every one is a random constant."""
+        from gcalign.estimation.ins_error import SensorProcesses
+
+        groups = [(self.gyro_bias_gm, "std_dph", u.DPH, self.gyro_bias_rw_dphrh,
+                   u.DPH / math.sqrt(u.HOUR)),
+                  (self.accel_bias_gm, "std_ug", u.UG, self.accel_bias_rw_ughrh,
+                   u.UG / math.sqrt(u.HOUR)),
+                  (self.gyro_scale_gm, "std_ppm", u.PPM, None, 0.0),
+                  (self.accel_scale_gm, "std_ppm", u.PPM, None, 0.0)]
+        if all(gm is None and rw is None for gm, _, _, rw, _ in groups):
+            return None
+        kinds: list[str] = []
+        std, tau, dens = [], [], []
+        for gm, key, unit, rw, rw_unit in groups:
+            if gm is not None:
+                kinds += ["gauss-markov"] * 3
+                std += [float(x) * unit for x in getattr(gm, key)]
+                tau += [float(x) for x in gm.tau_s]
+                dens += [0.0] * 3
+            elif rw is not None:
+                kinds += ["random-walk"] * 3
+                std += [0.0] * 3
+                tau += [math.inf] * 3
+                dens += [float(x) * rw_unit for x in rw]
+            else:
+                kinds += ["constant"] * 3
+                std += [0.0] * 3
+                tau += [math.inf] * 3
+                dens += [0.0] * 3
+        return SensorProcesses.of(kinds, std, tau, dens)
 
 
 class InitialError(Model):
@@ -133,6 +197,8 @@ LeverArm = Annotated[Vec3, B.LEVER_ARM_M]
 _LEVER_HELP = ("the point the file measures (a GNSS antenna, a reference INS) from the IMU, "
                "body axes x right, y forward, z up, m; the filter applies it")
 REFERENCE_POSITION_FORMATS = ("psins-mat", "i2nav-nav", "reference-csv")
+_INTERVAL_HELP = ("use only the epochs at whole multiples of this many seconds (a 10 Hz "
+                  "solution as 1 Hz fixes); default every epoch")
 
 
 class VelocityFile(Model):
@@ -145,12 +211,14 @@ class VelocityFile(Model):
     variable: str | None = None
     lever_arm_m: LeverArm = Field(default_factory=lambda: [0.0, 0.0, 0.0],
                                   description=_LEVER_HELP)
+    interval_s: float | None = Field(None, gt=0, description=_INTERVAL_HELP)
 
 
 class PositionFile(Model):
     """Measured positions: GNSS fixes (KF-GINS text, RTKLIB .pos, CSV) or a reference
-    solution's positions (the formats of a velocity file's reference). R is
-    ``calibrate.sigma_p_m``; the σ a GNSS file states is recorded, not used."""
+    solution's positions (the formats of a velocity file's reference). R is each fix's own
+    σ where the file states them (KF-GINS σN σE σD, RTKLIB sdn sde sdu, declared CSV
+    columns), else ``calibrate.sigma_p_m``."""
 
     path: Path
     format: Literal["i2nav-gnss", "rtklib-pos", "csv", "psins-mat", "i2nav-nav",
@@ -159,6 +227,7 @@ class PositionFile(Model):
     variable: str | None = None
     lever_arm_m: LeverArm = Field(default_factory=lambda: [0.0, 0.0, 0.0],
                                   description=_LEVER_HELP)
+    interval_s: float | None = Field(None, gt=0, description=_INTERVAL_HELP)
 
 
 class AidingFiles(Model):
@@ -191,10 +260,19 @@ class CalibrateConfig(Model):
     smoother: bool = False
     truth: Literal["scenario", "draw"] = "scenario"
     initial_error: InitialError = Field(default_factory=InitialError)
-    gnss_noise: bool = True
+    gnss_noise: bool | None = Field(None, description="add simulated DGNSS noise of σ to "
+                                    "the reference; default: on for simulations, off for "
+                                    "recordings")
     aiding: Literal["auto", "dgnss", "zero-velocity", "file"] = "auto"
     files: AidingFiles | None = Field(None, description="aiding file: the measured velocity "
                                       "and/or position files")
+    components: Literal["auto", "horizontal", "3d"] = Field(
+        "auto", description="horizontal (the seed's eqs. 5-7) or 3d (with the vertical "
+        "velocity and height); auto: 3d for files, horizontal otherwise")
+    max_gap_s: float | None = Field(None, gt=0, description="fixes further apart are an "
+                                    "outage; default twice the file's median interval")
+    output_rate_hz: float | None = Field(None, gt=0, description="the rate the solution is "
+                                         "stored at; default every navigation step")
     coarse: Coarse = Field(default_factory=Coarse)
     start_s: float = Field(0.0, ge=0)
     duration_s: float | None = Field(None, gt=0)
@@ -237,6 +315,11 @@ class CalibrateConfig(Model):
 
     def check(self, sc) -> None:
         """Checks that need the rest of the scenario; ScenarioError naming the field."""
+        if self.files is None:
+            for key in ("max_gap_s",):
+                if getattr(self, key) is not None:
+                    raise ScenarioError(f"calibrate.{key}: finds the outages of aiding files "
+                                        f"(aiding: file); this run has none (remove it)")
         if (self.aiding == "file") != (self.files is not None):
             raise ScenarioError("calibrate.files: goes with aiding 'file' (and it needs them); "
                                 f"got aiding {self.aiding!r}"
@@ -258,15 +341,19 @@ class CalibrateConfig(Model):
                                     "(imu_file); a simulation takes 'dgnss'")
             if self.gnss_noise:
                 raise ScenarioError("calibrate.gnss_noise: adds simulated noise to measured "
-                                    "files; set it false with aiding 'file'")
+                                    "files; remove it (or set it false) with aiding 'file'")
         if self.recorded(sc):
             if self.aiding == "dgnss":
                 raise ScenarioError("calibrate.aiding: 'dgnss' compares with the simulated "
                                     "truth; recorded data support 'zero-velocity' or 'file' "
                                     "(or auto)")
-            if self.coarse.method == "none":
-                raise ScenarioError("calibrate.coarse.method: recorded data have no truth to "
-                                    "start from; use analytic or inertial, got 'none'")
+            if self.coarse.method != "none" and (sc.initial is not None
+                                                 or sc.reference is not None):
+                key = "initial" if sc.initial is not None else "reference"
+                raise ScenarioError(f"calibrate.coarse.method: {self.coarse.method!r} cannot "
+                                    f"matter: the start comes from {key}; remove one (a coarse "
+                                    "alignment needs a vehicle parked at the start)")
+
             if self.truth == "draw":
                 raise ScenarioError("calibrate.truth: 'draw' injects errors into simulated "
                                     "data; recorded data carry their own (use scenario)")
@@ -296,17 +383,53 @@ class CalibrateConfig(Model):
 
     # ------------------------------------------------------------------ SI
 
-    def settings(self, site_si, earth: EarthModel, measure: str | None = None):
-        """The SI :class:`gcalign.calibrate.Settings` at the site ``[lat, lon, h]``."""
+    def components_for(self, sc) -> str:
+        """``horizontal`` or ``3d``: auto is 3d for files (a receiver measures height),
+        the seed's horizontal form otherwise."""
+        if self.components != "auto":
+            return self.components
+        return "3d" if self.aiding_for(sc) == "file" else "horizontal"
+
+    def settings(self, site_si, earth: EarthModel, measure: str | None = None, sc=None):
+        """The SI :class:`gcalign.calibrate.Settings` at the site ``[lat, lon, h]``; with the
+        scenario `sc`, its measurement components and the P0 of ``initial.sigma`` (the
+        navigation states' σ as given, not scaled by p0_scale)."""
         from gcalign.calibrate import Settings
 
         lat, h = float(site_si[0]), float(site_si[2])
+        sigma = self.p0.to_si(lat, h, earth)
+        given = None if sc is None or sc.initial is None else sc.initial.sigma
+        if given is not None:
+            k = self.p0_scale  # P0 = (p0_scale σ)²: the given σ enter divided by it
+            if given.phi_enu_deg is not None:
+                sigma[0:3] = np.asarray(given.phi_enu_deg) * u.DEG / k
+            if given.v_enu_mps is not None:
+                sigma[3:6] = np.asarray(given.v_enu_mps, float) / k
+            if given.pos_enu_m is not None:
+                sigma[6:9] = _enu_m_to_si(given.pos_enu_m, lat, h, earth) / k
         return Settings(
             measure=measure or self.measure, sigma_v=self.sigma_v_mps, sigma_p=self.sigma_p_m,
-            p0_scale=self.p0_scale, p0_sigma=tuple(self.p0.to_si(lat, h, earth)),
+            p0_scale=self.p0_scale, p0_sigma=tuple(sigma),
             arw=self.q.arw_dprh * u.DPSH, vrw=self.q.vrw_ugrhz * u.UGPSHZ,
             filter_rate=self.filter_rate_hz, discretization=self.discretization,
-            feedback=self.feedback, gnss_noise=self.gnss_noise, smoother=self.smoother)
+            feedback=self.feedback, smoother=self.smoother,
+            gnss_noise=self.gnss_noise if self.gnss_noise is not None
+            else (sc is None or not self.recorded(sc)),
+            components="horizontal" if sc is None else self.components_for(sc),
+            processes=self.q.processes())
+
+    def output_stride(self, nav_rate: float) -> int:
+        """Navigation steps per stored row of the solution; ScenarioError naming the field."""
+        if self.output_rate_hz is None:
+            return 1
+        k = _divides(nav_rate, self.output_rate_hz)
+        if k is None:
+            ok = [nav_rate / j for j in range(1, 11) if (nav_rate / j).is_integer()]
+            raise ScenarioError(
+                f"calibrate.output_rate_hz: must be the navigation rate {nav_rate:g} Hz divided "
+                f"by a whole number (e.g. {', '.join(f'{r:g}' for r in ok[:6])} Hz), got "
+                f"{self.output_rate_hz:g}")
+        return k
 
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
         rows = [
@@ -325,7 +448,18 @@ class CalibrateConfig(Model):
              else "feed-forward"),
             ("calibrate.discretization", self.discretization, ""),
             ("calibrate.smoother", str(self.smoother), ""),
+            ("calibrate.components", self.components_for(sc), "horizontal: the seed's eqs. "
+             "5-7; 3d: with the vertical velocity and height"),
         ]
+        procs = [k for k in ("gyro_bias_gm", "gyro_bias_rw_dphrh", "accel_bias_gm",
+                             "accel_bias_rw_ughrh", "gyro_scale_gm", "accel_scale_gm")
+                 if getattr(self.q, k) is not None]
+        rows.append(("calibrate.q processes", ", ".join(procs) or "none",
+                     "the other sensor states are random constants"))
+        if self.files is not None:
+            rows.append(("calibrate.max_gap_s", "twice the file's median interval"
+                         if self.max_gap_s is None else f"{self.max_gap_s:g} s",
+                         "fixes further apart are an outage"))
         if not self.recorded(sc):
             rate = sc.imu.rate_hz
             n = self.subsamples(rate)

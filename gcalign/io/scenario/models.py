@@ -9,7 +9,6 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import (
     AfterValidator,
-    BeforeValidator,
     Field,
     field_validator,
     model_serializer,
@@ -20,7 +19,7 @@ from gcalign import units as u
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.align import AlignConfig
 from gcalign.io.scenario.allan import AllanConfig
-from gcalign.io.scenario.base import Model, NonNegVec3, Vec3
+from gcalign.io.scenario.base import Model
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 from gcalign.io.scenario.modulate import ModulateConfig
 from gcalign.io.scenario.motion import MotionModel
@@ -28,34 +27,17 @@ from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, Ou
 from gcalign.io.scenario.northfind import NorthfindConfig
 from gcalign.io.scenario.realtime import RealtimeConfig
 from gcalign.io.scenario.recording import ImuLayout, Initial, ReferenceFile, split_imu_file
+from gcalign.io.scenario.sensors import (
+    AccelGaussMarkov,
+    GyroGaussMarkov,
+    Noise,
+    PerAxis,
+    ScaleGaussMarkov,
+    gauss_markov_si,
+    per_axis,
+)
 from gcalign.nav.earth import MODELS, EarthModel
 from gcalign.sim.errors import ImuErrors, SensorErrors
-
-
-def _is_number(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool)
-
-
-def _broadcast_scalar(x):
-    if _is_number(x):
-        if x < 0:
-            raise ValueError(f"must be ≥ 0 (one number, or one per axis), got {x}")
-        return [x, x, x]
-    return x
-
-
-def _broadcast(x):
-    return [x, x, x] if _is_number(x) else x
-
-
-# A noise density: one number for all three axes, or one per axis.
-Noise = Annotated[NonNegVec3, BeforeValidator(_broadcast_scalar)]
-# A bias or scale-factor error: one number for all three axes (the same sign), or one per axis.
-PerAxis = Annotated[Vec3, BeforeValidator(_broadcast)]
-
-
-def _vec(x) -> np.ndarray:
-    return np.broadcast_to(np.asarray(x, dtype=float), (3,)).copy()
 
 
 def _misalignment(m) -> np.ndarray:
@@ -89,37 +71,6 @@ class Site(Model):
     def to_si(self) -> np.ndarray:
         """``[lat (rad), lon (rad), h (m)]``."""
         return np.array([self.lat_deg * u.DEG, self.lon_deg * u.DEG, self.height_m])
-
-
-def _gm(std, tau, unit: float) -> tuple[np.ndarray, np.ndarray]:
-    """(std SI, τ s) of a Gauss–Markov section, or (zeros, inf) without one."""
-    if std is None:
-        return np.zeros(3), np.full(3, np.inf)
-    return _vec(std) * unit, _vec(tau)
-
-
-Tau = Annotated[PerAxis, B.CORRELATION_TIME_S]
-
-
-class GyroGaussMarkov(Model):
-    """A first-order Gauss–Markov gyro bias: stationary std and correlation time."""
-
-    std_dph: Annotated[Noise, B.GYRO_BIAS_DPH] = Field(description="stationary std, °/h")
-    tau_s: Tau = Field(description="correlation time, s")
-
-
-class AccelGaussMarkov(Model):
-    """A first-order Gauss–Markov accelerometer bias: stationary std and correlation time."""
-
-    std_ug: Annotated[Noise, B.ACCEL_BIAS_UG] = Field(description="stationary std, µg")
-    tau_s: Tau = Field(description="correlation time, s")
-
-
-class ScaleGaussMarkov(Model):
-    """A first-order Gauss–Markov scale-factor error: stationary std and correlation time."""
-
-    std_ppm: Annotated[Noise, B.SCALE_PPM] = Field(description="stationary std, ppm")
-    tau_s: Tau = Field(description="correlation time, s")
 
 
 def _tau_range(v):
@@ -170,23 +121,19 @@ class Gyro(Model):
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
     def to_si(self) -> SensorErrors:
-        gm = self.bias_gm
-        bias_std, bias_tau = _gm(None if gm is None else gm.std_dph,
-                                 None if gm is None else gm.tau_s, u.DPH)
-        sg = self.scale_gm
-        scale_std, scale_tau = _gm(None if sg is None else sg.std_ppm,
-                                   None if sg is None else sg.tau_s, u.PPM)
+        bias_std, bias_tau = gauss_markov_si(self.bias_gm, u.DPH)
+        scale_std, scale_tau = gauss_markov_si(self.scale_gm, u.PPM)
         return SensorErrors(
-            bias=_vec(self.bias_dph) * u.DPH,
-            noise=_vec(self.arw_dprh) * u.DPSH,
-            scale=_vec(self.scale_ppm) * u.PPM,
+            bias=per_axis(self.bias_dph) * u.DPH,
+            noise=per_axis(self.arw_dprh) * u.DPSH,
+            scale=per_axis(self.scale_ppm) * u.PPM,
             misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
             quantum=self.quantum_arcsec * u.ARCSEC,
-            asym=_vec(self.asym_ppm) * u.PPM,
+            asym=per_axis(self.asym_ppm) * u.PPM,
             bias_gm_std=bias_std, bias_gm_tau=bias_tau,
-            bias_rw=_vec(self.bias_rw_dphrh) * u.DPH / math.sqrt(u.HOUR),
+            bias_rw=per_axis(self.bias_rw_dphrh) * u.DPH / math.sqrt(u.HOUR),
             scale_gm_std=scale_std, scale_gm_tau=scale_tau,
-            instability=_vec(self.bias_instability_dph) * u.DPH,
+            instability=per_axis(self.bias_instability_dph) * u.DPH,
             instability_tau=_span(self.bias_instability_tau_s),
         )
 
@@ -220,23 +167,19 @@ class Accel(Model):
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
     def to_si(self) -> SensorErrors:
-        gm = self.bias_gm
-        bias_std, bias_tau = _gm(None if gm is None else gm.std_ug,
-                                 None if gm is None else gm.tau_s, u.UG)
-        sg = self.scale_gm
-        scale_std, scale_tau = _gm(None if sg is None else sg.std_ppm,
-                                   None if sg is None else sg.tau_s, u.PPM)
+        bias_std, bias_tau = gauss_markov_si(self.bias_gm, u.UG)
+        scale_std, scale_tau = gauss_markov_si(self.scale_gm, u.PPM)
         return SensorErrors(
-            bias=_vec(self.bias_ug) * u.UG,
-            noise=_vec(self.vrw_ugrhz) * u.UGPSHZ,
-            scale=_vec(self.scale_ppm) * u.PPM,
+            bias=per_axis(self.bias_ug) * u.UG,
+            noise=per_axis(self.vrw_ugrhz) * u.UGPSHZ,
+            scale=per_axis(self.scale_ppm) * u.PPM,
             misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
             quantum=self.quantum_ugs * u.UG,
-            asym=_vec(self.asym_ppm) * u.PPM,
+            asym=per_axis(self.asym_ppm) * u.PPM,
             bias_gm_std=bias_std, bias_gm_tau=bias_tau,
-            bias_rw=_vec(self.bias_rw_ughrh) * u.UG / math.sqrt(u.HOUR),
+            bias_rw=per_axis(self.bias_rw_ughrh) * u.UG / math.sqrt(u.HOUR),
             scale_gm_std=scale_std, scale_gm_tau=scale_tau,
-            instability=_vec(self.bias_instability_ug) * u.UG,
+            instability=per_axis(self.bias_instability_ug) * u.UG,
             instability_tau=_span(self.bias_instability_tau_s),
         )
 
@@ -270,7 +213,7 @@ class Imu(Model):
 #: (align and calibrate: the site when the file has none, and whether the base is at rest.)
 USED_BY: dict[str, tuple[str, ...]] = {"reference": ("navigation", "align", "calibrate",
                                                      "allan"),
-                                       "initial": ("navigation",)}
+                                       "initial": ("navigation", "calibrate")}
 
 
 class Scenario(Model):
@@ -393,6 +336,10 @@ class Scenario(Model):
                     and getattr(self, section, None) is not None:  # a section of the file
                 out.append(f"{key}: read and checked (gcalign validate shows it), but "
                            f"{section} does not use it yet")
+        if self.initial is not None and self.initial.sigma is not None \
+                and section == "navigation":
+            out.append("initial.sigma: cannot matter to navigate (no filter); it is the P0 "
+                       "of calibrate")
         model = getattr(self, section, None) if section else None
         if model is not None and hasattr(model, "unused"):
             out += model.unused(self)

@@ -23,13 +23,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import Field, ValidationError, field_validator
+import numpy as np
+from pydantic import Field, ValidationError, field_validator, model_validator
 
 from gcalign.errors import ScenarioError
 from gcalign.io.recorded.axes import rotation_to_rfu
 from gcalign.io.recorded.imu import ACCEL_UNITS, FORMAT_NAMES, GYRO_UNITS, Layout
 from gcalign.io.recorded.reference import REFERENCE_FORMATS
-from gcalign.io.scenario.base import Model, Vec3
+from gcalign.io.scenario.base import Model, Pos3, Vec3
 
 
 class Units(Model):
@@ -88,6 +89,9 @@ class ReferenceFile(Model):
     format: str = "psins-mat"
     variable: str | None = None
     columns: list[str] | None = None
+    max_gap_s: float | None = Field(None, gt=0, description="epochs further apart are a gap: "
+                                    "no error is reported inside it; default twice the "
+                                    "file's median interval")
 
     @field_validator("format")
     @classmethod
@@ -103,12 +107,44 @@ class ReferenceFile(Model):
         return read_reference(self.path, self.format, self.variable, self.columns)
 
 
+class InitialSigma(Model):
+    """``initial.sigma``: how well the initial state is known (1σ); the filter's P0 for the
+    attitude, velocity and position (KF-GINS ``initattstd``, ``initvelstd``, ``initposstd``)."""
+
+    phi_enu_deg: Pos3 | None = Field(
+        None, description="misalignment σ: φ east, north (the tilts) and up (the heading), deg")
+    v_enu_mps: Pos3 | None = Field(
+        None, description="velocity σ east, north, up, m/s")
+    pos_enu_m: Pos3 | None = Field(
+        None, description="position σ east, north, up, m")
+
+
 class Initial(Model):
-    """``initial: {att_deg, v_enu_mps}``: the state navigation starts from on recorded data
-    whose file gives none."""
+    """``initial: {att_deg, v_enu_mps, lat_deg, lon_deg, height_m, sigma}``: the state a run
+    on recorded data starts from (navigate, calibrate) when the file gives none, or to
+    replace what it gives; the position keys go together."""
 
     att_deg: Vec3 = Field(description="[pitch, roll, yaw], deg (ENU, yaw CCW positive)")
     v_enu_mps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    lat_deg: float | None = Field(None, gt=-90, lt=90, description="start latitude, deg")
+    lon_deg: float | None = Field(None, ge=-180, le=360, description="start longitude, deg")
+    height_m: float | None = Field(None, ge=-1000, le=1e5, description="start height, m")
+    sigma: InitialSigma | None = Field(None, description="1σ of the state: the filter's P0")
+
+    @model_validator(mode="after")
+    def _position_together(self):
+        given = [k for k in ("lat_deg", "lon_deg", "height_m") if getattr(self, k) is not None]
+        if given and len(given) < 3:
+            missing = [k for k in ("lat_deg", "lon_deg", "height_m") if k not in given]
+            raise ValueError(f"{', '.join(missing)}: missing; the start position takes "
+                             "lat_deg, lon_deg and height_m together")
+        return self
+
+    def position(self) -> np.ndarray | None:
+        """``[L (rad), λ (rad), h (m)]``, or None without the position keys."""
+        if self.lat_deg is None or self.lon_deg is None or self.height_m is None:
+            return None
+        return np.array([np.radians(self.lat_deg), np.radians(self.lon_deg), self.height_m])
 
 
 def split_imu_file(data: Any) -> Any:

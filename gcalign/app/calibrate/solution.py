@@ -1,0 +1,188 @@
+"""The filter's navigation solution at every navigation sample, as the run goes: stored at
+the output rate in ``/calibrate/runs/NN/navigation`` and compared with the truth or the
+reference at every sample, the errors summed apart inside and outside the outages.
+
+Memory stays flat in the run's length: the rows of one filter step at a time, the file's
+chunked series (:class:`gcalign.io.results.Series`) and a few sums.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gcalign.calibrate.fixes import Outage, inside
+from gcalign.io.recorded.reference import Reference, reference_at
+from gcalign.nav.earth import EarthModel
+from gcalign.nav.navigate import position_error_enu
+from gcalign.nav.rotation import attitude_error, quat_to_euler
+
+QUANTITIES = ("position", "velocity", "attitude")
+UNITS = {"position": "m", "velocity": "m/s", "attitude": "deg"}
+
+
+@dataclass
+class ErrorStats:
+    """Sums of squares, maxima and counts of 3-component errors (ENU m, ENU m/s, Euler
+    differences rad), and of the horizontal position error."""
+
+    n: int = 0
+    sq: dict[str, np.ndarray] = field(default_factory=lambda: {q: np.zeros(3)
+                                                               for q in QUANTITIES})
+    peak: dict[str, np.ndarray] = field(default_factory=lambda: {q: np.zeros(3)
+                                                                 for q in QUANTITIES})
+    h_sq: float = 0.0
+    h_peak: float = 0.0
+
+    def add(self, errors: dict[str, np.ndarray]) -> None:
+        """Rows (k, 3) of each quantity's error."""
+        k = len(errors["position"])
+        if not k:
+            return
+        self.n += k
+        for q in QUANTITIES:
+            e = errors[q]
+            self.sq[q] += np.sum(e * e, axis=0)
+            self.peak[q] = np.maximum(self.peak[q], np.abs(e).max(axis=0))
+        h = np.hypot(errors["position"][:, 0], errors["position"][:, 1])
+        self.h_sq += float(h @ h)
+        self.h_peak = max(self.h_peak, float(h.max()))
+
+    def summary(self) -> dict | None:
+        """RMS and maximum of each quantity (attitude in degrees), or None without rows."""
+        if not self.n:
+            return None
+        out: dict = {"samples": self.n}
+        for q in QUANTITIES:
+            k = np.degrees(1.0) if q == "attitude" else 1.0
+            out[f"{q}_rms_{UNITS[q].replace('/', 'p')}"] = (
+                np.sqrt(self.sq[q] / self.n) * k).tolist()
+            out[f"{q}_max_{UNITS[q].replace('/', 'p')}"] = (self.peak[q] * k).tolist()
+        out["horizontal_rms_m"] = float(np.sqrt(self.h_sq / self.n))
+        out["horizontal_max_m"] = self.h_peak
+        return out
+
+
+class Errors:
+    """Errors of solution rows against the truth (rows of a navigation-rate trajectory, in
+    step with the run) or against a reference (interpolated, its gaps left out)."""
+
+    def __init__(self, earth: EarthModel, truth=None, reference: Reference | None = None,
+                 ref_gaps: tuple[Outage, ...] = ()):
+        self.earth, self.truth, self.reference, self.ref_gaps = earth, truth, reference, ref_gaps
+        self.against = "truth" if truth is not None else (
+            "reference" if reference is not None else None)
+
+    def of(self, k: int, t_data: np.ndarray, att: np.ndarray, v: np.ndarray,
+           pos: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """``(valid (n,), errors)`` of rows k … k+n−1 (their data times `t_data`):
+        position ENU m, velocity ENU m/s, attitude Euler differences rad, each (n, 3), NaN
+        where nothing is compared (beyond the reference or in one of its gaps)."""
+        n = len(t_data)
+        out = {q: np.full((n, 3), np.nan) for q in QUANTITIES}
+        if self.truth is not None:
+            tr = self.truth
+            sl = slice(k, k + n)
+            out["position"] = position_error_enu(pos, tr.pos[sl], self.earth)
+            out["velocity"] = v - tr.v_n[sl]
+            out["attitude"] = attitude_error(att, tr.att[sl])
+            return np.ones(n, dtype=bool), out
+        ref = self.reference
+        if ref is None:
+            return np.zeros(n, dtype=bool), out
+        ok = (t_data >= ref.t[0] - 1e-9) & (t_data <= ref.t[-1] + 1e-9)
+        ok &= ~inside(t_data, self.ref_gaps)
+        if ok.any():
+            r_att, r_v, r_pos = reference_at(ref, t_data[ok], tol=1e-6)
+            out["position"][ok] = position_error_enu(pos[ok], r_pos, self.earth)
+            out["velocity"][ok] = v[ok] - r_v
+            if r_att is not None:
+                out["attitude"][ok] = attitude_error(att[ok], r_att)
+            else:
+                out["attitude"][ok] = 0.0
+        return ok, out
+
+
+class SolutionSink:
+    """``on_rows`` of :func:`gcalign.calibrate.calibrate`: stores every `stride`-th row
+    (``group`` an h5py group, or None) and sums the errors (:class:`Errors`) of every row
+    inside and outside `outages` (run time)."""
+
+    def __init__(self, group, stride: int, t0: float, errors: Errors,
+                 outages: tuple[Outage, ...] = (), rate_hz: float = 0.0,
+                 time_origin: str = ""):
+        from gcalign.io.results import ATT_FRAME, Series
+
+        self.stride, self.t0, self.errors, self.outages = stride, t0, errors, outages
+        self.k = 0
+        self.inside, self.outside = ErrorStats(), ErrorStats()
+        self.series = None
+        if group is not None:
+            spec = {"t": (None, "s", None), "t_run": (None, "s", None),
+                    "att": (3, "rad", ATT_FRAME), "v_n": (3, "m/s", "ENU"),
+                    "pos": (3, "rad, rad, m", "[latitude, longitude, height]")}
+            if errors.against is not None:
+                spec |= {"error/t": (None, "s", None),
+                         "error/att": (3, "rad", f"Euler differences est - {errors.against}"
+                                                 ", roll and yaw wrapped"),
+                         "error/v_n": (3, "m/s", "ENU"),
+                         "error/pos": (3, "m", "ENU (east, north, up)")}
+            self.series = Series(group, spec, stride=stride, rate_hz=rate_hz / stride,
+                                 time_origin=time_origin or "the recording's time",
+                                 description="the filter's corrected solution at every "
+                                 "navigation sample (t: the recording's time base; t_run: "
+                                 "s from the run's first sample)")
+            if errors.against is not None:
+                group.attrs["error_source"] = errors.against
+
+    def __call__(self, t: np.ndarray, q_nb: np.ndarray, v_n: np.ndarray,
+                 pos: np.ndarray) -> None:
+        n = len(t)
+        att = quat_to_euler(q_nb)
+        t_data = t + self.t0
+        if self.errors.against is not None:
+            ok, err = self.errors.of(self.k, t_data, att, v_n, pos)
+            out = inside(t, self.outages)
+            self.inside.add({q: e[ok & out] for q, e in err.items()})
+            self.outside.add({q: e[ok & ~out] for q, e in err.items()})
+        if self.series is not None:
+            keep = (self.k + np.arange(n)) % self.stride == 0
+            rows = {"t": t_data[keep], "t_run": t[keep], "att": att[keep], "v_n": v_n[keep],
+                    "pos": pos[keep]}
+            if self.errors.against is not None:  # where compared: not in a reference's gaps
+                sel = keep & ok
+                rows |= {"error/t": t_data[sel], "error/att": err["attitude"][sel],
+                         "error/v_n": err["velocity"][sel], "error/pos": err["position"][sel]}
+            self.series.append(**rows)
+        self.k += n
+
+    def close(self) -> dict | None:
+        """The series flushed; the error statistics (None without truth or reference)."""
+        if self.series is not None:
+            self.series.flush()
+        if self.errors.against is None:
+            return None
+        return {"against": self.errors.against, "outside_outages": self.outside.summary(),
+                "in_outages": self.inside.summary()}
+
+
+def epoch_errors(errors: Errors, t: np.ndarray, t0: float, index: np.ndarray, att: np.ndarray,
+                 v_n: np.ndarray, pos: np.ndarray, outages: tuple[Outage, ...]
+                 ) -> tuple[dict[str, dict | None], dict[str, np.ndarray]]:
+    """A solution at the filter epochs (the forward filter's or the smoother's) against
+    the truth or the reference: its statistics inside and outside the outages, and the
+    errors themselves (``t`` and position, velocity, attitude at the epochs compared)."""
+    if errors.truth is not None:
+        tr = errors.truth
+        err = {"position": position_error_enu(pos, tr.pos[index], errors.earth),
+               "velocity": v_n - tr.v_n[index], "attitude": attitude_error(att, tr.att[index])}
+        ok = np.ones(len(t), dtype=bool)
+    else:
+        ok, err = errors.of(0, t + t0, att, v_n, pos)
+    out = inside(t, outages)
+    stats = {"outside_outages": ErrorStats(), "in_outages": ErrorStats()}
+    stats["in_outages"].add({q: e[ok & out] for q, e in err.items()})
+    stats["outside_outages"].add({q: e[ok & ~out] for q, e in err.items()})
+    return ({k: s.summary() for k, s in stats.items()},
+            {"t": t[ok], **{q: e[ok] for q, e in err.items()}})
