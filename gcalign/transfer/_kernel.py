@@ -68,3 +68,22 @@ def propagate(q: Array, v: Array, x: Array, P: Array, dtheta: Array, dv: Array, 
         Pn = Phi @ P @ Phi.T + Qd
         P[:, :] = 0.5 * (Pn + Pn.T)
 
+
+@njit(cache=True)
+def mechanise(q: Array, v: Array, dtheta: Array, dv: Array, k_from: int, k_to: int,
+              fed: Array, w_in: Array, g_cc: Array, ts: float) -> None:
+    """The strapdown steps of :func:`propagate` alone, in place on q (4,), v (3,): the
+    slave's own solution when the filter's corrections are not fed back into it."""
+    wx, wy, wz = w_in[0] * ts, w_in[1] * ts, w_in[2] * ts
+    for k in range(k_from, k_to):
+        bx, by, bz = dtheta[k, 0] - fed[0] * ts, dtheta[k, 1] - fed[1] * ts, \
+            dtheta[k, 2] - fed[2] * ts
+        dx, dy, dz = dv[k, 0] - fed[3] * ts, dv[k, 1] - fed[4] * ts, dv[k, 2] - fed[5] * ts
+        q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
+        fx, fy, fz = specific_force_increment(q0, q1, q2, q3, bx, by, bz, dx, dy, dz,
+                                              wx, wy, wz)
+        v[0] += fx + g_cc[0] * ts
+        v[1] += fy + g_cc[1] * ts
+        v[2] += fz + g_cc[2] * ts
+        q[0], q[1], q[2], q[3] = attitude_update(q0, q1, q2, q3, bx, by, bz, wx, wy, wz)
+
