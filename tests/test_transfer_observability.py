@@ -5,7 +5,7 @@ covariance shows (spec 006, "What the data support"). Then the table of
 :func:`gcalign.transfer.observability.transfer_observability` on the filter's own run,
 against the rank argument of attitude matching on a roll about body y: the combination
 (φ along the forward axis d, μ along J_l(μ)⁻¹ e_y, the tangent of turning the slave about
-d) is an exact null vector of the filter's H (decision 016) without the earth rate."""
+d) is an exact null vector of the filter's H (decision 019) without the earth rate."""
 
 from __future__ import annotations
 

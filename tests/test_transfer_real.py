@@ -151,7 +151,7 @@ def _jl_inv(a):
 def _demo_loop(t_end: float):
     """PSINS's demo as it reads (qupdt, cnscl, kfupdate in the plain form), with the flexure
     discretised as Φ = expm(F T), Q_d = G Q Gᵀ T (not Van Loan), and with our attitude
-    measurement and reset (docs/decisions/016): H(φ rows, μ and θ) = −C_m of the master,
+    measurement and reset (docs/decisions/019): H(φ rows, μ and θ) = −C_m of the master,
     H(φ, φ) = J_l(a)⁻¹ with a = C_m (μ̂ + θ̂), the predicted measurement −a, and φ̂ fed into
     the slave after each update (qdelphi) with P ← G P Gᵀ, G(φ, φ) = I + ½[φ̂×]."""
     d = _mat()

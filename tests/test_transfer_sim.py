@@ -7,7 +7,7 @@ set to it. What the linear model leaves out, and so what a consistency test must
 
 * under attitude matching alone, the unmeasured vertical velocity carries g(1 − cos φ) of
   the unobservable forward-axis attitude error (about 1°): NEES 20.5 over 30 runs from the
-  demo's start, every state in band (docs/decisions/016);
+  demo's start, every state in band (docs/decisions/019);
 * starting from the master's attitude with a tight P0: φ0 = −C_nb μ exactly, a correlation
   P0 does not carry (NEES 17–21 over the first 5 s, 30 runs);
 * a 1° initial φ0 with 500 °/h gyro biases: φ and μ stay confused (σ ≈ 1°) for seconds
@@ -96,7 +96,7 @@ def test_every_state_consistent_in_every_mode(matching, feedback, start):
     docs/results_transfer.md): the mean over the runs of each state's (e/σ)² at the end is
     a mean of 30 χ²₁ for a consistent filter. Band: two-sided, 1 % for the whole family of
     12 modes × 15 states (each 1 − 0.01/180: 0.37–2.23). Before the exact attitude
-    measurement and the covariance reset (docs/decisions/016), attitude matching from the
+    measurement and the covariance reset (docs/decisions/019), attitude matching from the
     demo's start gave μ y 21.5 and φ E, N 21; without attitude feedback ∇ z 155.
     The NEES of the 15 states, a mean of 30 χ²₁₅, in its band of the same family level
     where the velocity is matched; under attitude matching alone the unmeasured vertical
@@ -151,7 +151,7 @@ def test_attitude_matching_leaves_roll_axis_mu_poorly_observed():
     """The drive rolls about the body's forward axis at a constant heading: μ y and the
     attitude error about that axis cancel in the measurement, only the earth rate tells
     them apart, and the filter keeps σ(μ y) near its 60′ prior (measured 54.3′; 13′ with
-    the mechanised attitude in H, which learnt what no data show: docs/decisions/016)."""
+    the mechanised attitude in H, which learnt what no data show: docs/decisions/019)."""
     r = _demo_start("attitude")
     sig = r.sigma[-1, 12:15] / ARCMIN
     assert sig[1] > 45.0, sig  # the roll axis (body y, forward)

@@ -36,14 +36,14 @@ Measurement at every master epoch (demo ``kfupdate(kf, [qq2phi(qnbs,qnbm); vns�
 ``a = C_m (μ̂ + θ̂)``) with ``H(φ rows, φ) = J_l(a)⁻¹`` and ``H(φ rows, μ) = H(φ rows, θ)
 = −C_m``, C_m the master's attitude; the demo's ``−C_nb`` of the mechanised slave turns
 with every attitude correction and made the filter learn the roll-axis mounting that no
-data show (docs/decisions/016). The lever arm l (body frame, m, from the master to the
+data show (docs/decisions/019). The lever arm l (body frame, m, from the master to the
 slave) is zero in the demo. The update is the Joseph form of
 :func:`gcalign.estimation.kalman.update` (the demo's ``kfupdate``); bias feedback after
 every update (``ebdb += x(ε,∇); x(ε,∇) = 0``); φ̂ reset into the filter's attitude after
 every update (the demo's commented ``qnbs = qdelphi(qnbs, xk(1:3))``) with the covariance
 carried, ``P ← G P Gᵀ``, ``G(φ,φ) = I + ½[φ̂×]``. With attitude feedback off the slave's
 own solution runs free beside the filter's and φ̂, δv̂ are reported as its corrections
-(decision 016: the estimates do not depend on the switch).
+(decision 019: the estimates do not depend on the switch).
 """
 
 from __future__ import annotations
@@ -114,7 +114,7 @@ class TransferSettings:
     flexure : add θ, ω (21 states; the demo does).
     bias_feedback : feed ε̂, ∇̂ into the compensation after every update (the demo).
     attitude_feedback : correct the slave's own attitude by φ̂ after every update (demo:
-        off). The filter linearises about its corrected attitude either way (decision 016);
+        off). The filter linearises about its corrected attitude either way (decision 019);
         off keeps the slave's solution free and reports φ̂, δv̂ as its corrections.
     lever_arm_b : (3,) m, slave position relative to the master, body frame.
     p0_sigma : (21,) initial σ (the first 15 without flexure).
@@ -391,7 +391,7 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
         np.zeros(K)
     C_nb, dv_n = np.zeros((3, 3)), np.zeros(3)
     # without attitude feedback the slave's own solution runs free beside the filter's
-    # corrected one (decision 016): the filter linearises about its best attitude always
+    # corrected one (decision 019): the filter linearises about its best attitude always
     q_free, v_free = q_s.copy(), v_s.copy()
     k_prev = k0 + 1
     for j, k in enumerate(k_meas):
@@ -409,7 +409,7 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
         z_v = v_s - vm_meas[j] - v_lever
         if qm_meas is not None:
             # the exact attitude measurement about the estimate, linear in μ through the
-            # master's attitude (model.attitude_measurement; decision 016)
+            # master's attitude (model.attitude_measurement; decision 019)
             C_m = quat_to_dcm(qm_meas[j])
             mount_n = C_m @ (x[MU] + (x[TH] if s.flexure else 0.0))
             H = measurement_matrix(C_m, "attitude+velocity", n, mount_n)

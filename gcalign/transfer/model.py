@@ -14,7 +14,7 @@ inverse left Jacobian of SO(3)): ``H(φ rows, φ) = J_l(a)⁻¹``, ``H(φ rows, 
 (:func:`measurement_matrix`). With ``H(φ, φ) = I`` and the mechanised ``C_nb`` in place of
 ``C_m`` (PSINS's demo) the μ columns turn with every attitude correction fed back, which
 the slave's true axes never do: the filter then learns the roll-axis μ that no data show
-(docs/decisions/016). Flexure θ enters as μ does. Rows of H by matching as
+(docs/decisions/019). Flexure θ enters as μ does. Rows of H by matching as
 :attr:`gcalign.transfer.TransferSettings.rows`.
 
 >>> import numpy as np

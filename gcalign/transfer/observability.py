@@ -35,7 +35,7 @@ What the model's structure says (the tests hold the command to it):
   attitude rows nor φ (zero columns). The filter's H takes μ through the master's attitude,
   which turns only as the vehicle does, and its model learns nothing of the combination
   (with the slave's mechanised C_nb, corrected at every update, it learnt what no data
-  show: docs/decisions/016);
+  show: docs/decisions/019);
 * attitude + velocity matching: φ along d is a tilt, which the velocity sees through
   ``f^n × φ`` (f^n ≈ g up, d horizontal): every μ is observable.
 
