@@ -84,7 +84,28 @@ def test_modulate_bar_counts_data_seconds_of_its_scheme(tmp_path, monkeypatch):
     res = runner.invoke(app, _args(tmp_path, "modulate"))
     assert res.exit_code == 0, res.output
     bar = ANSI.sub("", res.stderr)
-    assert "modulate seed-12 (data s)" in bar and "180/180" in bar  # 0.05 h = 180 s
+    assert "modulate seed-12 " in bar and "180/180" in bar  # 0.05 h = 180 s
+
+
+def test_progress_lines_fit_80_columns(capsys, monkeypatch):
+    """A 72 h modulate run counts to 259200 data seconds per scheme: its lines (the longest
+    built-in name, "four-position-12 3/4") stay within 80 columns; a longer description is
+    shortened with "…" rather than wrapping the line."""
+    from gcalign.cli.common import ProgressBar
+
+    monkeypatch.setenv("GCALIGN_PROGRESS", "always")
+    monkeypatch.setenv("COLUMNS", "80")
+    with ProgressBar("modulate") as bar:
+        for what in ("fixed 1/4", "four-position-12 3/4",
+                     "a-scheme-name-far-longer-than-any-built-in-one 4/4"):
+            bar(100270, 259200, what)
+            bar.bar.refresh()  # draw this state now (rich redraws ten times a second)
+    err = ANSI.sub("", capsys.readouterr().err).replace("\r", "\n")
+    lines = [x for x in err.splitlines() if "━" in x]
+    assert lines and all(len(x) <= 80 for x in lines), lines
+    assert any("four-position-12 3/4" in x and "100270/259200" in x for x in lines), lines
+    long = [x for x in err.splitlines() if "a-scheme-name" in x]
+    assert long and all("…" in x and "━" in x for x in long), long  # shortened, not wrapped
 
 
 def test_observability_reports_its_stages(tmp_path, monkeypatch):

@@ -21,8 +21,8 @@ from gcalign.modulate.terms import ErrorTerms
 from gcalign.units import ARCSEC
 
 
-def _render(summary: dict) -> str:
-    console = Console(width=200, record=True, file=open("/dev/null", "w"))  # noqa: SIM115
+def _render(summary: dict, width: int = 200) -> str:
+    console = Console(width=width, record=True, file=open("/dev/null", "w"))  # noqa: SIM115
     console.print(modulate_table(summary))
     return console.export_text()
 
@@ -78,7 +78,25 @@ def test_ratios_to_fixed_from_the_stored_series(short_run):
                                                                              rel=1e-9)
     assert q["rms"] == pytest.approx(rms["fixed"] / rms["seed-12"], rel=1e-9)
     assert 2.0 < q["last_hour"] < 4.5 and 2.0 < q["max"] < 4.5
-    assert "fixed ÷" in _render(s) and f"{q['last_hour']:.3g}/{q['max']:.3g}/" in _render(s)
+    row = next(x for x in _render(s).splitlines() if x.strip().startswith("seed-12")
+               and "fixed" not in x and f"{q['last_hour']:.3g}" in x)
+    assert row.split()[-3:] == [f"{q[k]:.3g}" for k in ("last_hour", "max", "rms")], row
+    assert "fixed ÷ at 2.5 h" in _render(s)
+
+
+def test_no_number_cut_at_80_columns(short_run):
+    """The 72 h table's columns (five report hours, max, linear model, three ratios) at 80
+    columns: every cell whole, no "…" (rich shortens cells that do not fit)."""
+    s, _ = short_run
+    s = {**s, "report_hours": [1.0, 4.0, 12.0, 24.0, 72.0],
+         "schemes": {n: {**r, "horizontal_error_m": {f"{h:g}h": 79609.0 for h in
+                                                       (1, 4, 12, 24, 72)},
+                         "max_horizontal_error_m": 79613.0}
+                     for n, r in s["schemes"].items()}}
+    text = _render(s, width=80)
+    assert "…" not in text, text
+    assert max(len(x) for x in text.splitlines()) <= 80
+    assert "79,609" in text and "79,613" in text
 
 
 def test_an_unrotated_scheme_has_no_cycle(short_run):

@@ -58,14 +58,16 @@ def sim(tmp_path_factory):
 
 
 def _forward_combination(c, s):
-    """The unit vector of (φ = d, μ = C(μ)ᵀ e_y) in the P0-scaled states (the closed form
-    of the roll axis' unobservable combination), d the forward axis at heading 30°."""
-    from gcalign.nav.rotation import quat_to_dcm, rotvec_to_quat
+    """The unit vector of (φ = d, μ = J_l(μ)⁻¹ e_y) in the P0-scaled states, d the forward
+    axis at heading 30°: the tangent of the roll axis' unobservable set. Turning the slave
+    by s about d, C_m C(μ') = exp([s d×]) C_m C(μ), gives C(μ') = exp([s e_y×]) C(μ), whose
+    rotation vector moves by s J_l(μ)⁻¹ e_y = s (e_y − ½ μ × e_y + …)."""
+    from gcalign.transfer.model import left_jacobian_inv
 
     x = dict.fromkeys(s["states"], 0.0)
     yaw = np.radians(30.0)
     x["phiE"], x["phiN"] = -np.sin(yaw), np.cos(yaw)
-    x.update(zip(MU, quat_to_dcm(rotvec_to_quat(c.mu)).T @ [0.0, 1.0, 0.0], strict=True))
+    x.update(zip(MU, left_jacobian_inv(c.mu) @ [0.0, 1.0, 0.0], strict=True))
     y = np.array([x[n] / s["sigma0"][n] for n in s["states"]])
     return y / np.linalg.norm(y)
 

@@ -137,9 +137,23 @@ def _sk(v):
     return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
 
 
+def _jl_inv(a):
+    """SO(3)'s inverse left Jacobian in its axis-angle form (Barfoot, eq. 7.77):
+    (θ/2) cot(θ/2) I + (1 − (θ/2) cot(θ/2)) u uᵀ − (θ/2) [u×]."""
+    th = np.linalg.norm(a)
+    if th == 0.0:  # the first epoch: μ̂ = θ̂ = 0
+        return np.eye(3)
+    u = a / th
+    c = 0.5 * th / np.tan(0.5 * th)
+    return c * np.eye(3) + (1 - c) * np.outer(u, u) - 0.5 * th * _sk(u)
+
+
 def _demo_loop(t_end: float):
     """PSINS's demo as it reads (qupdt, cnscl, kfupdate in the plain form), with the flexure
-    discretised as Φ = expm(F T), Q_d = G Q Gᵀ T (not Van Loan)."""
+    discretised as Φ = expm(F T), Q_d = G Q Gᵀ T (not Van Loan), and with our attitude
+    measurement and reset (docs/decisions/019): H(φ rows, μ and θ) = −C_m of the master,
+    H(φ, φ) = J_l(a)⁻¹ with a = C_m (μ̂ + θ̂), the predicted measurement −a, and φ̂ fed into
+    the slave after each update (qdelphi) with P ← G P Gᵀ, G(φ, φ) = I + ½[φ̂×]."""
     d = _mat()
     m, f = d["mimu"], d["fogavp"]
     a, b = 6378137.0, 1 / 298.257223563
@@ -196,20 +210,29 @@ def _demo_loop(t_end: float):
             continue
         qm, vnm, posm = _a2qua(f[i, :3]), f[i, 3:6], f[i, 6:9]
         wnin, gcc = eth(posm, vnm)
+        Cm = _q2mat(qm)
+        amount = Cm @ (x[12:15] + x[15:18])
         H = np.zeros((6, n))
         H[:, :6] = np.eye(6)
-        H[:3, 12:15] = H[:3, 15:18] = -C
+        H[:3, :3] = _jl_inv(amount)
+        H[:3, 12:15] = H[:3, 15:18] = -Cm
         qerr = _q_mul(qm, qs * np.array([1, -1, -1, -1]))  # qq2phi: q2rv(qnb ⊗ qpb*)
         qerr = qerr * np.sign(qerr[0])
         phi = 2 * np.arctan2(np.linalg.norm(qerr[1:]), qerr[0]) * qerr[1:] / \
             np.linalg.norm(qerr[1:])
         z = np.r_[phi, vs - vnm]
         Kk = P @ H.T @ np.linalg.inv(H @ P @ H.T + R)
-        x = x + Kk @ (z - H @ x)
+        # x̂'s φ is zero here (reset at every update, biases fed back): h(x̂) = [−a; δv̂]
+        x = x + Kk @ (z - np.r_[-amount, x[3:6]])
         P = (np.eye(n) - Kk @ H) @ P
         P = 0.5 * (P + P.T)
         ebdb = ebdb + x[6:12]
         x[6:12] = 0
+        qs = _q_mul(_rv2q(x[:3]), qs)  # qdelphi: C_nb = (I + [φ̂×]) C_nb,est
+        G = np.eye(n)
+        G[:3, :3] += 0.5 * _sk(x[:3])
+        P = G @ P @ G.T
+        x[:3] = 0
     return np.r_[x[:6], ebdb, x[12:]], np.sqrt(np.diag(P))
 
 

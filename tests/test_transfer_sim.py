@@ -5,10 +5,11 @@ The cases of :mod:`gcalign.transfer.simulate`: 12 m/s, heading 30°, roll ±20°
 error from 0.1° independently of μ; master noise 1′ and 0.02 m/s at 10 Hz, the filter's R
 set to it. What the linear model leaves out, and so what a consistency test must avoid:
 
-* no attitude feedback: the slave's attitude error stays as large as μ, and the
-  second-order term ½ φ × (φ × f), ≈ g|φ|²/2 ≈ 1e-3 m/s² at 1.5°, shows as several σ of ∇z;
-* starting from the master's attitude (the demo): φ0 = −C_nb μ exactly, a correlation P0
-  does not carry (NEES 17–21 over the first 5 s, 30 runs);
+* under attitude matching alone, the unmeasured vertical velocity carries g(1 − cos φ) of
+  the unobservable forward-axis attitude error (about 1°): NEES 20.5 over 30 runs from the
+  demo's start, every state in band (docs/decisions/019);
+* starting from the master's attitude with a tight P0: φ0 = −C_nb μ exactly, a correlation
+  P0 does not carry (NEES 17–21 over the first 5 s, 30 runs);
 * a 1° initial φ0 with 500 °/h gyro biases: φ and μ stay confused (σ ≈ 1°) for seconds
   while ε acts through C_nb,est instead of C_nb, an error of |φ|·|ε| ≈ 4e-5 rad/s
   (NEES 21–26 over the first 5 s, back to 15–16 at 15 s).
@@ -75,6 +76,51 @@ def test_monte_carlo_nees_in_its_chi2_band_60s():
     _check_nees(_monte_carlo(30, 60.0), 30)
 
 
+def _mc_module():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "docs" / "transfer_monte_carlo.py"
+    spec = importlib.util.spec_from_file_location("transfer_monte_carlo", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("start", ["wide", "tight"])
+@pytest.mark.parametrize("matching", ["attitude+velocity", "velocity", "attitude"])
+@pytest.mark.parametrize("feedback", [True, False])
+def test_every_state_consistent_in_every_mode(matching, feedback, start):
+    """30 seeded runs of 20 s per mode (docs/transfer_monte_carlo.py, the table of
+    docs/results_transfer.md): the mean over the runs of each state's (e/σ)² at the end is
+    a mean of 30 χ²₁ for a consistent filter. Band: two-sided, 1 % for the whole family of
+    12 modes × 15 states (each 1 − 0.01/180: 0.37–2.23). Before the exact attitude
+    measurement and the covariance reset (docs/decisions/019), attitude matching from the
+    demo's start gave μ y 21.5 and φ E, N 21; without attitude feedback ∇ z 155.
+    The NEES of the 15 states, a mean of 30 χ²₁₅, in its band of the same family level
+    where the velocity is matched; under attitude matching alone the unmeasured vertical
+    velocity carries g(1 − cos φ) of the unobservable forward-axis attitude error (≈ 1°,
+    1.5 mm/s²), which the linear model leaves out: its NEES (20.5, with a 0.1° mounting
+    15.2) is held to 25 only."""
+    mc = _mc_module().monte_carlo(matching, feedback, start, runs=30, duration=20.0)
+    cells = 12 * 15
+    a = 0.01 / cells / 2
+    lo, hi = chi2.ppf([a, 1 - a], 30) / 30
+    z2 = mc["z2"].mean(axis=0)
+    from gcalign.transfer.filter import NAMES_15
+
+    bad = {n: round(float(v), 2) for n, v in zip(NAMES_15, z2, strict=True)
+           if not lo < v < hi}
+    assert not bad, (bad, (round(lo, 2), round(hi, 2)))
+    a12 = 0.01 / 12 / 2
+    lo15, hi15 = chi2.ppf([a12, 1 - a12], 30 * 15) / 30
+    if matching == "attitude":
+        assert mc["nees"].mean() < 25.0, mc["nees"].mean()
+    else:
+        assert lo15 < mc["nees"].mean() < hi15, (mc["nees"].mean(), (lo15, hi15))
+
+
 def test_mu_and_gyro_bias_converge_to_the_injected_values():
     for seed in (1, 2, 3):
         c, r = _run(seed)
@@ -89,7 +135,7 @@ def test_mu_and_gyro_bias_converge_to_the_injected_values():
 
 def _demo_start(matching: str):
     """The demo's start: the slave from the master's attitude, φ's P0 10° (a P0 of 0.1°
-    would itself bound μ along the roll axis to about 6′ under attitude matching)."""
+    would itself bound μ along the roll axis under attitude matching)."""
     c = transfer_case(np.random.default_rng(1), duration=20.0, phi0_sigma=10 * DEG)
     s = replace(c.settings, matching=matching, attitude_feedback=True)
     return transfer_align(c.dtheta, c.dv, c.t, c.master, s)
@@ -102,9 +148,13 @@ def test_velocity_matching_leaves_mu_at_its_p0():
 
 
 def test_attitude_matching_leaves_roll_axis_mu_poorly_observed():
+    """The drive rolls about the body's forward axis at a constant heading: μ y and the
+    attitude error about that axis cancel in the measurement, only the earth rate tells
+    them apart, and the filter keeps σ(μ y) near its 60′ prior (measured 54.3′; 13′ with
+    the mechanised attitude in H, which learnt what no data show: docs/decisions/019)."""
     r = _demo_start("attitude")
     sig = r.sigma[-1, 12:15] / ARCMIN
-    assert sig[1] > 10.0, sig  # the roll axis (body y, forward)
+    assert sig[1] > 45.0, sig  # the roll axis (body y, forward)
     assert sig[0] < 1.0 and sig[2] < 1.0, sig
 
 

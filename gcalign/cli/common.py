@@ -32,6 +32,7 @@ import hashlib
 import inspect
 import os
 import re
+import shutil
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -407,13 +408,17 @@ class ProgressBar:
     def _start(self):
         from rich.console import Console
         from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn
+        from rich.table import Column
 
-        # one line of 80 columns (a pipe or a log has no width): what, how far, how long
+        # one line of at most 80 columns (a pipe or a log has no width): what, how far, how
+        # long; a description too long for it is shortened with "…" (_update), not wrapped
+        self.width = min(80, shutil.get_terminal_size((80, 24)).columns)
         self.bar = Progress(
-            TextColumn(f"[bold]{self.title}[/bold] {{task.description}}"),
-            BarColumn(bar_width=20), TaskProgressColumn(),
+            TextColumn(f"[bold]{self.title}[/bold] {{task.description}}",
+                       table_column=Column(no_wrap=True)),
+            BarColumn(bar_width=16), TaskProgressColumn(),
             TextColumn("{task.completed:.0f}/{task.total:.0f}"), _time_column(),
-            console=Console(stderr=True, force_terminal=self.force or None),
+            console=Console(stderr=True, force_terminal=self.force or None, width=self.width),
             transient=not self.force,
             # sys.stdout and sys.stderr left as they are: a module imported during the run
             # (colorama's init) must not keep rich's wrapper of them
@@ -464,7 +469,12 @@ class ProgressBar:
             for other in self.tasks.values():  # a new stage: the earlier ones are done
                 task = self.bar.tasks[other]
                 self.bar.update(other, completed=task.total)
-            self.tasks[what] = self.bar.add_task(what, total=total)
+            # the rest of the line: title, bar 16, "100%", done/total, "0:00:00 so far" and
+            # the spaces between them
+            rest = len(self.title) + 1 + 16 + 4 + 2 * len(f"{total:.0f}") + 1 + 14 + 4
+            room = max(8, self.width - rest)
+            shown = what if len(what) <= room else what[:room - 1] + "…"
+            self.tasks[what] = self.bar.add_task(shown, total=total)
         self.bar.update(self.tasks[what], completed=min(done, total), total=total)
 
     def close(self) -> None:

@@ -21,6 +21,25 @@ from gcalign.nav._kernels import attitude_update, specific_force_increment
 Array = NDArray[np.float64]
 
 
+@njit(cache=True, inline="always")
+def _step(q: Array, v: Array, dtheta: Array, dv: Array, k: int, fed: Array, g_cc: Array,
+          ts: float, wx: float, wy: float,
+          wz: float) -> tuple[float, float, float, float, float, float, float]:
+    """One strapdown step of sample k, in place on q (4,) and v (3,), the increments
+    corrected by the biases fed back. Returns the attitude at its start (q0 … q3) and its
+    Δv^n (fx, fy, fz)."""
+    bx, by, bz = dtheta[k, 0] - fed[0] * ts, dtheta[k, 1] - fed[1] * ts, \
+        dtheta[k, 2] - fed[2] * ts
+    dx, dy, dz = dv[k, 0] - fed[3] * ts, dv[k, 1] - fed[4] * ts, dv[k, 2] - fed[5] * ts
+    q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
+    fx, fy, fz = specific_force_increment(q0, q1, q2, q3, bx, by, bz, dx, dy, dz, wx, wy, wz)
+    v[0] += fx + g_cc[0] * ts
+    v[1] += fy + g_cc[1] * ts
+    v[2] += fz + g_cc[2] * ts
+    q[0], q[1], q[2], q[3] = attitude_update(q0, q1, q2, q3, bx, by, bz, wx, wy, wz)
+    return q0, q1, q2, q3, fx, fy, fz
+
+
 @njit(cache=True)
 def propagate(q: Array, v: Array, x: Array, P: Array, dtheta: Array, dv: Array, k_from: int,
               k_to: int, fed: Array, w_in: Array, g_cc: Array, ts: float, Phi: Array,
@@ -33,10 +52,7 @@ def propagate(q: Array, v: Array, x: Array, P: Array, dtheta: Array, dv: Array, 
     dv_n[:] = 0.0
     wx, wy, wz = w_in[0] * ts, w_in[1] * ts, w_in[2] * ts
     for k in range(k_from, k_to):
-        bx, by, bz = dtheta[k, 0] - fed[0] * ts, dtheta[k, 1] - fed[1] * ts, \
-            dtheta[k, 2] - fed[2] * ts
-        dx, dy, dz = dv[k, 0] - fed[3] * ts, dv[k, 1] - fed[4] * ts, dv[k, 2] - fed[5] * ts
-        q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
+        q0, q1, q2, q3, fx, fy, fz = _step(q, v, dtheta, dv, k, fed, g_cc, ts, wx, wy, wz)
         C_nb[0, 0] = q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3
         C_nb[0, 1] = 2 * (q1 * q2 - q0 * q3)
         C_nb[0, 2] = 2 * (q1 * q3 + q0 * q2)
@@ -46,15 +62,9 @@ def propagate(q: Array, v: Array, x: Array, P: Array, dtheta: Array, dv: Array, 
         C_nb[2, 0] = 2 * (q1 * q3 - q0 * q2)
         C_nb[2, 1] = 2 * (q2 * q3 + q0 * q1)
         C_nb[2, 2] = q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3
-        fx, fy, fz = specific_force_increment(q0, q1, q2, q3, bx, by, bz, dx, dy, dz,
-                                              wx, wy, wz)
         dv_n[0] += fx
         dv_n[1] += fy
         dv_n[2] += fz
-        v[0] += fx + g_cc[0] * ts
-        v[1] += fy + g_cc[1] * ts
-        v[2] += fz + g_cc[2] * ts
-        q[0], q[1], q[2], q[3] = attitude_update(q0, q1, q2, q3, bx, by, bz, wx, wy, wz)
         # spec 006: Φ(φ,φ) = I − [ω_in T×], Φ(δv,φ) = [Δv^n×], Φ(φ,ε) = −C_nb T, Φ(δv,∇) = C_nb T
         Phi[0, 1], Phi[0, 2], Phi[1, 2] = wz, -wy, wx
         Phi[1, 0], Phi[2, 0], Phi[2, 1] = -wz, wy, -wx
@@ -68,3 +78,12 @@ def propagate(q: Array, v: Array, x: Array, P: Array, dtheta: Array, dv: Array, 
         Pn = Phi @ P @ Phi.T + Qd
         P[:, :] = 0.5 * (Pn + Pn.T)
 
+
+@njit(cache=True)
+def mechanise(q: Array, v: Array, dtheta: Array, dv: Array, k_from: int, k_to: int,
+              fed: Array, w_in: Array, g_cc: Array, ts: float) -> None:
+    """The strapdown steps of :func:`propagate` alone, in place on q (4,), v (3,): the
+    slave's own solution when the filter's corrections are not fed back into it."""
+    wx, wy, wz = w_in[0] * ts, w_in[1] * ts, w_in[2] * ts
+    for k in range(k_from, k_to):
+        _step(q, v, dtheta, dv, k, fed, g_cc, ts, wx, wy, wz)

@@ -30,12 +30,20 @@ Measurement at every master epoch (demo ``kfupdate(kf, [qq2phi(qnbs,qnbm); vns�
     z = [φ_meas; v_slave − v_master − C_nb (ω_ib^b × l)],   φ_meas = qq2phi(q_slave, q_master)
 
 ``qq2phi`` is our :func:`gcalign.nav.rotation.misalignment_q`: the slave's true attitude is
-``q_master ⊗ q(μ + θ)`` (the data's ``qnb_mems = qnb_fog ∘ rv2q(mu0)``), so
-``φ_meas = φ − C_nb (μ + θ)`` and ``H = [I₆ 0]`` with ``H(φ rows, μ) = H(φ rows, θ) = −C_nb``.
-The lever arm l (body frame, m, from the master to the slave) is zero in the demo. The
-update is the Joseph form of :func:`gcalign.estimation.kalman.update` (the demo's
-``kfupdate``); bias feedback after every update (``ebdb += x(ε,∇); x(ε,∇) = 0``), attitude
-feedback optional (the demo's commented line ``qnbs = qdelphi(qnbs, x(φ)); x(φ) = 0``).
+``q_master ⊗ q(μ + θ)`` (the data's ``qnb_mems = qnb_fog ∘ rv2q(mu0)``), so to first order
+``φ_meas = φ − C_m (μ + θ)``. We take it exactly about the estimate
+(:func:`gcalign.transfer.model.attitude_measurement`, ``h = −rotvec(exp(−[φ̂×]) exp([a×]))``,
+``a = C_m (μ̂ + θ̂)``) with ``H(φ rows, φ) = J_l(a)⁻¹`` and ``H(φ rows, μ) = H(φ rows, θ)
+= −C_m``, C_m the master's attitude; the demo's ``−C_nb`` of the mechanised slave turns
+with every attitude correction and made the filter learn the roll-axis mounting that no
+data show (docs/decisions/019). The lever arm l (body frame, m, from the master to the
+slave) is zero in the demo. The update is the Joseph form of
+:func:`gcalign.estimation.kalman.update` (the demo's ``kfupdate``); bias feedback after
+every update (``ebdb += x(ε,∇); x(ε,∇) = 0``); φ̂ reset into the filter's attitude after
+every update (the demo's commented ``qnbs = qdelphi(qnbs, xk(1:3))``) with the covariance
+carried, ``P ← G P Gᵀ``, ``G(φ,φ) = I + ½[φ̂×]``. With attitude feedback off the slave's
+own solution runs free beside the filter's and φ̂, δv̂ are reported as its corrections
+(decision 019: the estimates do not depend on the switch).
 """
 
 from __future__ import annotations
@@ -54,11 +62,13 @@ from gcalign.nav.rotation import (
     misalignment_q,
     quat_conj,
     quat_mult,
+    quat_to_dcm,
     quat_to_euler,
     quat_to_rotvec,
     rotvec_to_quat,
+    skew,
 )
-from gcalign.transfer.model import measurement_matrix
+from gcalign.transfer.model import attitude_measurement, measurement_matrix
 from gcalign.units import ARCMIN, DEG, DPH, DPSH, G0, UG, UGPSHZ
 
 MATCHINGS = ("attitude+velocity", "velocity", "attitude")
@@ -103,7 +113,9 @@ class TransferSettings:
     matching : "attitude+velocity" | "velocity" | "attitude" (rows of z used).
     flexure : add θ, ω (21 states; the demo does).
     bias_feedback : feed ε̂, ∇̂ into the compensation after every update (the demo).
-    attitude_feedback : correct the slave attitude by φ̂ after every update (demo: off).
+    attitude_feedback : correct the slave's own attitude by φ̂ after every update (demo:
+        off). The filter linearises about its corrected attitude either way (decision 019);
+        off keeps the slave's solution free and reports φ̂, δv̂ as its corrections.
     lever_arm_b : (3,) m, slave position relative to the master, body frame.
     p0_sigma : (21,) initial σ (the first 15 without flexure).
     r_sigma : (6,) measurement σ, rad ×3 then m/s ×3.
@@ -224,16 +236,27 @@ class TransferResult:
 
     def convergence_s(self) -> dict[str, float]:
         """Per state, the first time (s from the start) after which the estimate stays
-        within 2σ of its final value."""
+        within 2σ of its final value, σ the final one."""
         return convergence_times(self.t - self.t0, self.x, self.sigma, self.names)
 
 
 def convergence_times(t: np.ndarray, x: np.ndarray, sigma: np.ndarray,
                       names: Sequence[str]) -> dict[str, float]:
-    """First time after which ``|x_k − x_final| ≤ 2 σ_k`` for every later k, per state."""
+    """First time after which ``|x_k − x_final| ≤ 2 σ_final`` for every later k, per state.
+
+    Against the final σ, not the running one: a state whose σ starts wide (500 °/h) and
+    shrinks while the estimate moves into place never leaves a band of its running 2σ,
+    which would put it at the first epoch.
+
+    >>> import numpy as np
+    >>> t = np.arange(5.0)
+    >>> x = np.array([[9.0], [5.0], [1.5], [1.0], [1.0]])
+    >>> convergence_times(t, x, np.array([[100.0], [50.0], [1.0], [0.5], [0.5]]), ["a"])
+    {'a': 2.0}
+    """
     out = {}
     for i, n in enumerate(names):
-        outside = np.nonzero(np.abs(x[:, i] - x[-1, i]) > 2.0 * sigma[:, i])[0]
+        outside = np.nonzero(np.abs(x[:, i] - x[-1, i]) > 2.0 * sigma[-1, i])[0]
         out[n] = float(t[0] if len(outside) == 0 else t[min(outside[-1] + 1, len(t) - 1)])
     return out
 
@@ -367,29 +390,51 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
     out_C, out_f, out_w, out_dt = np.zeros((K, 3, 3)), np.zeros((K, 3)), np.zeros((K, 3)), \
         np.zeros(K)
     C_nb, dv_n = np.zeros((3, 3)), np.zeros(3)
+    # without attitude feedback the slave's own solution runs free beside the filter's
+    # corrected one (decision 019): the filter linearises about its best attitude always
+    q_free, v_free = q_s.copy(), v_s.copy()
     k_prev = k0 + 1
     for j, k in enumerate(k_meas):
         # mechanisation and prediction over the IMU samples up to this epoch (the kernel)
+        if not s.attitude_feedback:
+            _kernel.mechanise(q_free, v_free, dtheta, dv, k_prev, k + 1, fed, w_in, g_cc, ts)
         _kernel.propagate(q_s, v_s, x, P, dtheta, dv, k_prev, k + 1, fed, w_in, g_cc, ts,
                           Phi, Qd, C_nb, dv_n)
         out_dt[j] = (k + 1 - k_prev) * ts
         out_C[j], out_f[j], out_w[j] = C_nb, dv_n / out_dt[j], w_in
         k_prev = k + 1
         w_in, g_cc = earth_terms(pm_meas[j], vm_meas[j])
-        H = measurement_matrix(C_nb, "attitude+velocity", n)
         omega_ib_b = dtheta[k] / ts - fed[:3]
         v_lever = C_nb @ np.cross(omega_ib_b, lever)
-        phi_meas = (misalignment_q(q_s, qm_meas[j]) if qm_meas is not None else np.zeros(3))
-        z = np.concatenate([phi_meas, v_s - vm_meas[j] - v_lever])
+        z_v = v_s - vm_meas[j] - v_lever
+        if qm_meas is not None:
+            # the exact attitude measurement about the estimate, linear in μ through the
+            # master's attitude (model.attitude_measurement; decision 019)
+            C_m = quat_to_dcm(qm_meas[j])
+            mount_n = C_m @ (x[MU] + (x[TH] if s.flexure else 0.0))
+            H = measurement_matrix(C_m, "attitude+velocity", n, mount_n)
+            h_phi = attitude_measurement(x[PHI], mount_n)
+            # z − h(x̂) + H x̂: the update's innovation is then z − h(x̂)
+            z = np.concatenate([misalignment_q(q_s, qm_meas[j]) - h_phi + H[0:3] @ x, z_v])
+        else:
+            H = measurement_matrix(C_nb, "attitude+velocity", n)
+            z = np.concatenate([np.zeros(3), z_v])
         u = update(x, P, z[rows], H[rows], R)
         x, P = u.x, u.P
         if s.bias_feedback:  # demo: ebdb = ebdb + kf.xk(7:12); kf.xk(7:12) = 0
             fed = fed + x[BIASES]
             x[BIASES] = 0.0
-        if s.attitude_feedback:  # demo (commented): qnbs = qdelphi(qnbs, xk(1:3))
-            q_s[:] = quat_mult(rotvec_to_quat(x[PHI]), q_s)
-            x[PHI] = 0.0
-        q_corr = quat_mult(rotvec_to_quat(x[PHI]), q_s)  # C_nb = (I + [φ̂×]) C_nb,est
+        # attitude reset (the demo's commented qnbs = qdelphi(qnbs, xk(1:3))), with the
+        # covariance carried to the new error: exp([φ'×]) = exp([φ×]) exp(−[φ̂×]) gives
+        # φ' = e + ½ φ̂ × e to first order in e = φ − φ̂, so P ← G P Gᵀ, G(φ,φ) = I + ½[φ̂×]
+        phi_hat = x[PHI].copy()
+        q_s[:] = quat_mult(rotvec_to_quat(phi_hat), q_s)
+        x[PHI] = 0.0
+        G = np.eye(3) + 0.5 * skew(phi_hat)
+        P[PHI, :] = G @ P[PHI, :]
+        P[:, PHI] = P[:, PHI] @ G.T
+        P = 0.5 * (P + P.T)
+        q_corr = q_s.copy()
         rel = x[MU] + (x[TH] if s.flexure else 0.0)
         if qm_meas is not None:
             out_err[j] = misalignment_q(q_corr, quat_mult(qm_meas[j], rotvec_to_quat(rel)))
@@ -397,8 +442,15 @@ def transfer_align(dtheta: np.ndarray, dv: np.ndarray, t: np.ndarray, master: Ma
             out_err[j] = np.nan
         out_x[j] = x
         out_x[j, BIASES] += fed
+        out_v[j] = v_s
+        if not s.attitude_feedback:
+            # the estimates as corrections of the free solution: C_nb = exp([φ̂×]) C_free,
+            # δv̂ = v_free − v (v the filter's velocity, δv̂ its error about it)
+            out_x[j, PHI] = quat_to_rotvec(quat_mult(q_corr, quat_conj(q_free)))
+            out_x[j, DV] += v_free - v_s
+            out_v[j] = v_free
         out_P[j] = P
-        out_fed[j], out_nis[j], out_q[j], out_v[j] = fed, u.nis, q_corr, v_s
+        out_fed[j], out_nis[j], out_q[j] = fed, u.nis, q_corr
     return TransferResult(
         t=t_meas, x=out_x, sigma=np.sqrt(np.diagonal(out_P, axis1=1, axis2=2)), P=out_P,
         sigma0=np.asarray(s.p0_sigma[:n], dtype=float),

@@ -6,7 +6,9 @@ Pieces: the run's master epochs grouped into pieces of ``piece_s``; a piece's F 
 continuous model of the filter's per-step Φ (:func:`gcalign.transfer.model.error_matrix`,
 ``Φ = I + F T``) with the slave attitude C_nb and ω_in^n of the filter at the piece's middle
 epoch and the mean specific force of the piece's steps; its H is the matching's rows of
-``[I₆ 0]`` with ``H(φ rows, μ) = −C_nb`` at the same epoch. Windows of ``window_s`` take the
+``[I₆ 0]`` with ``H(φ rows, μ) = −C_m``, the master's attitude at the same epoch, and
+``H(φ rows, φ) = J_l(C_m μ̂)⁻¹`` (the filter's own Jacobian,
+:func:`gcalign.transfer.model.measurement_matrix`). Windows of ``window_s`` take the
 place of a flight's manoeuvres: per window and cumulative, the SOM degree η = σ_(k)/σ_0
 (seed eq. 17, σ_0 the largest of the directly measured states: φ for attitude matching, δv
 for velocity matching; columns scaled by P0 by default, docs/decisions/013), the SOM and TOM
@@ -29,10 +31,11 @@ What the model's structure says (the tests hold the command to it):
   ``F x = (−ω_in × d, f^n × d, 0, …)``, whose attitude rows vanish without the earth and
   transport rate ω_in (7e-5 rad/s): μ along the roll axis, mostly μ_y, is told from a
   constant attitude error about the forward axis only through ω_in, while μ_x, μ_z (columns
-  −C_nb e_x, −C_nb e_z that turn with the roll) are observed; δv and ∇ reach neither H's
-  attitude rows nor φ (zero columns). The filter's own C_nb, off the slave's by its
-  estimation error, separates the combination a little more than the truth does
-  (docs/decisions/014);
+  −C_m e_x, −C_m e_z that turn with the roll) are observed; δv and ∇ reach neither H's
+  attitude rows nor φ (zero columns). The filter's H takes μ through the master's attitude,
+  which turns only as the vehicle does, and its model learns nothing of the combination
+  (with the slave's mechanised C_nb, corrected at every update, it learnt what no data
+  show: docs/decisions/019);
 * attitude + velocity matching: φ along d is a tilt, which the velocity sees through
   ``f^n × φ`` (f^n ≈ g up, d horizontal): every μ is observable.
 
@@ -55,6 +58,7 @@ import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.estimation import observability as ob
+from gcalign.nav.rotation import quat_to_dcm
 from gcalign.transfer.filter import NAMES_15, TransferResult
 from gcalign.transfer.model import error_matrix, measurement_matrix
 
@@ -143,9 +147,18 @@ def pieces(result: TransferResult, piece_s: float = 1.0, matching: str | None = 
     f_n = np.add.reduceat(r.f_n * r.dt[:, None], first, axis=0) / dur[:, None]
     F = np.array([error_matrix(r.C_nb[m], f, r.omega_in_n[m])
                   for m, f in zip(middle, f_n, strict=True)])
-    H = np.array([measurement_matrix(r.C_nb[m], matching) for m in middle])
+    # the filter's own H: μ through the master's attitude, φ through J_l(C_m μ̂)⁻¹ (velocity
+    # matching, whose reference may have no attitude, uses no attitude rows)
+    H = []
+    for m in middle:
+        if np.all(np.isfinite(r.q_master[m])):
+            C_m = quat_to_dcm(r.q_master[m])
+            mount = r.x[m, 12:15] + (r.x[m, 15:18] if r.x.shape[1] == 21 else 0.0)
+            H.append(measurement_matrix(C_m, matching, mount_n=C_m @ mount))
+        else:
+            H.append(measurement_matrix(r.C_nb[m], matching))
     start = np.maximum(end[first] - r.dt[first], 0.0)  # the first is 0 (not −1e-17)
-    return Pieces(F=F, H=H, duration=dur, start=start, middle=middle, last=last)
+    return Pieces(F=F, H=np.array(H), duration=dur, start=start, middle=middle, last=last)
 
 
 def transfer_observability(result: TransferResult, piece_s: float = 1.0,

@@ -115,17 +115,19 @@ def transfer_case(rng: np.random.Generator, duration: float = 20.0, ts: float = 
     q0_slave = quat_mult(q_true[0], rotvec_to_quat(mu))  # C_est = (I − [φ0×]) C_slave
     att0 = quat_to_euler(quat_mult(rotvec_to_quat(-phi0), q0_slave))
     base = settings or TransferSettings(flexure=False, p0_sigma=_p0(
-        phi0_sigma, mu_sigma, eb_sigma, db_sigma))
+        phi0_sigma, master_v_sigma, mu_sigma, eb_sigma, db_sigma))
     s = replace(base, arw=arw, vrw=vrw, lever_arm_b=(lever[0], lever[1], lever[2]),
                 r_sigma=(master_att_sigma,) * 3 + (master_v_sigma,) * 3)
     return TransferCase(dtheta, dv, ideal.t, master, truth, mu, eb, db, att0, lever, v_lever,
                         s)
 
 
-def _p0(phi0_sigma: float, mu_sigma: float, eb_sigma: float,
+def _p0(phi0_sigma: float, dv0_sigma: float, mu_sigma: float, eb_sigma: float,
         db_sigma: float) -> tuple[float, ...]:
-    """The demo's P0 with the case's φ, μ, ε, ∇ σ (15 states)."""
-    return ((phi0_sigma,) * 3 + (10.0,) * 3 + (eb_sigma,) * 3 + (db_sigma,) * 3
+    """The case's P0 (15 states): σ of what the case draws. The slave starts on the
+    master's velocity, so its δv0 is the master's velocity noise (the demo's 10 m/s would
+    leave an unmeasured δv, under attitude matching, at a σ 500× its error)."""
+    return ((phi0_sigma,) * 3 + (dv0_sigma,) * 3 + (eb_sigma,) * 3 + (db_sigma,) * 3
             + (mu_sigma,) * 3)
 
 

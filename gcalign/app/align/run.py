@@ -29,8 +29,8 @@ from gcalign.errors import InputError, ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import Aiding, AlignConfig
 from gcalign.nav.earth import EarthModel
-from gcalign.nav.rotation import quat_to_euler
-from gcalign.units import angle_text
+from gcalign.nav.rotation import euler_to_dcm, quat_to_euler
+from gcalign.units import DPH, DPSH, angle_text
 
 Progress = Callable[[float, float, str], None]
 
@@ -246,6 +246,82 @@ def _at_rest_warnings(sc: Scenario, stream: Stream, tl: Timeline, data: Window) 
             "file, path, format})"]
 
 
+#: The heading is out of reach when the gyrocompass's heading floor (the horizontal gyro
+#: drift over the horizontal earth rate) or its noise over the window passes this.
+HEADING_REACH_RAD = math.radians(1.0)
+
+
+def _reach_text(what: str, drift: float, omega_h: float, lat: float) -> str:
+    floor = drift / omega_h
+    floor_text = (f"a gyrocompass heading floor of ε/(ω_ie cos L) = {math.degrees(floor):.3g}°"
+                  if floor < 0.5 else f"{floor:.3g}× the rate it must measure: no heading")
+    return (f"the heading is out of reach of these gyros: {what} {drift / DPH:.3g} °/h "
+            f"against the horizontal earth rate ω_ie cos L = {omega_h / DPH:.3g} °/h at "
+            f"{math.degrees(lat):.1f}°, {floor_text}; the yaw is not a measurement")
+
+
+def heading_reach_warnings(sc: Scenario, stream: Stream, tl: Timeline, data: Window,
+                           reference) -> list[str]:
+    """Can the gyros find north at all? A gyrocompass takes the heading from the horizontal
+    earth rate Ω = ω_ie cos L; a horizontal gyro drift ε leaves a heading error of ε/Ω
+    (rad) whatever the loops do, and white gyro noise N one of about N/(Ω √T) over a
+    window of T s. One line with the numbers when either passes 1°:
+
+    * the grade, for simulated data: the scenario's gyro bias, turned into n at the true
+      attitude at T1 (its horizontal part), and its ARW;
+    * the data, for a recording with a reference attitude: the gyros strapped down from the
+      reference's attitude at T1 (with ω_ie and the transport rate of the reference's mean
+      velocity) drift from the reference by φ at T2; its horizontal part over T is the
+      drift the loops would meet.
+    """
+    lat, earth, ts = float(stream.site[0]), stream.earth, stream.ts
+    omega_h = earth.omega_ie * math.cos(lat)
+    T = (tl.i2 - tl.i1) * ts
+    if T <= 0 or omega_h <= 0:
+        return []
+    out = []
+    if stream.truth0 is not None and data.truth is not None and sc.imu is not None:
+        err = sc.imu.errors().gyro
+        C_nb = euler_to_dcm(data.truth.att[int(np.searchsorted(data.truth.samples, tl.i1))
+                                           if len(data.truth.samples) else 0])
+        eps_n = C_nb @ np.asarray(err.bias, dtype=float)
+        drift = float(np.hypot(eps_n[0], eps_n[1]))
+        if drift / omega_h > HEADING_REACH_RAD:
+            out.append("imu.gyro.bias_dph: " + _reach_text(
+                "its bias has a horizontal part of", drift, omega_h, lat))
+        arw = float(np.max(err.noise))
+        noise = arw / (omega_h * math.sqrt(T))
+        if noise > HEADING_REACH_RAD and not out:
+            out.append(f"imu.gyro.arw_dprh: the heading is out of reach of these gyros: ARW "
+                       f"{arw / DPSH:.3g} °/√h over the {T:.4g} s window against the "
+                       f"horizontal earth rate ω_ie cos L = {omega_h / DPH:.3g} °/h leaves a "
+                       f"heading noise of about ARW/(ω_ie cos L √T) = "
+                       f"{math.degrees(noise):.3g}°; the yaw is not a measurement")
+    elif reference is not None and getattr(reference, "att", None) is not None:
+        from gcalign.io.recorded import reference_at
+        from gcalign.nav.rotation import euler_to_quat, misalignment_q
+        from gcalign.nav.strapdown import integrate_attitude
+
+        t_a, t_b = stream.t0 + tl.i1 * ts, stream.t0 + tl.i2 * ts
+        try:
+            att, v_n, pos = reference_at(reference, np.array([t_a, t_b]), tol=1e-6)
+        except ScenarioError:
+            return []
+        k = slice(tl.i1 - tl.lo, tl.i2 - tl.lo)
+        v = 0.5 * (v_n[0] + v_n[1])
+        w_in = earth.omega_ie_n(lat) + earth.omega_en_n(lat, float(pos[0, 2]), v)
+        q = integrate_attitude(euler_to_quat(att[0]), data.dtheta[k], ts, w_in)[-1]
+        phi = misalignment_q(q, euler_to_quat(att[1]))
+        drift = float(np.hypot(phi[0], phi[1])) / T
+        if drift / omega_h > HEADING_REACH_RAD:
+            name = sc.reference.path.name if sc.reference is not None else "the reference"
+            out.append(f"reference ({name}): " + _reach_text(
+                f"strapped down from the reference's attitude over the {T:.4g} s window, "
+                f"the gyros drift from it by {math.degrees(float(np.hypot(phi[0], phi[1]))):.3g}° "
+                "horizontally, a horizontal drift of", drift, omega_h, lat))
+    return out
+
+
 def _scenario_error(err: InputError) -> ScenarioError:
     """The core's refusal, naming the scenario field it comes from."""
     names = {"site": "site.lat_deg", "coarse": "align.coarse.method", "passes": "align.stages"}
@@ -285,6 +361,7 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
                                             stream.earth)
         if cfg.aiding.source == "none" and stream.truth0 is None:  # recorded: at rest?
             warnings += _at_rest_warnings(sc, stream, tl, data)
+        warnings += heading_reach_warnings(sc, stream, tl, data, reference)
         run = align(data.dtheta, data.dv, ts, stream.site, settings, earth=stream.earth,
                     position_t1=data.pos_t1, vref=data.vref,
                     vref_body=cfg.aiding.body, truth_att=data.truth,

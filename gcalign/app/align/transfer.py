@@ -291,9 +291,9 @@ def table(s: dict):
              else f"corrected slave vs master ∘ μ̂ (φ E, N, U, ′): final "
              f"{_three(e['final'])}, RMS last 10 s {_three(e['rms_last_10s'])}",
              _nis_line(s["nis"], s["epochs"]),
-             "conv. s: first time after which the estimate stays within 2σ of its final "
-             "value; PSINS: the file's eb0, db0, mu0 (PSINS's own end-of-run estimates, "
-             "not a truth)"]
+             "conv. s: first time after which the estimate stays within 2σ (the final σ) "
+             "of its final value; PSINS: the file's eb0, db0, mu0 (PSINS's own end-of-run "
+             "estimates, not a truth)"]
     if "attitude_error_vs_psins_mu0_arcmin" in s:
         e0 = s["attitude_error_vs_psins_mu0_arcmin"]
         notes.insert(1, f"corrected slave vs master ∘ PSINS mu0 (′): final "

@@ -5,7 +5,7 @@
   the truth (Fig. 2; with ``--compare``: velocity, position and both on the designed
   flight, in the paper's styles: red dashed v+p, cyan v, purple dash-dot p);
 * ``scale_factors`` -- δKg, δKa (ppm) likewise (Fig. 3);
-* ``sigma`` -- σ/σ0 of the twelve sensor errors, log scale (they span decades);
+* ``sigma`` -- σ/σ0 of the twelve sensor errors, log scale where a panel spans decades;
 * ``navigation_errors`` -- φ, δv of the corrected INS (estimate − truth) with ±3σ;
 * ``innovations`` -- standardized innovations with ±3, NEES with its χ²₂₁ band, NIS;
 * ``attitude`` -- recorded data (no truth): the INS attitude with ±3σ of φ;
@@ -154,23 +154,45 @@ def sigma_figure(runs, attrs, title: str) -> Figure:
               ("gyro scale factor δKg", "dKg"), ("accelerometer scale factor δKa", "dKa"))
     colors = ("tab:blue", "tab:orange", "tab:green")
     for ax, (label, stem) in zip(axes, groups, strict=True):
+        ratio = [r["sigma"][:, names.index(stem + a)] / r["sigma"][0, names.index(stem + a)]
+                 for r in runs for a in AXES]
+        # a group that learnt (almost) nothing, e.g. scale factors held at a 1 ppm prior:
+        # σ/σ0 would read 1.000000 on every tick; draw what was learnt, 1 − σ/σ0
+        held = min(float(np.min(x)) for x in ratio) > 0.99
         for r in runs:
             tx, xlabel = _time_axis(r["t"])
             ls = STYLE[r["measure"]]["linestyle"] if len(runs) > 1 else "-"
             for c, axis in zip(colors, AXES, strict=True):
                 i = names.index(stem + axis)
-                ax.semilogy(tx, r["sigma"][:, i] / r["sigma"][0, i], color=c, linestyle=ls,
-                            linewidth=1.0, label=f"{axis}" + (f" {r['measure']}"
-                                                              if len(runs) > 1 else ""))
+                y = r["sigma"][:, i] / r["sigma"][0, i]
+                ax.semilogy(tx, np.maximum(1.0 - y, 1e-16) if held else y, color=c,
+                            linestyle=ls, linewidth=1.0,
+                            label=f"{axis}" + (f" {r['measure']}" if len(runs) > 1 else ""))
         _segment_lines(ax, attrs["segments"], xlabel.endswith("(min)"))
-        ax.set_title(label, fontsize="medium")
-        ax.set_ylabel("σ / σ0")
+        ax.set_title(label + (" — σ within 1 % of P0" if held else ""), fontsize="medium")
+        ax.set_ylabel("1 − σ / σ0" if held else "σ / σ0")
+        if not held:
+            _plain_log_ticks(ax)
         ax.grid(True, which="both", alpha=0.3)
         legend_right(ax)
     for ax in axes[2:]:
         ax.set_xlabel(xlabel)
     suptitle(fig, title)
     return fig
+
+
+def _plain_log_ticks(ax) -> None:
+    """A log axis spanning less than a decade labels its minor ticks, and matplotlib's
+    scientific labels then round them alike ("10 × 10⁻¹" on every tick; a scale factor held
+    at its 1 ppm prior spans 0.9996–1): such a panel is drawn linear, with plain numbers."""
+    from matplotlib.ticker import ScalarFormatter
+
+    lo, hi = ax.get_ylim()
+    if lo > 0 and hi / lo < 10:
+        ax.set_yscale("linear")
+        plain = ScalarFormatter(useOffset=False)
+        plain.set_scientific(False)
+        ax.yaxis.set_major_formatter(plain)
 
 
 def navigation_figure(run, attrs, title: str) -> Figure:
@@ -236,9 +258,13 @@ def attitude_figure(run, title: str) -> Figure:
         ax.plot(tx, a, color="tab:blue", linewidth=1.0, label=name)
         ax.fill_between(tx, a - 3 * np.degrees(s), a + 3 * np.degrees(s), color="tab:blue",
                         alpha=0.15, label="±3σ")
+        # the whole curve and, where it is narrow enough to read, its band: the ±3σ of the
+        # first epochs (P0: tens of degrees in yaw) would flatten the curve
         half = run["t"] >= run["t"][0] + 0.5 * (run["t"][-1] - run["t"][0])
-        span = float(np.max(3 * np.degrees(s[half]) + np.abs(a[half] - a[-1])))
-        ax.set_ylim(a[-1] - 1.5 * span, a[-1] + 1.5 * span)
+        band = float(np.max(3 * np.degrees(s[half])))
+        lo, hi = float(np.min(a)) - band, float(np.max(a)) + band
+        pad = 0.05 * (hi - lo) if hi > lo else 0.5
+        ax.set_ylim(lo - pad, hi + pad)
         ax.set_ylabel(f"{name} (deg)")
     return finish(fig, axes, xlabel, title)
 
@@ -394,8 +420,11 @@ def figures(f, name: str) -> dict[str, Figure]:
             first, attrs, f"{name}: misalignment φ and velocity error of the corrected INS "
             f"(estimate − truth) with ±3σ ({first['measure']})")
     else:
-        figs["attitude"] = attitude_figure(first, f"{name}: INS attitude with ±3σ "
-                                                  "(zero-velocity updates)")
+        aiding = attrs.get("aiding", "")
+        how = ("zero-velocity updates" if aiding == "zero-velocity" else
+               f"{AIDED.get(first['measure'], first['measure'])} from a file" if aiding == "file"
+               else f"{first['measure']} aiding")
+        figs["attitude"] = attitude_figure(first, f"{name}: INS attitude with ±3σ ({how})")
     if first["reference_error"] is not None:
         figs["reference_errors"] = reference_figure(
             first["reference_error"], f"{name}: INS solution against the reference "

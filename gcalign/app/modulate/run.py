@@ -283,7 +283,7 @@ def run_modulate(sc: Scenario, seed: int | None = None, sink: Any = None,
     n = len(plan.entries)
     for i, entry in enumerate(plan.entries):
         group = None if root is None else root.create_group(entry.name)
-        what = f"{entry.name} ({i + 1}/{n}, data s)" if n > 1 else f"{entry.name} (data s)"
+        what = f"{entry.name} {i + 1}/{n}" if n > 1 else entry.name  # counts: data s
         stage = None if progress is None else (
             lambda done, total, _, p=progress, w=what: p(done, total, w))
         r, analyses[entry.name] = run_scheme(sc, entry, plan, seed, group, linear, stage)

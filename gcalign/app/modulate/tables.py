@@ -59,12 +59,12 @@ def _net_peak_mean(r: dict, term: str) -> str:
     return "0" if all(x == "0" for x in parts) else " / ".join(parts)
 
 
-def _ratios(r: dict) -> str:
-    """The ratios to the unrotated run: last hour / whole-run maxima / RMS."""
+def _ratios(r: dict) -> list[str]:
+    """The ratios to the unrotated run: last hour, whole-run maxima, RMS."""
     q = r.get("ratio_to_fixed")
     if not q:
-        return "—"
-    return "/".join("—" if q[k] is None else f"{q[k]:.3g}" for k in ("last_hour", "max", "rms"))
+        return ["—"] * 3
+    return ["—" if q[k] is None else f"{q[k]:.3g}" for k in ("last_hour", "max", "rms")]
 
 
 def _terms_table(rows: list[list[str]]) -> Table:
@@ -98,10 +98,17 @@ def modulate_table(s: dict) -> Group:
     for h in hours:
         pos.add_column(f"{h:g} h", justify="right")
     pos.add_column("max", justify="right")
-    pos.add_column(f"lin. {hours[-1]:g} h" if hours else "linear", justify="right")
+    # the linear model and the ratios to the unrotated run in a table of their own: with
+    # them the 72 h table is 92 columns wide, and rich cut its numbers at 80 ("2,0…")
+    cmp = Table(title="against the linear model and the unrotated run", title_justify="left",
+                header_style="bold", box=box.SIMPLE_HEAD)
+    cmp.add_column("scheme", no_wrap=True, min_width=width)
+    cmp.add_column(f"lin. {hours[-1]:g} h" if hours else "linear", justify="right")
     ratios = any(s["schemes"][n].get("ratio_to_fixed") for n in s["compare"])
     if ratios:
-        pos.add_column("fixed ÷", justify="right", no_wrap=True)
+        last = f"{hours[-1]:g} h" if hours else "end"
+        for col in (f"fixed ÷ at {last}", "fixed ÷ max", "fixed ÷ RMS"):
+            cmp.add_column(col, justify="right")
     inv = Table(title="attitude error and invariants", title_justify="left",
                 header_style="bold", box=box.SIMPLE_HEAD)
     inv.add_column("scheme", no_wrap=True, min_width=width)
@@ -116,8 +123,8 @@ def modulate_table(s: dict) -> Group:
                                           lin["final_horizontal_error_m"])
         pos.add_row(*map(Text, [name] + [metres(r["horizontal_error_m"].get(f"{h:g}h"))
                                          for h in hours]
-                         + [metres(r["max_horizontal_error_m"]), metres(lin_v)]
-                         + ([_ratios(r)] if ratios else [])))
+                         + [metres(r["max_horizontal_error_m"])]))
+        cmp.add_row(*map(Text, [name, metres(lin_v)] + (_ratios(r) if ratios else [])))
         inv.add_row(*map(Text, [
             name, {"navigation": "nav"}.get(r["reference"], r["reference"])
             if r["mechanism"] else "—",
@@ -134,7 +141,7 @@ def modulate_table(s: dict) -> Group:
         "navigation against truth at each hour (the last: the run's end); max: over every "
         "sample; lin.: the linear error model (static base) for the same errors; fixed ÷: the "
         "unrotated run's error over this scheme's: at the last hour (one instant of an "
-        "oscillating curve) / of the whole-run maxima / of the RMS over the stored rows; "
+        "oscillating curve), of the whole-run maxima, of the RMS over the stored rows; "
         "φ max: largest misalignment, E N U; "
         "T: cycle; diag C̄: mean of C_s^r over the cycle (* off-diagonal terms too); "
         "invariants, open loop: peak of |∫C e_j dt| per sensor axis, attitude excursion "
@@ -153,7 +160,7 @@ def modulate_table(s: dict) -> Group:
                          f"°/h, C̄∇ = ({', '.join(f'{x:.3g}' for x in r['residual_accel_bias_ug'])}"
                          f") µg")
     notes.append(f"output {s.get('output') or '—'}; {s['wall_s']:.1f} s")
-    tables: list[RenderableType] = [head, pos, inv]
+    tables: list[RenderableType] = [head, pos, cmp, inv]
     if term_rows:
         tables.append(_terms_table(term_rows))
     return Group(*tables, Text("\n".join(notes), style="dim"))
