@@ -7,7 +7,9 @@ noise-free simulation, coarse alignment, the 5 passes over [10, 300] s, the T2 �
 compensation, the summary and the metrics), timed in CPU (user + system) per run over
 consecutive seeds after a warm-up, one run after another as in a worker; then the floor of
 each: the passes alone on the same block (``run_passes``, its data prepared beforehand).
-Target: ≤ 25 ms CPU a run.
+Target: ≤ 25 ms CPU a run. Then the same seeds as a batch worker runs them, in chunks of 16
+(``run_chunk``: the seeds of a variant in lockstep where the tree has it), CPU per run,
+each chunk's metrics checked equal to the same seeds run one by one. Target ≤ 12 ms.
 
 ``--before DIR`` runs the same seeds in a second process on the checkout DIR (e.g. a
 ``git worktree`` of main), seed by seed in turn with this one (before, after, before, …),
@@ -31,6 +33,8 @@ from pathlib import Path
 
 SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 TARGET_RUN_MS = 25.0
+TARGET_CHUNK_MS = 12.0
+CHUNK = 16  #: runs a worker takes at a time (gcalign.app.batch.engine.CHUNK_MAX)
 HERE = Path(__file__).resolve()
 
 
@@ -56,6 +60,7 @@ class Runs:
         B.runs.warm_up("align")  # what a worker's initializer does
         rec = B.run_task(self.tasks[0])  # warm-up: JIT cache, imports, the simulation
         assert rec["status"] == "ok", rec
+        B.runs.run_chunk(self.tasks[:2])  # and the chunk's kernels, if another
 
     def passes_of(self, task: dict):
         """The floor of a run: its passes on its block (the block prepared beforehand)."""
@@ -95,6 +100,15 @@ class Runs:
         return {"run": (u1 - u0 + s1 - s0) * 1e3, "sys": (s1 - s0) * 1e3, "faults": f1 - f0,
                 "error_t3": rec["metrics"]["error_t3_deg"]}
 
+    def chunk(self, k: int) -> dict:
+        """Seeds k .. k+CHUNK-1 as one worker chunk: CPU ms per run, their metrics."""
+        u0, s0, _ = usage()
+        recs = self.B.runs.run_chunk(self.tasks[k:k + CHUNK])
+        u1, s1, _ = usage()
+        assert all(r["status"] == "ok" for r in recs), recs
+        return {"per_run": (u1 - u0 + s1 - s0) * 1e3 / len(recs),
+                "metrics": [r["metrics"] for r in recs]}
+
     def floor(self, k: int) -> dict:
         """Seed k's passes alone (its block prepared beforehand): CPU ms."""
         if not hasattr(self, "floors"):
@@ -111,7 +125,8 @@ def serve(seeds: int) -> None:
     print("ready", flush=True)
     for line in sys.stdin:
         what, k = line.split()
-        print(json.dumps(runs.run(int(k)) if what == "run" else runs.floor(int(k))), flush=True)
+        fn = {"run": runs.run, "floor": runs.floor, "chunk": runs.chunk}[what]
+        print(json.dumps(fn(int(k))), flush=True)
 
 
 class Child:
@@ -136,7 +151,7 @@ class Child:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=3 if SMOKE else 40)
+    ap.add_argument("--seeds", type=int, default=3 if SMOKE else 80)
     ap.add_argument("--before", type=Path, help="another checkout, run interleaved")
     ap.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -155,8 +170,17 @@ def main() -> None:
     for k in range(1, args.seeds + 1):
         for name, child in sides.items():
             res[name][k - 1].update(child.ask("floor", k))
+    chunks: dict[str, list[dict]] = {k: [] for k in sides}
+    singles_of = {name: {k + 1: r["error_t3"] for k, r in enumerate(rs)}
+                  for name, rs in res.items()}
+    for k in range(1, args.seeds + 1, CHUNK):
+        for name, child in sides.items():
+            chunks[name].append(child.ask("chunk", k) | {"first": k})
     for child in sides.values():
         child.close()
+    chunk_same = all(m["error_t3_deg"] == singles_of[name][c["first"] + i]
+                     for name, cs in chunks.items() for c in cs
+                     for i, m in enumerate(c["metrics"]))
     if "before" in res:  # the same seeds: the same numbers (the change keeps the results)
         same = all(a["error_t3"] == b["error_t3"]
                    for a, b in zip(res["before"], res["after"], strict=True))
@@ -173,6 +197,14 @@ def main() -> None:
         print(f"  {name:<{width}}  one run {run:6.1f} ms (system {med(name, 'sys'):4.1f} ms, "
               f"{med(name, 'faults'):5.0f} page faults)   passes alone {flo:5.1f} ms   "
               f"run / passes {run / flo:4.2f}")
+    for name, cs in chunks.items():
+        per = statistics.median(c["per_run"] for c in cs)
+        print(f"  {name:<{width}}  in chunks of {CHUNK} (as a batch worker runs them): "
+              f"{per:6.1f} ms a run (median of {len(cs)} chunks)")
+    per = statistics.median(c["per_run"] for c in chunks["after"])
+    print(f"  target: a run in a chunk ≤ {TARGET_CHUNK_MS:g} ms: "
+          f"{'OK' if per <= TARGET_CHUNK_MS else 'MISSED'}; each chunk's error at T3 that of "
+          f"the same seed run alone: {'yes' if chunk_same else 'NO'}")
     run = med("after", "run")
     print(f"  target: one run ≤ {TARGET_RUN_MS:g} ms: {'OK' if run <= TARGET_RUN_MS else 'MISSED'}"
           + ("" if "before" not in res else

@@ -131,7 +131,15 @@ class Align(Command):
         return metric
 
     def warm_up(self) -> None:
+        """A tiny run alone and two seeds in lockstep (a batch worker's two routes)."""
         warm_run(self, WARM_SCENARIO)
+        import copy
+
+        from gcalign.app.align.run import summaries_of_seeds
+        from gcalign.io.scenario import parse_scenario
+
+        summaries_of_seeds(parse_scenario(copy.deepcopy(WARM_SCENARIO), "warm-up"), [1, 2],
+                           None)
 
 
 COMMAND = Align()

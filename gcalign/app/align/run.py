@@ -334,6 +334,18 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
     with the scenario's warnings."""
     if isinstance(stream, RunData):
         stream = stream_of(stream)
+    try:
+        kw, warnings = alignment_inputs(sc, stream, progress)
+        run = align(**kw)
+    except InputError as err:
+        raise _scenario_error(err) from None
+    return replace(run, warnings=tuple(warnings))
+
+
+def alignment_inputs(sc: Scenario, stream: Stream,
+                     progress: Progress | None = None) -> tuple[dict, list[str]]:
+    """The keyword arguments of :func:`gcalign.align.gyrocompass.align` for a scenario's
+    data, and the scenario's warnings on them (InputError from the core's checks)."""
     cfg = sc.align or AlignConfig()
     kind = sc.motion.kind if sc.motion else (
         stream.header.meta.get("motion_kind") if stream.header is not None else None)
@@ -348,27 +360,24 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
         stride = sc.output.stride(1.0 / ts, stream.samples * ts)
     except ValueError as err:
         raise ScenarioError(str(err)) from None
-    try:
-        settings = settings_of(cfg, kind)
-        tl = timeline(settings, ts, stream.samples)
-        reference = sc.reference.read() if sc.reference is not None else None
-        keep = truth_samples(settings, ts, stream.samples, stride)
-        data = collect(stream, tl, cfg.aiding, progress, reference, keep,
-                       None if sc.reference is None else sc.reference.max_gap_s)
-        if settings.coarse == "analytic":
-            k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
-            warnings += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
-                                            stream.earth)
-        if cfg.aiding.source == "none" and stream.truth0 is None:  # recorded: at rest?
-            warnings += _at_rest_warnings(sc, stream, tl, data)
-        warnings += heading_reach_warnings(sc, stream, tl, data, reference)
-        run = align(data.dtheta, data.dv, ts, stream.site, settings, earth=stream.earth,
-                    position_t1=data.pos_t1, vref=data.vref,
-                    vref_body=cfg.aiding.body, truth_att=data.truth,
-                    t0=stream.t0, stride=stride, first_sample=tl.lo, samples=stream.samples)
-    except InputError as err:
-        raise _scenario_error(err) from None
-    return replace(run, warnings=tuple(warnings))
+    settings = settings_of(cfg, kind)
+    tl = timeline(settings, ts, stream.samples)
+    reference = sc.reference.read() if sc.reference is not None else None
+    keep = truth_samples(settings, ts, stream.samples, stride)
+    data = collect(stream, tl, cfg.aiding, progress, reference, keep,
+                   None if sc.reference is None else sc.reference.max_gap_s)
+    if settings.coarse == "analytic":
+        k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
+        warnings += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
+                                        stream.earth)
+    if cfg.aiding.source == "none" and stream.truth0 is None:  # recorded: at rest?
+        warnings += _at_rest_warnings(sc, stream, tl, data)
+    warnings += heading_reach_warnings(sc, stream, tl, data, reference)
+    kw = dict(dtheta=data.dtheta, dv=data.dv, ts=ts, site=stream.site, settings=settings,
+              earth=stream.earth, position_t1=data.pos_t1, vref=data.vref,
+              vref_body=cfg.aiding.body, truth_att=data.truth, t0=stream.t0, stride=stride,
+              first_sample=tl.lo, samples=stream.samples)
+    return kw, warnings
 
 
 def summaries_of_seeds(sc: Scenario, seeds: list[int],
@@ -382,33 +391,14 @@ def summaries_of_seeds(sc: Scenario, seeds: list[int],
     from gcalign.align.lockstep import align_runs
     from gcalign.io.results import finite_summary
 
-    cfg = sc.align or AlignConfig()
-    kind = sc.motion.kind if sc.motion else None
-    warnings = []
-    if kind == "moving" and cfg.aiding.source == "none":
-        warnings.append("a moving base with align.aiding.source 'none': the loops take the "
-                        "vehicle's accelerations for tilt; expect degrees of error")
     out: list[dict | Exception] = []
     runs, streams, notes, where = [], [], [], []
     for seed in seeds:
         try:
             stream = stream_of(scenario_data(sc, seed, cache_key))
-            ts = stream.ts
-            try:
-                stride = sc.output.stride(1.0 / ts, stream.samples * ts)
-            except ValueError as err:
-                raise ScenarioError(str(err)) from None
-            settings = settings_of(cfg, kind)
-            tl = timeline(settings, ts, stream.samples)
-            keep = truth_samples(settings, ts, stream.samples, stride)
-            data = collect(stream, tl, cfg.aiding, None, None, keep)
-            more = list(warnings)
-            if settings.coarse == "analytic":
-                k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
-                more += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
-                                            stream.earth)
-        except (InputError, ScenarioError) as err:
-            out.append(_scenario_error(err) if isinstance(err, InputError) else err)
+            kw, warnings = alignment_inputs(sc, stream)
+        except InputError as err:
+            out.append(_scenario_error(err))
             continue
         except Exception as err:  # noqa: BLE001 - recorded for this seed, as a run would be
             out.append(err)
@@ -416,12 +406,8 @@ def summaries_of_seeds(sc: Scenario, seeds: list[int],
         where.append(len(out))
         out.append(ScenarioError("not aligned"))
         streams.append(stream)
-        notes.append(tuple(more))
-        runs.append(dict(dtheta=data.dtheta, dv=data.dv, ts=ts, site=stream.site,
-                         settings=settings, earth=stream.earth, position_t1=data.pos_t1,
-                         vref=data.vref, vref_body=cfg.aiding.body, truth_att=data.truth,
-                         t0=stream.t0, stride=stride, first_sample=tl.lo,
-                         samples=stream.samples))
+        notes.append(tuple(warnings))
+        runs.append(kw)
 
     def summary(i: int, run: Alignment) -> dict:
         s = alignment_summary(replace(run, warnings=notes[i]), streams[i], sc.name)
