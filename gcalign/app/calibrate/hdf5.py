@@ -78,13 +78,19 @@ def write_calibration(f: h5py.File, case, runs, compare: bool, against=None) -> 
         _write_run(rg.require_group(f"{i:02d}"), run)
         e = None if against is None else against[i]
         if e is not None:
-            ref = rg[f"{i:02d}"].create_group("reference_error")
-            ref.attrs["description"] = "INS solution - reference, at the epochs it covers"
-            put(ref, "t", e["t"], "s")
-            put(ref, "att", e["att"], "rad", description="Euler differences, roll and yaw "
-                "wrapped: pitch, roll, yaw")
-            put(ref, "v_n", e["v_n"], "m/s", "ENU")
-            put(ref, "pos", e["pos"], "m", "ENU")
+            _put_errors(rg[f"{i:02d}"].create_group("reference_error"),
+                        "INS solution - reference, at the epochs it covers",
+                        e["t"], e["att"], e["v_n"], e["pos"])
+
+
+def _put_errors(g: h5py.Group, description: str, t, att, v_n, pos) -> None:
+    """A solution's errors at its epochs: t (s), att (Euler differences), v_n, pos (ENU)."""
+    g.attrs["description"] = description
+    put(g, "t", t, "s")
+    put(g, "att", att, "rad", description="Euler differences, roll and yaw wrapped: pitch, "
+        "roll, yaw")
+    put(g, "v_n", v_n, "m/s", "ENU")
+    put(g, "pos", pos, "m", "ENU")
 
 
 def _write_run(g: h5py.Group, run) -> None:
@@ -125,10 +131,5 @@ def _write_run(g: h5py.Group, run) -> None:
         put(s, "pos", r.smoothed.pos, "rad, rad, m", "[latitude, longitude, height]")
         e = (run.epoch_errors or {}).get("smoothed_series")
         if e is not None:
-            se = s.create_group("error")
-            se.attrs["description"] = "the smoothed solution - the truth or the reference"
-            put(se, "t", e["t"], "s")
-            put(se, "att", e["attitude"], "rad", description="Euler differences, roll and "
-                "yaw wrapped: pitch, roll, yaw")
-            put(se, "v_n", e["velocity"], "m/s", "ENU")
-            put(se, "pos", e["position"], "m", "ENU")
+            _put_errors(s.create_group("error"), "the smoothed solution - the truth or the "
+                        "reference", e["t"], e["attitude"], e["velocity"], e["position"])

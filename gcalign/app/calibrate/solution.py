@@ -2,8 +2,8 @@
 the output rate in ``/calibrate/runs/NN/navigation`` and compared with the truth or the
 reference at every sample, the errors summed apart inside and outside the outages.
 
-Memory stays flat in the run's length: the rows of one filter step at a time, the file's
-chunked series (:class:`gcalign.io.results.Series`) and a few sums.
+Memory stays flat in the run's length: a block of rows at a time, the file's chunked
+series (:class:`gcalign.io.results.Series`) and a few sums.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from gcalign.nav.navigate import position_error_enu
 from gcalign.nav.rotation import attitude_error, quat_to_euler
 
 QUANTITIES = ("position", "velocity", "attitude")
+BLOCK_ROWS = 4096  #: rows held before they are compared and stored
 UNITS = {"position": "m", "velocity": "m/s", "attitude": "deg"}
 
 
@@ -115,7 +116,9 @@ class SolutionSink:
         from gcalign.io.results import ATT_FRAME, Series
 
         self.stride, self.t0, self.errors, self.outages = stride, t0, errors, outages
-        self.k = 0
+        self.k = 0  # rows processed
+        self._held: list[tuple[np.ndarray, ...]] = []
+        self._held_rows = 0
         self.inside, self.outside = ErrorStats(), ErrorStats()
         self.series = None
         if group is not None:
@@ -138,6 +141,16 @@ class SolutionSink:
 
     def __call__(self, t: np.ndarray, q_nb: np.ndarray, v_n: np.ndarray,
                  pos: np.ndarray) -> None:
+        self._held.append((t, q_nb, v_n, pos))
+        self._held_rows += len(t)
+        if self._held_rows >= BLOCK_ROWS:  # whole blocks: NumPy's per-call cost, not per step
+            self._process()
+
+    def _process(self) -> None:
+        if not self._held:
+            return
+        t, q_nb, v_n, pos = (np.concatenate(a) for a in zip(*self._held, strict=True))
+        self._held, self._held_rows = [], 0
         n = len(t)
         att = quat_to_euler(q_nb)
         t_data = t + self.t0
@@ -159,6 +172,7 @@ class SolutionSink:
 
     def close(self) -> dict | None:
         """The series flushed; the error statistics (None without truth or reference)."""
+        self._process()
         if self.series is not None:
             self.series.flush()
         if self.errors.against is None:
