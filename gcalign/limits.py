@@ -69,6 +69,9 @@ def _half_available_mb() -> float:
 MAX_SAMPLES = Limit("GCALIGN_MAX_SAMPLES", 2e9, "IMU samples")
 MAX_MEMORY_MB = Limit("GCALIGN_MAX_MEMORY_MB", _half_available_mb, "of memory", " MB")
 MAX_OUTPUT_MB = Limit("GCALIGN_MAX_OUTPUT_MB", 20_000, "of stored series", " MB")
+#: Input files held in memory at once (a recording, an aiding or reference file), after
+#: decompression: checked from the size on disk before reading, and while decompressing.
+MAX_INPUT_MB = Limit("GCALIGN_MAX_INPUT_MB", 1024, "of input data", " MB")
 MAX_RUNS = Limit("GCALIGN_MAX_RUNS", 1e6, "runs")
 MAX_VARIANTS = Limit("GCALIGN_MAX_VARIANTS", 20_000, "variants")
 MAX_YAML_NODES = Limit("GCALIGN_MAX_YAML_NODES", 1e6, "YAML values after expanding aliases")

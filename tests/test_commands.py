@@ -180,17 +180,32 @@ def test_observability_on_millisecond_pieces_is_refused_before_work(tmp_path, mo
                      "observability.piece_s")
 
 
-def test_realtime_with_a_million_taps_is_refused_by_the_work_limit(tmp_path, no_work):
+def test_realtime_with_fifty_thousand_taps_is_refused_by_the_work_limit(tmp_path, no_work,
+                                                                         monkeypatch):
+    monkeypatch.setenv("GCALIGN_MAX_WORK", "1e11")  # 13 cases × 12 s × 5 kHz × 3 × 5e4
     out = tmp_path / "out.h5"
-    res = runner.invoke(app, ["realtime", "--set", "realtime.filter.nav_order=1000000",
+    res = runner.invoke(app, ["realtime", "--set", "realtime.filter.nav_order=50000",
                               "-o", str(out)])
     assert_bad_input(res, out, "realtime: needs", "operations", "taps × samples",
                      "GCALIGN_MAX_WORK=N")
 
 
+def test_realtime_with_a_million_taps_on_a_short_case_is_refused_at_once(tmp_path, no_work):
+    """An FIR longer than the case (1e6 taps at 5 kHz: 200 s, on a 2 s case) ran for minutes
+    within the work limit; its output would be the filter's start-up transient only."""
+    import fuzz_cases as F
+
+    (tmp_path / "rt.yaml").write_text(F.emit(F.REALTIME))
+    out = tmp_path / "out.h5"
+    res = runner.invoke(app, ["realtime", str(tmp_path / "rt.yaml"), "--set",
+                              "realtime.filter.nav_order=1000000", "-o", str(out)])
+    assert_bad_input(res, out, "realtime.filter.nav_order: an FIR of order 1000000 spans "
+                     "200 s", "longer than case 'r5' (2 s)", "at most 9999")
+
+
 @pytest.mark.parametrize("name, sets, env, same", [
     ("observability", ["observability.piece_s=0.001"], {"GCALIGN_MAX_MEMORY_MB": "8192"}, True),
-    ("realtime", ["realtime.filter.nav_order=1000000"], {}, True),
+    ("realtime", ["realtime.filter.nav_order=50000"], {"GCALIGN_MAX_WORK": "1e11"}, True),
     ("realtime", [], {"GCALIGN_MAX_MEMORY_MB": "abc"}, True),
     # validate costs every section: the simulation of the motion is refused first
     ("modulate", ["modulate.hours=1"], {"GCALIGN_MAX_OUTPUT_MB": "1e-9"}, False),

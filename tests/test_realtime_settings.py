@@ -89,3 +89,35 @@ def test_the_fir_window_names_are_scipys_windows_without_parameters():
     for name in FIR_WINDOWS:
         assert len(signal.get_window(name, 8)) == 8
     assert "kaiser" not in FIR_WINDOWS  # needs its beta
+
+
+@pytest.mark.parametrize("pulses, message", [
+    ({"mode": "async", "rate_hz": 100, "jitter_us": 1e12},
+     "realtime.pulses.jitter_us: must be at most a tenth of the pulse period (1000 µs at 100 "
+     "Hz"),
+    ({"mode": "solution", "rate_hz": 100, "jitter_us": 5},
+     "realtime.pulses.jitter_us: mode 'solution' puts the pulses on solution instants, so it "
+     "cannot matter"),
+    ({"mode": "solution", "rate_hz": 100, "drift_ppm": 50},
+     "realtime.pulses.drift_ppm: mode 'solution'"),
+    ({"mode": "async", "rate_hz": 0.5},
+     "pulses.rate_hz: 0.5 Hz gives fewer than 2 pulses in the 1.5 s scored"),
+])
+def test_a_pulse_jitter_that_cannot_matter_or_leaves_no_pulse_is_refused(tmp_path, pulses,
+                                                                         message):
+    """jitter_us 1e12 on an asynchronous case left no pulse to score (an internal error);
+    a jitter in mode 'solution', where the pulses fall on solution instants, was accepted in
+    silence."""
+    import fuzz_cases as F
+    from cli_checks import assert_bad_input
+    from typer.testing import CliRunner
+
+    from gcalign.cli import app
+
+    d = {**F.REALTIME, "realtime": {**F.REALTIME["realtime"], "pulses": pulses}}
+    (tmp_path / "rt.yaml").write_text(F.emit(d))
+    out = tmp_path / "o.h5"
+    for argv in (["realtime", str(tmp_path / "rt.yaml"), "-o", str(out)],
+                 ["validate", str(tmp_path / "rt.yaml")]):
+        res = CliRunner().invoke(app, argv)
+        assert_bad_input(res, out, message)

@@ -155,6 +155,10 @@ def batch(
     than a shell loop over `gcalign align` (docs/batch.md)."""
     if workers is not None and workers < 1:
         raise ScenarioError(f"--workers: must be at least 1, got {workers}")
+    if scheduler is not None:  # a bad address at once, before the sweep is loaded
+        from gcalign.app.batch.backends import check_address
+
+        scheduler = check_address(scheduler)
     if workers is not None and scheduler:
         raise ScenarioError(
             "--workers: applies to the local process pool; with --scheduler "

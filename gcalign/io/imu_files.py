@@ -98,9 +98,34 @@ def data_suffix(path) -> str:
     return suffixes[-1] if suffixes else ""
 
 
-def read_bytes(path) -> tuple[str, bytes]:
-    """``(name, content)`` of `path`, decompressed when it ends in ``.gz`` or ``.xz``;
-    missing, unreadable or damaged files -> ImuFileError naming the file."""
+#: The first bytes of each compressed format, to tell a damaged file from a misnamed one.
+_MAGIC = {"gzip": b"\x1f\x8b", "lzma": b"\xfd7zXZ\x00"}
+_SUFFIX_OF = {"gzip": ".gz", "lzma": ".xz"}
+_BLOCK = 1 << 24  #: bytes decompressed at a time (the size limit is checked between blocks)
+#: memory of a text table while it is parsed, per byte of text (measured: 3.5 for a 154 MB
+#: CSV of IMU rows read by read_recording)
+TEXT_PARSE_BYTES = 4.0
+
+
+def _input_limit(name: str, size: float) -> None:
+    """ScenarioError naming GCALIGN_MAX_INPUT_MB when `size` bytes exceed it."""
+    from gcalign import limits
+
+    limits.MAX_INPUT_MB.check(size / 2**20, name, "read a part of it, or split it")
+
+
+def read_bytes(path, head: int | None = None, text: bool = False) -> tuple[str, bytes]:
+    """``(name, content)`` of `path`, decompressed when it ends in ``.gz`` or ``.xz`` (the
+    first `head` bytes only, when given).
+
+    The size is bounded before anything is held: a file larger than
+    ``GCALIGN_MAX_INPUT_MB`` is refused from its size on disk, a compressed one after at
+    most that much has been decompressed, in blocks. With `text` (a table is expected), a
+    NUL byte refuses the file at the block that holds it, and the memory the parse will
+    take is held against ``GCALIGN_MAX_MEMORY_MB`` (:func:`text_of`): a 2 GB sparse file, or
+    a small file of compressed zeros, is refused in seconds, naming the variable. Missing,
+    unreadable, damaged or misnamed files (gzip data named ``.xz``, text named ``.gz``) are
+    ImuFileError naming the file and what is wrong."""
     import importlib
 
     name = os.fspath(path)
@@ -109,23 +134,104 @@ def read_bytes(path) -> tuple[str, bytes]:
         raise ImuFileError(f"{name}: {not_a_file(p)}")
     if p.is_dir():
         raise ImuFileError(f"{name}: is a directory, expected an IMU data file")
+    compression = COMPRESSED.get(p.suffix.lower())
     try:
-        compression = COMPRESSED.get(p.suffix.lower())
-        if compression is None:
-            return name, p.read_bytes()
-        with importlib.import_module(compression).open(p, "rb") as fh:
-            return name, fh.read()
+        if head is None:
+            _input_limit(name, p.stat().st_size)
+        with open(p, "rb") as raw:
+            if compression is None:
+                data = raw.read(-1 if head is None else head)
+                if text and head is None:
+                    _no_nul(name, data, 0)
+                return name, data
+            start = raw.read(8)
+            raw.seek(0)
+            _check_magic(name, compression, start)
+            cap = head if head is not None else int(_max_input_bytes()) + 1
+            out = bytearray()
+            with importlib.import_module(compression).open(raw, "rb") as fh:
+                while len(out) < cap:
+                    block = fh.read(min(_BLOCK, cap - len(out)))
+                    if not block:
+                        break
+                    if text and head is None:
+                        _no_nul(name, block, len(out))
+                    out += block
+            if head is None and len(out) >= cap:
+                _input_limit(f"{name} (decompressed, at least)", len(out))
+            return name, bytes(out)
+    except (ScenarioError, MemoryError):  # ours (the limits), or out of memory
+        raise
     except (EOFError, ValueError) as exc:
-        raise ImuFileError(f"{name}: cannot decompress ({exc})") from None
+        raise ImuFileError(f"{name}: damaged {_SUFFIX_OF[compression or 'lzma']} data, "
+                           f"cannot decompress ({_why(exc)})") from None
     except OSError as exc:
+        if compression is not None and exc.errno is None:  # gzip.BadGzipFile and the like
+            raise ImuFileError(f"{name}: damaged {_SUFFIX_OF[compression]} data, cannot "
+                               f"decompress ({_why(exc)})") from None
         raise ImuFileError(f"{name}: cannot read file ({exc.strerror or exc})") from None
+    except Exception as exc:  # lzma.LZMAError, zlib.error: the compressed stream is damaged
+        if compression is None:
+            raise
+        raise ImuFileError(f"{name}: damaged {_SUFFIX_OF[compression]} data, cannot "
+                           f"decompress ({_why(exc)})") from None
+
+
+def _no_nul(name: str, data: bytes, offset: int) -> None:
+    if offset == 0 and data.startswith(_HDF5_MAGIC):
+        raise ImuFileError(f"{name}: is an HDF5 file, not text (a gcalign results file is "
+                           "read without format; a MAT v7.3 file: format psins-mat)")
+    nul = data.find(b"\x00")
+    if nul >= 0:
+        raise ImuFileError(f"{name}: binary data (a NUL byte at offset {offset + nul}), not a "
+                           "text table")
+
+
+def _why(exc: BaseException) -> str:
+    return (str(exc).splitlines() or [type(exc).__name__])[0][:80] or type(exc).__name__
+
+
+def _max_input_bytes() -> float:
+    from gcalign import limits
+
+    return limits.MAX_INPUT_MB.value() * 2**20
+
+
+def _check_magic(name: str, compression: str, start: bytes) -> None:
+    """A file named ``.gz``/``.xz`` must start as that format does; one that starts as
+    the other is misnamed, one that starts as neither is not compressed."""
+    if start.startswith(_MAGIC[compression]):
+        return
+    other = next((c for c, m in _MAGIC.items() if start.startswith(m)), None)
+    if other is not None:
+        raise ImuFileError(f"{name}: holds {other} ({_SUFFIX_OF[other]}) data, not "
+                           f"{_SUFFIX_OF[compression]}: rename it "
+                           f"{Path(name).stem}{_SUFFIX_OF[other]}")
+    if not start:
+        raise ImuFileError(f"{name}: an empty file, not {_SUFFIX_OF[compression]} data")
+    raise ImuFileError(f"{name}: not {_SUFFIX_OF[compression]} data (it starts with "
+                       f"{start[:8]!r}); an uncompressed file is named without "
+                       f"{_SUFFIX_OF[compression]}")
+
+
+def text_of(name: str, data: bytes) -> str:
+    """`data` as the text of a table: ImuFileError for binary content (a NUL byte: a
+    sparse or binary file named as text), ScenarioError naming GCALIGN_MAX_MEMORY_MB when
+    parsing it would need more memory than allowed."""
+    from gcalign import limits
+
+    _no_nul(name, data, 0)
+    limits.MAX_MEMORY_MB.check(len(data) * TEXT_PARSE_BYTES / 2**20,
+                               f"{name}: parsing {len(data) / 2**20:.4g} MB of text",
+                               "read a part of it")
+    return data.decode("utf-8", errors="replace")
 
 
 def _read_lines(path) -> tuple[str, list[str]]:
     """Text lines of `path` (without line ends, decompressed if ``.gz``/``.xz``); missing
     or unreadable files -> ImuFileError."""
-    name, data = read_bytes(path)
-    return name, data.decode("utf-8", errors="replace").splitlines()
+    name, data = read_bytes(path, text=True)
+    return name, text_of(name, data).splitlines()
 
 
 def _strip(line: str, comment: str) -> str:
@@ -498,7 +604,7 @@ def read_imu_file(path, ts: float | None = None) -> ImuData:
     if suffix in (".csv", ".txt"):
         return read_csv_imu(p, ts=ts)
     if p.is_file():
-        head = read_bytes(p)[1][:4096]
+        head = read_bytes(p, head=4096)[1]
         if head.startswith(_HDF5_MAGIC):
             raise ImuFileError(
                 f"{name}: is an HDF5 file; HDF5 IMU data is read by the results module, "

@@ -595,16 +595,57 @@ def read_recording_record(path: Path) -> dict | None:
     return record if isinstance(record, dict) else None
 
 
+def _raised_in_h5py(err: BaseException) -> bool:
+    """Whether `err` was raised inside h5py or HDF5 (its last frame is h5py's)."""
+    tb = err.__traceback__
+    last = None
+    while tb is not None:
+        last = tb.tb_frame.f_code.co_filename
+        tb = tb.tb_next
+    return last is not None and re.search(r"(^|[/\\])h5py[/\\]", last) is not None
+
+
+def _damaged_file(path: Path, err: BaseException) -> ScenarioError:
+    why = (str(err).splitlines() or [type(err).__name__])[0][:100]
+    return ScenarioError(f"{path}: a damaged HDF5 file: {type(err).__name__}: {why} (not as "
+                         "gcalign wrote it; write it again)")
+
+
+class _ResultsFile(h5py.File):
+    """A results file open for reading: what HDF5 raises while it reads a damaged file
+    (a corrupt object header, a block past the end: RuntimeError, OSError, KeyError from
+    inside h5py) leaves the ``with`` as one ScenarioError naming the file, not as an
+    internal error. Errors of ours, and any not raised inside h5py, pass unchanged."""
+
+    _gcalign_path: Path
+
+    def __exit__(self, *exc):
+        super().__exit__(*exc)
+        err = exc[1]
+        if (isinstance(err, Exception) and not isinstance(err, (GcalignError, MemoryError))
+                and _raised_in_h5py(err)):
+            raise _damaged_file(self._gcalign_path, err) from None
+
+
 def open_results(path: Path) -> h5py.File:
-    """Open a gcalign results file for reading; ScenarioError if it is missing or not ours."""
+    """Open a gcalign results file for reading; ScenarioError if it is missing or not ours,
+    and, used in a ``with``, if HDF5 meets damage while reading it (:class:`_ResultsFile`)."""
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: {not_a_file(path)}")
     try:
-        f = h5py.File(path, "r")
+        f = _ResultsFile(path, "r")
     except OSError:
         raise ScenarioError(f"{path}: not an HDF5 file (expected a gcalign results file)") from None
-    if "gcalign_version" not in f.attrs:
+    f._gcalign_path = path
+    try:
+        ours = "gcalign_version" in f.attrs
+    except Exception as err:  # noqa: BLE001 - a damaged root object, raised by HDF5
+        f.close()
+        if isinstance(err, MemoryError) or not _raised_in_h5py(err):
+            raise
+        raise _damaged_file(path, err) from None
+    if not ours:
         f.close()
         raise ScenarioError(
             f"{path}: an HDF5 file, but not a gcalign results file (no 'gcalign_version' attribute)"
@@ -702,11 +743,20 @@ def _damaged(ds: h5py.Dataset, strict: bool) -> str:
     if ds.dtype.kind not in "fiub":
         return f"must hold numbers, got {ds.dtype}"
     if not strict:
+        if ds.compression is None or not ds.size:
+            return ""
+        try:  # a compressed block that does not decompress fails only when read
+            ds[()]
+        except OSError as err:
+            return _unreadable(err)
         return ""
     if units is None:
         return "has no 'units' attribute (not as gcalign wrote it)"
     if ds.dtype.kind == "f" and ds.size:
-        a = ds[()]
+        try:
+            a = ds[()]
+        except OSError as err:
+            return _unreadable(err)
         if not np.isfinite(a).all():
             bad = np.argwhere(~np.isfinite(np.atleast_1d(a)))[0].tolist()
             return f"holds a value that is not finite at {bad}"
@@ -719,13 +769,28 @@ def _damaged(ds: h5py.Dataset, strict: bool) -> str:
     return ""
 
 
+def _unreadable(err: OSError) -> str:
+    """The words for a dataset HDF5 cannot read back (a damaged compressed block)."""
+    why = (str(err).splitlines() or ["read failed"])[0]
+    return f"cannot be read: its stored data is damaged ({why[:80]})"
+
+
+def read_dataset(ds: h5py.Dataset, path) -> np.ndarray:
+    """``ds[()]``; ScenarioError naming the file and the dataset when HDF5 cannot read it
+    (a compressed block that does not decompress: "internal error" before)."""
+    try:
+        return ds[()]
+    except OSError as err:
+        raise ScenarioError(f"{path}: dataset {ds.name} {_unreadable(err)}") from None
+
+
 def _dataset(g, name: str, path: Path) -> np.ndarray:
     if name not in g or not isinstance(g[name], h5py.Dataset):
         raise ScenarioError(f"{path}: dataset {g.name}/{name} missing")
     ds = g[name]
     if ds.dtype.kind not in "fiu":
         raise ScenarioError(f"{path}: dataset {ds.name} must hold numbers, got {ds.dtype}")
-    return ds[()]
+    return read_dataset(ds, path)
 
 
 def _vector_attr(g, name: str, path: Path, n: int = 3) -> np.ndarray | None:
@@ -941,9 +1006,9 @@ def series(path: Path, group: str = "navigate") -> dict[str, tuple[np.ndarray, s
                                 f"(no 1-D dataset 't'); groups that have: "
                                 f"{', '.join(timed[:8]) or 'none'}")
         n = len(t)
-        out = {"t": (t[()], _units_of(t))}
+        out = {"t": (read_dataset(t, path), _units_of(t))}
         for name, ds in _time_datasets(g, n):
-            out[name] = (ds[()], _units_of(ds))
+            out[name] = (read_dataset(ds, path), _units_of(ds))
         return out
 
 

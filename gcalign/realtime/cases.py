@@ -255,6 +255,26 @@ def check_case(case: Case, settings: Settings) -> None:
                          f"got {settings.settle_s:g} s")
     if case.pulses is not None:
         check_pulses(case.pulses, settings.solution_hz)
+    pulses = case.pulses or settings.pulses
+    scored = case.duration - settings.settle_s
+    if scored * pulses.rate_hz < 2:  # each case's statistics need pulses to score
+        raise ValueError(f"pulses.rate_hz: {pulses.rate_hz:g} Hz gives fewer than 2 pulses in "
+                         f"the {scored:g} s scored (the case's {case.duration:g} s after "
+                         f"settle_s); at least {2 / scored:.3g} Hz")
+
+
+def check_filter(case: Case, settings: Settings) -> None:
+    """The chain's FIR against a case: ValueError naming ``filter.nav_order`` (or
+    ``align_order``) when the FIR spans more than the case, whose output would then be the
+    filter's start-up transient only (an order of 1e6 on a 2 s case ran for minutes)."""
+    f = settings.filter
+    order, fs = (f.nav_order, f.fs_hz) if f.chain == "navigation" else (f.align_order, f.fs_hz)
+    if not order / fs < case.duration:
+        key = "nav_order" if f.chain == "navigation" else "align_order"
+        raise ValueError(f"filter.{key}: an FIR of order {order} spans {order / fs:g} s at "
+                         f"{fs:g} Hz, longer than case {case.name!r} ({case.duration:g} s): its "
+                         f"output would be start-up transient only; at most "
+                         f"{math.ceil(case.duration * fs) - 1}")
 
 
 def table1_cases(duration_s: float = 12.0) -> tuple[Case, ...]:

@@ -9,12 +9,13 @@ into :class:`WorkerLost`. The functions they send to workers live in
 from __future__ import annotations
 
 import os
+import re
 import signal
 import threading
 import time
 
 from gcalign.app.batch.runs import run_chunk, warm_up
-from gcalign.errors import GcalignError
+from gcalign.errors import GcalignError, ScenarioError
 
 SCHEDULER_TIMEOUT_S = 4.0  # each step of connecting to a Dask scheduler (≤ 15 s in all)
 WORKERS_TIMEOUT_S = 4.0  # waiting for a scheduler's first worker
@@ -25,6 +26,26 @@ def _watch_parent(parent: int) -> None:  # pragma: no cover - runs in workers
         time.sleep(0.5)
         if os.getppid() != parent:
             os._exit(1)  # the batch process died (SIGKILL): do not linger as an orphan
+
+
+def _die_with_parent(parent: int) -> None:  # pragma: no cover - runs in workers
+    """Have the kernel kill this worker when its parent dies (Linux ``PR_SET_PDEATHSIG``).
+
+    The watcher thread (:func:`_watch_parent`) needs the GIL, which a numba kernel holds
+    for the whole of a long run: a batch killed with SIGKILL left its pool (three
+    processes, 450 MB) computing for nine minutes. The kernel's signal needs nothing from
+    the worker. The parent is the process that forked the worker (the batch, or the fork
+    server, which exits when the batch does)."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):  # not Linux: the watcher thread only
+        return
+    if os.getppid() != parent:  # the parent died before the request took effect
+        os._exit(1)
 
 
 def _init_worker(command: str) -> None:  # pragma: no cover - runs in workers
@@ -38,7 +59,9 @@ def _init_worker(command: str) -> None:  # pragma: no cover - runs in workers
     # Forked with SIGTERM blocked (LocalBackend._new_pool): one sent before this point was
     # held, and is delivered now, with the default action.
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
-    threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True).start()
+    parent = os.getppid()
+    _die_with_parent(parent)
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
     warm_up(command)
 
 
@@ -149,6 +172,58 @@ def _probe(address: str, timeout: float) -> None:
         raise OSError(f"not a Dask scheduler (it answered {str(reply)[:60]!r})")
 
 
+#: Dask's network schemes (``distributed.comm``); ``inproc`` is this process, not a cluster
+SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+_HOST_LABEL = re.compile(r"^(?!-)[A-Za-z0-9-]{1,63}(?<!-)$")
+
+
+def check_address(address: str) -> str:
+    """`address` as a Dask scheduler address ``SCHEME://HOST:PORT`` (SCHEME one of
+    :data:`SCHEMES`, ``tcp`` when omitted; HOST a name, an IPv4 address or a bracketed IPv6
+    one; PORT 1..65535): ScenarioError naming ``--scheduler`` at once, instead of a failed
+    connection seconds later (port 0, 99999, no port, ``http://``, an unclosed bracket, a
+    5000-character host), and for an empty one, which ran locally in silence."""
+    import ipaddress
+
+    text = str(address).strip()
+    shown = text if len(text) <= 60 else text[:57] + "..."
+
+    def bad(why: str) -> ScenarioError:
+        return ScenarioError(f"--scheduler: {shown!r} {why}; give tcp://HOST:PORT (e.g. "
+                             "tcp://10.0.0.5:8786), or leave the option out to run locally")
+
+    if not text:
+        raise bad("is empty")
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    if scheme not in SCHEMES:
+        raise bad(f"has the scheme {scheme!r}; Dask schedulers speak {', '.join(SCHEMES)}")
+    if rest.startswith("["):
+        host, bracket, tail = rest[1:].partition("]")
+        if not bracket:
+            raise bad("opens an IPv6 bracket and never closes it")
+        try:
+            ipaddress.IPv6Address(host)
+        except ValueError:
+            raise bad(f"has {host!r} in brackets, not an IPv6 address") from None
+        if not tail.startswith(":"):
+            raise bad("has no port after the IPv6 address")
+        port = tail[1:]
+    else:
+        host, colon, port = rest.rpartition(":")
+        if not colon:
+            raise bad("has no port")
+        if ":" in host:
+            raise bad("has an IPv6 address without brackets ([::1]:8786)")
+        if len(host) > 253 or not all(_HOST_LABEL.match(x) for x in host.split(".")):
+            raise bad("does not name a host (letters, digits, '-' and '.', at most 253 "
+                      "characters)")
+    if not (port.isdigit() and 1 <= int(port) <= 65535):
+        raise bad(f"has the port {port[:12]!r}; a port is 1..65535")
+    return text if sep else f"tcp://{text}"
+
+
 def dask_client(address: str, timeout: float = SCHEDULER_TIMEOUT_S,
                 workers_timeout: float = WORKERS_TIMEOUT_S):
     """A ``distributed.Client`` connected to `address` with at least one worker; GcalignError
@@ -166,6 +241,7 @@ def dask_client(address: str, timeout: float = SCHEDULER_TIMEOUT_S,
         return GcalignError(f"cannot reach the Dask scheduler at {address} "
                             f"(waited {timeout:g} s): {msg[:120]}")
 
+    _quiet_dask()
     try:
         _probe(address, timeout)
     except Exception as err:  # OSError, TimeoutError, ValueError (bad address), ...
@@ -182,6 +258,18 @@ def dask_client(address: str, timeout: float = SCHEDULER_TIMEOUT_S,
                            f"{workers_timeout:g} s); start some with 'dask worker {address}'"
                            ) from None
     return client
+
+
+def _quiet_dask() -> None:
+    """Silence Dask's own loggers in this process: when the scheduler dies, the client logs
+    "distributed.client - ERROR - Failed to reconnect ..." on stderr before our one error
+    line says the same (and what to do: --resume)."""
+    import logging
+
+    names = ["distributed", *(n for n in logging.root.manager.loggerDict
+                              if n.startswith("distributed."))]
+    for name in names:
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
 def _close(client) -> None:
@@ -246,6 +334,6 @@ class DaskBackend:
 
 
 def make_backend(command: str, workers: int | None = None, scheduler: str | None = None):
-    if scheduler:
-        return DaskBackend(scheduler, command)
+    if scheduler is not None:
+        return DaskBackend(check_address(scheduler), command)
     return LocalBackend(workers or os.cpu_count() or 1, command)

@@ -88,6 +88,10 @@ def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
     """
     from gcalign.io.results import check_output, clean_stale_temps
 
+    if scheduler is not None:  # "" is refused too: it ran locally in silence
+        from gcalign.app.batch.backends import check_address
+
+        scheduler = check_address(scheduler)
     output = check_output(output)
     jpath = journal_path(output)
     if jpath.exists() and not jpath.is_file():

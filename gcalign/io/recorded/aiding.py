@@ -31,7 +31,7 @@ import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.gaps import default_max_gap
-from gcalign.io.imu_files import ImuFileError, read_bytes
+from gcalign.io.imu_files import ImuFileError, read_bytes, text_of
 from gcalign.io.recorded.axes import _DIRECTIONS
 from gcalign.io.recorded.imu import _table, _table_of, _text_lines
 from gcalign.io.recorded.rows import _check_rows, _columns, _finite
@@ -88,7 +88,7 @@ def read_gnss(path, format: str = "i2nav-gnss", columns=None, lever_arm_b=(0.0, 
     if lever.shape != (3,) or not np.isfinite(lever).all() or np.abs(lever).max() > 100:
         raise ScenarioError(f"aiding.lever_arm_m: must be 3 finite numbers (body x right, y "
                             f"forward, z up; m, within 100), got {lever.tolist()}")
-    data = read_bytes(name)[1]
+    data = read_bytes(name, text=True)[1]
     if format == "rtklib-pos":
         t, lat, lon, h, s_enu, origin = _rtklib(name, data)
     else:
@@ -129,7 +129,7 @@ def _ranges(name, lat, lon, sigma, where) -> None:
 
 def _rtklib(name: str, data: bytes):
     """RTKLIB .pos: the last ``%`` line before the data names the columns."""
-    lines = data.decode("utf-8", errors="replace").splitlines()
+    lines = text_of(name, data).splitlines()
     header = [ln for ln in lines if ln.startswith("%")]
     body = [(i + 1, ln.split()) for i, ln in enumerate(lines) if ln.strip()
             and not ln.startswith("%")]
@@ -183,7 +183,8 @@ def read_velocity(path, frame: str = "ENU", columns=None) -> Velocities:
         raise ScenarioError(f"aiding.frame: {frame!r}; allowed: ENU, NED")
     default = ("t", "ve", "vn", "vu") if frame == "ENU" else ("t", "vn", "ve", "vd")
     cols = _columns(columns, default)
-    rows, (_, where) = _table(name, _text_lines(name, read_bytes(name)[1]), len(cols), cols)
+    text = read_bytes(name, text=True)[1]
+    rows, (_, where) = _table(name, _text_lines(name, text), len(cols), cols)
     _finite(name, rows, cols, where)
     c = {k: rows[:, cols.index(k)] for k in default}
     _check_rows(name, c["t"], where)
@@ -205,7 +206,8 @@ def read_odometer(path, axis: str = "F", columns=None) -> Velocities:
     axis_b = np.zeros(3)
     axis_b[i] = sign
     cols = _columns(columns, ("t", "speed"))
-    rows, (_, where) = _table(name, _text_lines(name, read_bytes(name)[1]), len(cols), cols)
+    text = read_bytes(name, text=True)[1]
+    rows, (_, where) = _table(name, _text_lines(name, text), len(cols), cols)
     _finite(name, rows, cols, where)
     t, speed = rows[:, cols.index("t")], rows[:, cols.index("speed")]
     _check_rows(name, t, where)

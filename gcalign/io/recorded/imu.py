@@ -57,6 +57,7 @@ from gcalign.io.imu_files import (
     data_suffix,
     read_bytes,
     read_psins_imu,
+    text_of,
 )
 from gcalign.io.recorded import mat
 from gcalign.io.recorded.axes import axes_text, rotation_to_rfu
@@ -181,7 +182,7 @@ def guess_format(path) -> str:
     if suffix in (".csv", ".txt"):
         return "csv"
     try:
-        _, head = read_bytes(path)
+        _, head = read_bytes(path, head=4096)
     except ImuFileError:
         return "csv"
     first = next((ln.strip() for ln in head[:4096].decode("utf-8", "replace").splitlines()
@@ -195,7 +196,7 @@ def _text_lines(name: str, data: bytes) -> list[str]:
         raise ImuFileError(f"{name}: is an HDF5 file, not text (a gcalign results file is "
                            "read without format; a MAT v7.3 file: format psins-mat)")
     out = []
-    for line in data.decode("utf-8", errors="replace").splitlines():
+    for line in text_of(name, data).splitlines():
         cut = min((i for i in (line.find("#"), line.find("%")) if i >= 0), default=-1)
         out.append(line if cut < 0 else line[:cut])
     return out
@@ -657,7 +658,7 @@ def _read(name: str, layout: Layout) -> ImuData:
     if fmt == "psins":
         raw = _read_psins(name, name)
     else:
-        raw = _READERS[fmt](name, read_bytes(name)[1], layout)
+        raw = _READERS[fmt](name, read_bytes(name, text=fmt != "psins-mat")[1], layout)
     gyro_units, accel_units, quantity = _units(fmt, info, layout, raw.notes.get("header_units"))
     ts, ts_rule = _interval(name, raw.t, layout, raw.ts)
     t, weeks = (_unwrap_week(raw.t) if fmt == "i2nav" else (raw.t, 0))

@@ -12,6 +12,7 @@ data (a cost estimate before a run).
 from __future__ import annotations
 
 import io
+import math
 import os
 
 import numpy as np
@@ -26,12 +27,37 @@ def arrays(name: str, data: bytes) -> dict[str, np.ndarray]:
     name; ImuFileError (one line naming the file) for what ``scipy.io.loadmat`` cannot read."""
     import scipy.io
 
+    from gcalign import limits
+
+    if b"\x00" not in data[:128]:  # a MAT file's header holds binary fields by byte 128
+        what = ("an empty file" if not data.strip() else "text" if _is_text(data[:4096])
+                else "its first 128 bytes are not a MAT header")
+        raise ImuFileError(f"{name}: {what}, not a MATLAB file; format psins-mat reads the MAT "
+                           "v5/v7 files MATLAB's save writes (a text table: format csv)")
+    try:  # the arrays' sizes from their headers first: compressed ones can be huge
+        found = scipy.io.whosmat(io.BytesIO(data))
+        held = sum(8.0 * math.prod(int(n) for n in shape) for _, shape, _ in found)
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - scipy's parser of a damaged file raises anything
+        raise _refused(name, exc) from None
+    limits.MAX_INPUT_MB.check(held / 2**20, f"{name} (its arrays)", "read a part of it")
     try:
         mat = scipy.io.loadmat(io.BytesIO(data))
-    except (NotImplementedError, ValueError, TypeError, OSError) as exc:
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - as above (MatReadError, zlib.error, ...)
         raise _refused(name, exc) from None
     return {k: v for k, v in mat.items() if not k.startswith("__")
             and isinstance(v, np.ndarray) and v.dtype.kind in "fiu"}
+
+
+def _is_text(head: bytes) -> bool:
+    try:
+        text = head.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return all(c.isprintable() or c in "\r\n\t" for c in text)
 
 
 def read_vectors(path, names: tuple[str, ...]) -> dict[str, np.ndarray]:
@@ -51,7 +77,9 @@ def shapes(path) -> dict[str, tuple[int, ...]]:
     name = os.fspath(path)
     try:
         return {k: tuple(int(n) for n in shape) for k, shape, _ in scipy.io.whosmat(name)}
-    except (NotImplementedError, ValueError, TypeError, OSError) as exc:
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - scipy's parser of a damaged file raises anything
         raise _refused(name, exc) from None
 
 

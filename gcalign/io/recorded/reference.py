@@ -78,7 +78,7 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     if format not in REFERENCE_FORMATS:
         raise ScenarioError(f"reference.format: {format!r} is not a reference format; "
                             f"allowed: {', '.join(REFERENCE_FORMATS)}")
-    data = read_bytes(name)[1]
+    data = read_bytes(name, text=format != "psins-mat")[1]
     notes: dict = {}
     if format == "psins-mat":
         a, key, where = _avp(name, data, variable, attitude_optional)

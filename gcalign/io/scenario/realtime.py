@@ -176,6 +176,25 @@ class PulsesConfig(Model):
         0.0, description=B.CLOCK_DRIFT_PPM.range())
     resolution_us: float = Field(0.0, ge=0, description="Δt counter resolution (0: exact)")
 
+    @model_validator(mode="after")
+    def _jitter(self):
+        """In mode ``solution`` the pulses fall on solution instants: a jitter or a clock
+        drift cannot matter there, and is refused by its key rather than dropped. In mode
+        ``async`` the jitter (1σ) is bounded by a tenth of the pulse period: a larger one
+        reorders the pulses (1e12 µs left no pulse in the run, an internal error)."""
+        if self.mode == "solution":
+            for key in ("jitter_us", "drift_ppm"):
+                if getattr(self, key) != 0:
+                    raise ValueError(f"{key}: mode 'solution' puts the pulses on solution "
+                                     f"instants, so it cannot matter; remove it or use mode "
+                                     f"async, got {getattr(self, key):g}")
+        bound = 0.1e6 / self.rate_hz
+        if not self.jitter_us <= bound:
+            raise ValueError(f"jitter_us: must be at most a tenth of the pulse period "
+                             f"({bound:g} µs at {self.rate_hz:g} Hz; a larger jitter reorders "
+                             f"the pulses), got {self.jitter_us:g}")
+        return self
+
     def to_settings(self) -> PulseSettings:
         return PulseSettings(mode=self.mode, rate_hz=self.rate_hz,
                              offset_s=_us(self.offset_us), jitter_s=self.jitter_us * 1e-6,
@@ -245,7 +264,7 @@ class RealtimeConfig(Model):
             raise ValueError("pulses: semi_physical: true puts the pulses on every solution "
                              "instant (Δt = 0); remove realtime.pulses (a case may still "
                              "bring its own) or set semi_physical: false")
-        from gcalign.realtime.cases import check_case
+        from gcalign.realtime.cases import check_case, check_filter
 
         settings = self.to_settings()  # the core's checks, one line naming the setting
         for i, c in enumerate(self.cases or ()):
@@ -253,6 +272,7 @@ class RealtimeConfig(Model):
                 check_case(c.to_case(), settings)
             except ValueError as err:
                 raise ValueError(f"cases.{i}.{err}") from None
+            check_filter(c.to_case(), settings)
         return self
 
     # ---------------------------------------------------------------- resolved values
@@ -310,13 +330,17 @@ class RealtimeConfig(Model):
             if mo.repeat:
                 raise ScenarioError("motion.repeat: a realtime case runs its rows once; "
                                     "allowed: false, got true")
-            from gcalign.realtime.cases import check_case
+            from gcalign.realtime.cases import check_case, check_filter
 
+            case = case_of(sc.name, mo.steps, mo.attitude_deg, mo.duration_s)
             try:
-                check_case(case_of(sc.name, mo.steps, mo.attitude_deg, mo.duration_s),
-                           self.to_settings())
+                check_case(case, self.to_settings())
             except ValueError as err:
                 raise ScenarioError(f"motion.{err}") from None
+            try:
+                check_filter(case, self.to_settings())
+            except ValueError as err:
+                raise ScenarioError(f"realtime.{err}") from None
         imu = sc.imu
         if "rate_hz" in imu.model_fields_set and imu.rate_hz != self.filter.fs_hz:
             raise ScenarioError(f"imu.rate_hz: the realtime gyros are sampled at "
