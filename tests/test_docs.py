@@ -253,3 +253,42 @@ def test_quick_start_is_what_ci_runs():
         assert f"\n{line}\n" in ci, line
     started = next(b for b in blocks(DOCS / "getting-started.md") if b.lang in SHELL)
     assert started.body.strip() == lines[0]
+
+
+# --------------------------------------------------------------------------- the site's pages
+
+
+def _nav_files(items) -> set[str]:
+    out: set[str] = set()
+    for item in items:
+        target = next(iter(item.values())) if isinstance(item, dict) else item
+        out |= _nav_files(target) if isinstance(target, list) else {target}
+    return out
+
+
+def test_every_page_is_in_the_site_and_every_link_resolves():
+    """What `mkdocs build --strict` (CI) would refuse, said in the fast suite: a page of
+    docs/ missing from the nav of mkdocs.yml, a nav entry without its page, a relative link
+    to a file that does not exist."""
+    config = yaml.safe_load((ROOT / "mkdocs.yml").read_text())
+    sys.path.insert(0, str(DOCS))
+    try:
+        import hooks
+    finally:
+        sys.path.remove(str(DOCS))
+    nav = _nav_files(config["nav"])
+    generated = {"reference/cli.md", "reference/scenario.md", "reference/results-file.md",
+                 "reference/limits.md", "explanation/decisions.md"}
+    pages = {str(p.relative_to(DOCS)) for p in DOCS.rglob("*.md")} - {"results.md"}
+    pages = {p for p in pages if not p.startswith("decisions/")}
+    assert not pages - nav, f"pages not in the nav of mkdocs.yml: {sorted(pages - nav)}"
+    absent = nav - pages - generated - hooks.OPTIONAL
+    assert not absent, f"nav entries of mkdocs.yml without a page: {sorted(absent)}"
+    link = re.compile(r"\]\(([^)#\s]+\.md)(?:#[^)]*)?\)")
+    for page in [ROOT / "README.md", *DOCS.rglob("*.md")]:
+        for target in link.findall(page.read_text(encoding="utf-8")):
+            if "://" in target:
+                continue
+            assert (page.parent / target).resolve().exists() or target.startswith(
+                ("reference/", "../reference/", "explanation/", "../explanation/")), \
+                f"{page.relative_to(ROOT)}: link to {target}, no such file"
