@@ -255,6 +255,16 @@ def test_files_read_back_by_gcalign(tmp_path):
     assert cfg["imunoise"]["corrtime"] == 4 and cfg["imunoise"]["gbstd"] == [0.027] * 3
     assert euler_to_dcm(*np.radians(cfg["initatt"])) == pytest.approx(
         euler_to_dcm(*s.euler), abs=1e-10)
+    # the gcalign scenario starts from the same state, in ENU and body RFU
+    sc = yaml.safe_load(p["gcalign_yaml"].read_text())
+    init = sc["initial"]
+    np.testing.assert_allclose(g_euler_to_dcm(np.radians(init["att_deg"])),
+                               ned_to_enu @ euler_to_dcm(*s.euler) @ frd_to_rfu.T, atol=1e-12)
+    assert init["v_enu_mps"] == pytest.approx([s.v_ned[1], s.v_ned[0], -s.v_ned[2]])
+    assert [init["lat_deg"], init["lon_deg"], init["height_m"]] == pytest.approx(
+        [np.degrees(s.lat), np.degrees(s.lon), s.h])
+    lever = sc["calibrate"]["files"]["position"]["lever_arm_m"]
+    assert lever == pytest.approx(frd_to_rfu @ np.array(ds.config.lever_frd))
     # the start's drawn errors are those of the file: the φ between given and true
     C_err = euler_to_dcm(*s.euler) @ ds.truth.C_nb[0].T  # exp(−[φ×])
     anti = 0.5 * np.array([C_err[2, 1] - C_err[1, 2], C_err[0, 2] - C_err[2, 0],

@@ -125,17 +125,23 @@ def _start(cfg: Config, truth: State, rng: np.random.Generator) -> Start:
                  float(h - dpos[2]), truth.v_ned[0] + dvel, euler, dpos, dvel, phi)
 
 
-def simulate(cfg: Config = Config()) -> Dataset:
+def simulate(cfg: Config = Config(), increments: bool = True) -> Dataset:
     """The drive, its IMU data with errors, the GNSS fixes and the start (module
-    docstring)."""
+    docstring). `increments` False: all but the IMU's increments (left empty), which take
+    most of the time; the truth, the sensor errors, the fixes and the start are the same
+    numbers (enough to score a solution of the files written before)."""
     traj = Trajectory(ROUTES[cfg.route](), cfg.site)
     ss = np.random.SeedSequence(cfg.seed).spawn(5)
     rng_start, rng_proc, rng_noise, rng_sigma, rng_gnss = (np.random.default_rng(s) for s in ss)
     end = traj.duration if cfg.duration_s is None else min(cfg.duration_s, traj.duration)
     t = _stamps(cfg, end)
     dt = 1.0 / cfg.imu_rate_hz
-    th, dv = imu.ideal_increments(traj, np.concatenate([[t[0] - dt], t]))
-    th_m, dv_m, sensors = imu.measured(th, dv, dt, cfg.errors, rng_proc, rng_noise)
+    if increments:
+        th, dv = imu.ideal_increments(traj, np.concatenate([[t[0] - dt], t]))
+        th_m, dv_m, sensors = imu.measured(th, dv, dt, cfg.errors, rng_proc, rng_noise)
+    else:
+        th = dv = th_m = dv_m = np.empty((0, 3))
+        sensors = imu.sensor_processes(len(t), dt, cfg.errors, rng_proc)
     truth = traj.state(t)
     marks = {m[0]: 0.5 * (m[1] + m[2]) for m in traj.route.marks}
     names = ([m for m in marks if m.startswith("U-turn")] if cfg.outage_marks is None

@@ -14,6 +14,9 @@ file                   layout (KF-GINS README §2.2)
                        accelerometer scale factors (ppm): the drawn sensor errors
 ``kf-gins.yaml``       KF-GINS's configuration: the files, the start and its σ, the IMU
                        noise and the lever arm of this run; output to ``kfgins/``
+``gcalign.yaml``       the same run as a gcalign scenario (``gcalign calibrate``: the
+                       same files, start, σ, noise, processes and lever arm in gcalign's
+                       keys, ENU and body right, forward, up)
 ``dataset.json``       what was simulated: seed, start, outages, σ range, lever arm
 =====================  =================================================================
 """
@@ -24,6 +27,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from benchmarks.vehicle.dataset import Dataset
 from benchmarks.vehicle.imu import DEG, HOUR, MGAL, PPM
@@ -94,6 +98,50 @@ def kfgins_yaml(ds: Dataset, imu_path: Path, gnss_path: Path, out_dir: Path) -> 
         f"antlever: {_list(c.lever_frd)}", ""])
 
 
+def gcalign_scenario(ds: Dataset, imu_path: Path, gnss_path: Path) -> dict:
+    """The run as a gcalign scenario: ``calibrate`` on the recording, position fixes from
+    the GNSS file with its σ, 3-D, the start and σ given (no coarse alignment), the
+    sensor states as KF-GINS's Gauss–Markov processes. KF-GINS's NED/FRD become gcalign's
+    ENU/RFU: attitude [pitch, roll, −yaw], velocity [v_E, v_N, −v_D], lever arm [right,
+    forward, up]; KF-GINS's φ σ (its ``initattstd``: φ north, east, down) becomes φ east,
+    north, up. The run starts one sample into the file, at its first stamp (gcalign's data
+    time 0 is the start of the first row's increment), where KF-GINS starts."""
+    c, s, e = ds.config, ds.start, ds.config.errors
+    roll, pitch, yaw = np.degrees(s.euler)
+    vn, ve, vd = s.v_ned
+    pn, pe, pd = c.init_pos_std
+    sn, se, sd = c.init_vel_std
+    an, ae, ad = c.init_att_std
+    f, r, d = c.lever_frd
+    ug = e.abstd * MGAL / 9.80665e-6  # mGal -> µg (gcalign's µg is 1e-6 of 9.80665 m/s²)
+    tau = e.corrtime * HOUR
+    vrw = e.vrw / 60.0 / 9.80665e-6  # m/s/√h -> µg/√Hz
+    return {
+        "name": f"vehicle-{c.route}-seed{c.seed}",
+        "imu_file": {"path": str(imu_path), "format": "i2nav"},
+        "site": {"lat_deg": float(np.degrees(s.lat)), "lon_deg": float(np.degrees(s.lon)),
+                 "height_m": float(s.h)},
+        "initial": {"att_deg": [float(pitch), float(roll), float(-yaw)],
+                    "v_enu_mps": [float(ve), float(vn), float(-vd)],
+                    "lat_deg": float(np.degrees(s.lat)), "lon_deg": float(np.degrees(s.lon)),
+                    "height_m": float(s.h),
+                    "sigma": {"phi_enu_deg": [ae, an, ad], "v_enu_mps": [se, sn, sd],
+                              "pos_enu_m": [pe, pn, pd]}},
+        "calibrate": {
+            "aiding": "file", "measure": "position", "components": "3d",
+            "files": {"position": {"path": str(gnss_path), "format": "i2nav-gnss",
+                                   "lever_arm_m": [float(r), float(f), float(-d)]}},
+            "start_s": 1.0 / c.imu_rate_hz,
+            "p0_scale": 1,
+            "p0": {"gyro_bias_dph": e.gbstd, "accel_bias_ug": ug,
+                   "gyro_scale_ppm": e.gsstd, "accel_scale_ppm": e.asstd},
+            "q": {"arw_dprh": e.arw, "vrw_ugrhz": vrw,
+                  "gyro_bias_gm": {"std_dph": e.gbstd, "tau_s": tau},
+                  "accel_bias_gm": {"std_ug": ug, "tau_s": tau},
+                  "gyro_scale_gm": {"std_ppm": e.gsstd, "tau_s": tau},
+                  "accel_scale_gm": {"std_ppm": e.asstd, "tau_s": tau}}}}
+
+
 def summary(ds: Dataset) -> dict:
     c, s, f = ds.config, ds.start, ds.fixes
     return {"seed": c.seed, "route": c.route, "week": c.week,
@@ -119,18 +167,27 @@ def summary(ds: Dataset) -> dict:
             "imu_errors": vars(c.errors)}
 
 
+def paths(out_dir) -> dict[str, Path]:
+    """The run's files in `out_dir` by name (module docstring)."""
+    out = Path(out_dir).resolve()
+    return {"imu": out / "imu.txt", "gnss": out / "gnss.txt", "truth": out / "truth.nav",
+            "sensor_truth": out / "truth_imuerr.txt", "kfgins_yaml": out / "kf-gins.yaml",
+            "kfgins_out": out / KFGINS_OUT, "summary": out / "dataset.json",
+            "gcalign_yaml": out / "gcalign.yaml"}
+
+
 def write(ds: Dataset, out_dir) -> dict[str, Path]:
     """All of the run's files into `out_dir` (module docstring); their paths by name."""
-    out = Path(out_dir).resolve()
-    out.mkdir(parents=True, exist_ok=True)
-    (out / KFGINS_OUT).mkdir(exist_ok=True)
-    p = {"imu": out / "imu.txt", "gnss": out / "gnss.txt", "truth": out / "truth.nav",
-         "sensor_truth": out / "truth_imuerr.txt", "kfgins_yaml": out / "kf-gins.yaml",
-         "kfgins_out": out / KFGINS_OUT, "summary": out / "dataset.json"}
+    p = paths(out_dir)
+    p["kfgins_out"].mkdir(parents=True, exist_ok=True)
     write_imu(p["imu"], ds)
     write_gnss(p["gnss"], ds)
     write_truth(p["truth"], ds)
     write_sensor_truth(p["sensor_truth"], ds)
     p["kfgins_yaml"].write_text(kfgins_yaml(ds, p["imu"], p["gnss"], p["kfgins_out"]))
+    p["gcalign_yaml"].write_text(
+        "# gcalign scenario of a simulated vehicle run (benchmarks/vehicle); the KF-GINS\n"
+        "# run of the same files: kf-gins.yaml\n"
+        + yaml.safe_dump(gcalign_scenario(ds, p["imu"], p["gnss"]), sort_keys=False))
     p["summary"].write_text(json.dumps(summary(ds), indent=1) + "\n")
     return p

@@ -108,6 +108,15 @@ class SensorTruth:
     accel_scale: np.ndarray
 
 
+def sensor_processes(n: int, dt: float, errors: ImuErrors, rng: np.random.Generator
+                     ) -> SensorTruth:
+    """The four Gauss–Markov processes (gyro bias, accelerometer bias, gyro and
+    accelerometer scale factors) over `n` samples, drawn in that order from `rng`."""
+    e = errors.si()
+    return SensorTruth(*(gauss_markov(rng, n, e[k], e["corrtime"], dt)
+                         for k in ("gbstd", "abstd", "gsstd", "asstd")))
+
+
 def measured(dtheta: np.ndarray, dv: np.ndarray, dt: float, errors: ImuErrors,
              rng_processes: np.random.Generator, rng_noise: np.random.Generator
              ) -> tuple[np.ndarray, np.ndarray, SensorTruth]:
@@ -115,9 +124,7 @@ def measured(dtheta: np.ndarray, dv: np.ndarray, dt: float, errors: ImuErrors,
     docstring)."""
     e = errors.si()
     n = len(dtheta)
-    tau = e["corrtime"]
-    truth = SensorTruth(*(gauss_markov(rng_processes, n, e[k], tau, dt)
-                          for k in ("gbstd", "abstd", "gsstd", "asstd")))
+    truth = sensor_processes(n, dt, errors, rng_processes)
     noise = rng_noise.standard_normal((n, 6))
     dth = ((1.0 + truth.gyro_scale) * dtheta + truth.gyro_bias * dt
            + e["arw"] * np.sqrt(dt) * noise[:, :3])
