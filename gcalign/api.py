@@ -61,13 +61,13 @@ class Result:
 
     def table(self):
         """The rich table the command prints."""
-        from gcalign.app.report import summary_table
+        from gcalign.app.readback import summary_table
 
         return summary_table(self.kind, self.summary)
 
     def figures(self) -> dict:
         """The figures ``gcalign plot`` writes, as matplotlib Figures, by name."""
-        from gcalign.app.plots import figures_for
+        from gcalign.app.readback import figures_for
 
         return figures_for(self.path)
 

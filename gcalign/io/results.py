@@ -24,7 +24,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from gcalign import __version__
+from gcalign._version import __version__
 from gcalign.errors import GcalignError, ScenarioError, check_terminated
 from gcalign.io.paths import not_a_file
 from gcalign.limits import SEED_MAX
