@@ -217,7 +217,7 @@ def run(command: str, scenario, seed: int | None = None, output: str | Path | No
 
     from gcalign.io.scenario import Scenario
 
-    own = [p for p in inspect.signature(COMMANDS[command]._execute()).parameters
+    own = [p for p in inspect.signature(COMMANDS[command].runner()).parameters
            if p not in _RUN_PARAMETERS]
     unknown = [k for k in options if k not in own]
     if unknown:
