@@ -35,6 +35,10 @@ class Stored:
     attr : stored as an attribute of the group, not a dataset (a tuple of names as one text
         joined by commas).
     flag : a boolean array, stored as 0/1 (int8) and read back as bool.
+    axes : the order its axes are stored in (``numpy.transpose``), if not its own: a core
+        array (M, R) stored as the file's (R, M) says ``axes=(1, 0)``.
+    per : the field that names the entries of its first axis: each entry is stored in a
+        subgroup of that name (``per="methods"``: ``coordinate/error``, ``vector/error``).
     """
 
     units: str | None
@@ -44,6 +48,14 @@ class Stored:
     name: str | None = None
     attr: bool = False
     flag: bool = False
+    axes: tuple[int, ...] | None = None
+    per: str | None = None
+
+
+#: The frame text of an attitude triple (DESIGN.md conventions), as results files carry it.
+ATT_FRAME = "[pitch, roll, yaw], C_nb = Rz(yaw) Rx(pitch) Ry(roll), ENU, yaw CCW positive"
+#: The frame text of a misalignment vector φ.
+PHI_FRAME = "misalignment, ENU: C_nb,est C_nb,true^T = exp(-[phi x])"
 
 
 def stored(units: str | None, *, default: Any = dataclasses.MISSING, **how: Any) -> Any:

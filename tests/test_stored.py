@@ -72,3 +72,26 @@ def test_a_new_field_is_one_line(tmp_path):
         assert ds.attrs["units"] == "1" and ds.attrs["description"] == "largest degree"
         back = read_fields(f["observability"], Wider)
     assert np.array_equal(back.eta_max, base.eta.max(axis=1))
+
+
+def test_a_north_finding_result_comes_back(tmp_path):
+    """North-finding's arrays are (methods, azimuths, repeats) in the core and (repeats,
+    azimuths) per method in the file (``coordinate/error``): stored and read back to the
+    same arrays."""
+    from gcalign.northfind import NorthfindResult, NorthfindSetup, run_northfind
+
+    setup = NorthfindSetup(azimuths=np.radians([10.0, 200.0, 300.0]), lat=np.radians(40.0),
+                           positions=8, repeats=2, tilt=np.radians(2.0), gyro_arw=1e-7)
+    res = run_northfind(setup, np.random.default_rng(5))
+    with h5py.File(tmp_path / "n.h5", "w") as f:
+        write_fields(f.create_group("northfind"), res)
+    with h5py.File(tmp_path / "n.h5") as f:
+        g = f["northfind"]
+        assert g["coordinate/error"].shape == (2, 3)  # (repeats, azimuths)
+        assert np.array_equal(g["vector/estimate"][()], res.estimate("vector").T)
+        back = read_fields(g, NorthfindResult, gyro_residual=None, accel_residual=None)
+    for f_ in fields(NorthfindResult):
+        if spec(f_) is not None and f_.name != "methods":
+            a, b = getattr(res, f_.name), getattr(back, f_.name)
+            assert a.shape == b.shape and np.array_equal(a, b, equal_nan=True), f_.name
+    assert back.methods == res.methods

@@ -17,7 +17,7 @@ import h5py
 import numpy as np
 
 from gcalign.io.results import check_writes, put
-from gcalign.schema import spec
+from gcalign.schema import Stored, spec
 
 T = TypeVar("T")
 
@@ -41,11 +41,27 @@ def write_fields(g: h5py.Group, result: Any) -> None:
         elif how.units is None:  # text
             check_writes()
             g.create_dataset(name, data=np.array(value, dtype=h5py.string_dtype()))
+        elif how.per is not None:  # one subgroup per entry of the first axis
+            for entry, part in zip(getattr(result, how.per), value, strict=True):
+                _put(g.require_group(entry), name, part, how)
         else:
-            extra = {k: v for k, v in (("shape", how.shape), ("description", how.description))
-                     if v is not None}
-            data = np.asarray(value).astype(np.int8) if how.flag else np.asarray(value)
-            put(g, name, data, how.units, how.frame, **extra)
+            _put(g, name, value, how)
+
+
+def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
+    extra = {k: v for k, v in (("shape", how.shape), ("description", how.description))
+             if v is not None}
+    data = np.asarray(value)
+    if how.axes is not None:
+        data = np.transpose(data, how.axes)
+    put(g, name, data.astype(np.int8) if how.flag else data, how.units, how.frame, **extra)
+
+
+def _get(ds: h5py.Dataset, how: Stored) -> np.ndarray:
+    a = ds[()]
+    if how.axes is not None:
+        a = np.transpose(a, np.argsort(how.axes))
+    return a.astype(bool) if how.flag else a
 
 
 def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
@@ -64,12 +80,15 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
                 v = v.decode() if isinstance(v, bytes) else v
                 values[f.name] = (tuple(v.split(",")) if isinstance(v, str)
                                   and "tuple" in str(f.type) else _plain(v))
+        elif how.per is not None:
+            entries = values.get(how.per) or given[how.per]
+            values[f.name] = np.stack([_get(g[e][name], how) for e in entries])
         elif name in g:
-            a = g[name][()]
             if how.units is None:
-                values[f.name] = tuple(x.decode() if isinstance(x, bytes) else str(x) for x in a)
+                values[f.name] = tuple(x.decode() if isinstance(x, bytes) else str(x)
+                                       for x in g[name][()])
             else:
-                values[f.name] = a.astype(bool) if how.flag else a
+                values[f.name] = _get(g[name], how)
         elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
             values[f.name] = None  # an optional series the run did not make
     return cls(**values, **given)
