@@ -1,15 +1,15 @@
 """What a result's fields are, said once, on the field: the unit (SI, as stored), the frame,
 the shape, the name and form in the results file. The core's result dataclasses declare
-their fields with :func:`stored` (``dataclasses.field`` with this metadata); the results
+their fields with this metadata (``field(metadata=stored("rad", ...))``); the results
 file's generic writer and reader (:func:`gcalign.io.results.write_fields`,
 :func:`~gcalign.io.results.read_fields`) follow it, so that a new field of a result is one
 line in one file. No h5py, no pydantic: the core may import this module.
 
->>> from dataclasses import dataclass, fields
+>>> from dataclasses import dataclass, field, fields
 >>> @dataclass
 ... class Fix:
-...     t: float = stored("s", attr=True)
-...     pos: object = stored("rad, rad, m", frame="[latitude, longitude, height]")
+...     t: float = field(metadata=stored("s", attr=True))
+...     pos: object = field(metadata=stored("rad, rad, m", frame="[latitude, longitude, height]"))
 >>> [(f.name, spec(f).units) for f in fields(Fix)]
 [('t', 's'), ('pos', 'rad, rad, m')]
 """
@@ -58,10 +58,10 @@ ATT_FRAME = "[pitch, roll, yaw], C_nb = Rz(yaw) Rx(pitch) Ry(roll), ENU, yaw CCW
 PHI_FRAME = "misalignment, ENU: C_nb,est C_nb,true^T = exp(-[phi x])"
 
 
-def stored(units: str | None, *, default: Any = dataclasses.MISSING, **how: Any) -> Any:
-    """A dataclass field stored in the results file as :class:`Stored` says (`how`: its
-    keywords); `default` as :func:`dataclasses.field` takes it."""
-    return dataclasses.field(default=default, metadata={KEY: Stored(units, **how)})
+def stored(units: str | None, **how: Any) -> dict[str, Stored]:
+    """The metadata of a dataclass field stored in the results file as :class:`Stored` says
+    (`how`: its keywords): ``x: np.ndarray = field(metadata=stored("rad", frame=...))``."""
+    return {KEY: Stored(units, **how)}
 
 
 def spec(f: dataclasses.Field) -> Stored | None:

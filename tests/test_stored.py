@@ -5,7 +5,7 @@ in its dataclass, and the file has it."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 import h5py
 import numpy as np
@@ -60,7 +60,7 @@ def test_a_new_field_is_one_line(tmp_path):
 
     @dataclass(frozen=True)
     class Wider(ObservabilityTable):
-        eta_max: np.ndarray | None = stored("1", description="largest degree", default=None)
+        eta_max: np.ndarray | None = field(default=None, metadata=stored("1", description="max"))
 
     base = table()
     wider = Wider(**{f.name: getattr(base, f.name) for f in fields(base)},
@@ -69,7 +69,7 @@ def test_a_new_field_is_one_line(tmp_path):
         write_fields(f.create_group("observability"), wider)
     with h5py.File(tmp_path / "w.h5") as f:
         ds = f["observability/eta_max"]
-        assert ds.attrs["units"] == "1" and ds.attrs["description"] == "largest degree"
+        assert ds.attrs["units"] == "1" and ds.attrs["description"] == "max"
         back = read_fields(f["observability"], Wider)
     assert np.array_equal(back.eta_max, base.eta.max(axis=1))
 

@@ -54,7 +54,8 @@ def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
     data = np.asarray(value)
     if how.axes is not None:
         data = np.transpose(data, how.axes)
-    put(g, name, data.astype(np.int8) if how.flag else data, how.units, how.frame, **extra)
+    put(g, name, data.astype(np.int8) if how.flag else data, how.units or "1", how.frame,
+        **extra)
 
 
 def _get(ds: h5py.Dataset, how: Stored) -> np.ndarray:

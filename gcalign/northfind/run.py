@@ -9,7 +9,7 @@ and returns the errors against the truth beside the closed-form predictions
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -50,30 +50,32 @@ class NorthfindResult:
     theta : (n,) rad. Nominal table angles.
     """
 
-    methods: tuple[str, ...] = stored(None, attr=True)
-    azimuth_true: np.ndarray = stored("rad", frame=AZIMUTH)
-    tilt_true: np.ndarray = stored("rad", frame="table normal from the vertical")
-    tilt_direction_true: np.ndarray = stored("rad", frame=DESCENT)
-    azimuth_est: np.ndarray = stored("rad", frame=AZIMUTH, shape=RM, axes=(1, 0),
-                                     per="methods", name="estimate")
-    azimuth_error: np.ndarray = stored("rad", frame="estimate - true, wrapped to [-pi, pi)",
-                                       shape=RM, axes=(1, 0), per="methods", name="error")
-    error_pred: np.ndarray = stored("rad", frame="noise-free closed form (NaN: none)",
-                                    per="methods")
-    azimuth_std_pred: np.ndarray = stored("rad", frame="linearised 1-sigma prediction",
-                                          per="methods", name="std_pred")
-    tilt_est: np.ndarray = stored("rad", shape=RM, axes=(1, 0))
-    tilt_direction_est: np.ndarray = stored("rad", frame=DESCENT, shape=RM, axes=(1, 0))
-    pitch_est: np.ndarray = stored("rad", frame=ATT_FRAME, shape=RM, axes=(1, 0))
-    roll_est: np.ndarray = stored("rad", frame=ATT_FRAME, shape=RM, axes=(1, 0))
-    gyro_coef: np.ndarray = stored("rad/s", shape="(repeats, azimuths, [R, a, b])",
-                                   axes=(1, 0, 2))
-    accel_coef: np.ndarray = stored("m/s^2", shape="(repeats, azimuths, [x, y], [R, a, b])",
-                                    axes=(1, 0, 2, 3))
+    methods: tuple[str, ...] = field(metadata=stored(None, attr=True))
+    azimuth_true: np.ndarray = field(metadata=stored("rad", frame=AZIMUTH))
+    tilt_true: np.ndarray = field(metadata=stored("rad", frame="table normal from the vertical"))
+    tilt_direction_true: np.ndarray = field(metadata=stored("rad", frame=DESCENT))
+    azimuth_est: np.ndarray = field(metadata=stored(
+        "rad", frame=AZIMUTH, shape=RM, axes=(1, 0), per="methods", name="estimate"))
+    azimuth_error: np.ndarray = field(metadata=stored(
+        "rad", frame="estimate - true, wrapped to [-pi, pi)", shape=RM, axes=(1, 0),
+        per="methods", name="error"))
+    error_pred: np.ndarray = field(metadata=stored(
+        "rad", frame="noise-free closed form (NaN: none)", per="methods"))
+    azimuth_std_pred: np.ndarray = field(metadata=stored(
+        "rad", frame="linearised 1-sigma prediction", per="methods", name="std_pred"))
+    tilt_est: np.ndarray = field(metadata=stored("rad", shape=RM, axes=(1, 0)))
+    tilt_direction_est: np.ndarray = field(metadata=stored(
+        "rad", frame=DESCENT, shape=RM, axes=(1, 0)))
+    pitch_est: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME, shape=RM, axes=(1, 0)))
+    roll_est: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME, shape=RM, axes=(1, 0)))
+    gyro_coef: np.ndarray = field(metadata=stored(
+        "rad/s", shape="(repeats, azimuths, [R, a, b])", axes=(1, 0, 2)))
+    accel_coef: np.ndarray = field(metadata=stored(
+        "m/s^2", shape="(repeats, azimuths, [x, y], [R, a, b])", axes=(1, 0, 2, 3)))
     gyro_residual: np.ndarray
     accel_residual: np.ndarray
-    theta: np.ndarray = stored("rad", frame="table angles, counter-clockwise about the table "
-                               "normal")
+    theta: np.ndarray = field(metadata=stored(
+        "rad", frame="table angles, counter-clockwise about the table normal"))
 
     def _index(self, method: str) -> int:
         if method not in self.methods:
