@@ -60,7 +60,7 @@ def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
 
 def _get(ds: h5py.Dataset, how: Stored) -> np.ndarray:
     a = ds[()]
-    if how.axes is not None:
+    if how.axes is not None and a.ndim == len(how.axes):  # (else a form with fewer axes)
         a = np.transpose(a, np.argsort(how.axes))
     return a.astype(bool) if how.flag else a
 
@@ -82,8 +82,10 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
                 values[f.name] = (tuple(v.split(",")) if isinstance(v, str)
                                   and "tuple" in str(f.type) else _plain(v))
         elif how.per is not None:
-            entries = values.get(how.per) or given[how.per]
-            values[f.name] = np.stack([_get(g[e][name], how) for e in entries])
+            entries = values.get(how.per) or given.get(how.per) or ()
+            parts = [g[e][name] for e in entries if e in g and name in g[e]]
+            values[f.name] = (np.stack([_get(ds, how) for ds in parts])
+                              if parts and len(parts) == len(entries) else None)
         elif name in g:
             if how.units is None:
                 values[f.name] = tuple(x.decode() if isinstance(x, bytes) else str(x)
