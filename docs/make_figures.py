@@ -38,7 +38,7 @@ def _cli(*args: str) -> None:
 
 def _plot(results: Path, names: dict[str, str], tmp: Path) -> list[Path]:
     """Plot a results (or data) file and copy its figures `names` (stem -> docs name)."""
-    from gcalign.app.plots import plot_file
+    from gcalign.app.readback import plot_file
 
     written = {p.stem: p for p in plot_file(results, tmp / f"{results.name}_plots")}
     out = []

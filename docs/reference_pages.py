@@ -340,7 +340,10 @@ def _shape(shape) -> str:
 
 
 def results_page() -> str:
-    from gcalign.app.registry import COMMANDS
+    from gcalign.app.checked import layout as groups_of
+    from gcalign.app.readback import kinds
+
+    commands = kinds()
 
     lines = ["# Results file", "",
              "One HDF5 file per run, written under a temporary name and renamed when complete "
@@ -363,8 +366,8 @@ def results_page() -> str:
              ""]
     layout = result_layout()
     for kind, rows in layout.items():
-        cmd = COMMANDS.get(kind)
-        groups = ", ".join(f"`/{g}`" for g in cmd.layout) if cmd is not None else ""
+        cmd = commands.get(kind)
+        groups = ", ".join(f"`/{g}`" for g in groups_of(kind)) if cmd is not None else ""
         lines += [f"## {kind}", ""]
         if cmd is not None:
             lines += [f"Written by `gcalign {kind}`" + (f"; its groups: {groups}." if groups

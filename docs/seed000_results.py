@@ -142,7 +142,8 @@ def best_tz(tz: Batch) -> float:
 
 def figure(batch_file: Path, name: str, png: str) -> None:
     """docs/figures/PNG: figure NAME of a batch file, as `gcalign plot` draws it."""
-    from gcalign.app.plots import DPI, figures_for
+    from gcalign.app.plots import DPI
+    from gcalign.app.readback import figures_for
 
     figures_for(batch_file)[name].savefig(ROOT / "docs" / "figures" / png, dpi=DPI)
 

@@ -19,8 +19,7 @@ results file as ``gcalign align``), and :func:`read` a results file back into th
 :class:`Result`. Importing gcalign loads none of it until it is used.
 """
 
-
-__version__ = "0.1.0"
+from gcalign._version import __version__ as __version__
 
 _API = ("load", "example", "run", "read", "commands", "Result")
 

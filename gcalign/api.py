@@ -61,13 +61,13 @@ class Result:
 
     def table(self):
         """The rich table the command prints."""
-        from gcalign.app.report import summary_table
+        from gcalign.app.readback import summary_table
 
         return summary_table(self.kind, self.summary)
 
     def figures(self) -> dict:
         """The figures ``gcalign plot`` writes, as matplotlib Figures, by name."""
-        from gcalign.app.plots import figures_for
+        from gcalign.app.readback import figures_for
 
         return figures_for(self.path)
 
@@ -217,7 +217,7 @@ def run(command: str, scenario, seed: int | None = None, output: str | Path | No
 
     from gcalign.io.scenario import Scenario
 
-    own = [p for p in inspect.signature(COMMANDS[command]._execute()).parameters
+    own = [p for p in inspect.signature(COMMANDS[command].runner()).parameters
            if p not in _RUN_PARAMETERS]
     unknown = [k for k in options if k not in own]
     if unknown:

@@ -16,8 +16,8 @@ from typer.testing import CliRunner
 
 from gcalign import __version__, limits
 from gcalign.app import preflight, registry
-from gcalign.app.command import Command, Cost, Extent
-from gcalign.app.registry import COMMANDS, Outcome
+from gcalign.app.command import Command, Cost, Extent, Outcome
+from gcalign.app.registry import COMMANDS
 from gcalign.cli import app
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import parse_scenario

@@ -176,7 +176,7 @@ def test_a_sigterm_lost_in_a_finaliser_keeps_every_other_commit_from_its_name(
     from matplotlib.figure import Figure
 
     from gcalign import errors
-    from gcalign.app import export, plots
+    from gcalign.app import export, readback
     from gcalign.app.batch.store import Journal
 
     def csv_then_lost(fh, *a):
@@ -192,7 +192,7 @@ def test_a_sigterm_lost_in_a_finaliser_keeps_every_other_commit_from_its_name(
     monkeypatch.setattr(Figure, "savefig", savefig_then_lost)
     out = tmp_path / "out"
     run = {"export": lambda: export.export(small_nav, "csv", out),
-           "plot": lambda: plots.plot_file(small_nav, out),
+           "plot": lambda: readback.plot_file(small_nav, out),
            "journal": lambda: (_lose_a_sigterm(), Journal(out, {"v": 1}, [{"id": "a"}]))}
     try:
         with pytest.raises(errors.Terminated):

@@ -411,7 +411,7 @@ def test_plot_interrupted_midway_leaves_no_figure_and_no_temporary_folder(
     figure's save) leaves neither a truncated PNG under a figure's name nor the folder."""
     from matplotlib.figure import Figure
 
-    from gcalign.app import plots
+    from gcalign.app import readback
 
     saved = []
     real = Figure.savefig
@@ -424,6 +424,6 @@ def test_plot_interrupted_midway_leaves_no_figure_and_no_temporary_folder(
 
     monkeypatch.setattr(Figure, "savefig", savefig)
     with pytest.raises(KeyboardInterrupt):
-        plots.plot_file(results_of_kinds / "calibrate.h5", fuzz_env / "figs")
+        readback.plot_file(results_of_kinds / "calibrate.h5", fuzz_env / "figs")
     assert saved and list((fuzz_env / "figs").iterdir()) == []
     assert [p.name for p in fuzz_env.iterdir() if p.name != "figs"] == []

@@ -17,7 +17,7 @@ PKG = Path(__file__).resolve().parents[1] / "gcalign"
 # The packages in layers, lowest first. A module may import its own layer and the layers
 # below it, never one above, at the top of a file or inside a function alike.
 LAYERS = (
-    ("units", "errors", "limits", "gaps"),
+    ("units", "errors", "limits", "gaps", "_version", "schema"),
     ("nav",),
     ("sim", "estimation"),
     ("align", "northfind", "calibrate", "realtime", "modulate", "transfer",  # capabilities
@@ -173,3 +173,95 @@ def test_one_module_opens_matlab_files():
                            or f"import {fn}" in p.read_text(encoding="utf-8")
                            for fn in ("loadmat", "whosmat")))
     assert opened == ["io/recorded/mat.py"], opened
+
+
+def module_name(path: Path) -> str:
+    """``gcalign/app/align/__init__.py`` -> ``gcalign.app.align``."""
+    parts = path.relative_to(PKG.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def module_graph(sources: dict[str, str]) -> dict[str, set[str]]:
+    """Module -> the package modules it imports (`sources`: module name -> its text), at the
+    top of a file or inside a function alike: ``from gcalign.app import registry`` imports
+    the module ``gcalign.app.registry``, ``from gcalign.app.registry import COMMANDS`` it
+    too. A package's ``__init__`` counts only where it is named (the parents Python runs
+    first are not edges)."""
+    packages = {m.rpartition(".")[0] for m in sources}
+    graph: dict[str, set[str]] = {}
+    for name, text in sources.items():
+        pkg = name if name in packages else name.rpartition(".")[0]
+        edges: set[str] = set()
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.Import):
+                for a in node.names:
+                    m = a.name
+                    while m and m not in sources:
+                        m = m.rpartition(".")[0]
+                    edges.add(m)
+            elif isinstance(node, ast.ImportFrom):
+                base = pkg
+                for _ in range(max(node.level - 1, 0)):
+                    base = base.rpartition(".")[0]
+                module = (f"{base}.{node.module}" if node.module else base) if node.level \
+                    else (node.module or "")
+                for a in node.names:
+                    edges.add(f"{module}.{a.name}" if f"{module}.{a.name}" in sources
+                              else module)
+        graph[name] = {m for m in edges if m in sources and m != name}
+    return graph
+
+
+def circles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The import circles of `graph`: its strongly connected parts of two modules or more
+    (Tarjan), each sorted."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    found: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in sorted(graph[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            part = []
+            while True:
+                w = stack.pop()
+                part.append(w)
+                if w == v:
+                    break
+            if len(part) > 1:
+                found.append(sorted(part))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return found
+
+
+def package_sources() -> dict[str, str]:
+    return {module_name(p): p.read_text(encoding="utf-8") for p in sorted(PKG.rglob("*.py"))}
+
+
+def test_no_import_circle():
+    """No module of gcalign imports, through any chain, one that imports it back, counting
+    the imports inside functions: commands hold references to their functions, and what
+    dispatches by a command's name (the registry, ``show``, ``plot``) sits above them."""
+    found = circles(module_graph(package_sources()))
+    assert not found, "\n".join(", ".join(c) for c in found)
+
+
+def test_the_circle_check_sees_a_function_level_circle():
+    """A circle closed by an import inside a function, and one through ``from pkg import
+    module``, are found (so the test above can fail)."""
+    sources = package_sources()
+    sources["gcalign.app.command"] += ("\n\ndef _probe():\n"
+                                       "    from gcalign.app import registry\n")
+    found = circles(module_graph(sources))
+    assert any({"gcalign.app.command", "gcalign.app.registry"} <= set(c) for c in found), found

@@ -16,6 +16,7 @@ from gcalign.cli import app
 from gcalign.io import results
 
 plots = lazy_module("gcalign.app.plots")  # matplotlib: imported when a test runs
+readback = lazy_module("gcalign.app.readback")
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()
@@ -62,7 +63,7 @@ def align_files(tmp_path_factory):
 def test_alignment_figures_per_pass_on_equivalent_time(align_files):
     """Rows pitch, roll, yaw; left all passes, right the zoom after pass 1; linear axes in
     the unit of the values; pass boundaries dotted; the legend below the panels."""
-    figs = plots.figures_for(align_files["full-cycle"])
+    figs = readback.figures_for(align_files["full-cycle"])
     assert set(figs) == {"align_error", "align_attitude"}
     err = figs["align_error"]
     assert len(err.axes) == 6
@@ -104,7 +105,7 @@ def test_alignment_figures_per_pass_on_equivalent_time(align_files):
 
 
 def test_conventional_has_one_pass_and_no_boundary(align_files):
-    fig = plots.figures_for(align_files["conventional"])["align_error"]
+    fig = readback.figures_for(align_files["conventional"])["align_error"]
     assert fig.axes[1].get_title() == "second half of the pass (zoom)"
     for ax in fig.axes:
         assert len(data_series(ax)) == 1 and not boundaries(ax)
@@ -119,7 +120,7 @@ def test_alignment_of_recorded_data_has_no_truth_in_its_figures(tmp_path):
     res = runner.invoke(app, ["align", str(ROOT / "configs/lasergyro_align.yaml"), "-o",
                               str(out), "--set", "align.t2_s=150", "--set", "align.t3_s=150"])
     assert res.exit_code == 0, res.output
-    figs = plots.figures_for(out)
+    figs = readback.figures_for(out)
     assert set(figs) == {"align_attitude"}
     fig = figs["align_attitude"]
     assert "no truth" in fig.get_suptitle() and "vs truth" not in fig.get_suptitle()
@@ -150,7 +151,7 @@ def _northfind_file(path: Path, repeats: int | None):
 def test_northfind_figures_error_against_true_azimuth(tmp_path, repeats):
     path = tmp_path / "nf.h5"
     _northfind_file(path, repeats)
-    figs = plots.figures_for(path)
+    figs = readback.figures_for(path)
     assert set(figs) == {"northfind_error", "northfind_difference"}
     fig = figs["northfind_error"]
     assert [ax.get_ylabel().split("\n")[0] for ax in fig.axes] == ["coordinate", "vector", "none"]
@@ -192,7 +193,7 @@ def test_northfind_figures_from_the_real_command(tmp_path):
     out = tmp_path / "nf.h5"
     res = runner.invoke(app, ["northfind", "-o", str(out)])
     assert res.exit_code == 0, res.output
-    fig = plots.figures_for(out)["northfind_error"]
+    fig = readback.figures_for(out)["northfind_error"]
     with results.open_results(out) as f:
         methods = f["northfind"].attrs["methods"].split(",")
         m = f["northfind/azimuth_true"].shape[0]
@@ -232,7 +233,7 @@ def sweep_file(tmp_path_factory):
 
 @pytest.mark.slow
 def test_batch_figures_box_per_variant_and_component(batch_file):
-    figs = plots.figures_for(batch_file)
+    figs = readback.figures_for(batch_file)
     assert set(figs) == {"batch_error_t3_deg", "batch_equivalent_s"}
     fig = figs["batch_error_t3_deg"]
     assert len(fig.axes) == 3  # pitch, roll, yaw
@@ -255,7 +256,7 @@ def test_sweep_figure_median_against_the_numeric_key(sweep_file):
     """A numeric grid key gives lines instead of boxes: x = its values (sorted), y = the
     median over seeds of |metric| of each variant, read back from /batch/runs; one line
     per other grid value (mode), one column per case, one row per component."""
-    figs = plots.figures_for(sweep_file)
+    figs = readback.figures_for(sweep_file)
     assert set(figs) == {"batch_error_t3_deg_2_vs_t_z_s", "batch_error_t3_deg_vs_t_z_s"}
     with results.open_results(sweep_file) as f:
         r = f["batch/runs"]
@@ -363,7 +364,7 @@ def sim_and_nav(tmp_path_factory):
 
 
 def test_navigate_error_figure_phi_velocity_position_and_horizontal_norm(sim_and_nav):
-    figs = plots.figures_for(sim_and_nav["navigate"])
+    figs = readback.figures_for(sim_and_nav["navigate"])
     assert set(figs) == {"navigate_error"}
     fig = figs["navigate_error"]
     phi_ax, v_ax, p_ax = fig.axes
@@ -400,7 +401,7 @@ def test_envelope_bins_are_means_minima_and_maxima():
 
 
 def test_simulate_figures_truth_and_imu_output(sim_and_nav):
-    figs = plots.figures_for(sim_and_nav["simulate"])
+    figs = readback.figures_for(sim_and_nav["simulate"])
     assert set(figs) == {"truth", "imu"}
     truth = figs["truth"]
     assert [ln.get_label() for ln in data_series(truth.axes[0])] == ["pitch", "roll", "yaw"]
@@ -435,7 +436,7 @@ def test_plot_of_a_recorded_data_file_draws_its_imu_output(tmp_path):
     out = json.loads(res.stdout)
     assert out["kind"] == "data" and [Path(p).name for p in out["figures"]] == ["imu.png"]
     assert Path(out["figures"][0]).read_bytes().startswith(PNG)
-    fig = plots.figures_for(ROOT / "tests/data/lasergyro.imu.xz")["imu"]
+    fig = readback.figures_for(ROOT / "tests/data/lasergyro.imu.xz")["imu"]
     assert "increments / 10 ms" in fig.get_suptitle()
     assert fig.axes[3].get_xlabel() == "time from the start (min)"  # 1847 s
     # the specific force along z is gravity: its bin means sit at 9.79 m/s²
@@ -465,7 +466,7 @@ def test_navigate_figure_of_recorded_data_is_the_solution_and_its_drift(tmp_path
     res = runner.invoke(app, ["navigate", str(ROOT / "tests/data/lasergyro.imu.xz"),
                               "--init", "header", "--duration", "1800", "-o", str(nav)])
     assert res.exit_code == 0, res.output
-    figs = plots.figures_for(nav)
+    figs = readback.figures_for(nav)
     assert set(figs) == {"navigate"}
     fig = figs["navigate"]
     assert "no truth" in fig.get_suptitle() and "estimate vs truth" not in fig.get_suptitle()
@@ -519,7 +520,7 @@ def test_calibrate_figures_estimates_sigma_errors_innovations(calibrate_file):
     from gcalign.app.calibrate.plots import read_runs
 
     path = calibrate_file["calibrate"]
-    figs = plots.figures_for(path)
+    figs = readback.figures_for(path)
     assert set(figs) == {"trajectory", "sensor_biases", "scale_factors", "sigma",
                          "navigation_errors", "innovations"}
     with results.open_results(path) as f:
@@ -584,7 +585,7 @@ def test_observability_heat_maps_are_log10_of_the_file(calibrate_file):
     """The cells are log10 η (zeros masked, drawn grey) of /observability, segments ×
     states, the text in each cell its rounded exponent."""
     path = calibrate_file["observability"]
-    figs = plots.figures_for(path)
+    figs = readback.figures_for(path)
     assert {"trajectory", "observability_segments", "observability_cumulative"} <= set(figs)
     with results.open_results(path) as f:
         g = f["observability"]

@@ -14,6 +14,7 @@ from align_cases import small_align
 from rich.console import Console
 from typer.testing import CliRunner
 
+from gcalign.app import readback
 from gcalign.app import report as R
 from gcalign.cli import app
 
@@ -60,7 +61,7 @@ def test_durations_and_run_line():
 
 def _rendered(kind: str, summary: dict, width: int = 80) -> str:
     console = Console(width=width, record=True, file=open("/dev/null", "w"))  # noqa: SIM115
-    console.print(R.summary_table(kind, summary))
+    console.print(readback.summary_table(kind, summary))
     return console.export_text()
 
 

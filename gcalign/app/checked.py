@@ -1,5 +1,5 @@
 """Results files read back (plot, show, export, ``navigate --init``): the summary, the
-groups of the command that wrote it (its ``layout``), and one check per kind of what those
+groups of the command that wrote it (:func:`layout`), and one check per kind of what those
 groups hold.
 
 Each dataset is checked alone first (:func:`gcalign.io.results.check_layout`: numbers
@@ -26,7 +26,6 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from gcalign.app.registry import COMMANDS
 from gcalign.errors import ScenarioError
 from gcalign.io import results
 
@@ -201,14 +200,20 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
 }
 
 
+def layout(kind: str) -> tuple[str, ...]:
+    """The groups a command of that kind writes beside ``/truth``: its own (``/align``),
+    or ``simulate``'s ``/truth`` and ``/imu``."""
+    return ("truth", "imu") if kind == "simulate" else (kind,)
+
+
 def read_checked(path: Path) -> tuple[str, dict, dict]:
     """``(kind, summary, root attributes)`` of a results file whose command's groups
-    (:attr:`gcalign.app.command.Command.layout`) are present and undamaged
+    (:func:`layout`) are present and undamaged
     (:func:`gcalign.io.results.check_layout`) and whose datasets fit together as the
     kind's writer makes them (:data:`SCHEMAS`); ScenarioError (one line) otherwise."""
     kind, summary, attrs = results.read_summary(path)
-    if kind in COMMANDS:
-        results.check_layout(Path(path), kind, COMMANDS[kind].layout, kind in STRICT)
+    if kind in SCHEMAS:
+        results.check_layout(Path(path), kind, layout(kind), kind in STRICT)
         with results.open_results(path) as f:
             for block in SCHEMAS.get(kind, ()):
                 for g in _groups(f, block.where):

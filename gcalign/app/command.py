@@ -5,7 +5,7 @@ scenario), what it refuses (:meth:`~Command.check`, the one code path of ``gcali
 validate``, the preflight of every run and a batch's check of its variants), what a run
 costs (:meth:`~Command.cost`, held against :mod:`gcalign.limits` before any work), how it
 runs (:meth:`~Command.execute`) and how it shows and stores its results (table, figures,
-HDF5 layout, batch metrics). The registry (:mod:`gcalign.app.registry`) holds one object
+results file, batch metrics). The registry (:mod:`gcalign.app.registry`) holds one object
 per command; adding a command is a new folder with such an object and one registry line.
 
 A command imports its heavy parts (numba kernels, scipy, matplotlib) inside its methods,
@@ -15,7 +15,6 @@ so that ``gcalign show`` and ``gcalign validate`` never load them.
 from __future__ import annotations
 
 import gc
-import importlib
 import inspect
 import os
 from collections.abc import Callable, Iterator
@@ -26,7 +25,6 @@ from typing import TYPE_CHECKING, Any
 from gcalign.errors import ScenarioError
 
 if TYPE_CHECKING:
-    from gcalign.app.registry import Outcome
     from gcalign.io.scenario import Scenario
 
 #: The id of the process that runs one command and ends, set by the command line's ``main``
@@ -76,6 +74,27 @@ class Extent:
 
 
 @dataclass(frozen=True)
+class Outcome:
+    """What one run of a command produced, ready to be written and shown.
+
+    summary : plain numbers (degrees, seconds, ...): the JSON contract and ``summary_json``.
+    write : writes the command's groups into an open results file (h5py.File).
+    truth : the simulated truth to store under ``/truth``, if any.
+    seed : the random seed the run used (None for recorded data).
+    warnings : one line each, shown on stderr and kept in the summary.
+    result : the capability's typed result in SI (e.g.
+        :class:`gcalign.align.gyrocompass.Alignment`), or None.
+    """
+
+    summary: dict
+    write: Callable[[Any], None]
+    truth: Any = None
+    seed: int | None = None
+    warnings: tuple[str, ...] = ()
+    result: Any = None
+
+
+@dataclass(frozen=True)
 class Cost:
     """What one run of a command costs, estimated before it starts.
 
@@ -114,9 +133,9 @@ class Options:
 
 class Command:
     """One command: what it reads, refuses, costs, runs, shows and stores. A command folder
-    subclasses it once (its name is also the ``kind`` of its results file); the defaults
-    reach the folder's modules by dotted path, imported when called, and run the section's
-    own ``check(sc)``."""
+    subclasses it once (its name is also the ``kind`` of its results file); its methods
+    import the folder's modules when called (heavy ones load numba), and the default check
+    runs the section's own ``check(sc)``."""
 
     name: str = ""
     help: str = ""
@@ -126,10 +145,6 @@ class Command:
     section_keys: str | None = None
     builtin: str | None = None  #: its built-in scenario (package data gcalign/scenarios)
     options: Options = Options()
-    layout: tuple[str, ...] = ()  #: the HDF5 groups of its results file beside /truth
-    run: str = ""  #: the module whose ``execute(sc, seed, cache_key, **options)`` runs it
-    table_of: str = ""  #: dotted path of ``table(summary)``
-    figures_of: str = ""  #: dotted path of ``figures(f, name)``
 
     # ------------------------------------------------------------------ checks and cost
 
@@ -150,28 +165,30 @@ class Command:
 
     # ------------------------------------------------------------------ run
 
-    def _execute(self) -> Callable[..., Outcome]:
-        return importlib.import_module(self.run).execute  # type: ignore[no-any-return]
+    def runner(self) -> Callable[..., Outcome]:
+        """Its ``execute(sc, seed, cache_key, **options)`` (imported when asked: it loads
+        the kernels)."""
+        raise NotImplementedError(f"{self.name} runs no scenario")
 
     def execute(self, sc: Scenario, seed: int | None = None, cache_key: str | None = None,
                 **options: Any) -> Outcome:
         """Run the scenario (after its preflight: :func:`gcalign.app.preflight.checked_execute`):
         the summary and the writer of its results."""
-        return self._execute()(sc, seed, cache_key, **options)
+        return self.runner()(sc, seed, cache_key, **options)
 
     def accepts(self, option: str) -> bool:
         """Does :meth:`execute` take keyword `option` (``progress``, ``sink``, ...)?"""
-        return option in inspect.signature(self._execute()).parameters
+        return option in inspect.signature(self.runner()).parameters
 
     # ------------------------------------------------------------------ show and store
 
     def table(self, summary: dict) -> Any:
         """The table the command prints (and ``gcalign show``): a rich renderable."""
-        return _attr(self.table_of)(summary)
+        raise NotImplementedError(f"{self.name} has no table")
 
     def figures(self, f: Any, name: str) -> dict:
         """The figures of its results file (an open h5py.File), by file stem."""
-        return _attr(self.figures_of)(f, name) if self.figures_of else {}  # type: ignore[no-any-return]
+        return {}
 
     def components(self, metric: str, k: int) -> list[str]:
         """Names of the `k` components of a vector batch metric."""
@@ -190,11 +207,6 @@ class Command:
         if not self.builtin:
             raise KeyError(f"{self.name!r} has no built-in scenario")
         return builtin_text(self.builtin)
-
-
-def _attr(path: str) -> Any:
-    module, _, name = path.rpartition(".")
-    return getattr(importlib.import_module(module), name)
 
 
 def builtin_text(name: str) -> str:

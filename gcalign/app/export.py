@@ -31,7 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gcalign import __version__, limits
+from gcalign import limits
+from gcalign._version import __version__
 from gcalign.errors import ScenarioError
 from gcalign.io import results
 

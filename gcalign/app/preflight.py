@@ -17,8 +17,8 @@ from pathlib import Path
 from typing import Any
 
 from gcalign import limits
-from gcalign.app.command import DOUBLE, Command, Cost, Extent, loading
-from gcalign.app.registry import COMMANDS, Outcome, command
+from gcalign.app.command import DOUBLE, Command, Cost, Extent, Outcome, loading
+from gcalign.app.registry import COMMANDS, command
 from gcalign.errors import GcalignError, ScenarioError
 from gcalign.io.paths import not_a_file
 from gcalign.io.scenario import Scenario
@@ -105,10 +105,10 @@ def setup_error(section: str, err: Exception) -> ScenarioError:
     line, exit 2. Pydantic's errors become its one-line-per-field form."""
     from pydantic import ValidationError
 
-    from gcalign.io.scenario.loader import scenario_errors
+    from gcalign.io.scenario.messages import scenario_errors
 
     if isinstance(err, ValidationError):
-        return ScenarioError(scenario_errors(err, section))
+        return ScenarioError(scenario_errors(err, section, Scenario))
     return ScenarioError(f"{section}: {err}")
 
 

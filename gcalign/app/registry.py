@@ -1,5 +1,7 @@
-"""The command registry: one object per command (:class:`gcalign.app.command.Command`), one
-line each; adding a capability is a new folder under ``gcalign/app`` plus a line here.
+"""The command registry: one object per command that runs a scenario
+(:class:`gcalign.app.command.Command`), one line each; adding a capability is a new folder
+under ``gcalign/app`` plus a line here. ``batch`` runs these (so it is not among them); the
+kinds of results files, batch's with them, are :func:`gcalign.app.readback.kinds`.
 
 The objects import their heavy parts only when a method needs them, so ``gcalign show`` and
 ``gcalign validate`` never load numba.
@@ -7,38 +9,12 @@ The objects import their heavy parts only when a method needs them, so ``gcalign
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
-
 from gcalign.app.command import Command, builtin_text
-
-
-@dataclass(frozen=True)
-class Outcome:
-    """What one run of a command produced, ready to be written and shown.
-
-    summary : plain numbers (degrees, seconds, ...): the JSON contract and ``summary_json``.
-    write : writes the command's groups into an open results file (h5py.File).
-    truth : the simulated truth to store under ``/truth``, if any.
-    seed : the random seed the run used (None for recorded data).
-    warnings : one line each, shown on stderr and kept in the summary.
-    result : the capability's typed result in SI (e.g.
-        :class:`gcalign.align.gyrocompass.Alignment`), or None.
-    """
-
-    summary: dict
-    write: Callable[[Any], None]
-    truth: Any = None
-    seed: int | None = None
-    warnings: tuple[str, ...] = ()
-    result: Any = None
 
 
 def _registered() -> dict[str, Command]:
     from gcalign.app.align import COMMAND as align
     from gcalign.app.allan import COMMAND as allan
-    from gcalign.app.batch import COMMAND as batch
     from gcalign.app.calibrate import COMMAND as calibrate
     from gcalign.app.modulate import COMMAND as modulate
     from gcalign.app.navigate import COMMAND as navigate
@@ -48,12 +24,12 @@ def _registered() -> dict[str, Command]:
     from gcalign.app.simulate import COMMAND as simulate
 
     commands = (simulate, navigate, align, northfind, calibrate, observability, realtime,
-                modulate, allan, batch)
+                modulate, allan)
     return {c.name: c for c in commands}
 
 
 COMMANDS: dict[str, Command] = _registered()
-__all__ = ["COMMANDS", "Outcome", "batchable", "builtin_text", "command", "register"]
+__all__ = ["COMMANDS", "batchable", "builtin_text", "command", "register"]
 
 
 def command(name: str) -> Command:

@@ -9,7 +9,8 @@ Rules the helpers keep (a table is read down its columns):
 * attitude errors in the unit that reads best for their size (:func:`angle_unit`: deg from
   1°, arc-minutes from 1′, else arc-seconds) with a fixed resolution per unit;
 * the caption ends with what ``compute`` measured beside the wall time (:func:`run_line`)
-  and the run's warnings (:func:`summary_table` adds them to every command's table).
+  and the run's warnings (:func:`gcalign.app.readback.summary_table` adds them to every
+  command's table).
 """
 
 from __future__ import annotations
@@ -24,6 +25,11 @@ from rich.text import Text
 from gcalign import units
 
 DASH = "—"
+
+
+UNIT_TEXT = {"arcsec": "″", "arcmin": "′", "deg/h": "°/h", "ug": "µg", "ppm": "ppm",
+             "m/s": "m/s", "m": "m"}
+"""Printed symbols of the display units (:data:`gcalign.estimation.ins_error.DISPLAY_UNITS`)."""
 
 
 def fmt(x, digits: int = 4) -> str:
@@ -169,21 +175,3 @@ def with_warnings(table: RenderableType, warnings: Sequence[str]) -> RenderableT
     table.caption = text
     table.caption_justify = "left"
     return table
-
-
-def summary_table(kind: str, summary: dict) -> RenderableType:
-    """The table a command prints, from its summary (also for `gcalign show`), with the
-    run's warnings."""
-    from gcalign.app.registry import COMMANDS
-    from gcalign.errors import ScenarioError
-
-    if kind not in COMMANDS:
-        raise ScenarioError(f"kind: {kind!r} is not a gcalign command ({', '.join(COMMANDS)}); "
-                            "a results file from another version, or a damaged one")
-    try:
-        table = COMMANDS[kind].table(summary)
-    except (KeyError, IndexError, TypeError, ValueError, AttributeError) as err:
-        raise ScenarioError(f"summary_json: not the summary of a {kind!r} run "
-                            f"({type(err).__name__}: {str(err)[:60]}); a damaged results "
-                            "file, or one from another version") from None
-    return with_warnings(table, summary.get("warnings") or [])

@@ -11,8 +11,9 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from gcalign.app.command import Outcome
 from gcalign.app.preflight import checked_execute
-from gcalign.app.registry import Outcome, command
+from gcalign.app.registry import command
 from gcalign.errors import GcalignError, ScenarioError
 from gcalign.io import results
 from gcalign.io.scenario import Scenario

@@ -21,8 +21,10 @@ from gcalign.calibrate.filter import Settings, covariance_run
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
 from gcalign.estimation import observability as ob
+from gcalign.schema import stored
 
 SCALINGS = ("none", "p0")
+DEGREE = "(segments, 21) in the order of the 'states' attribute"  #: shape of a degree table
 
 
 @dataclass(frozen=True)
@@ -40,25 +42,31 @@ class ObservabilityTable:
         None without the covariance run.
     """
 
-    segments: tuple[str, ...]
-    measure: str
-    scaling: str
-    rtol: float
-    piece_s: float
-    eta: np.ndarray
-    sigma_state: np.ndarray
-    rank: np.ndarray
-    tom_rank: np.ndarray
-    null_residual: np.ndarray
-    condition: np.ndarray
-    eta_cum: np.ndarray
-    rank_cum: np.ndarray
-    tom_rank_cum: np.ndarray
-    cov_degree: np.ndarray | None
-    cov_degree_segment: np.ndarray | None
+    segments: tuple[str, ...] = field(metadata=stored(None, name="segment_name"))
+    measure: str = field(metadata=stored(None, attr=True))
+    scaling: str = field(metadata=stored(None, attr=True))
+    rtol: float = field(metadata=stored("1", attr=True, name="rank_rtol"))
+    piece_s: float = field(metadata=stored("s", attr=True))
+    eta: np.ndarray = field(metadata=stored(
+        "1", shape=DEGREE, description="seed eq. 17 per segment"))
+    sigma_state: np.ndarray = field(metadata=stored("SOM units", shape=DEGREE))
+    rank: np.ndarray = field(metadata=stored("1"))
+    tom_rank: np.ndarray = field(metadata=stored("1"))
+    null_residual: np.ndarray = field(metadata=stored("1"))
+    condition: np.ndarray = field(metadata=stored(
+        "1", flag=True, description="null(O_j) in null(F_j) for every piece (seed eq. 12)"))
+    eta_cum: np.ndarray = field(metadata=stored(
+        "1", shape=DEGREE, description="from the start of the run"))
+    rank_cum: np.ndarray = field(metadata=stored("1"))
+    tom_rank_cum: np.ndarray = field(metadata=stored("1"))
+    cov_degree: np.ndarray | None = field(metadata=stored(
+        "1", shape=DEGREE, description="sigma(0)/sigma(t_end), PSINS kfstat"))
+    cov_degree_segment: np.ndarray | None = field(metadata=stored(
+        "1", shape=DEGREE, description="sigma(t_start)/sigma(t_end)"))
     margin: np.ndarray = field(default_factory=lambda: np.zeros(0))
     margin_cum: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    names: tuple[str, ...] = field(default=ie.STATE_NAMES)
+    names: tuple[str, ...] = field(default=ie.STATE_NAMES,
+                                   metadata=stored(None, attr=True, name="states"))
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from pathlib import Path
 import typer
 
 from gcalign.app import batch as engine  # its parts load when used
-from gcalign.cli import app, consoles, default_output, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json, user_errors
 from gcalign.cli.options import Json, Sets
 from gcalign.errors import ScenarioError
 
@@ -164,9 +164,12 @@ def batch(
             "--workers: applies to the local process pool; with --scheduler "
             "the cluster's workers run the batch (give one or the other)"
         )
+    from gcalign.cli.common import output_name
+
     notes: list[str] = []
     sw = load_batch(files, command, seeds, seed_start, metric, set_, notes)
-    out = output or default_output(sw.name, "batch", None, _named(sw, seeds, seed_start, set_))
+    out = output or output_name(sw.name, "batch", None,
+                                list(_named(sw, seeds, seed_start, set_)))
     err = consoles(True)  # notes always on stderr
     for line in notes:
         sys.stderr.write(f"note: {line}\n")

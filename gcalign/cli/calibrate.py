@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
-from gcalign.cli import app, user_errors
+from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError

@@ -44,7 +44,7 @@ import typer
 
 from gcalign.app.command import loading
 from gcalign.app.registry import COMMANDS, builtin_text
-from gcalign.cli import consoles, emit_json
+from gcalign.cli.base import consoles, emit_json
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
 
@@ -600,7 +600,7 @@ def show(kind: str, summary: dict, as_json: bool, stdout_free: bool = False) -> 
     """Print a command's table with its warnings under it and, under --json, the table on
     stderr without the warnings (one line each beside it: :func:`warn`) and the summary;
     `stdout_free`: the table on stderr as under --json, and no JSON."""
-    from gcalign.app.report import summary_table
+    from gcalign.app.readback import summary_table
 
     aside = as_json or stdout_free
     shown = {**summary, "warnings": []} if aside else summary  # said above (warn)

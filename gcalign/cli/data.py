@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
-from gcalign.cli import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json, user_errors
 from gcalign.cli.common import imu_file_given, load_with_overrides, run_and_show, warn
 from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
@@ -113,7 +113,7 @@ def show(
 ):
     """Print the summary of a results file again, from the file alone."""
     from gcalign.app.checked import read_checked
-    from gcalign.app.report import summary_table
+    from gcalign.app.readback import summary_table
 
     kind, summary, attrs = read_checked(file)
     console = consoles(as_json)

@@ -12,7 +12,7 @@ import sys
 import typer
 
 from gcalign.app.registry import COMMANDS
-from gcalign.cli import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json, user_errors
 from gcalign.cli.common import builtin_text
 from gcalign.errors import ScenarioError
 

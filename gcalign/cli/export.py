@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from gcalign.cli import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json, user_errors
 from gcalign.cli.options import Json
 
 

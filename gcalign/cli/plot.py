@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from gcalign.cli import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json, user_errors
 from gcalign.cli.options import Json
 
 
@@ -28,11 +28,11 @@ def plot(
     """Write PNG figures: every figure the command that wrote FILE draws (alignment error
     and attitude per pass, navigation errors, north-finding error against azimuth, batch
     distributions, truth and IMU output, ...)."""
-    from gcalign.app import plots
+    from gcalign.app import readback
     from gcalign.cli.common import ProgressBar
 
     with ProgressBar("plot") as bar:
-        written = plots.plot_file(file, out_dir, progress=bar)
+        written = readback.plot_file(file, out_dir, progress=bar)
     console = consoles(as_json)
     for p in written:
         console.print(str(p), highlight=False, soft_wrap=True)

@@ -24,16 +24,16 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from gcalign import __version__
+from gcalign._version import __version__
 from gcalign.errors import GcalignError, ScenarioError, check_terminated
 from gcalign.io.paths import not_a_file
 from gcalign.limits import SEED_MAX
+from gcalign.schema import ATT_FRAME as ATT_FRAME  # the frame texts, for the writers
+from gcalign.schema import PHI_FRAME as PHI_FRAME
 from gcalign.sim.imu import ImuData
 from gcalign.sim.motions import Truth
 
 HDF5_SUFFIXES = {".h5", ".hdf5", ".hdf"}  #: file names read as our results files
-PHI_FRAME = "misalignment, ENU: C_nb,est C_nb,true^T = exp(-[phi x])"
-ATT_FRAME = "[pitch, roll, yaw], C_nb = Rz(yaw) Rx(pitch) Ry(roll), ENU, yaw CCW positive"
 
 
 TMP_SUFFIX = ".gcalign-tmp"  #: temporary files: .NAME.PID.RANDOM.gcalign-tmp

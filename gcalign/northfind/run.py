@@ -9,15 +9,20 @@ and returns the errors against the truth beside the closed-form predictions
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from gcalign.northfind.estimate import METHODS, estimate_northfind
 from gcalign.northfind.simulate import NorthfindSetup, simulate_table
 from gcalign.northfind.theory import predict_azimuth_std, predicted_error
+from gcalign.schema import ATT_FRAME, stored
 
 __all__ = ["NorthfindResult", "run_northfind"]
+
+AZIMUTH = "clockwise from true north, [0, 2pi)"  #: the frame of an azimuth
+DESCENT = "azimuth of descent, " + AZIMUTH  #: the frame of a tilt's direction
+RM = "(repeats, azimuths)"  #: the shape of a method's estimates as stored
 
 
 @dataclass(frozen=True, eq=False)
@@ -45,23 +50,32 @@ class NorthfindResult:
     theta : (n,) rad. Nominal table angles.
     """
 
-    methods: tuple[str, ...]
-    azimuth_true: np.ndarray
-    tilt_true: np.ndarray
-    tilt_direction_true: np.ndarray
-    azimuth_est: np.ndarray
-    azimuth_error: np.ndarray
-    error_pred: np.ndarray
-    azimuth_std_pred: np.ndarray
-    tilt_est: np.ndarray
-    tilt_direction_est: np.ndarray
-    pitch_est: np.ndarray
-    roll_est: np.ndarray
-    gyro_coef: np.ndarray
-    accel_coef: np.ndarray
+    methods: tuple[str, ...] = field(metadata=stored(None, attr=True))
+    azimuth_true: np.ndarray = field(metadata=stored("rad", frame=AZIMUTH))
+    tilt_true: np.ndarray = field(metadata=stored("rad", frame="table normal from the vertical"))
+    tilt_direction_true: np.ndarray = field(metadata=stored("rad", frame=DESCENT))
+    azimuth_est: np.ndarray = field(metadata=stored(
+        "rad", frame=AZIMUTH, shape=RM, axes=(1, 0), per="methods", name="estimate"))
+    azimuth_error: np.ndarray = field(metadata=stored(
+        "rad", frame="estimate - true, wrapped to [-pi, pi)", shape=RM, axes=(1, 0),
+        per="methods", name="error"))
+    error_pred: np.ndarray = field(metadata=stored(
+        "rad", frame="noise-free closed form (NaN: none)", per="methods"))
+    azimuth_std_pred: np.ndarray = field(metadata=stored(
+        "rad", frame="linearised 1-sigma prediction", per="methods", name="std_pred"))
+    tilt_est: np.ndarray = field(metadata=stored("rad", shape=RM, axes=(1, 0)))
+    tilt_direction_est: np.ndarray = field(metadata=stored(
+        "rad", frame=DESCENT, shape=RM, axes=(1, 0)))
+    pitch_est: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME, shape=RM, axes=(1, 0)))
+    roll_est: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME, shape=RM, axes=(1, 0)))
+    gyro_coef: np.ndarray = field(metadata=stored(
+        "rad/s", shape="(repeats, azimuths, [R, a, b])", axes=(1, 0, 2)))
+    accel_coef: np.ndarray = field(metadata=stored(
+        "m/s^2", shape="(repeats, azimuths, [x, y], [R, a, b])", axes=(1, 0, 2, 3)))
     gyro_residual: np.ndarray
     accel_residual: np.ndarray
-    theta: np.ndarray
+    theta: np.ndarray = field(metadata=stored(
+        "rad", frame="table angles, counter-clockwise about the table normal"))
 
     def _index(self, method: str) -> int:
         if method not in self.methods:

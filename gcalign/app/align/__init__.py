@@ -5,6 +5,8 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
 from gcalign.app.command import (
     DOUBLE,
@@ -14,6 +16,7 @@ from gcalign.app.command import (
     Cost,
     Extent,
     Options,
+    Outcome,
     stride,
     warm_run,
 )
@@ -67,10 +70,21 @@ class Align(Command):
     section = "align"
     builtin = "seed000_moving_full_cycle.yaml"
     options = Options(recorded=True, batch_metrics=("error_t3_deg",))
-    layout = ("align",)
-    run = "gcalign.app.align.run"
-    table_of = "gcalign.app.align.tables.align_table"
-    figures_of = "gcalign.app.align.plots.figures"
+
+    def runner(self) -> Callable[..., Outcome]:
+        from gcalign.app.align.run import execute
+
+        return execute
+
+    def table(self, summary: dict) -> Any:
+        from gcalign.app.align.tables import align_table
+
+        return align_table(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        from gcalign.app.align.plots import figures
+
+        return figures(f, name)
 
     def check(self, sc, ext: Extent | None) -> None:
         """The latitude (the scenario's site, else the data file's), what needs truth, the

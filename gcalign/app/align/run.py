@@ -23,8 +23,8 @@ from gcalign.align.gyrocompass import (
     timeline,
     truth_samples,
 )
+from gcalign.app.command import Outcome
 from gcalign.app.data import RunData, Stream, scenario_data, scenario_stream, stream_of
-from gcalign.app.registry import Outcome
 from gcalign.errors import InputError, ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import Aiding, AlignConfig

@@ -18,8 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gcalign.app.command import DOUBLE, Cost
-from gcalign.app.registry import Outcome
+from gcalign.app.command import DOUBLE, Cost, Outcome
 from gcalign.errors import ScenarioError
 from gcalign.units import ARCMIN, DPH, UG
 

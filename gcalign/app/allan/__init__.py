@@ -3,7 +3,10 @@ noise terms fitted to it, named as the scenario's ``imu`` keys."""
 
 from __future__ import annotations
 
-from gcalign.app.command import Command, Cost, Extent, Options
+from collections.abc import Callable
+from typing import Any
+
+from gcalign.app.command import Command, Cost, Extent, Options, Outcome
 from gcalign.errors import ScenarioError
 
 #: operations per sample and axis: the running sum and allantools' second differences at
@@ -17,10 +20,21 @@ class Allan(Command):
             "bias instability, ...).")
     section = "allan"
     options = Options(recorded=True)
-    layout = ("allan",)
-    run = "gcalign.app.allan.run"
-    table_of = "gcalign.app.allan.tables.allan_table"
-    figures_of = "gcalign.app.allan.plots.figures"
+
+    def runner(self) -> Callable[..., Outcome]:
+        from gcalign.app.allan.run import execute
+
+        return execute
+
+    def table(self, summary: dict) -> Any:
+        from gcalign.app.allan.tables import allan_table
+
+        return allan_table(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        from gcalign.app.allan.plots import figures
+
+        return figures(f, name)
 
     def check(self, sc, ext: Extent | None) -> None:
         if ext is None or sc.allan is None:

@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 from gcalign import units as u
-from gcalign.app.registry import Outcome
+from gcalign.app.command import Outcome
 from gcalign.errors import InputError, ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.allan import AllanConfig

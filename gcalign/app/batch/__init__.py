@@ -115,14 +115,22 @@ def __dir__() -> list[str]:
 
 
 class Batch(Command):
-    """``gcalign batch`` in the registry: its table and figures (``show``, ``plot``); a
-    batch runs sweeps, not a scenario (:func:`run_batch`)."""
+    """``gcalign batch`` as a kind of results file: its table and figures (``show``,
+    ``plot``); a batch runs sweeps of the registry's commands, not a scenario
+    (:func:`run_batch`)."""
 
     name = "batch"
     help = "Sweeps and Monte Carlo over any batchable command."
-    layout = ("batch",)
-    table_of = "gcalign.app.batch.tables.batch_table"
-    figures_of = "gcalign.app.batch.plots.figures"
+
+    def table(self, summary: dict) -> Any:
+        from gcalign.app.batch.tables import batch_table
+
+        return batch_table(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        from gcalign.app.batch.plots import figures
+
+        return figures(f, name)
 
 
 COMMAND = Batch()

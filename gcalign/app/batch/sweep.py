@@ -29,7 +29,7 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 from gcalign.app.batch.overrides import apply_override
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.base import Model
-from gcalign.io.scenario.loader import _cut
+from gcalign.io.scenario.messages import _cut
 from gcalign.io.scenario.recording import absolute_paths
 from gcalign.limits import SEED_MAX
 

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from gcalign.app.command import (
     DOUBLE,
     KALMAN_OPS,
@@ -11,12 +14,9 @@ from gcalign.app.command import (
     Cost,
     Extent,
     Options,
+    Outcome,
     warm_run,
 )
-
-UNIT_TEXT = {"arcsec": "″", "arcmin": "′", "deg/h": "°/h", "ug": "µg", "ppm": "ppm",
-             "m/s": "m/s", "m": "m"}
-"""Printed symbols of the display units (:data:`gcalign.estimation.ins_error.DISPLAY_UNITS`)."""
 
 SIMULATION_DOUBLES = 24  #: per IMU sample of the noise-free simulation held (truth + IMU)
 RECORDED_DOUBLES = 7  #: per sample of recorded data (t, increments)
@@ -74,10 +74,21 @@ class Calibrate(Command):
     builtin = "seed002_designed.yaml"
     options = Options(recorded=True, streams=True,
                       batch_metrics=("nees.final", "normalized_error"))
-    layout = ("calibrate",)
-    run = "gcalign.app.calibrate.run"
-    table_of = "gcalign.app.calibrate.tables.calibrate_table"
-    figures_of = "gcalign.app.calibrate.plots.figures"
+
+    def runner(self) -> Callable[..., Outcome]:
+        from gcalign.app.calibrate.run import execute
+
+        return execute
+
+    def table(self, summary: dict) -> Any:
+        from gcalign.app.calibrate.tables import calibrate_table
+
+        return calibrate_table(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        from gcalign.app.calibrate.plots import figures
+
+        return figures(f, name)
 
     def check(self, sc, ext: Extent | None) -> None:
         config(sc).check(sc)

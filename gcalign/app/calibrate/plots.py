@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.calibrate import UNIT_TEXT
 from gcalign.app.plots import _s, finish, legend_below, legend_right, new_figure, suptitle
+from gcalign.app.report import UNIT_TEXT
 from gcalign.units import ANGLE_UNITS, angle_unit
 
 STYLE = {"both": dict(color="tab:red", linestyle="--"),

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gcalign.app.calibration_files import AidingInput
-from gcalign.app.registry import Outcome
+from gcalign.app.command import Outcome
 from gcalign.calibrate import (
     CalibrationResult,
     FlightData,

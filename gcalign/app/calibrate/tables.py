@@ -11,8 +11,7 @@ from rich import box
 from rich.table import Table
 from rich.text import Text
 
-from gcalign.app.calibrate import UNIT_TEXT
-from gcalign.app.report import number, numbers, run_line
+from gcalign.app.report import UNIT_TEXT, number, numbers, run_line
 from gcalign.units import angle_text
 
 GROUP_ENDS = ("phiU", "dvU", "dh", "ebz", "dbz", "dKgz", "dKaz")

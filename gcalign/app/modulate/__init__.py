@@ -3,6 +3,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from gcalign.app.command import (
     DOUBLE,
     SIMULATE_OPS,
@@ -11,6 +14,7 @@ from gcalign.app.command import (
     Cost,
     Extent,
     Options,
+    Outcome,
 )
 from gcalign.app.navigate import ROW_DOUBLES
 
@@ -25,10 +29,21 @@ class Modulate(Command):
     section = "modulate"
     builtin = "seed004_modulation.yaml"
     options = Options(streams=True, batch_metrics=("max_horizontal_error_m",))
-    layout = ("modulate",)
-    run = "gcalign.app.modulate.run"
-    table_of = "gcalign.app.modulate.tables.modulate_table"
-    figures_of = "gcalign.app.modulate.plots.figures"
+
+    def runner(self) -> Callable[..., Outcome]:
+        from gcalign.app.modulate.run import execute
+
+        return execute
+
+    def table(self, summary: dict) -> Any:
+        from gcalign.app.modulate.tables import modulate_table
+
+        return modulate_table(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        from gcalign.app.modulate.plots import figures
+
+        return figures(f, name)
 
     def check(self, sc, ext: Extent | None) -> None:
         from gcalign.io.scenario.modulate import plan_of

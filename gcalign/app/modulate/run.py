@@ -25,8 +25,8 @@ from typing import Any
 
 import numpy as np
 
+from gcalign.app.command import Outcome
 from gcalign.app.navigate.run import run_navigation
-from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.modulate import Entry, Plan, default_rate_hz, plan_of

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from gcalign.app.command import (
     DOUBLE,
     SIMULATE_OPS,
@@ -10,6 +13,7 @@ from gcalign.app.command import (
     Cost,
     Extent,
     Options,
+    Outcome,
     stride,
 )
 from gcalign.errors import ScenarioError
@@ -23,10 +27,21 @@ class Navigate(Command):
     help = "Strapdown navigation of simulated or recorded data."
     section = "navigation"
     options = Options(recorded=True, streams=True)
-    layout = ("navigate",)
-    run = "gcalign.app.navigate.run"
-    table_of = "gcalign.app.navigate.tables.navigate_table"
-    figures_of = "gcalign.app.navigate.plots.figures"
+
+    def runner(self) -> Callable[..., Outcome]:
+        from gcalign.app.navigate.run import execute
+
+        return execute
+
+    def table(self, summary: dict) -> Any:
+        from gcalign.app.navigate.tables import navigate_table
+
+        return navigate_table(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        from gcalign.app.navigate.plots import figures
+
+        return figures(f, name)
 
     def check(self, sc, ext: Extent | None) -> None:
         if ext is None:

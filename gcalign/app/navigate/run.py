@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from gcalign.app.command import Outcome
 from gcalign.app.data import DataBlock, Stream, scenario_stream
-from gcalign.app.registry import Outcome
 from gcalign.errors import InputError, ScenarioError
 from gcalign.io.recorded.reference import Reference, initial_state, reference_at, reference_gaps
 from gcalign.io.scenario import Scenario

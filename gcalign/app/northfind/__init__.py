@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-from gcalign.app.command import DOUBLE, SIMULATE_OPS, Command, Cost, Extent, Options
+from collections.abc import Callable
+from typing import Any
+
+from gcalign.app.command import DOUBLE, SIMULATE_OPS, Command, Cost, Extent, Options, Outcome
 
 READING_DOUBLES = 16  #: per dwell reading: gyro and accelerometer means, per method results
 
@@ -14,11 +17,22 @@ class Northfind(Command):
     builtin = "seed001_simulation.yaml"
     options = Options(self_contained=True,
                       batch_metrics=("methods.coordinate.rms_error_deg",))
-    layout = ("northfind",)
-    run = "gcalign.app.northfind.run"
-    table_of = "gcalign.app.northfind.tables.northfind_table"
     section_keys = "positions, dwell_s, azimuth_deg or sweep, tilt_deg, …"
-    figures_of = "gcalign.app.northfind.plots.figures"
+
+    def runner(self) -> Callable[..., Outcome]:
+        from gcalign.app.northfind.run import execute
+
+        return execute
+
+    def table(self, summary: dict) -> Any:
+        from gcalign.app.northfind.tables import northfind_table
+
+        return northfind_table(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        from gcalign.app.northfind.plots import figures
+
+        return figures(f, name)
 
     def cost(self, sc, ext: Extent | None) -> Cost:
         cfg = sc.northfind

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.plots import _s, angle_scale, legend_below, legend_right, new_figure, suptitle
+from gcalign.app.plots import angle_scale, legend_below, legend_right, new_figure, suptitle
 
 METHOD_ORDER = ("coordinate", "vector", "naive", "none")
 
@@ -100,29 +100,23 @@ def northfind_difference_figure(azimuth_true: np.ndarray, a: np.ndarray, b: np.n
     return fig
 
 
-def read_northfind(f) -> tuple[np.ndarray, dict, dict]:
-    g = f["northfind"]
-    names = _s(g.attrs.get("methods", "")).split(",") if "methods" in g.attrs else []
-    import h5py
-
-    names = [n for n in names if n in g] or [k for k in g if isinstance(g[k], h5py.Group)
-                                             and "error" in g[k]]
-    errors = {m: g[m]["error"][()] for m in names}
-    pred = {m: g[m]["error_pred"][()] for m in names if "error_pred" in g[m]}
-    return g["azimuth_true"][()], errors, pred
-
-
 def figures(f, name: str) -> dict[str, Figure]:
-    """The figures of a northfind results file."""
+    """The figures of a northfind results file, from its result read back
+    (:class:`gcalign.northfind.NorthfindResult`)."""
+    from gcalign.io.stored import read_fields
+    from gcalign.northfind import NorthfindResult
+
     figs: dict[str, Figure] = {}
     if "northfind" not in f:
         return figs
-    az, errors, pred = read_northfind(f)
-    head = f"{name}: {len(az)} azimuth(s)"
+    res = read_fields(f["northfind"], NorthfindResult, gyro_residual=None, accel_residual=None)
+    errors = {m: res.error(m).T for m in res.methods}
+    pred = ({} if res.error_pred is None else dict(zip(res.methods, res.error_pred, strict=True)))
+    head = f"{name}: {len(res.azimuth_true)} azimuth(s)"
     figs["northfind_error"] = northfind_error_figure(
-        az, errors, pred, title=f"{head} — azimuth error per method")
+        res.azimuth_true, errors, pred, title=f"{head} — azimuth error per method")
     if "coordinate" in errors and "vector" in errors:
         figs["northfind_difference"] = northfind_difference_figure(
-            az, errors["coordinate"], errors["vector"],
+            res.azimuth_true, errors["coordinate"], errors["vector"],
             title=f"{head} — coordinate − vector (seed 001 fig. 5)")
     return figs

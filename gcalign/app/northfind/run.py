@@ -20,7 +20,7 @@ import numpy as np
 
 from gcalign import northfind as nf
 from gcalign import units as u
-from gcalign.app.registry import Outcome
+from gcalign.app.command import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.northfind import NorthfindConfig, axis

@@ -4,6 +4,9 @@ its check, cost, run, table and figures chosen by the scenario's mode."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from gcalign.app.calibrate import COMMAND as CALIBRATE
 from gcalign.app.calibrate import (
     SIMULATION_DOUBLES,
@@ -11,7 +14,7 @@ from gcalign.app.calibrate import (
     state_components,
     steps,
 )
-from gcalign.app.command import DOUBLE, KALMAN_OPS, Command, Cost, Extent, Options
+from gcalign.app.command import DOUBLE, KALMAN_OPS, Command, Cost, Extent, Options, Outcome
 
 N = 21  #: states
 PIECE_OPS = 40.0 * N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, its QR
@@ -28,10 +31,37 @@ class Observability(Command):
     section = "observability"
     builtin = "seed002_designed.yaml"
     options = Options(batch_metrics=("rank_final",))
-    layout = ("observability",)
-    run = "gcalign.app.observability.run"
-    table_of = "gcalign.app.observability.tables.observability_table"
-    figures_of = "gcalign.app.observability.plots.figures"
+
+    def runner(self) -> Callable[..., Outcome]:
+        from gcalign.app.observability.run import execute
+
+        return execute
+
+    def execute(self, sc: Any, seed: int | None = None, cache_key: str | None = None,
+                **options: Any) -> Outcome:
+        if transfer_mode(sc):
+            from gcalign.app.observability import transfer
+
+            return transfer.execute(sc, seed, cache_key, **options)
+        return super().execute(sc, seed, cache_key, **options)
+
+    def table(self, summary: dict) -> Any:
+        if summary.get("mode") == "transfer":
+            from gcalign.app.observability.transfer import table
+
+            return table(summary)
+        from gcalign.app.observability.tables import observability_table
+
+        return observability_table(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        if "observability" in f and f["observability"].attrs.get("mode") == "transfer":
+            from gcalign.app.observability.transfer import figures as transfer_figures
+
+            return transfer_figures(f, name)
+        from gcalign.app.observability.plots import figures
+
+        return figures(f, name)
 
     def check(self, sc, ext: Extent | None) -> None:
         from gcalign.io.scenario.calibrate import ObservabilityConfig

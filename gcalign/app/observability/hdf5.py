@@ -16,10 +16,8 @@ import h5py
 import numpy as np
 
 from gcalign.app.calibrate.hdf5 import write_segments
-from gcalign.estimation import ins_error as ie
 from gcalign.io.results import put
-
-DEGREE = "(segments, 21) in the order of the 'states' attribute"
+from gcalign.io.stored import write_fields
 
 
 def put_rows(g: h5py.Group, tab, names, t0, t1, condition, *, shape: str, row: str,
@@ -40,15 +38,11 @@ def put_rows(g: h5py.Group, tab, names, t0, t1, condition, *, shape: str, row: s
 
 
 def write_observability(f: h5py.File, tab, truth, spans) -> None:
+    """/observability: the table as its fields say
+    (:class:`gcalign.calibrate.observability.ObservabilityTable`), and each
+    segment's start and end."""
     write_segments(f, truth, spans)
     g = f.create_group("observability")
-    g.attrs["measure"], g.attrs["scaling"] = tab.measure, tab.scaling
-    g.attrs["rank_rtol"], g.attrs["piece_s"] = tab.rtol, tab.piece_s
-    g.attrs["states"] = ",".join(ie.STATE_NAMES)
-    put_rows(g, tab, [s.name for s in spans], [s.start for s in spans],
-             [s.end for s in spans], tab.condition, shape=DEGREE, row="segment")
-    if tab.cov_degree is not None:
-        put(g, "cov_degree", tab.cov_degree, "1", shape=DEGREE,
-            description="sigma(0)/sigma(t_end), PSINS kfstat")
-        put(g, "cov_degree_segment", tab.cov_degree_segment, "1", shape=DEGREE,
-            description="sigma(t_start)/sigma(t_end)")
+    write_fields(g, tab)
+    put(g, "t0", [s.start for s in spans], "s")
+    put(g, "t1", [s.end for s in spans], "s")

@@ -47,10 +47,6 @@ def heat_map(values: np.ndarray, rows: list[str], cols: list[str], title: str, l
 
 
 def figures(f, name: str) -> dict[str, Figure]:
-    if "observability" in f and f["observability"].attrs.get("mode") == "transfer":
-        from gcalign.app.observability.transfer import figures as transfer_figures
-
-        return transfer_figures(f, name)
     figs = truth_trajectory(f, name)
     if "observability" not in f:
         return figs

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from gcalign.app.registry import Outcome
+from gcalign.app.command import Outcome
 from gcalign.calibrate import (
     ObservabilitySettings,
     ObservabilityTable,
@@ -119,15 +119,10 @@ def summary(sc: Scenario, tab: ObservabilityTable, spans: tuple[Span, ...],
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             progress: Any = None) -> Outcome:
-    """The table of the scenario's flight, or of its transfer alignment; the registry's
-    entry point (no randomness: the seed only names the run)."""
-    from gcalign.app.observability import transfer_mode
+    """The table of the scenario's flight (a transfer alignment's is
+    :func:`gcalign.app.observability.transfer.execute`); no randomness: the seed only names
+    the run."""
     from gcalign.app.observability.hdf5 import write_observability
-
-    if transfer_mode(sc):
-        from gcalign.app.observability import transfer
-
-        return transfer.execute(sc, seed, cache_key, progress)
 
     tab, traj, spans, compute_s = run_table(sc, cache_key, progress)
     truth = sampled_truth(traj, spans)

@@ -32,10 +32,6 @@ def _block(title: str | None) -> Table:
 
 
 def observability_table(s: dict) -> Table:
-    if s.get("mode") == "transfer":
-        from gcalign.app.observability.transfer import table
-
-        return table(s)
     names = s["states"]
     nav, rest = names[:6], names[6:]
     rows = [(seg, cum) for seg, cum in zip(s["segments"], s["cumulative"], strict=True)]

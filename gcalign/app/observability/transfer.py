@@ -20,9 +20,8 @@ import h5py
 import numpy as np
 
 from gcalign.app.align.transfer import DECIMALS, DISPLAY, SI_UNIT, group_of
-from gcalign.app.command import DOUBLE, Cost
+from gcalign.app.command import DOUBLE, Cost, Outcome
 from gcalign.app.observability.hdf5 import put_rows
-from gcalign.app.registry import Outcome
 from gcalign.io.results import put
 
 PWCS_N = 15

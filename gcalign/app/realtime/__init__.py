@@ -3,7 +3,10 @@
 
 from __future__ import annotations
 
-from gcalign.app.command import DOUBLE, Command, Cost, Extent, Options
+from collections.abc import Callable
+from typing import Any
+
+from gcalign.app.command import DOUBLE, Command, Cost, Extent, Options, Outcome
 
 NOTCH_OPS = 5.0  #: a second-order IIR section per sample
 SOLUTION_DOUBLES = 24  #: per attitude solution: truth, output and each predictor's error
@@ -16,11 +19,22 @@ class Realtime(Command):
     builtin = "seed003_table1.yaml"
     options = Options(self_contained=True,
                       batch_metrics=("cases.0.after_max_arcsec.kalman-ls",))
-    layout = ("realtime",)
-    run = "gcalign.app.realtime.run"
-    table_of = "gcalign.app.realtime.tables.realtime_table"
     section_keys = "cases or a turntable motion, filter, sensor, tracker, pulses"
-    figures_of = "gcalign.app.realtime.plots.figures"
+
+    def runner(self) -> Callable[..., Outcome]:
+        from gcalign.app.realtime.run import execute
+
+        return execute
+
+    def table(self, summary: dict) -> Any:
+        from gcalign.app.realtime.tables import realtime_table
+
+        return realtime_table(summary)
+
+    def figures(self, f: Any, name: str) -> dict:
+        from gcalign.app.realtime.plots import figures
+
+        return figures(f, name)
 
     def cost(self, sc, ext: Extent | None) -> Cost:
         """Three gyro channels through the chain's FIR (taps × samples, a direct

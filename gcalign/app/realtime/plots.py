@@ -14,8 +14,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.app.plots import ANGLES, _s, finish, legend_right, new_figure, suptitle
+from gcalign.units import ARCSEC
 
-ARCSEC = np.pi / 180.0 / 3600.0
 REFERENCE = {"seed": "against the INS's output T later (the seed's reference)",
              "truth": "against the truth"}
 

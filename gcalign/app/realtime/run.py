@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gcalign import units as u
-from gcalign.app.registry import Outcome
+from gcalign.app.command import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.realtime import RealtimeConfig

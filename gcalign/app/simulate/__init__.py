@@ -2,9 +2,19 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
-from gcalign.app.command import DOUBLE, SIMULATE_OPS, Command, Cost, Extent, Options, stride
+from gcalign.app.command import (
+    DOUBLE,
+    SIMULATE_OPS,
+    Command,
+    Cost,
+    Extent,
+    Options,
+    Outcome,
+    stride,
+)
 
 #: doubles stored per row: /truth t, att, v_n, pos, segment and /imu t, dtheta, dv, q_bs
 ROW_DOUBLES = 26
@@ -14,9 +24,16 @@ class Simulate(Command):
     name = "simulate"
     help = "Simulate truth and IMU data."
     options = Options(streams=True)
-    layout = ("truth", "imu")
-    run = "gcalign.app.simulate.run"
-    table_of = "gcalign.app.simulate.tables.simulate_table"
+
+    def runner(self) -> Callable[..., Outcome]:
+        from gcalign.app.simulate.run import execute
+
+        return execute
+
+    def table(self, summary: dict) -> Any:
+        from gcalign.app.simulate.tables import simulate_table
+
+        return simulate_table(summary)
 
     def check(self, sc, ext: Extent | None) -> None:
         if ext is not None:

@@ -12,8 +12,8 @@ import time
 
 import numpy as np
 
+from gcalign.app.command import Outcome
 from gcalign.app.data import scenario_stream
-from gcalign.app.registry import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 

@@ -4,7 +4,8 @@ The YAML schema is the public contract (docs: Reference, Scenario keys): units i
 ``extra="forbid"`` so that a misspelt key is an error. Conversion to SI happens here once.
 """
 
-from gcalign.io.scenario.loader import load_scenario, parse_scenario, scenario_errors
+from gcalign.io.scenario.loader import load_scenario, parse_scenario
+from gcalign.io.scenario.messages import scenario_errors
 from gcalign.io.scenario.models import Scenario
 
 __all__ = ["Scenario", "load_scenario", "parse_scenario", "scenario_errors"]

@@ -132,7 +132,7 @@ def plan_of(sc) -> Plan:
             try:
                 cfg_e = MechanismConfig(scheme=name, **kept)
             except ValidationError as err:  # the mechanism's timing does not suit this scheme
-                from gcalign.io.scenario.loader import scenario_errors
+                from gcalign.io.scenario.messages import scenario_errors
 
                 raise ScenarioError(f"modulate.compare: {name} with the mechanism's timing: "
                                     f"mechanism.{scenario_errors(err)}") from None

@@ -42,13 +42,12 @@ def kind_arm(tp, kind):
     return None
 
 
-def keys_at(loc) -> list[str] | None:
-    """The keys of the mapping at `loc` (a pydantic error location without its last
-    part: ``("initial",)``, ``("motion", "moving", "segments", 0)``), or None where the
-    schema has no single mapping there."""
-    from gcalign.io.scenario import Scenario
-
-    tp = Scenario
+def keys_at(loc, root: type) -> list[str] | None:
+    """The keys of the mapping at `loc` in the model `root` (a pydantic error location
+    without its last part: ``("initial",)``, ``("motion", "moving", "segments", 0)`` in
+    :class:`~gcalign.io.scenario.Scenario`), or None where the schema has no single mapping
+    there."""
+    tp = root
     for part in loc:
         tp = unwrap(tp)
         arm = kind_arm(tp, part)

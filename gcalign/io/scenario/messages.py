@@ -1,0 +1,84 @@
+"""The one-line messages of a scenario that pydantic refuses: one line per field, the bad
+value shown cut to a readable length."""
+
+from __future__ import annotations
+
+import re
+import reprlib
+
+from pydantic import ValidationError
+
+from gcalign.io.scenario.motion import MOTION_KINDS
+from gcalign.io.scenario.walk import keys_at
+
+# Model-level checks name their field at the start of the message ("segments: ..."),
+# since pydantic gives them the model's location only.
+_FIELD_PREFIX = re.compile(r"^([a-z_0-9]+(?:\.[a-z_0-9]+)*): ")
+
+
+# Location parts that name a member of a union type, not a key the user wrote (also the
+# tags of the discriminated motion union).
+_UNION_TAG = re.compile(r"^(float|int|str|bool|constrained-\w+|\w+\[.*\]|"
+                        + "|".join(MOTION_KINDS) + r")$")
+
+
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxlist, _REPR.maxdict = 3, 6, 4
+_REPR.maxstring = _REPR.maxother = 60
+_REPR.maxlong = 40
+CUT = 80  #: characters of a bad value echoed in a message
+
+
+def _cut(value) -> str:
+    """A value as a message shows it: repr, at most about CUT characters (a bad value
+    can be megabytes long, or an alias bomb)."""
+    text = value if isinstance(value, str) else _REPR.repr(value)
+    if isinstance(value, str):
+        text = repr(value if len(value) <= CUT else value[:CUT - 3] + "...")
+    return text if len(text) <= CUT + 2 else text[:CUT - 3] + "..."
+
+
+def scenario_errors(err: ValidationError, source: str = "", root: type | None = None) -> str:
+    """One line per invalid field: ``source: field: what is wrong, got VALUE``; an unknown
+    key lists the keys of its mapping in `root` (the model that was validated).
+
+    Pydantic reports every failed member of a union (``float | 'measured'``) separately;
+    those become one line whose alternatives are joined by "or".
+    """
+    by_field: dict[str, list[str]] = {}
+    got_of: dict[str, str] = {}
+    for e in err.errors():
+        loc = [str(x) for x in e["loc"] if not _UNION_TAG.match(str(x))]
+        msg = e["msg"].removeprefix("Value error, ")
+        m = _FIELD_PREFIX.match(msg)
+        if m:
+            if not loc or loc[-1] != m.group(1):  # a field validator names its own field
+                loc.append(m.group(1))
+            msg = msg[m.end() :]
+        where = ".".join(loc) or "scenario"
+        if e["type"] == "extra_forbidden":
+            keys = keys_at(e["loc"][:-1], root) if root is not None else None
+            here = ".".join(loc[:-1]) or "the scenario"
+            msg = ("unknown key" + (f"; {here} has: {', '.join(keys)}" if keys else
+                                    " (check the spelling)"))
+        elif e["type"] in ("union_tag_invalid", "union_tag_not_found"):
+            ctx = e.get("ctx", {})
+            key = str(ctx.get("discriminator", "kind")).strip("'")
+            where = ".".join([*loc, key])
+            allowed = str(ctx.get("expected_tags", "")).replace("'", "") or ", ".join(
+                MOTION_KINDS)
+            msg = (f"allowed: {allowed}, got {_cut(ctx['tag'])}" if "tag" in ctx
+                   else f"missing; allowed: {allowed}")
+            by_field.setdefault(where, [])
+            if msg not in by_field[where]:
+                by_field[where].append(msg)
+            continue
+        elif e["type"] not in {"missing", "model_type", "value_error"}:
+            got_of[where] = f", got {_cut(e.get('input'))}"
+        by_field.setdefault(where, [])
+        if msg not in by_field[where]:
+            by_field[where].append(msg)
+    lines = [
+        f"{where}: {' or '.join(msgs)}{got_of.get(where, '')}" for where, msgs in by_field.items()
+    ]
+    return "\n".join(f"{source}: {line}" if source else line for line in lines)

@@ -1,0 +1,102 @@
+"""A result written and read back from what its fields say (:mod:`gcalign.schema`): one writer
+and one reader for every result dataclass, instead of one per command.
+
+Each field declared with :func:`gcalign.schema.stored` becomes a dataset of the group (with
+its ``units``, ``frame``, ``shape`` and ``description`` attributes) or an attribute of it;
+a nested result dataclass becomes a subgroup, a list of them numbered subgroups (``00``,
+``01``, ...); a field whose value is None is left out. Fields without that metadata are not
+stored (what the run derives again, or what the command stores itself).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, TypeVar
+
+import h5py
+import numpy as np
+
+from gcalign.io.results import check_writes, put
+from gcalign.schema import Stored, spec
+
+T = TypeVar("T")
+
+
+def write_fields(g: h5py.Group, result: Any) -> None:
+    """Write the stored fields of the dataclass `result` into the group `g`."""
+    for f in dataclasses.fields(result):
+        how = spec(f)
+        value = getattr(result, f.name)
+        if how is None or value is None:
+            continue
+        name = how.name or f.name
+        if how.attr:
+            g.attrs[name] = ",".join(value) if isinstance(value, tuple) else value
+        elif dataclasses.is_dataclass(value):
+            write_fields(g.create_group(name), value)
+        elif isinstance(value, list) and value and dataclasses.is_dataclass(value[0]):
+            h = g.create_group(name)
+            for i, item in enumerate(value):
+                write_fields(h.create_group(f"{i:02d}"), item)
+        elif how.units is None:  # text
+            check_writes()
+            g.create_dataset(name, data=np.array(value, dtype=h5py.string_dtype()))
+        elif how.per is not None:  # one subgroup per entry of the first axis
+            for entry, part in zip(getattr(result, how.per), value, strict=True):
+                _put(g.require_group(entry), name, part, how)
+        else:
+            _put(g, name, value, how)
+
+
+def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
+    extra = {k: v for k, v in (("shape", how.shape), ("description", how.description))
+             if v is not None}
+    data = np.asarray(value)
+    if how.axes is not None:
+        data = np.transpose(data, how.axes)
+    put(g, name, data.astype(np.int8) if how.flag else data, how.units or "1", how.frame,
+        **extra)
+
+
+def _get(ds: h5py.Dataset, how: Stored) -> np.ndarray:
+    a = ds[()]
+    if how.axes is not None and a.ndim == len(how.axes):  # (else a form with fewer axes)
+        a = np.transpose(a, np.argsort(how.axes))
+    return a.astype(bool) if how.flag else a
+
+
+def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
+    """The dataclass `cls` from the group `g` as :func:`write_fields` wrote it; `given` fills
+    fields the file does not hold. A field stored as a flag comes back as bool, one stored
+    as names as a tuple of str."""
+    values: dict[str, Any] = {}
+    for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+        how = spec(f)
+        if how is None or f.name in given:
+            continue
+        name = how.name or f.name
+        if how.attr:
+            if name in g.attrs:
+                v = g.attrs[name]
+                v = v.decode() if isinstance(v, bytes) else v
+                values[f.name] = (tuple(v.split(",")) if isinstance(v, str)
+                                  and "tuple" in str(f.type) else _plain(v))
+        elif how.per is not None:
+            entries = values.get(how.per) or given.get(how.per) or ()
+            parts = [g[e][name] for e in entries if e in g and name in g[e]]
+            values[f.name] = (np.stack([_get(ds, how) for ds in parts])
+                              if parts and len(parts) == len(entries) else None)
+        elif name in g:
+            if how.units is None:
+                values[f.name] = tuple(x.decode() if isinstance(x, bytes) else str(x)
+                                       for x in g[name][()])
+            else:
+                values[f.name] = _get(g[name], how)
+        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+            values[f.name] = None  # an optional series the run did not make
+    return cls(**values, **given)
+
+
+def _plain(v: Any) -> Any:
+    """A scalar attribute as a Python number or text."""
+    return v.item() if isinstance(v, np.generic) else v

@@ -1,0 +1,97 @@
+"""A result written and read back from what its fields say (gcalign.schema,
+gcalign.io.stored): the observability table of the seed-002 flight as ``gcalign
+observability`` stores it, read back field for field; a new field of a result is one line
+in its dataclass, and the file has it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+
+import h5py
+import numpy as np
+import pytest
+
+from gcalign.calibrate.observability import DEGREE, ObservabilityTable
+from gcalign.estimation.ins_error import STATE_NAMES
+from gcalign.io.stored import read_fields, write_fields
+from gcalign.schema import spec, stored
+
+
+def table(cov: bool = True) -> ObservabilityTable:
+    rng = np.random.default_rng(3)
+    s = 4
+    return ObservabilityTable(
+        segments=("static", "climb", "turn", "cruise"), measure="velocity", scaling="p0",
+        rtol=1e-12, piece_s=1.0, eta=rng.random((s, 21)), sigma_state=rng.random((s, 21)),
+        rank=np.array([9, 15, 17, 12]), tom_rank=np.array([9, 14, 18, 13]),
+        null_residual=rng.random(s) * 1e-10, condition=np.array([True, False, True, True]),
+        eta_cum=rng.random((s, 21)), rank_cum=np.array([9, 16, 20, 20]),
+        tom_rank_cum=np.array([9, 16, 20, 20]),
+        cov_degree=rng.random((s, 21)) if cov else None,
+        cov_degree_segment=rng.random((s, 21)) if cov else None)
+
+
+@pytest.mark.parametrize("cov", [True, False])
+def test_the_table_comes_back_field_for_field(tmp_path, cov):
+    tab = table(cov)
+    with h5py.File(tmp_path / "t.h5", "w") as f:
+        write_fields(f.create_group("observability"), tab)
+    with h5py.File(tmp_path / "t.h5") as f:
+        g = f["observability"]
+        assert g.attrs["states"] == ",".join(STATE_NAMES)
+        assert g.attrs["rank_rtol"] == 1e-12 and g.attrs["measure"] == "velocity"
+        assert g["eta"].attrs["units"] == "1" and g["eta"].attrs["shape"] == DEGREE
+        assert g["condition"].dtype == np.int8
+        assert ("cov_degree" in g) is cov and "margin" not in g  # not stored: derived
+        back = read_fields(g, ObservabilityTable)
+    for f_ in fields(ObservabilityTable):
+        a, b = getattr(tab, f_.name), getattr(back, f_.name)
+        if spec(f_) is None:
+            continue
+        if isinstance(a, np.ndarray):
+            assert b.dtype == a.dtype and np.array_equal(a, b), f_.name
+        else:
+            assert a == b, f_.name
+
+
+def test_a_new_field_is_one_line(tmp_path):
+    """The one line below is all a new field needs to reach the results file, with its
+    units and description, and to come back from it."""
+
+    @dataclass(frozen=True)
+    class Wider(ObservabilityTable):
+        eta_max: np.ndarray | None = field(default=None, metadata=stored("1", description="max"))
+
+    base = table()
+    wider = Wider(**{f.name: getattr(base, f.name) for f in fields(base)},
+                  eta_max=base.eta.max(axis=1))
+    with h5py.File(tmp_path / "w.h5", "w") as f:
+        write_fields(f.create_group("observability"), wider)
+    with h5py.File(tmp_path / "w.h5") as f:
+        ds = f["observability/eta_max"]
+        assert ds.attrs["units"] == "1" and ds.attrs["description"] == "max"
+        back = read_fields(f["observability"], Wider)
+    assert np.array_equal(back.eta_max, base.eta.max(axis=1))
+
+
+def test_a_north_finding_result_comes_back(tmp_path):
+    """North-finding's arrays are (methods, azimuths, repeats) in the core and (repeats,
+    azimuths) per method in the file (``coordinate/error``): stored and read back to the
+    same arrays."""
+    from gcalign.northfind import NorthfindResult, NorthfindSetup, run_northfind
+
+    setup = NorthfindSetup(azimuths=np.radians([10.0, 200.0, 300.0]), lat=np.radians(40.0),
+                           positions=8, repeats=2, tilt=np.radians(2.0), gyro_arw=1e-7)
+    res = run_northfind(setup, np.random.default_rng(5))
+    with h5py.File(tmp_path / "n.h5", "w") as f:
+        write_fields(f.create_group("northfind"), res)
+    with h5py.File(tmp_path / "n.h5") as f:
+        g = f["northfind"]
+        assert g["coordinate/error"].shape == (2, 3)  # (repeats, azimuths)
+        assert np.array_equal(g["vector/estimate"][()], res.estimate("vector").T)
+        back = read_fields(g, NorthfindResult, gyro_residual=None, accel_residual=None)
+    for f_ in fields(NorthfindResult):
+        if spec(f_) is not None and f_.name != "methods":
+            a, b = getattr(res, f_.name), getattr(back, f_.name)
+            assert a.shape == b.shape and np.array_equal(a, b, equal_nan=True), f_.name
+    assert back.methods == res.methods
