@@ -114,7 +114,7 @@ def test_results_file_show_and_plot(builtin, tmp_path):
     assert res.exit_code == 0, res.output
     names = {Path(p).stem for p in json.loads(res.stdout)["figures"]}
     assert names == {"trajectory", "sensor_biases", "scale_factors", "sigma",
-                     "navigation_errors", "innovations"}
+                     "navigation_errors", "innovations", "solution_errors"}
 
 
 def test_data_are_the_simulated_imu_with_the_scenario_errors():
