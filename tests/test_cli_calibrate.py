@@ -114,7 +114,7 @@ def test_results_file_show_and_plot(builtin, tmp_path):
     assert res.exit_code == 0, res.output
     names = {Path(p).stem for p in json.loads(res.stdout)["figures"]}
     assert names == {"trajectory", "sensor_biases", "scale_factors", "sigma",
-                     "navigation_errors", "innovations"}
+                     "navigation_errors", "innovations", "solution_errors"}
 
 
 def test_data_are_the_simulated_imu_with_the_scenario_errors():
@@ -353,8 +353,8 @@ def test_recorded_data_start_where_the_user_says(tmp_path):
                               str(tmp_path / "h.h5"), "--json"])
     assert res.exit_code == 0, res.output
     s = json.loads(res.stdout.strip().splitlines()[-1])
-    assert s["start"]["source"] == "the file's header"
-    assert s["coarse_attitude_deg"][2] == pytest.approx(-90.6, abs=0.01)  # the header's yaw
+    assert s["start"]["source"] == "the file's header" and s["coarse_attitude_deg"] is None
+    assert s["start"]["attitude_deg"][2] == pytest.approx(-90.6, abs=0.01)  # the header's yaw
     both = dict(d, initial={"att_deg": [0, 0, -90]},
                 calibrate={"coarse": {"method": "inertial"}})
     _bad(tmp_path, [_write(tmp_path, both)], "calibrate.coarse.method", "cannot matter",

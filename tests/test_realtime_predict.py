@@ -174,7 +174,9 @@ def test_numba_tracker_equals_the_slow_route():
     assert close(fast.P, slow.P, 1e-12)
     assert close(fast.innovation, slow.innovation, 1e-12)
     assert close(fast.S, slow.S, 1e-12)
-    np.testing.assert_allclose(fast.x_last, slow.x_last, rtol=1e-12)
+    # the reference route's Kalman steps are kernels held to their NumPy form to 1e-12 a
+    # step (docs/decisions/016): after 3000 steps its last state is 1.2e-12 of itself off
+    np.testing.assert_allclose(fast.x_last, slow.x_last, rtol=1e-11)
     # From a vague start (σ_ω, σ_α = 20°/s, 20°/s² against σ_θ = 0.03″) the first updates
     # cancel seven decades of P in both routes; they then agree to 1e-9, not 1e-12.
     vague = np.diag([R, (20 * DEG) ** 2, (20 * DEG) ** 2])

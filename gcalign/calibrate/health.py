@@ -22,8 +22,11 @@ def nis_warnings(r: CalibrationResult, label: str = "") -> list[str]:
 
 
 def sigma_growth_warnings(r: CalibrationResult, label: str = "") -> list[str]:
-    """One line per state whose σ grows past :data:`SIGMA_GROWTH` times its first σ."""
-    return health.sigma_growth_warnings(r.sigma[0], r.sigma, r.names, ie.STATE_UNITS, label)
+    """One line per state whose σ grows past :data:`SIGMA_GROWTH` times its first σ, at the
+    epochs with a measurement (in an outage the σ of what the fixes hold grows by design,
+    and falls at the next fix)."""
+    sigma = r.sigma if r.updated is None or r.updated[1:].all() else r.sigma[r.updated]
+    return health.sigma_growth_warnings(r.sigma[0], sigma, r.names, ie.STATE_UNITS, label)
 
 
 def health_warnings(r: CalibrationResult, label: str = "") -> list[str]:

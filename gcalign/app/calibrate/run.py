@@ -64,7 +64,8 @@ class Case:
     aid : the aiding files' fixes and what to report of them (``aiding: file``).
     start_source : where the start state came from. output_stride : navigation steps per
     stored row of the solution. reference : the scenario's reference solution, read once
-    (recorded data), or None.
+    (recorded data), or None. coarse : whether coarse_att is a coarse alignment's (else the
+    start the user gave).
     """
 
     data: FlightData
@@ -82,6 +83,7 @@ class Case:
     start_source: str = ""
     output_stride: int = 1
     reference: Reference | None = None
+    coarse: bool = False
 
     @property
     def navigation_rate(self) -> float:
@@ -188,7 +190,7 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
     start_att = att if att is not None else quat_to_euler(data.start.q_nb)
     return Case(data, cfg.settings(site, earth, sc=sc), imu.source, aiding, n, rate, None,
                 None, start_att, (start, coarse_end, end), t0, aid, source,
-                cfg.output_stride(rate / n), reference)
+                cfg.output_stride(rate / n), reference, cfg.coarse.method != "none")
 
 
 def scenario_case(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Case:
@@ -400,7 +402,7 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
                                   ie.display_scale(float(d.start.pos[0]), float(d.start.pos[2]),
                                                    d.earth).tolist(), strict=True)),
         "display_units": dict(zip(ie.STATE_NAMES, ie.DISPLAY_UNITS, strict=True)),
-        "coarse_attitude_deg": None if case.coarse_att is None
+        "coarse_attitude_deg": None if case.coarse_att is None or not case.coarse
         else np.degrees(case.coarse_att).tolist(),
         "aiding_files": aiding_files(config_of(sc)),
         "compare": compare,
@@ -409,7 +411,9 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
     }
     if case.source != "simulated":
         out["start"] = {"source": case.start_source, "t_s": float(d.t[0]),
-                        "t_data_s": float(d.t[0] + case.t0)}
+                        "t_data_s": float(d.t[0] + case.t0),
+                        "attitude_deg": None if case.coarse_att is None
+                        else np.degrees(case.coarse_att).tolist()}
         out["time"] = {"t0_s": case.t0, "origin": "the recording's time base (t_data = t + "
                        "t0)" if case.aid is None else case.aid.info["time_origin"]}
     if case.aid is not None:

@@ -141,8 +141,10 @@ def aided_notes(s: dict) -> list[str]:
     notes = []
     start = s.get("start")
     if start:
+        att = start.get("attitude_deg")
         notes.append(f"start at {start['t_data_s']:.3f} s (the recording's time): "
-                     f"{start['source']}")
+                     f"{start['source']}" + ("" if att is None else
+                                             f"; attitude {'  '.join(numbers(att, most=4))}°"))
     fx = s.get("fixes")
     if fx:
         sig = ("σ per fix " + "–".join(f"{x:.3g}" for x in fx["sigma_enu_range_m"]) + " m"

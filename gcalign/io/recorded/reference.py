@@ -112,7 +112,10 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     record = {"format": format, "path": name, "epochs": int(len(t)), "t_first_s": float(t[0]),
               "t_last_s": float(t[-1]), "time_origin": origin,
               "rate_hz": float(1.0 / np.median(np.diff(t))), **notes}
-    return Reference(t.copy(), None if att is None else att.copy(), v.copy(), pos.copy(),
+    # columns of the table are copied (so the table can go); the text formats' att, v,
+    # pos are new arrays already and are not copied again (a long reference held once)
+    att = None if att is None else np.ascontiguousarray(att)
+    return Reference(np.array(t), att, np.ascontiguousarray(v), np.ascontiguousarray(pos),
                      record)
 
 
