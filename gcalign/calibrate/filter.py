@@ -391,7 +391,7 @@ def calibrate(data: FlightData, settings: Settings | None = None,
                                 "measured fixes carry their own (set it false)")
         stops, dropped = _fix_stops(data.t, fixes, S)
     K = len(stops)
-    if K < 1 or (fixes is None and K < 1):
+    if K < 1:
         raise ScenarioError(f"data: {N} navigation steps are fewer than one "
                             f"filter step ({S})")
     earth = data.earth
@@ -427,8 +427,8 @@ def calibrate(data: FlightData, settings: Settings | None = None,
     innov, stdz, nis, r_sig = [], [], [], []
     quat, vel, posn = np.zeros((K + 1, 4)), np.zeros((K + 1, 3)), np.zeros((K + 1, 3))
     # what the errors against the truth need, evaluated after the loop in whole arrays:
-    # the INS solution before each correction, the compensation in force, x⁺ and, as
-    # they come, the NEES terms (P is not kept per epoch)
+    # the INS solution before each correction, the compensation in force, x⁺ and (with a
+    # truth only: a recording's run keeps no P per epoch) P⁺ for the NEES
     pre_q, pre_v, pre_p = np.zeros((K + 1, 4)), np.zeros((K + 1, 3)), np.zeros((K + 1, 3))
     in_force, x_all = np.zeros((K + 1, N_STATES)), np.zeros((K + 1, N_STATES))
     P_all = np.zeros((K + 1, N_STATES, N_STATES)) if truth is not None else None

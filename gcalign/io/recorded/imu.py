@@ -271,18 +271,16 @@ def _blocks(name: str, data: bytes, ncols: int):
                 text_start = end + 1
             break
         text_start = end + 1
-    body = data[text_start:]
-    if not body.strip():
-        return None
-    sample = body[:4096].decode("utf-8", errors="replace")
+    # the rows after the header, parsed in place (offsets into `data`: a slice would copy it)
+    sample = data[text_start:text_start + 4096].decode("utf-8", errors="replace")
     delimiter = "," if "," in sample else None
-    out = np.empty((body.count(b"\n") + 1, ncols))
-    n, pos = 0, 0
-    while pos < len(body):
-        end = body.rfind(b"\n", pos, pos + _BLOCK_BYTES) if pos + _BLOCK_BYTES < len(body) \
-            else len(body)
-        end = len(body) if end <= pos else end
-        chunk = body[pos:end].decode("utf-8", errors="strict")
+    out = np.empty((data.count(b"\n", text_start) + 1, ncols))
+    n, pos = 0, text_start
+    while pos < len(data):
+        end = data.rfind(b"\n", pos, pos + _BLOCK_BYTES) if pos + _BLOCK_BYTES < len(data) \
+            else len(data)
+        end = len(data) if end <= pos else end
+        chunk = data[pos:end].decode("utf-8", errors="strict")
         pos = end + 1
         block = np.loadtxt(io.StringIO(chunk), comments=("#", "%"), delimiter=delimiter,
                            ndmin=2, dtype=float)
