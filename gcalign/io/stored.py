@@ -115,8 +115,9 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
                                        for x in g[name][()])
             else:
                 values[f.name] = _get(g[name], how)
-        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
-            values[f.name] = None  # an optional series the run did not make
+        if f.name not in values and f.default is dataclasses.MISSING and \
+                f.default_factory is dataclasses.MISSING:
+            values[f.name] = None  # not in the file (an optional series the run did not make)
     return cls(**values, **given)
 
 
