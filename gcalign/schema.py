@@ -68,6 +68,6 @@ def stored(units: str | None, **how: Any) -> dict[str, Stored]:
     return {KEY: Stored(units, **how)}
 
 
-def spec(f: dataclasses.Field) -> Stored | None:
+def spec(f: dataclasses.Field[Any]) -> Stored | None:
     """How the field `f` is stored, or None (not stored)."""
     return f.metadata.get(KEY)

@@ -76,7 +76,7 @@ def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
 
 
 def _get(ds: h5py.Dataset, how: Stored) -> np.ndarray:
-    a = ds[()]
+    a: np.ndarray = np.asarray(ds[()])
     if how.axes is not None and a.ndim == len(how.axes):  # (else a form with fewer axes)
         a = np.transpose(a, np.argsort(how.axes))
     return a.astype(bool) if how.flag else a
@@ -121,7 +121,7 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
     return cls(**values, **given)
 
 
-def _type(cls: type, f: dataclasses.Field) -> Any:
+def _type(cls: type, f: dataclasses.Field[Any]) -> Any:
     """The type of field `f` of `cls` (its annotation evaluated in the module of `cls`), or
     Any where it cannot be evaluated here."""
     if not isinstance(f.type, str):
