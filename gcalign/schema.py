@@ -39,6 +39,8 @@ class Stored:
         array (M, R) stored as the file's (R, M) says ``axes=(1, 0)``.
     per : the field that names the entries of its first axis: each entry is stored in a
         subgroup of that name (``per="methods"``: ``coordinate/error``, ``vector/error``).
+    inline : a nested result whose fields join its parent's group (no subgroup of its own).
+    compress : stored compressed (gzip, shuffled): long series.
     """
 
     units: str | None
@@ -50,6 +52,8 @@ class Stored:
     flag: bool = False
     axes: tuple[int, ...] | None = None
     per: str | None = None
+    inline: bool = False
+    compress: bool = False
 
 
 #: The frame text of an attitude triple (DESIGN.md conventions), as results files carry it.
@@ -64,6 +68,6 @@ def stored(units: str | None, **how: Any) -> dict[str, Stored]:
     return {KEY: Stored(units, **how)}
 
 
-def spec(f: dataclasses.Field) -> Stored | None:
+def spec(f: dataclasses.Field[Any]) -> Stored | None:
     """How the field `f` is stored, or None (not stored)."""
     return f.metadata.get(KEY)

@@ -14,6 +14,7 @@ import pytest
 from gcalign.calibrate.observability import DEGREE, ObservabilityTable
 from gcalign.estimation.ins_error import STATE_NAMES
 from gcalign.io.stored import read_fields, write_fields
+from gcalign.realtime.pulses import Pulses
 from gcalign.schema import spec, stored
 
 
@@ -95,3 +96,27 @@ def test_a_north_finding_result_comes_back(tmp_path):
             a, b = getattr(res, f_.name), getattr(back, f_.name)
             assert a.shape == b.shape and np.array_equal(a, b, equal_nan=True), f_.name
     assert back.methods == res.methods
+
+
+def test_nested_mapped_and_compressed_fields_come_back(tmp_path):
+    """A nested result stored inline (the pulses in a realtime case's group), a mapping of
+    series (one dataset per predictor) and compressed series, read back as they were."""
+
+    @dataclass(frozen=True)
+    class Case:
+        pulses: Pulses = field(metadata=stored(None, inline=True))
+        predicted: dict = field(metadata=stored("rad", frame="f", compress=True))
+        note: str = "not stored"
+
+    p = Pulses(t=np.arange(5.0), k=np.arange(5), dt_true=np.full(5, 1e-4), dt=np.zeros(5))
+    case = Case(pulses=p, predicted={"kalman": np.ones((5, 3)), "ls": np.zeros((5, 3))})
+    with h5py.File(tmp_path / "c.h5", "w") as f:
+        write_fields(f.create_group("c"), case)
+    with h5py.File(tmp_path / "c.h5") as f:
+        g = f["c"]
+        assert sorted(g) == ["dt", "dt_true", "k", "predicted", "t"]  # pulses inline
+        assert g["t"].compression == "gzip" and g["predicted/ls"].attrs["frame"] == "f"
+        back = read_fields(g, Case)
+    assert all(np.array_equal(getattr(back.pulses, n), getattr(p, n)) for n in ("t", "k", "dt"))
+    assert sorted(back.predicted) == ["kalman", "ls"]
+    assert np.array_equal(back.predicted["kalman"], np.ones((5, 3)))

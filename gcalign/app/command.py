@@ -86,7 +86,7 @@ class Outcome:
         :class:`gcalign.align.gyrocompass.Alignment`), or None.
     """
 
-    summary: dict
+    summary: dict[str, Any]
     write: Callable[[Any], None]
     truth: Any = None
     seed: int | None = None
@@ -182,11 +182,11 @@ class Command:
 
     # ------------------------------------------------------------------ show and store
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         """The table the command prints (and ``gcalign show``): a rich renderable."""
         raise NotImplementedError(f"{self.name} has no table")
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         """The figures of its results file (an open h5py.File), by file stem."""
         return {}
 
@@ -225,7 +225,7 @@ def stride(sc: Scenario, ext: Extent) -> int:
         raise ScenarioError(str(err)) from None
 
 
-def warm_run(command: Command, scenario: dict) -> None:
+def warm_run(command: Command, scenario: dict[str, Any]) -> None:
     """A tiny run of `command` on `scenario` (a mapping), so that its kernels are loaded."""
     import copy
 

@@ -7,8 +7,9 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from gcalign.app.command import Command
 from gcalign.app.report import with_warnings
@@ -28,7 +29,7 @@ def kinds() -> dict[str, Command]:
     return {**COMMANDS, batch.name: batch}
 
 
-def summary_table(kind: str, summary: dict) -> RenderableType:
+def summary_table(kind: str, summary: dict[str, Any]) -> RenderableType:
     """The table a command prints, from its summary (also for `gcalign show`), with the
     run's warnings."""
     commands = kinds()
@@ -101,7 +102,8 @@ def default_plot_dir(path: Path) -> Path:
     return path.with_name(path.name.split(".")[0] + "_plots")
 
 
-def plot_file(path: Path, out_dir: Path | str | None = None, progress=None) -> list[Path]:
+def plot_file(path: Path, out_dir: Path | str | None = None,
+              progress: Callable[[int, int, str], None] | None = None) -> list[Path]:
     """Write every figure of a results file as PNG; the paths written. `progress(done,
     total, what)` hears of each figure written."""
     figs = figures_for(path)

@@ -2,15 +2,18 @@
 and one reader for every result dataclass, instead of one per command.
 
 Each field declared with :func:`gcalign.schema.stored` becomes a dataset of the group (with
-its ``units``, ``frame``, ``shape`` and ``description`` attributes) or an attribute of it;
-a nested result dataclass becomes a subgroup, a list of them numbered subgroups (``00``,
-``01``, ...); a field whose value is None is left out. Fields without that metadata are not
-stored (what the run derives again, or what the command stores itself).
+its ``units``, ``frame``, ``shape`` and ``description`` attributes) or an attribute of it; a
+nested result dataclass becomes a subgroup (or, ``inline``, its fields join the group), a
+list of them numbered subgroups (``00``, ``01``, ...), a mapping of arrays a subgroup of one
+dataset per key; a field whose value is None is left out. Fields without that metadata are
+not stored (what the run derives again, or what the command stores itself).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import sys
+import typing
 from typing import Any, TypeVar
 
 import h5py
@@ -33,11 +36,15 @@ def write_fields(g: h5py.Group, result: Any) -> None:
         if how.attr:
             g.attrs[name] = ",".join(value) if isinstance(value, tuple) else value
         elif dataclasses.is_dataclass(value):
-            write_fields(g.create_group(name), value)
+            write_fields(g if how.inline else g.create_group(name), value)
         elif isinstance(value, list) and value and dataclasses.is_dataclass(value[0]):
             h = g.create_group(name)
             for i, item in enumerate(value):
                 write_fields(h.create_group(f"{i:02d}"), item)
+        elif isinstance(value, dict):
+            h = g.create_group(name)
+            for key, part in value.items():
+                _put(h, key, part, how)
         elif how.units is None:  # text
             check_writes()
             g.create_dataset(name, data=np.array(value, dtype=h5py.string_dtype()))
@@ -54,12 +61,22 @@ def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
     data = np.asarray(value)
     if how.axes is not None:
         data = np.transpose(data, how.axes)
-    put(g, name, data.astype(np.int8) if how.flag else data, how.units or "1", how.frame,
-        **extra)
+    if how.flag:
+        data = data.astype(np.int8)
+    if not how.compress:
+        put(g, name, data, how.units or "1", how.frame, **extra)
+        return
+    check_writes()
+    ds = g.create_dataset(name, data=data, compression="gzip", compression_opts=1,
+                          shuffle=True)
+    ds.attrs["units"] = how.units or "1"
+    for k, v in (("frame", how.frame), *extra.items()):
+        if v:
+            ds.attrs[k] = v
 
 
 def _get(ds: h5py.Dataset, how: Stored) -> np.ndarray:
-    a = ds[()]
+    a: np.ndarray = np.asarray(ds[()])
     if how.axes is not None and a.ndim == len(how.axes):  # (else a form with fewer axes)
         a = np.transpose(a, np.argsort(how.axes))
     return a.astype(bool) if how.flag else a
@@ -75,12 +92,18 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
         if how is None or f.name in given:
             continue
         name = how.name or f.name
+        kind = _type(cls, f)
+        inner = next((a for a in typing.get_args(kind) if dataclasses.is_dataclass(a)), kind)
         if how.attr:
             if name in g.attrs:
                 v = g.attrs[name]
                 v = v.decode() if isinstance(v, bytes) else v
                 values[f.name] = (tuple(v.split(",")) if isinstance(v, str)
-                                  and "tuple" in str(f.type) else _plain(v))
+                                  and "tuple" in str(kind) else _plain(v))
+        elif dataclasses.is_dataclass(inner) and (how.inline or name in g):
+            values[f.name] = read_fields(g if how.inline else g[name], inner)  # type: ignore[arg-type]
+        elif dict in (kind, typing.get_origin(kind)) and name in g:
+            values[f.name] = {k: _get(ds, how) for k, ds in g[name].items()}
         elif how.per is not None:
             entries = values.get(how.per) or given.get(how.per) or ()
             parts = [g[e][name] for e in entries if e in g and name in g[e]]
@@ -92,9 +115,21 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
                                        for x in g[name][()])
             else:
                 values[f.name] = _get(g[name], how)
-        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
-            values[f.name] = None  # an optional series the run did not make
+        if f.name not in values and f.default is dataclasses.MISSING and \
+                f.default_factory is dataclasses.MISSING:
+            values[f.name] = None  # not in the file (an optional series the run did not make)
     return cls(**values, **given)
+
+
+def _type(cls: type, f: dataclasses.Field[Any]) -> Any:
+    """The type of field `f` of `cls` (its annotation evaluated in the module of `cls`), or
+    Any where it cannot be evaluated here."""
+    if not isinstance(f.type, str):
+        return f.type
+    try:
+        return eval(f.type, vars(sys.modules[cls.__module__]))  # noqa: S307 - an annotation
+    except (NameError, AttributeError, SyntaxError, TypeError):
+        return Any
 
 
 def _plain(v: Any) -> Any:

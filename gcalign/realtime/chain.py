@@ -36,7 +36,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -56,6 +56,7 @@ from gcalign.realtime.predict import Track, TrackerModel, run_predictor, track, 
 from gcalign.realtime.pulses import Pulses, make_pulses
 from gcalign.realtime.sensor import GyroChannel
 from gcalign.realtime.settings import Settings
+from gcalign.schema import ATT_FRAME, stored
 from gcalign.sim.ideal import ideal_blocks
 from gcalign.units import DEG
 
@@ -116,13 +117,19 @@ class CaseResult:
     earth: EarthModel
     chain_delay: float
     delay: float
-    pulses: Pulses
+    pulses: Pulses = field(metadata=stored(None, inline=True))
     t_update: np.ndarray
-    t_valid: np.ndarray
-    latched: np.ndarray
-    predicted: dict[str, np.ndarray]
-    truth: np.ndarray
-    ins_ref: np.ndarray
+    t_valid: np.ndarray = field(metadata=stored(
+        "s", frame="time of validity of the latched attitude", compress=True))
+    latched: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME + "; unwrapped",
+                                                compress=True))
+    predicted: dict[str, np.ndarray] = field(metadata=stored(
+        "rad", frame=ATT_FRAME + "; at the pulse time (extrapolated)", compress=True))
+    truth: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME + "; at the pulse time",
+                                              compress=True))
+    ins_ref: np.ndarray = field(metadata=stored(
+        "rad", frame=ATT_FRAME + "; the INS's output T after the pulse (the seed's reference)",
+        compress=True))
     series: Series | None = None
 
     def error(self, predictor: str, metric: str = "truth") -> np.ndarray:

@@ -16,11 +16,12 @@ are on the INS clock, which is also the simulation's clock.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from gcalign.realtime.settings import PulseSettings, check_pulses
+from gcalign.schema import stored
 
 __all__ = ["Pulses", "latch", "make_pulses"]
 
@@ -33,10 +34,13 @@ class Pulses:
     dt_true : (P,) ``t − kτ`` (s); dt : (P,) Δt as the FPGA counter measures it (s).
     """
 
-    t: np.ndarray
-    k: np.ndarray
-    dt_true: np.ndarray
-    dt: np.ndarray
+    t: np.ndarray = field(metadata=stored("s", frame="pulse edge times (INS clock)",
+                                          compress=True))
+    k: np.ndarray = field(metadata=stored(
+        "1", frame="index of the latched solution, t_update = k / solution_hz", compress=True))
+    dt_true: np.ndarray = field(metadata=stored("s", frame="t - t_update", compress=True))
+    dt: np.ndarray = field(metadata=stored("s", frame="Δt as the counter measures it",
+                                           compress=True))
 
     def __len__(self) -> int:
         return len(self.t)

@@ -26,12 +26,12 @@ class Allan(Command):
 
         return execute
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         from gcalign.app.allan.tables import allan_table
 
         return allan_table(summary)
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         from gcalign.app.allan.plots import figures
 
         return figures(f, name)

@@ -122,12 +122,12 @@ class Batch(Command):
     name = "batch"
     help = "Sweeps and Monte Carlo over any batchable command."
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         from gcalign.app.batch.tables import batch_table
 
         return batch_table(summary)
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         from gcalign.app.batch.plots import figures
 
         return figures(f, name)

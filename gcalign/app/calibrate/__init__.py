@@ -80,12 +80,12 @@ class Calibrate(Command):
 
         return execute
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         from gcalign.app.calibrate.tables import calibrate_table
 
         return calibrate_table(summary)
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         from gcalign.app.calibrate.plots import figures
 
         return figures(f, name)

@@ -35,12 +35,12 @@ class Modulate(Command):
 
         return execute
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         from gcalign.app.modulate.tables import modulate_table
 
         return modulate_table(summary)
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         from gcalign.app.modulate.plots import figures
 
         return figures(f, name)

@@ -33,12 +33,12 @@ class Navigate(Command):
 
         return execute
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         from gcalign.app.navigate.tables import navigate_table
 
         return navigate_table(summary)
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         from gcalign.app.navigate.plots import figures
 
         return figures(f, name)

@@ -24,12 +24,12 @@ class Northfind(Command):
 
         return execute
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         from gcalign.app.northfind.tables import northfind_table
 
         return northfind_table(summary)
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         from gcalign.app.northfind.plots import figures
 
         return figures(f, name)

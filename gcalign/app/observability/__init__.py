@@ -45,7 +45,7 @@ class Observability(Command):
             return transfer.execute(sc, seed, cache_key, **options)
         return super().execute(sc, seed, cache_key, **options)
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         if summary.get("mode") == "transfer":
             from gcalign.app.observability.transfer import table
 
@@ -54,7 +54,7 @@ class Observability(Command):
 
         return observability_table(summary)
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         if "observability" in f and f["observability"].attrs.get("mode") == "transfer":
             from gcalign.app.observability.transfer import figures as transfer_figures
 

@@ -7,7 +7,6 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.app.calibrate.plots import truth_trajectory
-from gcalign.app.plots import _s
 
 
 def heat_map(values: np.ndarray, rows: list[str], cols: list[str], title: str, label: str,
@@ -47,22 +46,27 @@ def heat_map(values: np.ndarray, rows: list[str], cols: list[str], title: str, l
 
 
 def figures(f, name: str) -> dict[str, Figure]:
+    """The flight's trajectory and heat maps of its table read back
+    (:class:`gcalign.calibrate.observability.ObservabilityTable`)."""
+    from gcalign.calibrate.observability import ObservabilityTable
+    from gcalign.io.stored import read_fields
+
     figs = truth_trajectory(f, name)
     if "observability" not in f:
         return figs
-    g = f["observability"]
-    states = _s(g.attrs["states"]).split(",")
-    segs = [f"{i + 1} {_s(n)}" for i, n in enumerate(g["segment_name"][()])]
-    how = f"{_s(g.attrs['measure'])} matching, scaling {_s(g.attrs['scaling'])}"
+    tab = read_fields(f["observability"], ObservabilityTable)
+    states = list(tab.names)
+    segs = [f"{i + 1} {n}" for i, n in enumerate(tab.segments)]
+    how = f"{tab.measure} matching, scaling {tab.scaling}"
     figs["observability_segments"] = heat_map(
-        g["eta"][()], segs, states, f"{name}: degree of observability η per segment ({how}; "
+        tab.eta, segs, states, f"{name}: degree of observability η per segment ({how}; "
         "grey ·: 0)", "log10 η", "·")
     figs["observability_cumulative"] = heat_map(
-        g["eta_cum"][()], [f"to {s}" for s in segs], states,
+        tab.eta_cum, [f"to {s}" for s in segs], states,
         f"{name}: cumulative degree η from the start ({how})", "log10 η", "·")
-    if "cov_degree" in g:
+    if tab.cov_degree is not None:
         figs["covariance_degree"] = heat_map(
-            g["cov_degree"][()], [f"after {s}" for s in segs], states,
+            tab.cov_degree, [f"after {s}" for s in segs], states,
             f"{name}: covariance degree σ(0)/σ(t) at the end of each segment (PSINS kfstat, "
-            f"{_s(g.attrs['measure'])})", "log10 σ(0)/σ(t)", exponents=False)
+            f"{tab.measure})", "log10 σ(0)/σ(t)", exponents=False)
     return figs

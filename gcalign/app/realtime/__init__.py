@@ -26,12 +26,12 @@ class Realtime(Command):
 
         return execute
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         from gcalign.app.realtime.tables import realtime_table
 
         return realtime_table(summary)
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         from gcalign.app.realtime.plots import figures
 
         return figures(f, name)

@@ -19,20 +19,13 @@ from __future__ import annotations
 import h5py
 import numpy as np
 
-from gcalign.io.results import ATT_FRAME, put
+from gcalign.io.results import put
+from gcalign.io.stored import write_fields
 from gcalign.realtime.filters import FilterChain
 
 #: frequency grid of the stored response (Hz): a quarter step off the notch's zero, where
 #: the group delay is singular
 _FREQ_STEP = 0.5
-
-
-def _series(g: h5py.Group, name: str, data, units: str, frame: str | None = None) -> None:
-    ds = g.create_dataset(name, data=np.asarray(data), compression="gzip", compression_opts=1,
-                          shuffle=True)
-    ds.attrs["units"] = units
-    if frame:
-        ds.attrs["frame"] = frame
 
 
 def write_filter(g: h5py.Group, chain) -> None:
@@ -68,22 +61,11 @@ def write_realtime(f: h5py.File, run) -> None:
     cases = g.create_group("cases")
     for i, res in enumerate(run.result.cases):
         c = cases.create_group(f"{i:02d}")
-        case, p = res.case, res.pulses
+        case = res.case
         train = case.pulses or s.pulses
         c.attrs.update(name=case.name, kind=case.kind, component=case.component,
                        axis=np.asarray(case.shape.axis if case.shape.axis else [np.nan] * 3),
                        seed_before=case.seed_before, seed_after=case.seed_after,
                        pulses=train.mode, pulse_rate_hz=train.rate_hz,
                        rate=case.shape.rate, duration=case.duration)
-        _series(c, "t", p.t, "s", "pulse edge times (INS clock)")
-        _series(c, "k", p.k, "1", "index of the latched solution, t_update = k / solution_hz")
-        _series(c, "dt_true", p.dt_true, "s", "t - t_update")
-        _series(c, "dt", p.dt, "s", "Δt as the counter measures it")
-        _series(c, "t_valid", res.t_valid, "s", "time of validity of the latched attitude")
-        _series(c, "latched", res.latched, "rad", ATT_FRAME + "; unwrapped")
-        _series(c, "truth", res.truth, "rad", ATT_FRAME + "; at the pulse time")
-        _series(c, "ins_ref", res.ins_ref, "rad",
-                ATT_FRAME + "; the INS's output T after the pulse (the seed's reference)")
-        pred = c.create_group("predicted")
-        for name, a in res.predicted.items():
-            _series(pred, name, a, "rad", ATT_FRAME + "; at the pulse time (extrapolated)")
+        write_fields(c, res)  # the pulse records as CaseResult's fields say

@@ -30,7 +30,7 @@ class Simulate(Command):
 
         return execute
 
-    def table(self, summary: dict) -> Any:
+    def table(self, summary: dict[str, Any]) -> Any:
         from gcalign.app.simulate.tables import simulate_table
 
         return simulate_table(summary)
@@ -47,7 +47,7 @@ class Simulate(Command):
                     output_bytes=n / stride(sc, ext) * ROW_DOUBLES * DOUBLE,
                     work=n * SIMULATE_OPS, work_what="samples × their simulation")
 
-    def figures(self, f: Any, name: str) -> dict:
+    def figures(self, f: Any, name: str) -> dict[str, Any]:
         """The truth and the IMU output (the shared figures of :mod:`gcalign.app.plots`)."""
         from gcalign.app.plots import truth_and_imu
 
