@@ -138,9 +138,9 @@ def test_figures_show_and_the_set_route(sim):
     _, path, out = sim
     s, h5 = out["attitude"]
     with h5py.File(h5) as f:
-        from gcalign.app.observability.plots import figures
+        from gcalign.app.registry import command
 
-        figs = figures(f, "sim")
+        figs = command("observability").figures(f, "sim")  # the command's, by its mode
     assert sorted(figs) == ["covariance_degree", "observability_cumulative",
                             "sigma_reduction"]
     assert len(figs["sigma_reduction"].axes) == 5  # φ, δv, ε, ∇, μ (15 states)

@@ -114,10 +114,15 @@ def show(
     """Print the summary of a results file again, from the file alone."""
     from gcalign.app.checked import read_checked
     from gcalign.app.readback import summary_table
+    from gcalign.errors import ScenarioError
 
     kind, summary, attrs = read_checked(file)
     console = consoles(as_json)
-    console.print(summary_table(kind, summary))
+    try:
+        table = summary_table(kind, summary)
+    except ScenarioError as err:  # a summary the file's command cannot read: name the file
+        raise ScenarioError(f"{file}: {err}") from None
+    console.print(table)
     console.print(
         f"[dim]{attrs.get('command_line', '')}  ({attrs.get('created_utc', '')}, "
         f"gcalign {attrs.get('gcalign_version', '?')})[/dim]"
