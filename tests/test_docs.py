@@ -94,10 +94,12 @@ def test_every_runnable_block_runs_or_says_why_not():
 
 def sandbox(tmp: Path) -> Path:
     """A folder laid out like the repository for the examples: configs/ copied (a block may
-    write a sweep beside the others), the recordings linked, runs/ empty."""
+    write a sweep beside the others), the recordings and benchmarks/ (the simulators) linked,
+    runs/ empty."""
     shutil.copytree(ROOT / "configs", tmp / "configs")
     (tmp / "tests").mkdir()
     (tmp / "tests" / "data").symlink_to(ROOT / "tests" / "data")
+    (tmp / "benchmarks").symlink_to(ROOT / "benchmarks")
     (tmp / "runs").mkdir()
     return tmp
 

@@ -100,9 +100,10 @@ def run_table(s: dict) -> Table:
                         f"{UNIT_TEXT.get(units[n], units[n])}" for n in ("phiE", "phiN", "phiU"))
         notes.append(f"RTS smoother: φ at the start (E, N, U) {phi}; φU σ "
                      f"{sm['phiU']['filtered_sigma'] * k:.3g}′ filtered → "
-                     f"{sm['phiU']['sigma'] * k:.3g}′ smoothed (the sensor errors, constants "
-                     "without process noise, gain nothing: their smoothed σ is the final "
-                     "filtered σ)")
+                     f"{sm['phiU']['sigma'] * k:.3g}′ smoothed" + (
+                         " (the sensor errors, constants without process noise, gain nothing: "
+                         "their smoothed σ is the final filtered σ)"
+                         if s.get("processes") is None else ""))
     e = s.get("final_error") if s.get("error_source") == "reference" else None
     if e:
         a = [angle_text(math.radians(x)) for x in e["attitude_deg"]]
