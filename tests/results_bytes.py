@@ -9,7 +9,7 @@ raw data). One small real file of every kind (:func:`damage_cases.make_files`).
 Outcomes of each read-back: ``ok`` (exit 0: the damage fell where nothing is read, or in
 uncompressed numbers, which HDF5 stores without a checksum), ``refused`` (exit 2, one line
 naming the file), and the broken ones: an internal error, a traceback, anything else.
-``python tests/results_bytes.py`` prints the counts (docs/robustness.md).
+``python tests/results_bytes.py [OFFSETS]`` prints the counts (docs/robustness.md).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ class Case:
         return f"{self.kind}@{self.offset}"
 
 
-def offsets(path: Path, kind: str) -> list[Case]:
+def offsets(path: Path, kind: str, random_offsets: int | None = None) -> list[Case]:
     import h5py
 
     chunks: list[tuple[str, int]] = []
@@ -55,7 +55,7 @@ def offsets(path: Path, kind: str) -> list[Case]:
     size = path.stat().st_size
     return ([Case(kind, off, f"chunk of {name}") for name, off in chunks[:3]]
             + [Case(kind, rng.randrange(0, size - 16), "random")
-               for _ in range(RANDOM_OFFSETS)])
+               for _ in range(RANDOM_OFFSETS if random_offsets is None else random_offsets)])
 
 
 def damaged(src: Path, case: Case, dst: Path) -> Path:
@@ -84,11 +84,12 @@ def read_back(path: Path, command: str, folder: Path) -> tuple[str, str]:
     return "other", last
 
 
-def count(folder: Path, files: dict[str, Path]) -> tuple[Counter, list]:
+def count(folder: Path, files: dict[str, Path], random_offsets: int | None = None
+          ) -> tuple[Counter, list]:
     tally: Counter = Counter()
     broken = []
     for kind, src in files.items():
-        for case in offsets(src, kind):
+        for case in offsets(src, kind, random_offsets):
             dst = damaged(src, case, folder / f"d-{case.id}.h5")
             for command in COMMANDS:
                 cls, line = read_back(dst, command, folder)
@@ -103,13 +104,14 @@ def count(folder: Path, files: dict[str, Path]) -> tuple[Counter, list]:
 if __name__ == "__main__":
     import tempfile
 
+    n_random = int(sys.argv[1]) if len(sys.argv) > 1 else RANDOM_OFFSETS
     with tempfile.TemporaryDirectory() as d:
         files = D.make_files(Path(d))
-        tally, broken = count(Path(d), files)
+        tally, broken = count(Path(d), files, n_random)
     classes = ("ok", "refused", "internal", "traceback", "other")
     n = sum(tally[c] for c in classes)
-    print(f"{len(files)} files × {3 + RANDOM_OFFSETS} damages × {len(COMMANDS)} read-backs: "
-          f"{n}")
+    print(f"{len(files)} kinds, {n // len(COMMANDS)} damaged files (up to 3 compressed chunks "
+          f"and {n_random} offsets each) × {len(COMMANDS)} read-backs: {n}")
     print("| kind | read-backs | " + " | ".join(classes) + " |")
     print("| --- | ---: | " + " | ".join("---:" for _ in classes) + " |")
     for kind in files:
