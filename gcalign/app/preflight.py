@@ -13,6 +13,7 @@ so both take the same decisions. Nothing here imports numba or scipy.
 from __future__ import annotations
 
 import os
+import typing
 from pathlib import Path
 from typing import Any
 
@@ -79,6 +80,8 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
     would refuse, and what would exceed a resource limit. ``name=None``: every section the
     scenario has (``gcalign validate``)."""
     commands = [command(name)] if name else _commands_of(sc)
+    if name is not None:
+        recorded_defaults(sc, commands[0].section)
     check_seed(sc.imu.seed, "imu.seed")
     # recorded data are read only for a command that can use them (the others refuse them)
     ext = extent(sc, read_recorded and any(c.options.recorded for c in commands))
@@ -97,6 +100,20 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
             raise
         except (ValueError, TypeError) as err:  # a settings object refused what it was given
             raise setup_error(c.section or c.name, err) from None
+
+
+def recorded_defaults(sc: Scenario, section: str | None) -> None:
+    """A recording's scenario without the command's section runs with the section
+    ``--imu-file X`` alone gets (:data:`gcalign.io.scenario.recording.RECORDED_DEFAULTS`:
+    an inertial-frame coarse alignment over the first minute, not the simulated default
+    'given', which needs truth), set on `sc` in place."""
+    from gcalign.io.scenario.recording import RECORDED_DEFAULTS
+
+    if sc.imu_file is None or section not in RECORDED_DEFAULTS or getattr(sc, section) is not None:
+        return
+    model = type(sc).model_fields[section].annotation
+    kind = next(t for t in typing.get_args(model) if t is not type(None))
+    setattr(sc, section, kind.model_validate(RECORDED_DEFAULTS[section]))
 
 
 def setup_error(section: str, err: Exception) -> ScenarioError:

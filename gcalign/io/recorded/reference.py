@@ -78,6 +78,7 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     if format not in REFERENCE_FORMATS:
         raise ScenarioError(f"reference.format: {format!r} is not a reference format; "
                             f"allowed: {', '.join(REFERENCE_FORMATS)}")
+    check_keys(format, variable, columns, "reference")
     data = read_bytes(name, text=format != "psins-mat")[1]
     notes: dict = {}
     if format == "psins-mat":
@@ -117,6 +118,19 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     att = None if att is None else np.ascontiguousarray(att)
     return Reference(np.array(t), att, np.ascontiguousarray(v), np.ascontiguousarray(pos),
                      record)
+
+
+def check_keys(format: str, variable, columns, where: str) -> None:
+    """A MAT variable names an array of a psins-mat file, columns the layout of a CSV: for
+    any other format they cannot matter, and are refused rather than ignored (a CSV
+    reference's variable was dropped in silence, while an imu_file's was refused)."""
+    if variable is not None and format != "psins-mat":
+        raise ScenarioError(f"{where}.variable: names an array of a MAT file; format "
+                            f"{format!r} has none (remove it), got {variable!r}")
+    if columns is not None and format not in ("csv", "reference-csv", "velocity-enu",
+                                              "velocity-ned", "odometer"):
+        raise ScenarioError(f"{where}.columns: names the columns of a CSV file; format "
+                            f"{format!r} fixes its own (remove it), got {list(columns)}")
 
 
 def _avp(name: str, data: bytes, variable: str | None, attitude_optional: bool = False):
