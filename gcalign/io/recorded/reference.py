@@ -110,6 +110,8 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     _check_rows(name, t, where)
     if len(t) < 2:
         raise ImuFileError(f"{name}: {len(t)} epoch(s); a reference needs at least 2")
+    if att is not None:
+        _angles(name, att, where, format)
     record = {"format": format, "path": name, "epochs": int(len(t)), "t_first_s": float(t[0]),
               "t_last_s": float(t[-1]), "time_origin": origin,
               "rate_hz": float(1.0 / np.median(np.diff(t))), **notes}
@@ -118,6 +120,21 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     att = None if att is None else np.ascontiguousarray(att)
     return Reference(np.array(t), att, np.ascontiguousarray(v), np.ascontiguousarray(pos),
                      record)
+
+
+def _angles(name: str, att: np.ndarray, where, format: str) -> None:
+    """Euler angles within their ranges (pitch within ±90°, roll and yaw within ±360°): a
+    psins-mat avp in degrees, read as radians, has angles of tens of radians."""
+    unit, scale = ("rad", 1.0) if format == "psins-mat" else ("deg", 1.0 / DEG)
+    for col, label, bound in ((0, "pitch", np.pi / 2), (1, "roll", 2 * np.pi),
+                              (2, "yaw", 2 * np.pi)):
+        bad = np.abs(att[:, col]) > bound * (1 + 1e-9)
+        if bad.any():
+            k = int(np.argmax(bad))
+            hint = (": it looks like degrees, and psins-mat takes radians"
+                    if format == "psins-mat" else "")
+            raise ImuFileError(f"{name}{where(k)}: {label} {att[k, col] * scale:.6g} {unit} "
+                               f"is beyond ±{bound * scale:g} {unit}{hint}")
 
 
 def check_keys(format: str, variable, columns, where: str) -> None:

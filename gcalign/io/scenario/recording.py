@@ -52,6 +52,10 @@ class ImuLayout(Model):
     rate_hz: float | None = Field(None, gt=0, le=1e5)
     max_gap_s: float = Field(0.0, ge=0, le=3600)
     check_gravity: bool = True
+    check_consistency: bool = Field(
+        True, description="refuse a recording that contradicts itself: gyros against the "
+        "accelerometers and the earth rate, the forward axis against a velocity (wrong units "
+        "or axes)")
 
     @field_validator("format")
     @classmethod
@@ -79,7 +83,8 @@ class ImuLayout(Model):
             gyro_units=None if self.units is None else self.units.gyro,
             accel_units=None if self.units is None else self.units.accel,
             quantity=self.quantity, time=self.time, variable=self.variable,
-            rate_hz=self.rate_hz, max_gap_s=self.max_gap_s, check_gravity=self.check_gravity)
+            rate_hz=self.rate_hz, max_gap_s=self.max_gap_s, check_gravity=self.check_gravity,
+            check_consistency=self.check_consistency)
 
 
 class ReferenceFile(Model):
@@ -93,6 +98,9 @@ class ReferenceFile(Model):
     max_gap_s: float | None = Field(None, gt=0, description="epochs further apart are a gap: "
                                     "no error is reported inside it; default twice the "
                                     "file's median interval")
+    check_attitude: bool = Field(True, description="refuse an attitude that turns 57.3 times "
+                                 "too little or too much against the gyros (radians read as "
+                                 "degrees, or degrees as radians)")
 
     @field_validator("format")
     @classmethod
