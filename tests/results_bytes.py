@@ -9,7 +9,9 @@ raw data). One small real file of every kind (:func:`damage_cases.make_files`).
 Outcomes of each read-back: ``ok`` (exit 0: the damage fell where nothing is read, or in
 uncompressed numbers, which HDF5 stores without a checksum), ``refused`` (exit 2, one line
 naming the file), and the broken ones: an internal error, a traceback, anything else.
-``python tests/results_bytes.py [OFFSETS]`` prints the counts (docs/robustness.md).
+``python tests/results_bytes.py [OFFSETS] [--children]`` prints the counts
+(docs/robustness.md); ``--children`` reads back in child processes with a time limit, so
+that a version that hangs inside HDF5 is counted too (``hang``).
 """
 
 from __future__ import annotations
@@ -65,11 +67,49 @@ def damaged(src: Path, case: Case, dst: Path) -> Path:
     return dst
 
 
+#: seconds a read-back may take in a child process (``--children``): longer is a hang
+HANG_S = 60.0
+
+
+def _child(argv: list) -> tuple[int, str, BaseException | None]:
+    """The command line in a child process with :data:`HANG_S` (a version that hangs in
+    HDF5 cannot be interrupted in-process): ``(exit code, stderr, None)``, -1 for a hang."""
+    import subprocess
+
+    code = ("import sys; from gcalign.cli import main; sys.argv = ['gcalign'] + sys.argv[1:]; "
+            "main()")
+    try:
+        res = subprocess.run([sys.executable, "-c", code, *map(str, argv)],
+                             capture_output=True, text=True, timeout=HANG_S)
+    except subprocess.TimeoutExpired:
+        return -1, "", None
+    return res.returncode, res.stderr, None
+
+
+CHILDREN = False  #: read back in child processes (``python tests/results_bytes.py --children``)
+
+
 def read_back(path: Path, command: str, folder: Path) -> tuple[str, str]:
-    """``(outcome, last stderr line)`` of one read-back (module docstring)."""
+    """``(outcome, last stderr line)`` of one read-back (module docstring); ``hang`` when a
+    child process (:data:`CHILDREN`) did not finish within :data:`HANG_S`."""
     argv = {"show": ["show", path],
             "export": ["export", path, "--format", "csv", "-o", folder / "x.csv"],
             "plot": ["plot", path, "-o", folder / "figs"]}[command]
+    if CHILDREN:
+        code, stderr, _ = _child(argv)
+        if code == -1:
+            return "hang", f"no answer within {HANG_S:g} s"
+        lines = stderr.strip().splitlines()
+        last = lines[-1] if lines else ""
+        if code == 0:
+            return "ok", ""
+        if "Traceback" in stderr or code < 0:
+            return "traceback", last
+        if "internal error" in stderr:
+            return "internal", last
+        if code == 2 and len(lines) == 1 and str(path) in lines[0]:
+            return "refused", last
+        return "other", last
     res = D._cli(argv)
     lines = res.stderr.strip().splitlines()
     last = lines[-1] if lines else repr(res.exception)
@@ -95,7 +135,7 @@ def count(folder: Path, files: dict[str, Path], random_offsets: int | None = Non
                 cls, line = read_back(dst, command, folder)
                 tally[cls] += 1
                 tally[(kind, cls)] += 1
-                if cls not in ("ok", "refused"):
+                if cls not in ("ok", "refused"):  # internal, traceback, hang, other
                     broken.append((case.id, case.where, command, cls, line))
             dst.unlink()
     return tally, broken
@@ -104,20 +144,16 @@ def count(folder: Path, files: dict[str, Path], random_offsets: int | None = Non
 if __name__ == "__main__":
     import tempfile
 
-    n_random = int(sys.argv[1]) if len(sys.argv) > 1 else RANDOM_OFFSETS
+    args = [a for a in sys.argv[1:] if a != "--children"]
+    CHILDREN = "--children" in sys.argv
+    n_random = int(args[0]) if args else RANDOM_OFFSETS
     with tempfile.TemporaryDirectory() as d:
         files = D.make_files(Path(d))
         tally, broken = count(Path(d), files, n_random)
-    classes = ("ok", "refused", "internal", "traceback", "other")
+    classes = ("ok", "refused", "internal", "traceback", "hang", "other")
     n = sum(tally[c] for c in classes)
     print(f"{len(files)} kinds, {n // len(COMMANDS)} damaged files (up to 3 compressed chunks "
           f"and {n_random} offsets each) × {len(COMMANDS)} read-backs: {n}")
-    print("| kind | read-backs | " + " | ".join(classes) + " |")
-    print("| --- | ---: | " + " | ".join("---:" for _ in classes) + " |")
-    for kind in files:
-        m = sum(tally[(kind, c)] for c in classes)
-        print(f"| {kind} | {m} | " + " | ".join(str(tally[(kind, c)]) for c in classes) + " |")
-    print(f"| all | {n} | " + " | ".join(str(tally[c]) for c in classes) + " |")
-    print(f"broken: {len(broken)}")
-    for b in broken:
-        print("  ", *b)
+    from reader_damage import print_counts
+
+    print_counts(tally, broken, "kind", "read-backs", list(files), classes)
