@@ -99,11 +99,10 @@ class Model(BaseModel):
             super().__setattr__(name, value)
         except ValidationError as err:
             from gcalign.errors import ScenarioError
-            from gcalign.io.scenario.messages import scenario_errors
 
             prefix = f"{self._where}." if self._where else ""
-            lines = scenario_errors(err).splitlines()
-            raise ScenarioError("; ".join(prefix + line for line in lines)) from None
+            raise ScenarioError("; ".join(prefix + _one_line(e) for e in err.errors())
+                                ) from None
         locate(getattr(self, name), prefix_of(self._where, name))
 
     @model_validator(mode="before")
@@ -135,6 +134,18 @@ def _yaml_bool(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     return next(_yaml_bool(v) for v in value[:10_000] if _has_bool(v))
+
+
+def _one_line(e: Any) -> str:
+    """One pydantic error of an assignment as ``key: what is wrong, got VALUE`` (the file's
+    errors have :func:`gcalign.io.scenario.messages.scenario_errors`, which imports the
+    models)."""
+    where = ".".join(str(x) for x in e["loc"])
+    msg = str(e["msg"]).removeprefix("Value error, ")
+    value = repr(e.get("input"))
+    got = "" if e["type"] in ("missing", "model_type", "value_error") else (
+        f", got {value if len(value) <= 60 else value[:57] + '...'}")
+    return f"{where}: {msg}{got}"
 
 
 def prefix_of(where: str, name: str) -> str:
