@@ -291,6 +291,20 @@ def count(folder: Path) -> tuple[Counter, list[tuple[str, str, str]]]:
     return tally, bad
 
 
+def print_counts(tally: Counter, broken: list, row: str, what: str, rows, classes) -> None:
+    """The counts as a Markdown table (docs/robustness.md), one row per `rows`, then the
+    broken cases."""
+    print(f"| {row} | {what} | " + " | ".join(classes) + " |")
+    print("| --- | ---: | " + " | ".join("---:" for _ in classes) + " |")
+    for r in [*rows, None]:
+        counts = [tally[c] if r is None else tally[(r, c)] for c in classes]
+        print(f"| {'all' if r is None else r} | {sum(counts)} | "
+              + " | ".join(map(str, counts)) + " |")
+    print(f"broken: {len(broken)}")
+    for b in broken:
+        print("  ", *b)
+
+
 if __name__ == "__main__":
     import tempfile
 
@@ -300,14 +314,5 @@ if __name__ == "__main__":
           f"readers: {len(all_cases)} reads")
     with tempfile.TemporaryDirectory() as d:
         tally, bad = count(Path(d))
-    readers = sorted({c.reader for c in all_cases})
-    classes = ("same", "refused", "data", "vague", "internal")
-    print("| reader | reads | " + " | ".join(classes) + " |")
-    print("| --- | ---: | " + " | ".join("---:" for _ in classes) + " |")
-    for r in readers:
-        n = sum(tally[(r, c)] for c in classes)
-        print(f"| {r} | {n} | " + " | ".join(str(tally[(r, c)]) for c in classes) + " |")
-    print(f"| all | {len(all_cases)} | " + " | ".join(str(tally[c]) for c in classes) + " |")
-    print(f"broken: {len(bad)}")
-    for b in bad:
-        print("  ", *b)
+    print_counts(tally, bad, "reader", "reads", sorted({c.reader for c in all_cases}),
+                 ("same", "refused", "data", "vague", "internal"))

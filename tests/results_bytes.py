@@ -9,7 +9,9 @@ raw data). One small real file of every kind (:func:`damage_cases.make_files`).
 Outcomes of each read-back: ``ok`` (exit 0: the damage fell where nothing is read, or in
 uncompressed numbers, which HDF5 stores without a checksum), ``refused`` (exit 2, one line
 naming the file), and the broken ones: an internal error, a traceback, anything else.
-``python tests/results_bytes.py`` prints the counts (docs/robustness.md).
+``python tests/results_bytes.py [OFFSETS] [--children]`` prints the counts
+(docs/robustness.md); ``--children`` reads back in child processes with a time limit, so
+that a version that hangs inside HDF5 is counted too (``hang``).
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ class Case:
         return f"{self.kind}@{self.offset}"
 
 
-def offsets(path: Path, kind: str) -> list[Case]:
+def offsets(path: Path, kind: str, random_offsets: int | None = None) -> list[Case]:
     import h5py
 
     chunks: list[tuple[str, int]] = []
@@ -55,7 +57,7 @@ def offsets(path: Path, kind: str) -> list[Case]:
     size = path.stat().st_size
     return ([Case(kind, off, f"chunk of {name}") for name, off in chunks[:3]]
             + [Case(kind, rng.randrange(0, size - 16), "random")
-               for _ in range(RANDOM_OFFSETS)])
+               for _ in range(RANDOM_OFFSETS if random_offsets is None else random_offsets)])
 
 
 def damaged(src: Path, case: Case, dst: Path) -> Path:
@@ -65,11 +67,49 @@ def damaged(src: Path, case: Case, dst: Path) -> Path:
     return dst
 
 
+#: seconds a read-back may take in a child process (``--children``): longer is a hang
+HANG_S = 60.0
+
+
+def _child(argv: list) -> tuple[int, str, BaseException | None]:
+    """The command line in a child process with :data:`HANG_S` (a version that hangs in
+    HDF5 cannot be interrupted in-process): ``(exit code, stderr, None)``, -1 for a hang."""
+    import subprocess
+
+    code = ("import sys; from gcalign.cli import main; sys.argv = ['gcalign'] + sys.argv[1:]; "
+            "main()")
+    try:
+        res = subprocess.run([sys.executable, "-c", code, *map(str, argv)],
+                             capture_output=True, text=True, timeout=HANG_S)
+    except subprocess.TimeoutExpired:
+        return -1, "", None
+    return res.returncode, res.stderr, None
+
+
+CHILDREN = False  #: read back in child processes (``python tests/results_bytes.py --children``)
+
+
 def read_back(path: Path, command: str, folder: Path) -> tuple[str, str]:
-    """``(outcome, last stderr line)`` of one read-back (module docstring)."""
+    """``(outcome, last stderr line)`` of one read-back (module docstring); ``hang`` when a
+    child process (:data:`CHILDREN`) did not finish within :data:`HANG_S`."""
     argv = {"show": ["show", path],
             "export": ["export", path, "--format", "csv", "-o", folder / "x.csv"],
             "plot": ["plot", path, "-o", folder / "figs"]}[command]
+    if CHILDREN:
+        code, stderr, _ = _child(argv)
+        if code == -1:
+            return "hang", f"no answer within {HANG_S:g} s"
+        lines = stderr.strip().splitlines()
+        last = lines[-1] if lines else ""
+        if code == 0:
+            return "ok", ""
+        if "Traceback" in stderr or code < 0:
+            return "traceback", last
+        if "internal error" in stderr:
+            return "internal", last
+        if code == 2 and len(lines) == 1 and str(path) in lines[0]:
+            return "refused", last
+        return "other", last
     res = D._cli(argv)
     lines = res.stderr.strip().splitlines()
     last = lines[-1] if lines else repr(res.exception)
@@ -84,17 +124,18 @@ def read_back(path: Path, command: str, folder: Path) -> tuple[str, str]:
     return "other", last
 
 
-def count(folder: Path, files: dict[str, Path]) -> tuple[Counter, list]:
+def count(folder: Path, files: dict[str, Path], random_offsets: int | None = None
+          ) -> tuple[Counter, list]:
     tally: Counter = Counter()
     broken = []
     for kind, src in files.items():
-        for case in offsets(src, kind):
+        for case in offsets(src, kind, random_offsets):
             dst = damaged(src, case, folder / f"d-{case.id}.h5")
             for command in COMMANDS:
                 cls, line = read_back(dst, command, folder)
                 tally[cls] += 1
                 tally[(kind, cls)] += 1
-                if cls not in ("ok", "refused"):
+                if cls not in ("ok", "refused"):  # internal, traceback, hang, other
                     broken.append((case.id, case.where, command, cls, line))
             dst.unlink()
     return tally, broken
@@ -103,19 +144,16 @@ def count(folder: Path, files: dict[str, Path]) -> tuple[Counter, list]:
 if __name__ == "__main__":
     import tempfile
 
+    args = [a for a in sys.argv[1:] if a != "--children"]
+    CHILDREN = "--children" in sys.argv
+    n_random = int(args[0]) if args else RANDOM_OFFSETS
     with tempfile.TemporaryDirectory() as d:
         files = D.make_files(Path(d))
-        tally, broken = count(Path(d), files)
-    classes = ("ok", "refused", "internal", "traceback", "other")
+        tally, broken = count(Path(d), files, n_random)
+    classes = ("ok", "refused", "internal", "traceback", "hang", "other")
     n = sum(tally[c] for c in classes)
-    print(f"{len(files)} files × {3 + RANDOM_OFFSETS} damages × {len(COMMANDS)} read-backs: "
-          f"{n}")
-    print("| kind | read-backs | " + " | ".join(classes) + " |")
-    print("| --- | ---: | " + " | ".join("---:" for _ in classes) + " |")
-    for kind in files:
-        m = sum(tally[(kind, c)] for c in classes)
-        print(f"| {kind} | {m} | " + " | ".join(str(tally[(kind, c)]) for c in classes) + " |")
-    print(f"| all | {n} | " + " | ".join(str(tally[c]) for c in classes) + " |")
-    print(f"broken: {len(broken)}")
-    for b in broken:
-        print("  ", *b)
+    print(f"{len(files)} kinds, {n // len(COMMANDS)} damaged files (up to 3 compressed chunks "
+          f"and {n_random} offsets each) × {len(COMMANDS)} read-backs: {n}")
+    from reader_damage import print_counts
+
+    print_counts(tally, broken, "kind", "read-backs", list(files), classes)

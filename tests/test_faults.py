@@ -454,21 +454,35 @@ class Listener:
         self.sock.close()
 
 
-@pytest.fixture
-def zero_worker_scheduler():
-    """A real Dask scheduler on 127.0.0.1 with no workers (a child process, stopped after)."""
+def dask_cluster(workers: int = 0, life_s: float = 60.0) -> tuple[subprocess.Popen, str]:
+    """A real Dask scheduler on 127.0.0.1 with `workers` one-thread workers, in a child
+    process that ends after `life_s`: the process and the scheduler's address."""
     pytest.importorskip("distributed")
-    code = ("import asyncio, sys\nfrom distributed import Scheduler\n"
+    code = ("import asyncio\nfrom contextlib import AsyncExitStack\n"
+            "from distributed import Scheduler, Worker\n"
             "async def main():\n"
             "    async with Scheduler(host='127.0.0.1', port=0, dashboard_address=None) as s:\n"
-            "        print(s.address, flush=True)\n"
-            "        await asyncio.sleep(60)\n"
+            "        async with AsyncExitStack() as stack:\n"
+            f"            for _ in range({workers}):\n"
+            "                await stack.enter_async_context(Worker(s.address, nthreads=1))\n"
+            "            print(s.address, flush=True)\n"
+            f"            await asyncio.sleep({life_s})\n"
             "asyncio.run(main())\n")
     p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
                          stderr=subprocess.DEVNULL)
+    address = p.stdout.readline().strip()  # type: ignore[union-attr]
+    if not address.startswith("tcp://127.0.0.1:"):
+        p.kill()
+        p.wait()
+        raise AssertionError(address)
+    return p, address
+
+
+@pytest.fixture
+def zero_worker_scheduler():
+    """A real Dask scheduler on 127.0.0.1 with no workers (a child process, stopped after)."""
+    p, address = dask_cluster()
     try:
-        address = p.stdout.readline().strip()
-        assert address.startswith("tcp://127.0.0.1:"), address
         yield address
     finally:
         p.kill()
@@ -530,19 +544,8 @@ def test_good_scheduler_addresses_are_taken_as_dask_writes_them():
 def test_a_scheduler_that_dies_mid_batch_is_one_line(tmp_path):
     """Dask's client logged "distributed.client - ERROR - Failed to reconnect ..." before
     our line; only ours remains, and the journal keeps the finished runs."""
-    pytest.importorskip("distributed")
-    code = ("import asyncio\nfrom distributed import Scheduler, Worker\n"
-            "async def main():\n"
-            "    async with Scheduler(host='127.0.0.1', port=0, dashboard_address=None) as s:\n"
-            "        async with Worker(s.address, nthreads=1):\n"
-            "            print(s.address, flush=True)\n"
-            "            await asyncio.sleep(120)\n"
-            "asyncio.run(main())\n")
-    cluster = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
-                               stderr=subprocess.DEVNULL)
+    cluster, address = dask_cluster(workers=1, life_s=120.0)
     try:
-        address = cluster.stdout.readline().strip()
-        assert address.startswith("tcp://127.0.0.1:"), address
         sweep(tmp_path, seeds=200)
         p = subprocess.Popen(GCALIGN + ["batch", "SW.yaml", "-o", "b.h5", "--scheduler",
                                         address], cwd=tmp_path, stdout=subprocess.PIPE,

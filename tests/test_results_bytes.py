@@ -27,3 +27,41 @@ def test_every_byte_damage_of_every_kind_is_refused_or_harmless(results_of_every
     tally, broken = RB.count(tmp_path, results_of_every_kind)
     assert broken == [], broken
     assert tally["refused"] > 0
+
+
+def _endless_heap(path):
+    """A results-like file whose first global-heap object claims a length of about 2^64:
+    HDF5 loops forever reading the text attribute stored there."""
+    import struct
+
+    import h5py
+    import numpy as np
+
+    with h5py.File(path, "w") as f:
+        f.attrs["gcalign_version"] = "0"
+        for i in range(3):
+            f.create_dataset(f"d{i}", data=np.arange(3.0)).attrs["units"] = np.array(
+                "m", dtype=h5py.string_dtype())
+    b = bytearray(path.read_bytes())
+    obj = b.find(b"GCOL") + 16  # the collection's header, then its first object
+    assert struct.unpack("<HHIQ", bytes(b[obj:obj + 16]))[3] == 1  # object 1: "m"
+    b[obj + 8:obj + 16] = bytes(x ^ 0xFF for x in b[obj + 8:obj + 16])
+    path.write_bytes(bytes(b))
+    return path
+
+
+@pytest.mark.parametrize("command", ["show", "export", "plot"])
+def test_a_heap_that_sends_hdf5_into_an_endless_loop_is_refused_in_seconds(
+        tmp_path, monkeypatch, command):
+    """Seen in the byte damage of a north-finding file: show, export and plot hung."""
+    import time
+
+    from gcalign.io import results
+
+    monkeypatch.setattr(results, "PROBE_S", 1.0)
+    bad = _endless_heap(tmp_path / "heap.h5")
+    t0 = time.perf_counter()
+    cls, line = RB.read_back(bad, command, tmp_path)
+    assert cls == "refused", (cls, line)
+    assert "a damaged HDF5 file: HDF5 did not get through its metadata in 1 s" in line, line
+    assert time.perf_counter() - t0 < 5.0

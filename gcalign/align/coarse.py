@@ -128,22 +128,6 @@ def analytic_coarse(dtheta: ArrayLike, dv: ArrayLike, ts: float, lat: float,
     return rotation.dcm_to_euler(C_nb)
 
 
-def _cumulative_quat(dq: ArrayLike) -> Array:
-    """Prefix products ``dq_1 ⊗ dq_2 ⊗ … ⊗ dq_k`` for k = 1..N, shape (N, 4).
-
-    A Hillis-Steele scan: log2(N) vectorised passes instead of a Python loop per sample;
-    each result is a product of at most log2(N) partial products (less round-off than
-    the sequential product), renormalised after every pass.
-    """
-    q = np.array(dq, dtype=float)
-    step = 1
-    while step < len(q):
-        q[step:] = rotation.quat_mult(q[:-step], q[step:])
-        q[step:] /= np.linalg.norm(q[step:], axis=-1, keepdims=True)
-        step *= 2
-    return q
-
-
 def _gravity_velocity_in0(t: NDArray[np.floating], lat: float, g: float, w: float) -> Array:
     """Velocity ∫_0^t C_n^in0(τ) [0, 0, g] dτ (m/s) of a point at rest, in in0, shape (N, 3).
 
@@ -226,7 +210,7 @@ def inertial_frame_coarse(dtheta: ArrayLike, dv: ArrayLike, ts: float, lat: floa
         raise ValueError(f"at must be one of {', '.join(map(repr, COARSE_EPOCHS))}, got {at!r}")
     n = len(dtheta)
     # 1. C_b^ib0 at t_1 … t_N (rows), and at t_0 … t_{N−1} for the velocity transformation
-    q_ib0_b = _cumulative_quat(rotation.rotvec_to_quat(dtheta))
+    q_ib0_b = rotation.cumulative_quat(rotation.rotvec_to_quat(dtheta))
     C_prev = np.concatenate([np.eye(3)[None], rotation.quat_to_dcm(q_ib0_b[:-1])])
     # 2. v^ib0(t_k) = Σ C_b^ib0(t_{j−1}) (Δv_j + ½ Δθ_j × Δv_j)  (rotation compensation)
     dv_comp = dv + 0.5 * np.cross(dtheta, dv)
@@ -262,7 +246,7 @@ def unexplained_velocity(dtheta: ArrayLike, dv: ArrayLike, ts: float, lat: float
     (hundreds of °/h) also shows here: it mis-rotates gravity.
     """
     dtheta, dv, ts, lat = _check_inputs(dtheta, dv, ts, lat, min_samples=2)
-    q_ib0_b = _cumulative_quat(rotation.rotvec_to_quat(dtheta))
+    q_ib0_b = rotation.cumulative_quat(rotation.rotvec_to_quat(dtheta))
     C_prev = np.concatenate([np.eye(3)[None], rotation.quat_to_dcm(q_ib0_b[:-1])])
     v_ib0 = np.cumsum(np.einsum("kij,kj->ki", C_prev, dv + 0.5 * np.cross(dtheta, dv)), axis=0)
     t = ts * np.arange(1, len(dtheta) + 1)

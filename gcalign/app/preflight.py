@@ -13,6 +13,7 @@ so both take the same decisions. Nothing here imports numba or scipy.
 from __future__ import annotations
 
 import os
+import typing
 from pathlib import Path
 from typing import Any
 
@@ -79,6 +80,8 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
     would refuse, and what would exceed a resource limit. ``name=None``: every section the
     scenario has (``gcalign validate``)."""
     commands = [command(name)] if name else _commands_of(sc)
+    if name is not None:
+        recorded_defaults(sc, commands[0].section)
     check_seed(sc.imu.seed, "imu.seed")
     # recorded data are read only for a command that can use them (the others refuse them)
     ext = extent(sc, read_recorded and any(c.options.recorded for c in commands))
@@ -89,6 +92,8 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
         raise ScenarioError("motion: missing; the scenario needs 'motion' (simulated data) "
                             "or 'imu_file' (recorded data)"
                             + ("" if name else ", or a northfind/realtime section"))
+    if ext is not None and ext.recorded:
+        consistent(sc)
     for c in commands:
         try:
             c.check(sc, ext)
@@ -97,6 +102,63 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
             raise
         except (ValueError, TypeError) as err:  # a settings object refused what it was given
             raise setup_error(c.section or c.name, err) from None
+
+
+def consistent(sc: Scenario) -> None:
+    """A recording against what else the scenario says of the same vehicle
+    (:mod:`gcalign.io.recorded.consistency`): at rest, its gyros against the earth rate at
+    the site (a PSINS header's site is checked as the file is read); a reference's attitude
+    against its gyros; its forward axis against a velocity (the reference's, a velocity
+    aiding file's). ScenarioError naming the likely fix; ``imu_file.check_consistency:
+    false`` and ``reference.check_attitude: false`` turn them off."""
+    import numpy as np
+
+    from gcalign.app.data import read_data_file
+    from gcalign.io.recorded import consistency as K
+
+    layout = sc.recording_layout()
+    assert sc.imu_file is not None
+    imu, _ = read_data_file(Path(sc.imu_file), layout)
+    record = imu.meta.get("recording") or {}
+    if not record or not layout.check_consistency:
+        return
+    name = str(sc.imu_file)
+    units = record["units"]["gyro"]
+    ref = sc.reference.read() if sc.reference is not None else None
+    if imu.site is None:
+        lat = (sc.site.to_si()[0] if sc.site is not None else
+               float(ref.pos[0, 0]) if ref is not None else None)
+        if lat is not None:
+            K.earth_rate_at_rest(name, imu.dtheta, imu.dv, imu.ts, float(lat),
+                                 gyro_units=units, fmt=record["format"])
+    if ref is not None and ref.att is not None and sc.reference is not None and \
+            sc.reference.check_attitude:
+        K.reference_against_gyros(str(sc.reference.path), ref.t, ref.att, float(ref.pos[0, 0]),
+                                  imu.t, imu.dtheta, sc.reference.format)
+    velocity = None
+    if ref is not None:
+        velocity = (ref.t, ref.v_n, f"the reference {sc.reference.path}")  # type: ignore[union-attr]
+    elif sc.align is not None and sc.align.aiding.source == "file" and \
+            sc.align.aiding.format != "odometer":
+        v = sc.align.aiding.read()
+        velocity = (v.t, v.v_n, f"align.aiding {sc.align.aiding.path}")
+    if velocity is not None and velocity[1] is not None:
+        K.forward_axis(name, imu.t, imu.dtheta, imu.dv, velocity[0], velocity[1],
+                       np.asarray(record["C_rfu_file"], dtype=float), velocity[2])
+
+
+def recorded_defaults(sc: Scenario, section: str | None) -> None:
+    """A recording's scenario without the command's section runs with the section
+    ``--imu-file X`` alone gets (:data:`gcalign.io.scenario.recording.RECORDED_DEFAULTS`:
+    an inertial-frame coarse alignment over the first minute, not the simulated default
+    'given', which needs truth), set on `sc` in place."""
+    from gcalign.io.scenario.recording import RECORDED_DEFAULTS
+
+    if sc.imu_file is None or section not in RECORDED_DEFAULTS or getattr(sc, section) is not None:
+        return
+    model = type(sc).model_fields[section].annotation
+    kind = next(t for t in typing.get_args(model) if t is not type(None))
+    setattr(sc, section, kind.model_validate(RECORDED_DEFAULTS[section]))
 
 
 def setup_error(section: str, err: Exception) -> ScenarioError:

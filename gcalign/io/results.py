@@ -627,12 +627,79 @@ class _ResultsFile(h5py.File):
             raise _damaged_file(self._gcalign_path, err) from None
 
 
+#: Files whose metadata a child process read through: (resolved path, mtime, size)
+_PROBED: set[tuple[str, int, int]] = set()
+PROBE_S = 5.0  #: the metadata probe's time, plus 1 s per 100 MB of file
+
+
+def _touch(f: h5py.File) -> None:
+    """Read what HDF5 keeps beside the numbers: every object header, every attribute, every
+    dataset of text (vlen strings live in the global heap), every dataset's shape."""
+    def visit(_, obj):
+        for key in obj.attrs:
+            obj.attrs[key]
+        if isinstance(obj, h5py.Dataset):
+            _ = obj.shape
+            if obj.dtype.kind == "O" or h5py.check_string_dtype(obj.dtype) is not None:
+                obj[()]
+
+    visit("/", f)
+    f.visititems(visit)
+
+
+def _probe(path: Path) -> None:
+    """Read the metadata of `path` once in a forked child with a time limit: a damaged
+    global heap sent HDF5 into an endless loop while it read one attribute (a length field
+    of ~2^64), which no Python code can interrupt, and a damaged file may crash HDF5. The
+    parent reads the file only if the child got through; otherwise ScenarioError naming the
+    file. Errors HDF5 raises are left to the reader that meets them (one line, by
+    :class:`_ResultsFile`)."""
+    import signal
+    import time
+
+    st = path.stat()
+    key = (str(path.resolve()), st.st_mtime_ns, st.st_size)
+    if key in _PROBED or not hasattr(os, "fork"):
+        return
+    limit = PROBE_S + st.st_size / 100e6
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child
+        try:
+            with h5py.File(path, "r") as f:
+                _touch(f)
+        except BaseException:  # noqa: BLE001 - an error is the parent's to meet and report
+            pass
+        os._exit(0)
+    try:
+        deadline = time.monotonic() + limit
+        while True:
+            done, status = os.waitpid(pid, os.WNOHANG)
+            if done:
+                break
+            if time.monotonic() > deadline:
+                raise ScenarioError(f"{path}: a damaged HDF5 file: HDF5 did not get through "
+                                    f"its metadata in {limit:.3g} s (not as gcalign wrote it; "
+                                    "write it again)")
+            time.sleep(0.005)
+    finally:
+        if not done:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+    if os.WIFSIGNALED(status):
+        raise ScenarioError(f"{path}: a damaged HDF5 file: HDF5 crashed reading its metadata "
+                            f"(signal {os.WTERMSIG(status)}; not as gcalign wrote it)")
+    _PROBED.add(key)
+
+
 def open_results(path: Path) -> h5py.File:
     """Open a gcalign results file for reading; ScenarioError if it is missing or not ours,
-    and, used in a ``with``, if HDF5 meets damage while reading it (:class:`_ResultsFile`)."""
+    if its metadata cannot be read through in time (:func:`_probe`), and, used in a
+    ``with``, if HDF5 meets damage while reading it (:class:`_ResultsFile`)."""
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: {not_a_file(path)}")
+    if _is_hdf5(path):
+        _probe(path)
     try:
         f = _ResultsFile(path, "r")
     except OSError:

@@ -165,6 +165,22 @@ def quat_to_rotvec(q: ArrayLike) -> NDArray[np.float64]:
     return q[..., 1:] * ratio[..., None]
 
 
+def cumulative_quat(dq: ArrayLike) -> NDArray[np.float64]:
+    """Prefix products ``dq_1 ⊗ dq_2 ⊗ … ⊗ dq_k`` for k = 1..N, shape (N, 4).
+
+    A Hillis-Steele scan: log2(N) vectorised passes instead of a Python loop per sample;
+    each result is a product of at most log2(N) partial products (less round-off than
+    the sequential product), renormalised after every pass.
+    """
+    q = np.array(dq, dtype=float)
+    step = 1
+    while step < len(q):
+        q[step:] = quat_mult(q[:-step], q[step:])
+        q[step:] /= np.linalg.norm(q[step:], axis=-1, keepdims=True)
+        step *= 2
+    return q
+
+
 def wrap_pi(a: ArrayLike) -> NDArray[np.float64]:
     """Wrap angles (rad) to [-π, π)."""
     return (np.asarray(a) + np.pi) % (2.0 * np.pi) - np.pi

@@ -237,6 +237,9 @@ def read_velocity_aiding(path, format: str, columns=None, variable: str | None =
                          axis: str = "F") -> Velocities:
     """Velocity aiding from `path` in one of :data:`VELOCITY_FORMATS`: ENU m/s in ``v_n``,
     or an odometer's speed along ``axis_b``."""
+    from gcalign.io.recorded.reference import check_keys
+
+    check_keys(format, variable, columns, "aiding")
     if format == "velocity-enu" or format == "velocity-ned":
         return read_velocity(path, format.removeprefix("velocity-"), columns)
     if format == "odometer":

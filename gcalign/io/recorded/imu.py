@@ -59,7 +59,7 @@ from gcalign.io.imu_files import (
     read_psins_imu,
     text_of,
 )
-from gcalign.io.recorded import mat
+from gcalign.io.recorded import consistency, mat
 from gcalign.io.recorded.axes import axes_text, rotation_to_rfu
 from gcalign.sim.imu import ImuData
 
@@ -131,6 +131,8 @@ class Layout:
     rate_hz : the sample rate (default: the median step of the time column)
     max_gap_s : the longest gap filled (s); longer ones are refused
     check_gravity : refuse a start whose specific force does not point up
+    check_consistency : refuse gyros that contradict the accelerometers or, at rest with a
+        known latitude, the earth rate (:mod:`~.consistency`)
     """
 
     format: str = "auto"
@@ -144,6 +146,7 @@ class Layout:
     rate_hz: float | None = None
     max_gap_s: float = 0.0
     check_gravity: bool = True
+    check_consistency: bool = True
 
     def declared(self) -> set[str]:
         """The keys this layout sets (to check them against the format)."""
@@ -684,6 +687,16 @@ def _read(name: str, layout: Layout) -> ImuData:
                         "sample(s) of the mean rate around it (max_gap_s)")
     gravity = (_gravity(name, dv, ts, C, axes_text(declared_axes), accel_units)
                if layout.check_gravity else None)
+    gyros: dict | str = "off (check_consistency: false)"
+    if layout.check_consistency:
+        gyros = consistency.check_gyros(name, dtheta, dv, ts, gyro_units=gyro_units,
+                                        C_rfu_file=C, fmt=fmt)
+        if gyros.get("warning"):
+            warnings.append(gyros["warning"])
+        if raw.header is not None and raw.header.site is not None:
+            gyros["at_rest"] = consistency.earth_rate_at_rest(
+                name, dtheta, dv, ts, float(raw.header.site[0]), gyro_units=gyro_units,
+                fmt=fmt)
     record = {
         "format": fmt,
         "path": name,
@@ -710,6 +723,7 @@ def _read(name: str, layout: Layout) -> ImuData:
         "jitter_max": jitter,
         "gaps": gaps,
         "gravity_check": gravity if gravity is not None else "off (check_gravity: false)",
+        "gyro_check": gyros,
         "warnings": warnings,
         **raw.notes,
     }

@@ -78,6 +78,7 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     if format not in REFERENCE_FORMATS:
         raise ScenarioError(f"reference.format: {format!r} is not a reference format; "
                             f"allowed: {', '.join(REFERENCE_FORMATS)}")
+    check_keys(format, variable, columns, "reference")
     data = read_bytes(name, text=format != "psins-mat")[1]
     notes: dict = {}
     if format == "psins-mat":
@@ -109,6 +110,8 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     _check_rows(name, t, where)
     if len(t) < 2:
         raise ImuFileError(f"{name}: {len(t)} epoch(s); a reference needs at least 2")
+    if att is not None:
+        _angles(name, att, where, format)
     record = {"format": format, "path": name, "epochs": int(len(t)), "t_first_s": float(t[0]),
               "t_last_s": float(t[-1]), "time_origin": origin,
               "rate_hz": float(1.0 / np.median(np.diff(t))), **notes}
@@ -117,6 +120,34 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     att = None if att is None else np.ascontiguousarray(att)
     return Reference(np.array(t), att, np.ascontiguousarray(v), np.ascontiguousarray(pos),
                      record)
+
+
+def _angles(name: str, att: np.ndarray, where, format: str) -> None:
+    """Euler angles within their ranges (pitch within ±90°, roll and yaw within ±360°): a
+    psins-mat avp in degrees, read as radians, has angles of tens of radians."""
+    unit, scale = ("rad", 1.0) if format == "psins-mat" else ("deg", 1.0 / DEG)
+    for col, label, bound in ((0, "pitch", np.pi / 2), (1, "roll", 2 * np.pi),
+                              (2, "yaw", 2 * np.pi)):
+        bad = np.abs(att[:, col]) > bound * (1 + 1e-9)
+        if bad.any():
+            k = int(np.argmax(bad))
+            hint = (": it looks like degrees, and psins-mat takes radians"
+                    if format == "psins-mat" else "")
+            raise ImuFileError(f"{name}{where(k)}: {label} {att[k, col] * scale:.6g} {unit} "
+                               f"is beyond ±{bound * scale:g} {unit}{hint}")
+
+
+def check_keys(format: str, variable, columns, where: str) -> None:
+    """A MAT variable names an array of a psins-mat file, columns the layout of a CSV: for
+    any other format they cannot matter, and are refused rather than ignored (a CSV
+    reference's variable was dropped in silence, while an imu_file's was refused)."""
+    if variable is not None and format != "psins-mat":
+        raise ScenarioError(f"{where}.variable: names an array of a MAT file; format "
+                            f"{format!r} has none (remove it), got {variable!r}")
+    if columns is not None and format not in ("csv", "reference-csv", "velocity-enu",
+                                              "velocity-ned", "odometer"):
+        raise ScenarioError(f"{where}.columns: names the columns of a CSV file; format "
+                            f"{format!r} fixes its own (remove it), got {list(columns)}")
 
 
 def _avp(name: str, data: bytes, variable: str | None, attitude_optional: bool = False):

@@ -7,7 +7,15 @@ import typing
 from pathlib import PurePath
 from typing import Annotated, Any
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    model_validator,
+)
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 NonNegVec3 = Annotated[list[Annotated[float, Field(ge=0)]], Field(min_length=3, max_length=3)]
@@ -78,6 +86,24 @@ class Model(BaseModel):
     convert) where the field takes numbers and no text."""
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True, allow_inf_nan=False)
+    _where: str = PrivateAttr(default="")  #: the dotted key of this section (locate)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        """An assignment that does not validate (``sc.align.t2_s = nan`` in the Python
+        API) is a ScenarioError naming the dotted key, as a bad key of a file is, not
+        pydantic's ValidationError."""
+        if name.startswith("_"):
+            super().__setattr__(name, value)
+            return
+        try:
+            super().__setattr__(name, value)
+        except ValidationError as err:
+            from gcalign.errors import ScenarioError
+
+            prefix = f"{self._where}." if self._where else ""
+            raise ScenarioError("; ".join(prefix + _one_line(e) for e in err.errors())
+                                ) from None
+        locate(getattr(self, name), prefix_of(self._where, name))
 
     @model_validator(mode="before")
     @classmethod
@@ -108,3 +134,32 @@ def _yaml_bool(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     return next(_yaml_bool(v) for v in value[:10_000] if _has_bool(v))
+
+
+def _one_line(e: Any) -> str:
+    """One pydantic error of an assignment as ``key: what is wrong, got VALUE`` (the file's
+    errors have :func:`gcalign.io.scenario.messages.scenario_errors`, which imports the
+    models)."""
+    where = ".".join(str(x) for x in e["loc"])
+    msg = str(e["msg"]).removeprefix("Value error, ")
+    value = repr(e.get("input"))
+    got = "" if e["type"] in ("missing", "model_type", "value_error") else (
+        f", got {value if len(value) <= 60 else value[:57] + '...'}")
+    return f"{where}: {msg}{got}"
+
+
+def prefix_of(where: str, name: str) -> str:
+    return f"{where}.{name}" if where else name
+
+
+def locate(value: Any, where: str = "") -> None:
+    """Tell every section of a scenario its dotted key (``imu.gyro``), so that an assignment
+    that fails names it (:meth:`Model.__setattr__`)."""
+    if isinstance(value, Model):
+        value._where = where
+        for name in type(value).model_fields:
+            locate(getattr(value, name), prefix_of(where, name))
+    elif isinstance(value, list):
+        for i, item in enumerate(value):
+            if isinstance(item, Model):
+                locate(item, prefix_of(where, str(i)))

@@ -115,5 +115,9 @@ P0_RATE_DPS = Bound(1e-6, 3600.0, "°/s", f"up to the largest rate; {_FLOOR}")
 P0_ANGULAR_ACCEL_DPS2 = Bound(1e-6, 1e5, "°/s²", f"up to the largest acceleration; {_FLOOR}")
 LEVER_ARM_M = Bound(0.0, 100.0, "m", "an aiding antenna on the vehicle carrying the IMU "
                     "(the largest aircraft span 80 m)", magnitude=True)
+TRANSFER_LEVER_ARM_M = Bound(0.0, 500.0, "m", "a slave IMU and its master INS on one vehicle "
+                             "(the longest ship is 458 m)", magnitude=True)
+VELOCITY_MPS = Bound(0.0, 1e4, "m/s", "about Mach 30, beyond any navigating vehicle (the "
+                     "range of a PSINS header)", magnitude=True)
 NOISE_MPS = Bound(0.0, 1e3, "m/s", "no information beyond it")
 CLOCK_DRIFT_PPM = Bound(0.0, 1e5, "ppm", "10 %, more than any clock drifts", magnitude=True)

@@ -19,6 +19,7 @@ from pydantic import ValidationError
 from gcalign import limits
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
+from gcalign.io.scenario.base import locate
 from gcalign.io.scenario.messages import CUT, _cut, scenario_errors
 from gcalign.io.scenario.models import Scenario
 
@@ -33,9 +34,11 @@ def parse_scenario(data: dict, source: str = "scenario") -> Scenario:
         raise ScenarioError(f"{source}: a sweep file (it has 'base'): run it with gcalign "
                             "batch (gcalign validate checks it)")
     try:
-        return Scenario.model_validate(data)
+        sc = Scenario.model_validate(data)
     except ValidationError as err:
         raise ScenarioError(scenario_errors(err, source, Scenario)) from None
+    locate(sc)
+    return sc
 
 
 def _mark(node) -> str:

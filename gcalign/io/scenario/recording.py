@@ -21,7 +21,7 @@ the rest in ``Scenario.imu_layout``; it writes them back as one ``imu_file`` map
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, ValidationError, field_validator, model_validator
@@ -30,6 +30,7 @@ from gcalign.errors import ScenarioError
 from gcalign.io.recorded.axes import rotation_to_rfu
 from gcalign.io.recorded.imu import ACCEL_UNITS, FORMAT_NAMES, GYRO_UNITS, Layout
 from gcalign.io.recorded.reference import REFERENCE_FORMATS
+from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, Pos3, Vec3
 
 
@@ -51,6 +52,10 @@ class ImuLayout(Model):
     rate_hz: float | None = Field(None, gt=0, le=1e5)
     max_gap_s: float = Field(0.0, ge=0, le=3600)
     check_gravity: bool = True
+    check_consistency: bool = Field(
+        True, description="refuse a recording that contradicts itself: gyros against the "
+        "accelerometers and the earth rate, the forward axis against a velocity (wrong units "
+        "or axes)")
 
     @field_validator("format")
     @classmethod
@@ -78,7 +83,8 @@ class ImuLayout(Model):
             gyro_units=None if self.units is None else self.units.gyro,
             accel_units=None if self.units is None else self.units.accel,
             quantity=self.quantity, time=self.time, variable=self.variable,
-            rate_hz=self.rate_hz, max_gap_s=self.max_gap_s, check_gravity=self.check_gravity)
+            rate_hz=self.rate_hz, max_gap_s=self.max_gap_s, check_gravity=self.check_gravity,
+            check_consistency=self.check_consistency)
 
 
 class ReferenceFile(Model):
@@ -92,6 +98,9 @@ class ReferenceFile(Model):
     max_gap_s: float | None = Field(None, gt=0, description="epochs further apart are a gap: "
                                     "no error is reported inside it; default twice the "
                                     "file's median interval")
+    check_attitude: bool = Field(True, description="refuse an attitude that turns 57.3 times "
+                                 "too little or too much against the gyros (radians read as "
+                                 "degrees, or degrees as radians)")
 
     @field_validator("format")
     @classmethod
@@ -100,6 +109,16 @@ class ReferenceFile(Model):
             raise ValueError(f"{v!r} is not a reference format; allowed: "
                              f"{', '.join(REFERENCE_FORMATS)}")
         return v
+
+    @model_validator(mode="after")
+    def _keys_of_the_format(self):
+        from gcalign.io.recorded.reference import check_keys
+
+        try:
+            check_keys(self.format, self.variable, self.columns, "reference")
+        except ScenarioError as err:
+            raise ValueError(str(err).removeprefix("reference.")) from None
+        return self
 
     def read(self):
         from gcalign.io.recorded.reference import read_reference
@@ -124,12 +143,26 @@ class Initial(Model):
     on recorded data starts from (navigate, calibrate) when the file gives none, or to
     replace what it gives; the position keys go together."""
 
-    att_deg: Vec3 = Field(description="[pitch, roll, yaw], deg (ENU, yaw CCW positive)")
-    v_enu_mps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    att_deg: Vec3 = Field(description="[pitch, roll, yaw], deg (ENU, yaw CCW positive); "
+                          "pitch within (-90, 90), roll and yaw within [-360, 360]")
+    v_enu_mps: Annotated[Vec3, B.VELOCITY_MPS] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0], description=B.VELOCITY_MPS.range())
     lat_deg: float | None = Field(None, gt=-90, lt=90, description="start latitude, deg")
     lon_deg: float | None = Field(None, ge=-180, le=360, description="start longitude, deg")
     height_m: float | None = Field(None, ge=-1000, le=1e5, description="start height, m")
     sigma: InitialSigma | None = Field(None, description="1σ of the state: the filter's P0")
+
+    @field_validator("att_deg")
+    @classmethod
+    def _euler_range(cls, v):
+        """Pitch 100° is no Euler angle of ours (C_nb = Rz Rx Ry: pitch within ±90°); it
+        was accepted and the navigation diverged."""
+        if not -90.0 < v[0] < 90.0:
+            raise ValueError(f"pitch must be within (-90, 90) deg, got {v[0]:g}")
+        big = [x for x in v[1:] if not abs(x) <= 360.0]
+        if big:
+            raise ValueError(f"roll and yaw must be within [-360, 360] deg, got {big[0]:g}")
+        return v
 
     @model_validator(mode="after")
     def _position_together(self):

@@ -30,10 +30,11 @@ converts them once to the SI :class:`gcalign.transfer.TransferSettings`.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field
 
+from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, PosVec3, Vec3
 from gcalign.units import ARCMIN, DEG, DPH, DPSH, UG, UGPSHZ
 
@@ -87,7 +88,9 @@ class TransferConfig(Model):
     matching: Literal["attitude+velocity", "velocity", "attitude"] = "attitude+velocity"
     flexure: bool = True
     feedback: Feedback = Field(default_factory=Feedback)
-    lever_arm_m: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    lever_arm_m: Annotated[Vec3, B.TRANSFER_LEVER_ARM_M] = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description=f"slave relative to master, body frame, m; {B.TRANSFER_LEVER_ARM_M.range()}")
     gravity: Literal["normal", "constant"] = "normal"
     p0: P0 = Field(default_factory=P0)
     r: R = Field(default_factory=R)
