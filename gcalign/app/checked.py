@@ -28,6 +28,7 @@ import h5py
 import numpy as np
 
 from gcalign.errors import ScenarioError
+from gcalign.estimation.degrees import ObservabilityTable
 from gcalign.io import results
 from gcalign.northfind.run import NorthfindResult
 from gcalign.schema import spec as stored_spec
@@ -164,14 +165,8 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
             names=(("S", "calibrate", "states"), ("m", ".", "measure_names"))),
         TRUTH, REFERENCE),
     "observability": (
-        Block("observability", {
-            "segment_name": text(("Q",)), "t0": times("Q"), "t1": times("Q"),
-            "eta": num(("Q", "S")), "eta_cum": num(("Q", "S")),
-            "sigma_state?": num(("Q", "S")), "cov_degree?": num(("Q", "S")),
-            "cov_degree_segment?": num(("Q", "S")), "rank?": num(("Q",), whole=True),
-            "tom_rank?": num(("Q",), whole=True), "rank_cum?": num(("Q",), whole=True),
-            "tom_rank_cum?": num(("Q",), whole=True), "null_residual?": num(("Q",)),
-            "condition?": num(("Q",), whole=True)},
+        Block("observability", {**from_fields(ObservabilityTable), "t0": times("Q"),
+                                 "t1": times("Q")},
             names=(("S", ".", "states"),)),
         TRUTH),
     "realtime": (
