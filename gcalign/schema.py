@@ -41,6 +41,17 @@ class Stored:
         subgroup of that name (``per="methods"``: ``coordinate/error``, ``vector/error``).
     inline : a nested result whose fields join its parent's group (no subgroup of its own).
     compress : stored compressed (gzip, shuffled): long series.
+
+    What its values must be when a results file is read back (the checks of
+    :mod:`gcalign.app.checked`):
+
+    dims : its stored shape in sizes named within the result (``"R M"``: repeats ×
+        azimuths; a number is a fixed size; ``"R M | M"``: either form), or None (no check
+        of its own).
+    optional : the readers do without it.
+    finite : every value finite (False: NaN stands for "none").
+    whole : whole numbers (indices, counts).
+    rule : ``increasing`` (a time), ``unit`` (unit quaternions) or empty.
     """
 
     units: str | None
@@ -54,6 +65,11 @@ class Stored:
     per: str | None = None
     inline: bool = False
     compress: bool = False
+    dims: str | None = None
+    optional: bool = False
+    finite: bool = True
+    whole: bool = False
+    rule: str = ""
 
 
 #: The frame text of an attitude triple (DESIGN.md conventions), as results files carry it.

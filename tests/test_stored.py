@@ -120,3 +120,38 @@ def test_nested_mapped_and_compressed_fields_come_back(tmp_path):
     assert all(np.array_equal(getattr(back.pulses, n), getattr(p, n)) for n in ("t", "k", "dt"))
     assert sorted(back.predicted) == ["kalman", "ls"]
     assert np.array_equal(back.predicted["kalman"], np.ones((5, 3)))
+
+
+def test_a_new_north_finding_field_is_written_read_and_checked_from_its_one_line(tmp_path):
+    """The one line of `spread` below is all it takes for the results file to hold it, for
+    the reader to give it back and for the checks of a file read back to hold it to its
+    shape (repeats × azimuths, like the estimates it sits beside)."""
+    from gcalign.app.checked import Block, _check_block, from_fields
+    from gcalign.errors import ScenarioError
+    from gcalign.northfind import NorthfindResult, NorthfindSetup, run_northfind
+
+    @dataclass(frozen=True, eq=False)
+    class Wider(NorthfindResult):
+        spread: np.ndarray | None = field(default=None, metadata=stored(
+            "rad", shape="(repeats, azimuths)", axes=(1, 0), dims="R M"))
+
+    setup = NorthfindSetup(azimuths=np.radians([10.0, 200.0, 300.0]), lat=np.radians(40.0),
+                           positions=8, repeats=2)
+    res = run_northfind(setup, np.random.default_rng(5))
+    base = {f.name: getattr(res, f.name) for f in fields(res)}
+    block = Block("northfind", from_fields(Wider))
+    assert block.items["spread"].shapes == (("R", "M"),)
+    for spread, ok in ((np.ones((3, 2)), True), (np.ones((3, 3)), False)):
+        path = tmp_path / f"w{ok}.h5"
+        with h5py.File(path, "w") as f:
+            write_fields(f.create_group("northfind"), Wider(**base, spread=spread))
+        with h5py.File(path) as f:
+            g = f["northfind"]
+            assert np.array_equal(read_fields(g, Wider, gyro_residual=None,
+                                              accel_residual=None).spread, spread)
+            if ok:
+                _check_block(path, f, g, block)
+            else:
+                with pytest.raises(ScenarioError, match="dataset /northfind/spread must have "
+                                   r"shape \(2, 3\), got \(3, 3\)"):
+                    _check_block(path, f, g, block)

@@ -17,6 +17,7 @@ A dataset of a schema's group that no entry names is checked alone only; the dam
 
 from __future__ import annotations
 
+import dataclasses
 import fnmatch
 from collections import Counter
 from collections.abc import Callable
@@ -27,7 +28,10 @@ import h5py
 import numpy as np
 
 from gcalign.errors import ScenarioError
+from gcalign.estimation.degrees import ObservabilityTable
 from gcalign.io import results
+from gcalign.northfind.run import NorthfindResult
+from gcalign.schema import spec as stored_spec
 
 #: kinds whose every dataset has units and finite values when written (north-finding stores
 #: NaN for a prediction it cannot make, a batch for a failed run's metrics, navigation for
@@ -79,6 +83,22 @@ class Block:
     counts: tuple[tuple[str, str, int], ...] = ()  #: (size, attribute of the group, + k)
 
 
+def from_fields(cls: type) -> dict[str, Data]:
+    """A block's entries from the stored fields of a result dataclass that say their dims
+    (:class:`gcalign.schema.Stored`): a new field is checked as it is declared."""
+    items = {}
+    for f in dataclasses.fields(cls):
+        how = stored_spec(f)
+        if how is None or how.dims is None:
+            continue
+        key = ("*/" if how.per else "") + (how.name or f.name) + ("?" if how.optional else "")
+        shapes = tuple(tuple(int(d) if d.isdigit() else d for d in alt.split())
+                       for alt in how.dims.split("|"))
+        items[key] = Data(shapes, text=how.units is None, finite=how.finite, whole=how.whole,
+                          rule=how.rule)
+    return items
+
+
 V3 = num(("N", 3))
 STATES = num(("K", "S"))
 INDEX = num(("_",), rule="range")  # the dimension scales of HDF5's netCDF view
@@ -112,15 +132,8 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
               names=(("S", ".", "states"), ("S", ".", "display_units")),
               numbers=(("S", ".", "display_scale"),)),
         TRUTH, REFERENCE),
-    "northfind": (Block("northfind", {
-        "azimuth_true": num(("M",)), "theta?": num(("P",)), "tilt_true?": num(("M",)),
-        "tilt_direction_true?": num(("M",)), "tilt_est?": num(("R", "M")),
-        "tilt_direction_est?": num(("R", "M")), "pitch_est?": num(("R", "M")),
-        "roll_est?": num(("R", "M")), "gyro_coef?": num(("R", "M", 3)),
-        "accel_coef?": num(("R", "M", 2, 3)), "*/estimate?": num(("R", "M"), ("M",)),
-        "*/error": num(("R", "M"), ("M",)), "*/error_pred?": num(("M",), finite=False),
-        "*/std_pred?": num(("M",), finite=False)},
-        counts=(("P", "positions", 0), ("R", "repeats", 0))),),
+    "northfind": (Block("northfind", from_fields(NorthfindResult),
+                        counts=(("P", "positions", 0), ("R", "repeats", 0))),),
     "calibrate": (
         Block("calibrate", {}, names=(("S", ".", "states"), ("S", ".", "display_units")),
               numbers=(("S", ".", "display_scale"),)),
@@ -152,14 +165,8 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
             names=(("S", "calibrate", "states"), ("m", ".", "measure_names"))),
         TRUTH, REFERENCE),
     "observability": (
-        Block("observability", {
-            "segment_name": text(("Q",)), "t0": times("Q"), "t1": times("Q"),
-            "eta": num(("Q", "S")), "eta_cum": num(("Q", "S")),
-            "sigma_state?": num(("Q", "S")), "cov_degree?": num(("Q", "S")),
-            "cov_degree_segment?": num(("Q", "S")), "rank?": num(("Q",), whole=True),
-            "tom_rank?": num(("Q",), whole=True), "rank_cum?": num(("Q",), whole=True),
-            "tom_rank_cum?": num(("Q",), whole=True), "null_residual?": num(("Q",)),
-            "condition?": num(("Q",), whole=True)},
+        Block("observability", {**from_fields(ObservabilityTable), "t0": times("Q"),
+                                 "t1": times("Q")},
             names=(("S", ".", "states"),)),
         TRUTH),
     "realtime": (

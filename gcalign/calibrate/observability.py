@@ -12,7 +12,7 @@ from :func:`gcalign.calibrate.filter.covariance_run`.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -21,52 +21,10 @@ from gcalign.calibrate.filter import Settings, covariance_run
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
 from gcalign.estimation import observability as ob
-from gcalign.schema import stored
+from gcalign.estimation.degrees import DEGREE as DEGREE
+from gcalign.estimation.degrees import ObservabilityTable as ObservabilityTable
 
 SCALINGS = ("none", "p0")
-DEGREE = "(segments, 21) in the order of the 'states' attribute"  #: shape of a degree table
-
-
-@dataclass(frozen=True)
-class ObservabilityTable:
-    """Degrees of observability per segment and cumulative (S segments, 21 states).
-
-    eta, sigma_state : (S, 21) per-segment SOM degree η = σ_(k)/σ_0 and the state's σ.
-    rank, tom_rank : (S,) per-segment SOM and TOM ranks.
-    null_residual : (S,) the largest ``‖F_j N_j‖/‖F_j‖`` over the segment's pieces
-        (N_j = null(O_j)); condition : (S,) whether it is ≤ null_tol.
-    eta_cum, rank_cum, tom_rank_cum : the same from the start of the run to each segment end.
-    margin, margin_cum : (S,) the SOM rank's distance from the cut-off, per segment and
-        cumulative (:attr:`gcalign.estimation.observability.Degree.margin`).
-    cov_degree : (S, 21) σ_k(0)/σ_k(t_end); cov_degree_segment : σ_k(t_start)/σ_k(t_end);
-        None without the covariance run.
-    """
-
-    segments: tuple[str, ...] = field(metadata=stored(None, name="segment_name"))
-    measure: str = field(metadata=stored(None, attr=True))
-    scaling: str = field(metadata=stored(None, attr=True))
-    rtol: float = field(metadata=stored("1", attr=True, name="rank_rtol"))
-    piece_s: float = field(metadata=stored("s", attr=True))
-    eta: np.ndarray = field(metadata=stored(
-        "1", shape=DEGREE, description="seed eq. 17 per segment"))
-    sigma_state: np.ndarray = field(metadata=stored("SOM units", shape=DEGREE))
-    rank: np.ndarray = field(metadata=stored("1"))
-    tom_rank: np.ndarray = field(metadata=stored("1"))
-    null_residual: np.ndarray = field(metadata=stored("1"))
-    condition: np.ndarray = field(metadata=stored(
-        "1", flag=True, description="null(O_j) in null(F_j) for every piece (seed eq. 12)"))
-    eta_cum: np.ndarray = field(metadata=stored(
-        "1", shape=DEGREE, description="from the start of the run"))
-    rank_cum: np.ndarray = field(metadata=stored("1"))
-    tom_rank_cum: np.ndarray = field(metadata=stored("1"))
-    cov_degree: np.ndarray | None = field(metadata=stored(
-        "1", shape=DEGREE, description="sigma(0)/sigma(t_end), PSINS kfstat"))
-    cov_degree_segment: np.ndarray | None = field(metadata=stored(
-        "1", shape=DEGREE, description="sigma(t_start)/sigma(t_end)"))
-    margin: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    margin_cum: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    names: tuple[str, ...] = field(default=ie.STATE_NAMES,
-                                   metadata=stored(None, attr=True, name="states"))
 
 
 @dataclass(frozen=True)

@@ -51,31 +51,42 @@ class NorthfindResult:
     """
 
     methods: tuple[str, ...] = field(metadata=stored(None, attr=True))
-    azimuth_true: np.ndarray = field(metadata=stored("rad", frame=AZIMUTH))
-    tilt_true: np.ndarray = field(metadata=stored("rad", frame="table normal from the vertical"))
-    tilt_direction_true: np.ndarray = field(metadata=stored("rad", frame=DESCENT))
+    azimuth_true: np.ndarray = field(metadata=stored("rad", frame=AZIMUTH, dims="M"))
+    tilt_true: np.ndarray = field(metadata=stored(
+        "rad", frame="table normal from the vertical", dims="M", optional=True))
+    tilt_direction_true: np.ndarray = field(metadata=stored(
+        "rad", frame=DESCENT, dims="M", optional=True))
     azimuth_est: np.ndarray = field(metadata=stored(
-        "rad", frame=AZIMUTH, shape=RM, axes=(1, 0), per="methods", name="estimate"))
+        "rad", frame=AZIMUTH, shape=RM, axes=(1, 0), per="methods", name="estimate",
+        dims="R M | M", optional=True))
     azimuth_error: np.ndarray = field(metadata=stored(
         "rad", frame="estimate - true, wrapped to [-pi, pi)", shape=RM, axes=(1, 0),
-        per="methods", name="error"))
+        per="methods", name="error", dims="R M | M"))
     error_pred: np.ndarray = field(metadata=stored(
-        "rad", frame="noise-free closed form (NaN: none)", per="methods"))
+        "rad", frame="noise-free closed form (NaN: none)", per="methods", dims="M",
+        optional=True, finite=False))
     azimuth_std_pred: np.ndarray = field(metadata=stored(
-        "rad", frame="linearised 1-sigma prediction", per="methods", name="std_pred"))
-    tilt_est: np.ndarray = field(metadata=stored("rad", shape=RM, axes=(1, 0)))
+        "rad", frame="linearised 1-sigma prediction", per="methods", name="std_pred",
+        dims="M", optional=True, finite=False))
+    tilt_est: np.ndarray = field(metadata=stored("rad", shape=RM, axes=(1, 0), dims="R M",
+                                                 optional=True))
     tilt_direction_est: np.ndarray = field(metadata=stored(
-        "rad", frame=DESCENT, shape=RM, axes=(1, 0)))
-    pitch_est: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME, shape=RM, axes=(1, 0)))
-    roll_est: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME, shape=RM, axes=(1, 0)))
+        "rad", frame=DESCENT, shape=RM, axes=(1, 0), dims="R M", optional=True))
+    pitch_est: np.ndarray = field(metadata=stored(
+        "rad", frame=ATT_FRAME, shape=RM, axes=(1, 0), dims="R M", optional=True))
+    roll_est: np.ndarray = field(metadata=stored(
+        "rad", frame=ATT_FRAME, shape=RM, axes=(1, 0), dims="R M", optional=True))
     gyro_coef: np.ndarray = field(metadata=stored(
-        "rad/s", shape="(repeats, azimuths, [R, a, b])", axes=(1, 0, 2)))
+        "rad/s", shape="(repeats, azimuths, [R, a, b])", axes=(1, 0, 2), dims="R M 3",
+        optional=True))
     accel_coef: np.ndarray = field(metadata=stored(
-        "m/s^2", shape="(repeats, azimuths, [x, y], [R, a, b])", axes=(1, 0, 2, 3)))
+        "m/s^2", shape="(repeats, azimuths, [x, y], [R, a, b])", axes=(1, 0, 2, 3),
+        dims="R M 2 3", optional=True))
     gyro_residual: np.ndarray
     accel_residual: np.ndarray
     theta: np.ndarray = field(metadata=stored(
-        "rad", frame="table angles, counter-clockwise about the table normal"))
+        "rad", frame="table angles, counter-clockwise about the table normal", dims="P",
+        optional=True))
 
     def _index(self, method: str) -> int:
         if method not in self.methods:
