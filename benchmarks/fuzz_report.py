@@ -68,6 +68,7 @@ def run(case: F.Case, src: str | None, timeout: float, mem_gb: float) -> F.Outco
                 v = subprocess.run(cmd + ["validate", case.validate], cwd=d, env=env,
                                    capture_output=True, timeout=timeout, preexec_fn=limit)
                 out.validate_exit = v.returncode
+                out.validate_stderr = v.stderr.decode("utf-8", "replace")
             except subprocess.TimeoutExpired:
                 out.validate_exit = None
     return out

@@ -210,3 +210,26 @@ def test_every_proper_axes_rewriting_of_the_mems_vehicle_declared_rightly_passes
                               C_rfu_file=C, fmt="csv")
         assert found["judged"]
         K.forward_axis("m", imu.t, th @ C.T, dv @ C.T, ref.t, ref.v_n, C, "fogavp")
+
+
+def test_x_forward_axes_declared_y_forward_are_refused_with_calibration_velocities(
+        mems, tmp_path):
+    imu, ref = mems
+    p = _flu(mems, tmp_path)
+    vel = tmp_path / "vel.csv"
+    np.savetxt(vel, np.column_stack([ref.t, ref.v_n]), delimiter=",", fmt="%.12g",
+               header="t,ve,vn,vu", comments="")
+    scenario = {"name": "flu", "imu_file": {"path": str(p), "format": "csv"},
+                "initial": {"att_deg": np.degrees(ref.att[0]).tolist(),
+                            "v_enu_mps": ref.v_n[0].tolist(),
+                            "lat_deg": float(np.degrees(ref.pos[0, 0])),
+                            "lon_deg": float(np.degrees(ref.pos[0, 1])),
+                            "height_m": float(ref.pos[0, 2])},
+                "calibrate": {"aiding": "file", "measure": "velocity", "start_s": 0.11,
+                              "files": {"velocity": {"path": str(vel),
+                                                     "format": "velocity-enu"}}}}
+    (tmp_path / "c.yaml").write_text(yaml.safe_dump(scenario))
+    out = tmp_path / "c.h5"
+    res = runner.invoke(app, ["validate", str(tmp_path / "c.yaml")])
+    assert_bad_input(res, out, "the vehicle moves along the body's +x axis",
+                     "calibrate.files.velocity", "give axes: flu")

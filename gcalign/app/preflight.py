@@ -142,6 +142,13 @@ def consistent(sc: Scenario) -> None:
             sc.align.aiding.format != "odometer":
         v = sc.align.aiding.read()
         velocity = (v.t, v.v_n, f"align.aiding {sc.align.aiding.path}")
+    elif (sc.calibrate is not None and sc.calibrate.files is not None
+          and sc.calibrate.files.velocity is not None):
+        from gcalign.io.recorded.aiding import read_velocity_aiding
+
+        f = sc.calibrate.files.velocity
+        v = read_velocity_aiding(f.path, f.format, f.columns, f.variable)
+        velocity = (v.t, v.v_n, f"calibrate.files.velocity {f.path}")
     if velocity is not None and velocity[1] is not None:
         K.forward_axis(name, imu.t, imu.dtheta, imu.dv, velocity[0], velocity[1],
                        np.asarray(record["C_rfu_file"], dtype=float), velocity[2])

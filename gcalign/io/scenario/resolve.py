@@ -128,7 +128,24 @@ def recording_rows(sc: Scenario) -> list[tuple[str, str, str]]:
          f"tilt {gravity['tilt_deg']:.2f}° over the first {gravity['window_s']:g} s",
          "" if isinstance(gravity, str) else
          f"f = {_v(gravity['specific_force_rfu_mps2'], 5)} m/s² (RFU)"),
+        ("imu_file.gyros", *_gyro_rows(r.get("gyro_check"))),
     ]
+
+
+def _gyro_rows(check) -> tuple[str, str]:
+    """The gyro check of a recording (gcalign.io.recorded.consistency) as a validate row."""
+    if not isinstance(check, dict):
+        return "not checked", str(check or "")
+    if not check.get("judged"):
+        return "not judged", str(check.get("why", ""))
+    rest = check.get("at_rest")
+    at_rest = (f"; at rest {rest['ratio_to_earth_rate']:.3g} × the earth rate, "
+               f"{rest['angle_from_up_deg']:.1f}° from up ({rest['expected_deg']:.1f}° "
+               "expected)" if isinstance(rest, dict) and rest.get("judged") else "")
+    verdict = "disagree with" if check.get("warning") else "agree with"
+    return (f"{verdict} the accelerometers (k {check['k']:.3g})",
+            f"specific force turns as the gyros say: correlation {check['rho']:.2f} over "
+            f"{check['windows']} windows{at_rest}")
 
 
 def reference_rows(sc: Scenario) -> list[tuple[str, str, str]]:
