@@ -424,9 +424,10 @@ def forward_axis(name: str, imu_t: np.ndarray, dtheta: np.ndarray, dv: np.ndarra
                   "-x": ((-1.0, 0.0), (0.0, 1.0))}[fits[0][1]]
     R_fix = np.array([[right[0], right[1], 0.0], [fwd[0], fwd[1], 0.0], [0.0, 0.0, 1.0]])
     likely = describe(R_fix @ C_rfu_file)
+    # The fix first: the CLI cuts a long message, and the file names can be long.
     raise ScenarioError(
-        f"imu_file: {name}: the vehicle moves along the body's {fits[0][1]} axis, not +y "
-        f"(forward): its accelerations along and across the track of {source} show there "
-        f"(correlation {fits[0][0]:.2f}, against {declared[0]:.2f} on +y); the axes look "
-        f"like {likely}, declared {describe(C_rfu_file)}: give axes: {likely.lower()}, or "
-        "set imu_file check_consistency: false")
+        f"imu_file: the vehicle moves along the body's {fits[0][1]} axis, not +y (forward): "
+        f"the axes look like {likely}, declared {describe(C_rfu_file)}: give axes: "
+        f"{likely.lower()}, or set imu_file check_consistency: false (accelerations along "
+        f"and across the track of {source}: correlation {fits[0][0]:.2f}, against "
+        f"{declared[0]:.2f} on +y; {name})")
