@@ -20,6 +20,10 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
+from gcalign import units as u
+
 KEY = "gcalign"  #: the key of the metadata mapping that holds a :class:`Stored`
 
 
@@ -40,7 +44,11 @@ class Stored:
     per : the field that names the entries of its first axis: each entry is stored in a
         subgroup of that name (``per="methods"``: ``coordinate/error``, ``vector/error``).
     inline : a nested result whose fields join its parent's group (no subgroup of its own).
-    compress : stored compressed (gzip, shuffled): long series.
+    compress : stored compressed (gzip, shuffled): long series; True: level 1, a number:
+        that level.
+    summary : the unit the summary gives it in (:func:`summary_of`: the key
+        ``<name>_<summary>``, e.g. ``"arcsec"``), or None (not in the summary, or summarised
+        by its command).
 
     What its values must be when a results file is read back (the checks of
     :mod:`gcalign.app.checked`):
@@ -64,7 +72,8 @@ class Stored:
     axes: tuple[int, ...] | None = None
     per: str | None = None
     inline: bool = False
-    compress: bool = False
+    compress: bool | int = False
+    summary: str | None = None
     dims: str | None = None
     optional: bool = False
     finite: bool = True
@@ -87,3 +96,20 @@ def stored(units: str | None, **how: Any) -> dict[str, Stored]:
 def spec(f: dataclasses.Field[Any]) -> Stored | None:
     """How the field `f` is stored, or None (not stored)."""
     return f.metadata.get(KEY)
+
+
+#: SI per summary unit (:attr:`Stored.summary`): the summary divides the stored value by it
+SUMMARY_UNITS = {"s": 1.0, "m": 1.0, "deg": u.DEG, "arcsec": u.ARCSEC, "dph": u.DPH,
+                 "ug": u.UG}
+
+
+def summary_of(result: Any) -> dict[str, Any]:
+    """The fields of the dataclass `result` that name a summary unit, in field order, as
+    plain numbers in that unit: ``{"<name>_<unit>": value / SUMMARY_UNITS[unit]}``."""
+    out: dict[str, Any] = {}
+    for f in dataclasses.fields(result):
+        how = spec(f)
+        if how is not None and how.summary is not None:
+            v = np.asarray(getattr(result, f.name), dtype=float) / SUMMARY_UNITS[how.summary]
+            out[f"{f.name}_{how.summary}"] = v.tolist()
+    return out

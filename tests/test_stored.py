@@ -155,3 +155,34 @@ def test_a_new_north_finding_field_is_written_read_and_checked_from_its_one_line
                 with pytest.raises(ScenarioError, match="dataset /northfind/spread must have "
                                    r"shape \(2, 3\), got \(3, 3\)"):
                     _check_block(path, f, g, block)
+
+
+def test_a_new_invariant_is_written_checked_and_summarised_from_its_one_line(tmp_path):
+    """The one line of `drift_peak` below puts a new invariant of a modulation scheme in the
+    results file (units, frame), in the checks of a file read back (three values) and in
+    the summary in arc-seconds (``drift_peak_arcsec``), beside the invariants there."""
+    from gcalign.app.checked import from_fields
+    from gcalign.modulate import ErrorTerms, builtin_scheme
+    from gcalign.modulate.invariants import REF, InvariantReport, invariant_report
+    from gcalign.schema import summary_of
+    from gcalign.units import ARCSEC
+
+    @dataclass(frozen=True)
+    class Wider(InvariantReport):
+        drift_peak: np.ndarray | None = field(default=None, metadata=stored(
+            "rad", frame=REF, summary="arcsec", dims="3"))
+
+    r = invariant_report(builtin_scheme("seed-12"), ErrorTerms.seed004())
+    wider = Wider(**{f.name: getattr(r, f.name) for f in fields(r)},
+                  drift_peak=np.array([2.0, 4.0, 8.0]) * ARCSEC)
+    with h5py.File(tmp_path / "i.h5", "w") as f:
+        write_fields(f.create_group("invariants"), wider)
+    with h5py.File(tmp_path / "i.h5") as f:
+        ds = f["invariants/drift_peak"]
+        assert ds.attrs["units"] == "rad" and ds.attrs["frame"] == REF
+        assert f["invariants"].attrs["period_s"] == r.period
+    assert from_fields(Wider, "invariants/")["invariants/drift_peak"].shapes == ((3,),)
+    got = summary_of(wider)
+    assert np.allclose(got["drift_peak_arcsec"], [2.0, 4.0, 8.0], rtol=1e-14)
+    assert list(got)[-1] == "drift_peak_arcsec"  # after the invariants, in field order
+    assert got["misalignment_net_arcsec"] == (r.misalignment_net / ARCSEC).tolist()

@@ -30,6 +30,9 @@ import numpy as np
 from gcalign.errors import ScenarioError
 from gcalign.estimation.degrees import ObservabilityTable
 from gcalign.io import results
+from gcalign.modulate.analysis import MechanismCycle
+from gcalign.modulate.invariants import InvariantReport
+from gcalign.modulate.linear import LinearSeries
 from gcalign.northfind.run import NorthfindResult
 from gcalign.schema import spec as stored_spec
 
@@ -83,15 +86,17 @@ class Block:
     counts: tuple[tuple[str, str, int], ...] = ()  #: (size, attribute of the group, + k)
 
 
-def from_fields(cls: type) -> dict[str, Data]:
+def from_fields(cls: type, under: str = "") -> dict[str, Data]:
     """A block's entries from the stored fields of a result dataclass that say their dims
-    (:class:`gcalign.schema.Stored`): a new field is checked as it is declared."""
+    (:class:`gcalign.schema.Stored`), in its subgroup `under` (``"linear/"``), if any: a new
+    field is checked as it is declared."""
     items = {}
     for f in dataclasses.fields(cls):
         how = stored_spec(f)
         if how is None or how.dims is None:
             continue
-        key = ("*/" if how.per else "") + (how.name or f.name) + ("?" if how.optional else "")
+        key = (under + ("*/" if how.per else "") + (how.name or f.name)
+               + ("?" if how.optional else ""))
         shapes = tuple(tuple(int(d) if d.isdigit() else d for d in alt.split())
                        for alt in how.dims.split("|"))
         items[key] = Data(shapes, text=how.units is None, finite=how.finite, whole=how.whole,
@@ -182,15 +187,9 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
               counts=(("H", "order", 1),))),
     "modulate": (Block("modulate/*", {
         **NAVIGATION, "error/pos": V3, "error/phi": V3,
-        "mechanism/t?": times("C"), "mechanism/angle?": num(("C", 3)),
-        "mechanism/C_diag?": num(("C", 3)), "mechanism/q?": num(("C", 4), rule="unit"),
-        "mechanism/component*?": INDEX,
-        **{f"invariants/{k}?": num((3, 3)) for k in ("integral_C", "mean_C",
-                                                     "abs_rate_integral")},
-        "invariants/rate_tensor?": num((3, 3, 3)), "invariants/*?": num((3,)),
-        "linear/t?": times("L"), "linear/north?": num(("L",)), "linear/east?": num(("L",)),
-        "linear/horizontal?": num(("L",)), "linear/sigma_horizontal?": num(("L",)),
-        "linear/phi?": num(("L", 3)), "linear/component*?": INDEX}),),
+        **from_fields(MechanismCycle, "mechanism/"), "mechanism/component*?": INDEX,
+        **from_fields(InvariantReport, "invariants/"), "invariants/*?": num((3,)),
+        **from_fields(LinearSeries, "linear/"), "linear/component*?": INDEX}),),
     "allan": (Block("allan/*", {
         "tau": times("M"), "adev": num(("M", 3)), "adev_lo": num(("M", 3)),
         "adev_hi": num(("M", 3)), "clusters": num(("M",), whole=True), "model": num(("M", 3)),

@@ -63,13 +63,14 @@ def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
         data = np.transpose(data, how.axes)
     if how.flag:
         data = data.astype(np.int8)
+    units = "1" if how.units is None else how.units  # ("": a pure number, as stored)
     if not how.compress:
-        put(g, name, data, how.units or "1", how.frame, **extra)
+        put(g, name, data, units, how.frame, **extra)
         return
     check_writes()
-    ds = g.create_dataset(name, data=data, compression="gzip", compression_opts=1,
-                          shuffle=True)
-    ds.attrs["units"] = how.units or "1"
+    ds = g.create_dataset(name, data=data, compression="gzip",
+                          compression_opts=int(how.compress), shuffle=True)
+    ds.attrs["units"] = units
     for k, v in (("frame", how.frame), *extra.items()):
         if v:
             ds.attrs[k] = v

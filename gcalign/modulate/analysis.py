@@ -17,16 +17,17 @@ the other half of the command.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from gcalign.modulate.invariants import InvariantReport, invariant_report
+from gcalign.modulate.invariants import REF, InvariantReport, invariant_report
 from gcalign.modulate.linear import LinearErrors, linear_errors
 from gcalign.modulate.schemes import Scheme
 from gcalign.modulate.terms import SEED004_LAT, ErrorTerms
 from gcalign.nav.earth import SEED004, EarthModel
 from gcalign.nav.rotation import euler_to_dcm, quat_to_dcm
+from gcalign.schema import stored
 from gcalign.sim.schedule import Schedule
 
 __all__ = ["CYCLE_DT_S", "LINEAR_DT_S", "MechanismCycle", "SchemeAnalysis", "analyse_scheme",
@@ -46,10 +47,17 @@ class MechanismCycle:
     q : (K, 4), C(t) as a quaternion, scalar first.
     """
 
-    t: np.ndarray
-    angle: np.ndarray
-    C_diag: np.ndarray
-    q: np.ndarray
+    t: np.ndarray = field(metadata=stored("s", description="time in the cycle", compress=4,
+                                          dims="C", rule="increasing", optional=True))
+    angle: np.ndarray = field(metadata=stored(
+        "rad", frame="sensor axes x, y, z", compress=4, dims="C 3", optional=True,
+        description="angle turned about each sensor axis since the start of the cycle"))
+    C_diag: np.ndarray = field(metadata=stored("", frame=REF, compress=4, dims="C 3",
+                                               optional=True,
+                                               description="diagonal of C_s^r(t)"))
+    q: np.ndarray = field(metadata=stored("", frame=REF, compress=4, dims="C 4", rule="unit",
+                                          optional=True, description="quaternion of "
+                                          "C_s^r(t), scalar first"))
 
 
 @dataclass(frozen=True)
@@ -58,8 +66,8 @@ class SchemeAnalysis:
     the linear error model (None unless a static base's attitude was given)."""
 
     scheme: Scheme
-    invariants: InvariantReport
-    cycle: MechanismCycle
+    invariants: InvariantReport = field(metadata=stored("", optional=True))
+    cycle: MechanismCycle = field(metadata=stored("", name="mechanism", optional=True))
     linear: LinearErrors | None
 
 

@@ -58,7 +58,7 @@ the turning column; within a few 1e-5 otherwise).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -66,6 +66,7 @@ from gcalign.modulate._quadrature import CycleGrid, cycle_grid
 from gcalign.modulate.schemes import Scheme
 from gcalign.modulate.terms import SEED004_LAT, ErrorTerms
 from gcalign.nav.earth import SEED004, EarthModel
+from gcalign.schema import stored
 from gcalign.sim.schedule import Schedule
 
 SCHULER_BAND = 0.2  # warn when a harmonic's period is within ±20 % of Schuler's
@@ -82,6 +83,10 @@ class Harmonic:
     period: float
     amplitude: float
     attenuation: float
+
+
+#: the frame of the stored invariants
+REF = "reference frame of the scheme (body or navigation), sensor axes in columns"
 
 
 @dataclass(frozen=True)
@@ -115,25 +120,37 @@ class InvariantReport:
 
     scheme: str
     reference: str
-    period: float
-    integral_C: np.ndarray
-    mean_C: np.ndarray
-    rate_tensor: np.ndarray
-    peak_integral_C: np.ndarray
+    period: float = field(metadata=stored("s", attr=True, name="period_s"))
+    integral_C: np.ndarray = field(metadata=stored("s", frame=REF, dims="3 3", optional=True))
+    mean_C: np.ndarray = field(metadata=stored("", frame=REF, dims="3 3", optional=True))
+    rate_tensor: np.ndarray = field(metadata=stored("rad", frame=REF, dims="3 3 3", optional=True))
+    peak_integral_C: np.ndarray = field(
+        metadata=stored("s", frame=REF, summary="s", dims="3", optional=True))
     errors: ErrorTerms
-    residual_gyro_bias: np.ndarray
-    residual_accel_bias: np.ndarray
-    gyro_bias_excursion: np.ndarray
-    gyro_bias_offset: np.ndarray
-    scale_factor_net: np.ndarray
-    scale_factor_peak: np.ndarray
-    scale_factor_offset: np.ndarray
-    misalignment_net: np.ndarray
-    misalignment_peak: np.ndarray
-    misalignment_offset: np.ndarray
-    abs_rate_integral: np.ndarray
-    asym_net: np.ndarray
-    schuler_period: float
+    residual_gyro_bias: np.ndarray = field(
+        metadata=stored("rad/s", frame=REF, dims="3", optional=True))
+    residual_accel_bias: np.ndarray = field(
+        metadata=stored("m/s^2", frame=REF, dims="3", optional=True))
+    gyro_bias_excursion: np.ndarray = field(
+        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
+    gyro_bias_offset: np.ndarray = field(
+        metadata=stored("rad", frame=REF, dims="3", optional=True))
+    scale_factor_net: np.ndarray = field(
+        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
+    scale_factor_peak: np.ndarray = field(
+        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
+    scale_factor_offset: np.ndarray = field(
+        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
+    misalignment_net: np.ndarray = field(
+        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
+    misalignment_peak: np.ndarray = field(
+        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
+    misalignment_offset: np.ndarray = field(
+        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
+    abs_rate_integral: np.ndarray = field(
+        metadata=stored("rad", frame=REF, dims="3 3", optional=True))
+    asym_net: np.ndarray = field(metadata=stored("rad", frame=REF, dims="3", optional=True))
+    schuler_period: float = field(metadata=stored("s", attr=True, name="schuler_period_s"))
     harmonics: tuple[Harmonic, ...]
     warnings: tuple[str, ...]
     t: np.ndarray

@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -55,6 +55,7 @@ from gcalign.modulate._quadrature import gauss_legendre, pieces, split_count
 from gcalign.modulate.schemes import Scheme
 from gcalign.modulate.terms import SEED004_LAT, ErrorTerms
 from gcalign.nav.earth import SEED004, EarthModel
+from gcalign.schema import stored
 from gcalign.sim.schedule import Schedule
 from gcalign.units import HOUR
 
@@ -80,6 +81,20 @@ def error_matrix(lat: float, earth: EarthModel = SEED004) -> np.ndarray:
     F[5, 4] = 1.0 / r_m
     F[6, 3] = 1.0 / (r_n * math.cos(lat))
     return F
+
+
+@dataclass(frozen=True)
+class LinearSeries:
+    """What the results file keeps of :class:`LinearErrors` (its ``linear`` group): the
+    output times and the errors there (SI); the noise's RMS horizontal error with noise."""
+
+    t: np.ndarray = field(metadata=stored("s", dims="L", rule="increasing", optional=True))
+    north: np.ndarray = field(metadata=stored("m", dims="L", optional=True))
+    east: np.ndarray = field(metadata=stored("m", dims="L", optional=True))
+    horizontal: np.ndarray = field(metadata=stored("m", dims="L", optional=True))
+    phi: np.ndarray = field(metadata=stored("rad", frame="ENU", dims="L 3", optional=True))
+    sigma_horizontal: np.ndarray | None = field(default=None, metadata=stored(
+        "m", description="RMS horizontal error from noise", dims="L", optional=True))
 
 
 @dataclass(frozen=True)
@@ -147,6 +162,11 @@ class LinearErrors:
     def sigma_horizontal(self) -> np.ndarray:
         """RMS horizontal error from noise, √(σ_N² + σ_E²) (N,), m."""
         return np.hypot(self.sigma_north, self.sigma_east)
+
+    def series(self) -> LinearSeries:
+        """The series the results file keeps."""
+        return LinearSeries(self.t, self.north, self.east, self.horizontal, self.phi,
+                            None if self.P is None else self.sigma_horizontal)
 
     def _var(self, i: int) -> np.ndarray:
         return np.zeros(len(self.t)) if self.P is None else np.maximum(self.P[:, i, i], 0.0)

@@ -31,10 +31,12 @@ from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.modulate import Entry, Plan, default_rate_hz, plan_of
 from gcalign.io.scenario.navigation import NavigationConfig, OutputConfig
+from gcalign.io.stored import write_fields
 from gcalign.modulate.analysis import SchemeAnalysis, analyse_scheme
 from gcalign.modulate.invariants import InvariantReport
 from gcalign.modulate.linear import REPORT_HOURS, LinearErrors
 from gcalign.modulate.terms import ErrorTerms
+from gcalign.schema import summary_of
 from gcalign.units import ARCSEC, DPH, DPSH, HOUR, PPM, UG, UGPSHZ
 
 Progress = Callable[[float, float, str], None]  # (done, total, what)
@@ -157,14 +159,7 @@ def invariants_summary(r: InvariantReport, rotated: bool = True) -> dict:
                                    / DPH).tolist(),
         "residual_accel_bias_ug": (_clean(r.residual_accel_bias, np.abs(e.accel_bias).sum())
                                    / UG).tolist(),
-        "peak_integral_C_s": np.asarray(r.peak_integral_C, dtype=float).tolist(),
-        "gyro_bias_excursion_arcsec": _arcsec(r.gyro_bias_excursion),
-        "scale_factor_net_arcsec": _arcsec(r.scale_factor_net),
-        "scale_factor_peak_arcsec": _arcsec(r.scale_factor_peak),
-        "scale_factor_offset_arcsec": _arcsec(r.scale_factor_offset),
-        "misalignment_net_arcsec": _arcsec(r.misalignment_net),
-        "misalignment_peak_arcsec": _arcsec(r.misalignment_peak),
-        "misalignment_offset_arcsec": _arcsec(r.misalignment_offset),
+        **summary_of(r),  # the invariants whose fields name a summary unit
         "asym_drift_dph": (r.asym_net / r.period / DPH).tolist(),
         "schuler_period_s": r.schuler_period,
         "schuler_warnings": list(r.warnings),
@@ -196,8 +191,6 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group: 
     summary and the analysis. `group`: an h5py group for the series, the invariants, the
     mechanism cycle and the linear model; `progress(done_s, total_s, what)` hears of every
     block navigated."""
-    from gcalign.app.modulate.hdf5 import write_scheme
-
     hours = report_hours(plan.hours)
     v = variant(sc, entry, plan)
     _stride_checked(v, [h for h in hours if h in REPORT_HOURS])  # the last: its final row
@@ -230,8 +223,13 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group: 
         "linear": None if lin is None else linear_summary(lin, hours),
         "compute_s": nav["compute_s"],
     }
-    if group is not None:
-        write_scheme(group, entry, analysis, stream.ts)
+    if group is not None:  # the scheme, then the analysis as its fields say
+        group.attrs.update(scheme=entry.name, reference=s.reference, description=s.description,
+                           period_s=report.period, imu_ts=stream.ts, mechanism=out["mechanism"])
+        write_fields(group, analysis)
+        group["invariants"].attrs["warnings"] = list(report.warnings) or [""]
+        if lin is not None:
+            write_fields(group.create_group("linear"), lin.series())
     return out, analysis
 
 
