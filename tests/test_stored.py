@@ -186,3 +186,27 @@ def test_a_new_invariant_is_written_checked_and_summarised_from_its_one_line(tmp
     assert np.allclose(got["drift_peak_arcsec"], [2.0, 4.0, 8.0], rtol=1e-14)
     assert list(got)[-1] == "drift_peak_arcsec"  # after the invariants, in field order
     assert got["misalignment_net_arcsec"] == (r.misalignment_net / ARCSEC).tolist()
+
+
+@pytest.mark.parametrize("notch", [400.0, None])
+def test_a_filter_chains_response_comes_back(tmp_path, notch):
+    """A real-time filter chain's response as its fields say: the delays as attributes of
+    the group, the notch's parts only with a notch; read back to the same arrays (what
+    ``gcalign plot`` draws)."""
+    from dataclasses import replace
+
+    from gcalign.realtime.filters import ChainResponse, navigation_chain
+    from gcalign.realtime.settings import FilterSettings
+
+    r = navigation_chain(replace(FilterSettings(), notch_hz=notch)).on_grid()
+    assert r.freq[0] == 0.125 and r.order == len(r.h) - 1
+    with h5py.File(tmp_path / "r.h5", "w") as f:
+        write_fields(f.create_group("filter"), r)
+    with h5py.File(tmp_path / "r.h5") as f:
+        g = f["filter"]
+        assert g.attrs["delay"] == r.delay and g["group_delay"].attrs["units"] == "s"
+        assert ("notch_b" in g) is (notch is not None)
+        back = read_fields(g, ChainResponse)
+    for f_ in fields(ChainResponse):
+        a, b = getattr(r, f_.name), getattr(back, f_.name)
+        assert (a is None and b is None) or np.array_equal(a, b), f_.name

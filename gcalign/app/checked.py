@@ -34,6 +34,7 @@ from gcalign.modulate.analysis import MechanismCycle
 from gcalign.modulate.invariants import InvariantReport
 from gcalign.modulate.linear import LinearSeries
 from gcalign.northfind.run import NorthfindResult
+from gcalign.realtime.filters import ChainResponse
 from gcalign.schema import spec as stored_spec
 
 #: kinds whose every dataset has units and finite values when written (north-finding stores
@@ -180,11 +181,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
             "dt?": num(("P",)), "t_valid?": num(("P",)), "latched": num(("P", 3)),
             "truth": num(("P", 3)), "ins_ref": num(("P", 3)), "predicted/*": num(("P", 3)),
             "component*?": INDEX}),
-        Block("realtime/filter", {
-            "h?": num(("H",)), "freq": times("F"), "magnitude": num(("F",)),
-            "magnitude_fir": num(("F",)), "magnitude_notch?": num(("F",)),
-            "group_delay": num(("F",)), "notch_b?": num((3,)), "notch_a?": num((3,))},
-              counts=(("H", "order", 1),))),
+        Block("realtime/filter", from_fields(ChainResponse), counts=(("H", "order", 1),))),
     "modulate": (Block("modulate/*", {
         **NAVIGATION, "error/pos": V3, "error/phi": V3,
         **from_fields(MechanismCycle, "mechanism/"), "mechanism/component*?": INDEX,

@@ -26,14 +26,16 @@ pieces with the same numbers as in one piece (tested).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import ModuleType
 
 import numpy as np
 
 from gcalign.realtime.settings import FilterSettings
+from gcalign.schema import stored
 
 __all__ = [
+    "ChainResponse",
     "ChainState",
     "FilterChain",
     "alignment_chain",
@@ -99,6 +101,33 @@ class ChainState:
     fir: np.ndarray
 
 
+#: frequency step of :meth:`FilterChain.on_grid` (Hz); the grid is a quarter step off the
+#: notch's zero, where the group delay is singular
+GRID_STEP_HZ = 0.5
+
+
+@dataclass(frozen=True)
+class ChainResponse:
+    """A chain's taps and its response on a frequency grid (:meth:`FilterChain.on_grid`), as
+    the results file keeps them; the notch's parts are None without a notch."""
+
+    fs: float = field(metadata=stored("Hz", attr=True))
+    fir_delay: float = field(metadata=stored("s", attr=True))
+    notch_delay: float = field(metadata=stored("s", attr=True))
+    delay: float = field(metadata=stored("s", attr=True))
+    order: int = field(metadata=stored("1", attr=True))
+    h: np.ndarray = field(metadata=stored("1", description="FIR taps, sum 1", dims="H",
+                                          optional=True))
+    freq: np.ndarray = field(metadata=stored("Hz", dims="F", rule="increasing"))
+    magnitude: np.ndarray = field(metadata=stored("1", description="|H| of the chain",
+                                                  dims="F"))
+    magnitude_fir: np.ndarray = field(metadata=stored("1", dims="F"))
+    notch_b: np.ndarray | None = field(metadata=stored("1", dims="3", optional=True))
+    notch_a: np.ndarray | None = field(metadata=stored("1", dims="3", optional=True))
+    magnitude_notch: np.ndarray | None = field(metadata=stored("1", dims="F", optional=True))
+    group_delay: np.ndarray = field(metadata=stored("s", dims="F"))
+
+
 @dataclass(frozen=True)
 class FilterChain:
     """A notch (optional) followed by a linear-phase FIR, at the sample rate `fs` (Hz).
@@ -145,6 +174,18 @@ class FilterChain:
         if self.notch_ba is not None:
             gd = gd + _signal().group_delay(self.notch_ba, w=f, fs=self.fs)[1]
         return gd / self.fs
+
+    def on_grid(self, step: float = GRID_STEP_HZ) -> ChainResponse:
+        """The taps and the magnitude (chain, FIR, notch) and group delay of the chain at
+        ``(k + 1/4) step`` Hz up to the Nyquist frequency."""
+        freq = (np.arange(int(self.fs / 2 / step)) + 0.25) * step
+        b, a = (None, None) if self.notch_ba is None else self.notch_ba
+        return ChainResponse(
+            self.fs, self.fir_delay, self.notch_delay, self.delay, self.order, self.h, freq,
+            np.abs(self.response(freq)), np.abs(FilterChain(self.fs, self.h).response(freq)),
+            b, a, None if self.notch_ba is None else  # the notch alone
+            np.abs(FilterChain(self.fs, np.ones(1), self.notch_ba).response(freq)),
+            self.group_delay(freq))
 
     def response(self, freqs_hz: np.ndarray) -> np.ndarray:
         """Complex frequency response of the chain at `freqs_hz`, (F,)."""

@@ -31,7 +31,6 @@ from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.modulate import Entry, Plan, default_rate_hz, plan_of
 from gcalign.io.scenario.navigation import NavigationConfig, OutputConfig
-from gcalign.io.stored import write_fields
 from gcalign.modulate.analysis import SchemeAnalysis, analyse_scheme
 from gcalign.modulate.invariants import InvariantReport
 from gcalign.modulate.linear import REPORT_HOURS, LinearErrors
@@ -224,6 +223,8 @@ def run_scheme(sc: Scenario, entry: Entry, plan: Plan, seed: int | None, group: 
         "compute_s": nav["compute_s"],
     }
     if group is not None:  # the scheme, then the analysis as its fields say
+        from gcalign.io.stored import write_fields
+
         group.attrs.update(scheme=entry.name, reference=s.reference, description=s.description,
                            period_s=report.period, imu_ts=stream.ts, mechanism=out["mechanism"])
         write_fields(group, analysis)

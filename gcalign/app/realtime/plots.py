@@ -14,6 +14,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.app.plots import ANGLES, _s, finish, legend_right, new_figure, suptitle
+from gcalign.io.stored import read_fields
+from gcalign.realtime.filters import ChainResponse
 from gcalign.units import ARCSEC
 
 REFERENCE = {"seed": "against the INS's output T later (the seed's reference)",
@@ -151,16 +153,16 @@ def figures(f, name: str) -> dict[str, Figure]:
                 w = keep & (t >= t[keep][0] + 4.0) & (t < t[keep][0] + 4.03)
                 window = (t[w], truth[w, comp], latched[w, comp], cname, abs(rate))
     if "filter" in g:
-        fg = g["filter"]
-        mags = {"FIR": fg["magnitude_fir"][()]}
-        if "magnitude_notch" in fg:
-            mags["notch"] = fg["magnitude_notch"][()]
-        mags["chain"] = fg["magnitude"][()]
+        fr = read_fields(g["filter"], ChainResponse)
+        mags = {"FIR": fr.magnitude_fir}
+        if fr.magnitude_notch is not None:
+            mags["notch"] = fr.magnitude_notch
+        mags["chain"] = fr.magnitude
         figs["realtime_filter"] = filter_figure(
-            fg["freq"][()], mags, fg["group_delay"][()], float(g.attrs["delay"]),
+            fr.freq, mags, fr.group_delay, float(g.attrs["delay"]),
             float(g.attrs["chain_delay"]),
-            title=f"{name}: filter chain (order {int(fg.attrs['order'])} FIR"
-            + (" after a notch" if "notch_b" in fg else "") + ")")
+            title=f"{name}: filter chain (order {int(fr.order)} FIR"
+            + (" after a notch" if fr.notch_b is not None else "") + ")")
     if lags:
         figs["realtime_lag"] = lag_figure(
             None if window is None else window[:4], lags, float(g.attrs["chain_delay"]),

@@ -26,6 +26,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -38,6 +39,9 @@ from gcalign.realtime.cases import Case
 from gcalign.realtime.chain import CaseResult
 from gcalign.realtime.table import CaseSummary, RealtimeResult
 from gcalign.realtime.table import run_realtime as core_run
+
+if TYPE_CHECKING:
+    import h5py
 
 __all__ = ["RealtimeRun", "execute", "realtime_summary", "run_realtime"]
 
@@ -184,8 +188,32 @@ def realtime_summary(run: RealtimeRun, sc: Scenario) -> dict:
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             progress: Callable[[int, int, str], None] | None = None) -> Outcome:
     """Run, summarise; the registry's entry point (`progress`: one report per case)."""
-    from gcalign.app.realtime.hdf5 import write_realtime
-
     run = run_realtime(sc, seed, progress)
     return Outcome(realtime_summary(run, sc), lambda f: write_realtime(f, run), None,
                    run.seed, result=run.result)
+
+
+def write_realtime(f: h5py.File, run: RealtimeRun) -> None:
+    """/realtime: the run's settings; ``filter``, the chain's response (its fields say how);
+    ``cases/NN``, each case's motion and pulse train, and its per-pulse records (CaseResult's
+    fields say how)."""
+    from gcalign.io.stored import write_fields
+
+    s, r = run.result.settings, run.result
+    g = f.create_group("realtime")
+    g.attrs.update(reference=run.cfg.reference, delay=r.delay, chain_delay=r.chain_delay,
+                   solution_hz=s.solution_hz, fs_hz=s.filter.fs_hz,
+                   predictors=",".join(s.predictors), settle_s=s.settle_s,
+                   corner_s=s.corner_s,
+                   units="delay, chain_delay, settle_s, corner_s: s; solution_hz, fs_hz: Hz")
+    write_fields(g.create_group("filter"), r.chain.on_grid())
+    cases = g.create_group("cases")
+    for i, res in enumerate(r.cases):
+        c, case = cases.create_group(f"{i:02d}"), res.case
+        train = case.pulses or s.pulses
+        c.attrs.update(name=case.name, kind=case.kind, component=case.component,
+                       axis=np.asarray(case.shape.axis if case.shape.axis else [np.nan] * 3),
+                       seed_before=case.seed_before, seed_after=case.seed_after,
+                       pulses=train.mode, pulse_rate_hz=train.rate_hz,
+                       rate=case.shape.rate, duration=case.duration)
+        write_fields(c, res)
