@@ -307,6 +307,8 @@ def main() -> int:
         "GCALIGN_BENCH_DATA", "/tmp/gcalign-bench-vehicle")))
     ap.add_argument("--runs", type=int, default=1 if SMOKE else 5)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--route", choices=sorted(dataset.ROUTES), default="standard",
+                    help="standard: the 30 min drive; hour: it twice over (CPU for an hour)")
     ap.add_argument("--json", type=Path, help="write the figures here")
     ap.add_argument("--figure", type=Path, help="draw the errors over the drive here (PNG)")
     args = ap.parse_args()
@@ -314,7 +316,7 @@ def main() -> int:
         print(f"skipped: {TIME} (GNU time) is needed for CPU and peak memory")
         return 0
     cfg = (dataset.Config(route="short", duration_s=150.0, seed=args.seed) if SMOKE
-           else dataset.Config(seed=args.seed))
+           else dataset.Config(route=args.route, seed=args.seed))
     data = args.data / f"{cfg.route}-seed{cfg.seed}" / ("smoke" if SMOKE else "full")
     ds, paths = prepare(cfg, data)
     exe = args.kfgins

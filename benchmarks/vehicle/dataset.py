@@ -16,7 +16,7 @@ import numpy as np
 from benchmarks.vehicle import earth, gnss, imu, route
 from benchmarks.vehicle.trajectory import Site, State, Trajectory
 
-ROUTES = {"standard": route.standard, "short": route.short}
+ROUTES = {"standard": route.standard, "short": route.short, "hour": route.hour}
 
 
 @dataclass(frozen=True)
