@@ -134,3 +134,30 @@ def test_a_chunk_of_seeds_gives_the_metrics_of_each_run():
     strip = [{k: v for k, v in r.items() if k != "wall_s"} for r in alone]
     assert [{k: v for k, v in r.items() if k != "wall_s"} for r in chunk] == strip
     assert [r["status"] for r in chunk] == ["ok", "ok", "failed", "ok", "ok"]
+
+
+@pytest.mark.parametrize("source", ["odometer", "nav"])
+def test_windows_of_seeds_share_what_no_seed_changes(source):
+    """collect with a `shared` dict (the seeds of a variant in a batch) gives each seed the
+    window it gets alone, field by field to the bit, the truth rows taken from the first."""
+    from gcalign.app.align.run import alignment_inputs
+    from gcalign.app.batch.runs import noise_free_key
+    from gcalign.app.data import scenario_data, stream_of
+    from gcalign.io.scenario import parse_scenario
+
+    d = copy.deepcopy(SMALL)
+    d["align"]["aiding"]["source"] = source
+    sc = parse_scenario(d)
+    shared: dict = {}
+    got = []
+    for seed in (1, 2, 3):
+        stream = stream_of(scenario_data(sc, seed, noise_free_key(sc)))
+        kw, _ = alignment_inputs(sc, stream, shared=shared)
+        alone, _ = alignment_inputs(sc, stream_of(scenario_data(sc, seed)))
+        for name in ("dtheta", "dv", "vref", "position_t1"):
+            assert np.array_equal(kw[name], alone[name]), (seed, name)
+        assert np.array_equal(kw["truth_att"].samples, alone["truth_att"].samples)
+        assert np.array_equal(kw["truth_att"].att, alone["truth_att"].att)
+        got.append(kw)
+    assert got[2]["truth_att"].att is got[0]["truth_att"].att  # shared, not gathered again
+    assert not np.array_equal(got[0]["vref"], got[1]["vref"])  # each seed its own noise

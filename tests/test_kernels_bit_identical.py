@@ -24,7 +24,7 @@ from gcalign.align.cycles import Block, loop_gains
 from gcalign.align.stages import Stage
 from gcalign.nav import _kernels as K
 from gcalign.nav.earth import WGS84
-from gcalign.nav.rotation import attitude_error, euler_to_quat, quat_to_euler
+from gcalign.nav.rotation import attitude_error, euler_to_quat, quat_to_euler, wrap_pi
 from gcalign.sim.imu import ideal_imu
 from gcalign.sim.motions import Moving, Segment
 from gcalign.units import DEG
@@ -248,3 +248,18 @@ def test_column_spread_is_numpy_to_the_bit(n):
     assert np.array_equal(peak, np.abs(e).max(0))
     e[n // 2, 1] = np.nan
     assert np.isnan(AK.column_spread(e)[2][1]) and np.isnan(np.abs(e).max(0)[1])
+
+
+def test_kernel_wrap_is_numpys_to_the_bit():
+    """The kernels' wrap (a comparison where the modulo leaves d + π as it is) against
+    rotation.wrap_pi's (d + π) mod 2π − π, at and around every boundary and far outside."""
+    pi = np.pi
+    edges = np.array([-pi, pi, 0.0, -0.0, 2 * pi, -2 * pi, 3 * pi, -3 * pi, 1e-300, 50.0])
+    near = np.concatenate([np.nextafter(edges, np.inf), np.nextafter(edges, -np.inf), edges])
+    rng = np.random.default_rng(4)
+    d = np.concatenate([near, rng.uniform(-7, 7, 20_000), rng.uniform(-1e6, 1e6, 1000),
+                        [np.inf, -np.inf, np.nan]])
+    got = np.array([K.wrap_pi(x) for x in d])
+    want = wrap_pi(d)
+    assert np.array_equal(got, want, equal_nan=True)
+    assert np.array_equal(np.signbit(got), np.signbit(want))  # the zeros too

@@ -383,14 +383,23 @@ def attitude_errors(q: np.ndarray, samples: np.ndarray, truth_samples: np.ndarra
     [−π, π), as ``rotation.attitude_error(rotation.quat_to_euler(q), truth)`` computes
     them, to the bit (the same operations in the same order, and libm's asin and atan2).
 
-    Each row's truth is found by bisection (no gathered copy of the truth). Returns m, or
-    the index of the first row whose sample has no truth row (the rows before it written).
+    Each row's truth is found next to the previous row's (the rows of a pass are
+    consecutive samples, forward or reverse) or else by bisection (no gathered copy of the
+    truth). Returns m, or the index of the first row whose sample has no truth row (the
+    rows before it written).
     """
     m, big = samples.shape[0], truth_samples.shape[0]
+    k = -2
     for i in range(m):
-        k = np.searchsorted(truth_samples, samples[i])
-        if k >= big or truth_samples[k] != samples[i]:
-            return i
+        want = samples[i]
+        if 0 <= k + 1 < big and truth_samples[k + 1] == want:
+            k += 1
+        elif 1 <= k <= big and truth_samples[k - 1] == want:
+            k -= 1
+        else:
+            k = np.searchsorted(truth_samples, want)
+            if k >= big or truth_samples[k] != want:
+                return i
         pitch, roll, yaw = euler_of(q[i, 0], q[i, 1], q[i, 2], q[i, 3])
         out[i, 0] = pitch - truth_att[k, 0]
         out[i, 1] = wrap_pi(roll - truth_att[k, 1])

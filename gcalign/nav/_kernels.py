@@ -427,8 +427,12 @@ def wrapped(d: float) -> float:
 def wrap_pi(d: float) -> float:
     """`d` wrapped to [−π, π) by the formula of rotation.wrap_pi, ``(d + π) mod 2π − π``,
     to the bit (the sum with π rounds: unlike :func:`wrapped`, which leaves d in
-    [−π, π) untouched)."""
-    return (d + math.pi) % (2.0 * math.pi) - math.pi
+    [−π, π) untouched). Where d + π is already in [0, 2π) the modulo returns it as it is,
+    so a comparison stands for it there (a floating-point modulo costs ~15 ns)."""
+    x = d + math.pi
+    if 0.0 <= x < 2.0 * math.pi:
+        return x - math.pi
+    return x % (2.0 * math.pi) - math.pi
 
 
 @njit(cache=True)

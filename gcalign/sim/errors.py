@@ -40,8 +40,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-_SKIP_BLOCK = 1 << 18  # normals discarded at a time when the accelerometer stream skips
-
 
 @dataclass(frozen=True)
 class SensorErrors:
@@ -258,17 +256,27 @@ class _Channel:
         self.last: tuple[np.ndarray, np.ndarray] | None = None
 
     def apply(self, ideal: np.ndarray) -> np.ndarray:
+        from gcalign.sim import _noise
+
         err = self.err
-        out = ideal + self.bias_ts if self.unit else ideal @ self.M + self.bias_ts
-        if self.asym is not None:
-            out += self.asym * np.abs(ideal)
-        if self.processes is not None:
-            bias, scale = self.last = self.processes.next(len(ideal))
-            out += bias * self.ts + scale * ideal
-        if self.rng is not None:
-            noise = self.rng.standard_normal(ideal.shape)
-            noise *= self.sigma  # in place: one block-sized temporary fewer
-            out += noise
+        triad = ideal.ndim == 2 and ideal.shape[1] == 3 and ideal.dtype == np.float64
+        if (self.rng is not None and triad and self.unit and self.asym is None
+                and self.processes is None):  # the common case in one loop, same numbers
+            out = _noise.noisy_sum(ideal, self.bias_ts, self.rng, self.sigma)
+        else:
+            out = ideal + self.bias_ts if self.unit else ideal @ self.M + self.bias_ts
+            if self.asym is not None:
+                out += self.asym * np.abs(ideal)
+            if self.processes is not None:
+                bias, scale = self.last = self.processes.next(len(ideal))
+                out += bias * self.ts + scale * ideal
+            if self.rng is not None:
+                if triad:  # rng.standard_normal(shape) · sigma added, without the array
+                    _noise.add_noise(out, self.rng, self.sigma)
+                else:
+                    noise = self.rng.standard_normal(ideal.shape)
+                    noise *= self.sigma  # in place: one block-sized temporary fewer
+                    out += noise
         if err.quantum > 0:
             # Quantise the running sum, then difference it (the remainder is kept).
             run = np.cumsum(np.concatenate([self.running[None], out]), axis=0)[1:]
@@ -311,10 +319,9 @@ class ErrorStream:
         if self._private and self.gyro.rng is not None and self._g_drawn == 3 * self._samples:
             return self.gyro.rng  # the gyro's draws were the skip; it draws no more
         a_rng, left = self._a_start, 3 * self._samples
-        while left > 0:  # skip the gyro part of the stream
-            k = min(left, _SKIP_BLOCK)
-            a_rng.standard_normal(k)
-            left -= k
+        from gcalign.sim import _noise
+
+        _noise.skip_normals(a_rng, left)  # skip the gyro part of the stream
         return a_rng
 
     def apply(self, dtheta: np.ndarray, dv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

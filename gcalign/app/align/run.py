@@ -66,37 +66,52 @@ class Window:
 
 
 def _reference(aiding: Aiding, att, v_n, rng: np.random.Generator, body: bool,
-               rows: slice) -> np.ndarray:
+               rows: slice, speeds: dict | None = None, k0: int = 0) -> np.ndarray:
     """Reference velocity at `rows` of samples with true attitude att and velocity v_n
     (n, 3): (m, 3) ENU, or for an odometer the forward speed (m,).
 
     nav: the true ENU velocity plus white noise. odometer: the body-frame forward speed
     plus white noise (seed §1: converted to the navigation frame with the computed attitude
     inside the loop). The noise of successive blocks continues one stream: it is drawn for
-    all n samples, whichever rows are kept.
+    all n samples, whichever rows are kept (NumPy's normals, drawn by
+    :func:`gcalign.sim._noise.normals`). `speeds` keeps the true forward speed of the
+    block at sample `k0` for the next seed of the same truth.
     """
+    from gcalign.sim._noise import normals
+
     noise = aiding.noise_mps
     if not body:
-        return v_n[rows] + noise * rng.standard_normal(v_n.shape)[rows]
-    white = rng.standard_normal(len(att))[rows]
-    att, v_n = att[rows], v_n[rows]
-    # y of C_bn v_n: column y of C_nb (the terms of euler_to_dcm, summed in einsum's order)
-    sp, cp = np.sin(att[:, 0]), np.cos(att[:, 0])
-    sy, cy = np.sin(att[:, 2]), np.cos(att[:, 2])
-    speed = (-sy * cp) * v_n[:, 0] + (cy * cp) * v_n[:, 1] + sp * v_n[:, 2]
+        return v_n[rows] + noise * normals(rng, v_n.size).reshape(v_n.shape)[rows]
+    white = normals(rng, len(att))[rows]
+    key = (k0, rows.start, rows.stop)
+    speed = None if speeds is None else speeds.get(key)
+    if speed is None:
+        att, v_n = att[rows], v_n[rows]
+        # y of C_bn v_n: column y of C_nb (the terms of euler_to_dcm, summed in einsum's order)
+        sp, cp = np.sin(att[:, 0]), np.cos(att[:, 0])
+        sy, cy = np.sin(att[:, 2]), np.cos(att[:, 2])
+        speed = (-sy * cp) * v_n[:, 0] + (cy * cp) * v_n[:, 1] + sp * v_n[:, 2]
+        if speeds is not None:
+            speeds[key] = speed
     return speed + noise * white
 
 
 def collect(stream: Stream, tl: Timeline, aiding: Aiding,
             progress: Progress | None = None, reference=None,
-            keep: np.ndarray | None = None, ref_gap: float | None = None) -> Window:
+            keep: np.ndarray | None = None, ref_gap: float | None = None,
+            shared: dict | None = None) -> Window:
     """One pass over the stream for the samples tl.lo .. tl.hi; the rest of the run is
     never held (nor, simulated, generated). `progress(done_s, total_s, what)` hears of
     every block (the simulation, if it is one, is most of an alignment's time). A
     `reference` (:class:`gcalign.io.recorded.Reference`, recorded data) stands for the
     truth attitude, for the errors only. The truth is kept at the record samples `keep`
     (increasing, within lo .. hi: :func:`gcalign.align.gyrocompass.truth_samples`, all that
-    the alignment reads), by default at every sample lo .. hi."""
+    the alignment reads), by default at every sample lo .. hi.
+
+    `shared` (a dict, empty at first) serves the seeds of one simulated variant: what no
+    seed changes (the truth rows kept, the position at T1, an odometer's true speed) is
+    taken from the first seed's window (read-only), the same numbers without the work.
+    """
     source = aiding.source  # simulated aiding on recorded data is refused by Align.check
     has_truth = stream.truth0 is not None
     body = source == "odometer"
@@ -117,6 +132,20 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
     pos_t1 = stream.site.copy()
     if reference is not None and not has_truth:
         truth_att = _reference_attitude(reference, stream, lo, hi, samples, ref_gap)
+    memo = None
+    known = False  # the truth rows and the position at T1 are the shared ones
+    if shared is not None and stream.truth0 is not None and reference is None:
+        token = (stream.truth0.att.ctypes.data, lo, hi, i1, len(samples),
+                 int(samples[0]) if len(samples) else -1,
+                 int(samples[-1]) if len(samples) else -1)
+        if shared.get("token") != token:  # another truth: start again
+            shared.clear()
+            shared.update(token=token, speeds={})
+        memo = shared
+        known = "truth_att" in shared
+        if known:
+            truth_att, pos_t1 = shared["truth_att"], shared["pos_t1"].copy()
+    speeds = None if memo is None else memo["speeds"]
 
     def take(k0: int, att, v_n, pos) -> None:
         """Truth rows of samples k0 .. k0+len-1: reference velocity, attitude, pos at T1."""
@@ -125,11 +154,13 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
         a, c = max(lo - k0, 0), min(hi - k0 + 1, n)  # the block's rows of samples lo .. hi
         rows, out = slice(a, max(a, c)), slice(k0 + a - lo, k0 + max(a, c) - lo)
         if source != "none":
-            ref = _reference(aiding, att, v_n, rng, body, rows)
+            ref = _reference(aiding, att, v_n, rng, body, rows, speeds, k0)
             if body:
                 vref[out, 1] = ref  # an odometer measures along the body's y axis only
             else:
                 vref[out] = ref
+        if known:
+            return
         assert truth_att is not None
         kept = slice(*np.searchsorted(samples, [k0, k0 + n]))  # the kept samples here
         truth_att[kept] = att[samples[kept] - k0]
@@ -152,6 +183,9 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
             progress(min(b.k0 + n, hi) * stream.ts, hi * stream.ts, what)
         if b.k0 + n >= hi:
             break  # everything needed is in; the rest of the run is never generated
+    if memo is not None and not known and truth_att is not None:
+        truth_att.flags.writeable = False
+        memo.update(truth_att=truth_att, pos_t1=pos_t1.copy())
     truth = None if truth_att is None else TruthRows(samples, truth_att)
     return Window(dtheta, dv, vref, truth, pos_t1)
 
@@ -342,10 +376,11 @@ def run_alignment(sc: Scenario, stream: Stream | RunData,
     return replace(run, warnings=tuple(warnings))
 
 
-def alignment_inputs(sc: Scenario, stream: Stream,
-                     progress: Progress | None = None) -> tuple[dict, list[str]]:
+def alignment_inputs(sc: Scenario, stream: Stream, progress: Progress | None = None,
+                     shared: dict | None = None) -> tuple[dict, list[str]]:
     """The keyword arguments of :func:`gcalign.align.gyrocompass.align` for a scenario's
-    data, and the scenario's warnings on them (InputError from the core's checks)."""
+    data, and the scenario's warnings on them (InputError from the core's checks).
+    `shared`: :func:`collect`'s, for the seeds of one variant."""
     cfg = sc.align or AlignConfig()
     kind = sc.motion.kind if sc.motion else (
         stream.header.meta.get("motion_kind") if stream.header is not None else None)
@@ -365,7 +400,7 @@ def alignment_inputs(sc: Scenario, stream: Stream,
     reference = sc.reference.read() if sc.reference is not None else None
     keep = truth_samples(settings, ts, stream.samples, stride)
     data = collect(stream, tl, cfg.aiding, progress, reference, keep,
-                   None if sc.reference is None else sc.reference.max_gap_s)
+                   None if sc.reference is None else sc.reference.max_gap_s, shared)
     if settings.coarse == "analytic":
         k = slice(tl.i0 - tl.lo, tl.i1 - tl.lo)
         warnings += still_base_warnings(data.dtheta[k], data.dv[k], ts, stream.site[0],
@@ -393,10 +428,11 @@ def summaries_of_seeds(sc: Scenario, seeds: list[int],
 
     out: list[dict | Exception] = []
     runs, streams, notes, where = [], [], [], []
+    shared: dict = {}  # what the seeds' windows share (collect)
     for seed in seeds:
         try:
             stream = stream_of(scenario_data(sc, seed, cache_key))
-            kw, warnings = alignment_inputs(sc, stream)
+            kw, warnings = alignment_inputs(sc, stream, shared=shared)
         except InputError as err:
             out.append(_scenario_error(err))
             continue
