@@ -150,8 +150,8 @@ def validate(
     if isinstance(data, dict) and "base" in data:
         return _validate_sweep(scenario, set_, as_json)
     sc, _, _ = load_with_overrides(scenario, "", "", {}, sets=set_)
-    preflight(sc)  # the checks every command runs first, for every section
-    rows = resolved_rows(sc)
+    inputs = preflight(sc)  # the checks every command runs first, for every section
+    rows = resolved_rows(sc, None if inputs.recording is None else inputs.recording.imu)
     sections = [c.section for c in COMMANDS.values() if c.section]
     warnings = list(dict.fromkeys(w for sec in sections for w in sc.unused(sec)))
     warn(warnings, as_json)
