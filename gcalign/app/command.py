@@ -133,7 +133,7 @@ class Options:
     """How a command runs.
 
     recorded : it can run on recorded data (the command line adds the recorded-data
-        options, :func:`gcalign.cli.common.recorded_parameters`).
+        options, :mod:`gcalign.cli.options`).
     streams : its ``execute`` writes series into an open results file (``sink=``).
     self_contained : it simulates its own data from its section (no motion needed).
     batch_metrics : default metrics of a batch; () = not batchable.
