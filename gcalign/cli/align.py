@@ -8,6 +8,7 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
+from gcalign.choices import ALIGN_MODES_ALL, COMPENSATIONS, listed
 from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, recorded, run_and_show
 from gcalign.cli.options import (
@@ -73,9 +74,9 @@ def align(
         "(`gcalign example align` prints it)."
     ),
     mode: str | None = typer.Option(
-        None, "--mode", help="conventional | full-cycle | half-cycle | transfer"),
+        None, "--mode", help=listed(ALIGN_MODES_ALL)),
     compensation: str | None = typer.Option(
-        None, "--compensation", help="none | one-off | continued (T2 -> T3)"
+        None, "--compensation", help=f"{listed(COMPENSATIONS)} (T2 -> T3)"
     ),
     passes: int | None = typer.Option(
         None, "--passes", help="Forward and reverse passes in all (sets the last stage's "

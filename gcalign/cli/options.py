@@ -12,6 +12,8 @@ from typing import Annotated
 
 import typer
 
+from gcalign.choices import RECORDING_FORMATS, listed
+
 JSON_HELP = "Print one JSON object on stdout (tables go to stderr)."
 OUT_HELP = ("Results file; default runs/NAME-COMMAND[-OVERRIDES][-rngN].h5, with every option "
             "that changes the result in the name and N the random seed.")
@@ -29,8 +31,9 @@ IMU_FILE_HELP = ("Recorded IMU data (PSINS .imu, CSV/text, gcalign HDF5; .gz/.xz
                  "compressed) instead of the scenario's simulation: it replaces the motion, "
                  "mechanism, imu and site sections; the site then comes from the file's "
                  "header or --lat/--lon/--height.")
-FORMAT_HELP = ("Layout of the --imu-file (or the scenario's imu_file): psins | psins-mat | "
-               "i2nav | csv | auto (from the suffix); see docs/how-to/file-formats.md.")
+FORMAT_HELP = (f"Layout of the --imu-file (or the scenario's imu_file): "
+               f"{listed(RECORDING_FORMATS)} | auto (from the suffix); see "
+               "docs/how-to/file-formats.md.")
 REFERENCE_HELP = ("Reference solution of the recording (a master INS, a post-processed "
                   "trajectory): .mat psins-mat avp, .csv csv, else i2nav-nav (KF-GINS); "
                   "errors against it, and the initial state when the data have none.")
