@@ -59,7 +59,7 @@ def main() -> None:
     rate = n / t / 1e6
     rows.append(("gyrocompass steps (M/s, one core)", f"{rate:.1f}", "≥ 5", f"{rate / 5:.2f}×"))
 
-    sc, _, _ = load_with_overrides(None, BUILTIN, "align", {})
+    sc = load_with_overrides(None, BUILTIN, "align", {}).scenario
     data = scenario_data(sc)
     run_alignment(sc, data)  # warm
     repeat = 1 if SMOKE else 7

@@ -244,16 +244,12 @@ def _same(a, b) -> bool:
 def outcome(case: Case, folder: Path) -> tuple[str, str]:
     """``(class, message)`` of reading the damaged file (module docstring)."""
     from gcalign.errors import ScenarioError
-    from gcalign.io.recorded.imu import _CACHE
-
     good = folder / "good" / case.source.name
     bad = folder / "bad" / case.source.name
     for p, content in ((good, case.source.content), (bad, DAMAGES[case.damage](case.source))):
         p.parent.mkdir(parents=True, exist_ok=True)
         p.write_bytes(content)  # type: ignore[arg-type]
-    _CACHE.clear()
     expected = case.read(good)
-    _CACHE.clear()
     try:
         got = case.read(bad)
     except ScenarioError as err:

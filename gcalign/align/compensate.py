@@ -18,11 +18,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from gcalign.align import kernel as K
 from gcalign.align.cycles import Block, run_block
+from gcalign.choices import COMPENSATIONS
 from gcalign.nav.earth import WGS84, C_en, EarthModel
 from gcalign.nav.rotation import dcm_to_quat, quat_to_dcm
 from gcalign.nav.strapdown import integrate_attitude
 
-METHODS = ("none", "one-off", "continued")
+METHODS = COMPENSATIONS
 Array = NDArray[np.float64]
 
 

@@ -19,9 +19,10 @@ from numpy.typing import ArrayLike
 from gcalign.align import kernel as K
 from gcalign.align.gains import azimuth_gains, level_gains
 from gcalign.align.stages import Stage, stage_of_passes
+from gcalign.choices import ALIGN_MODES
 from gcalign.nav.earth import WGS84, EarthModel
 
-MODES = ("conventional", "full-cycle", "half-cycle")
+MODES = ALIGN_MODES
 
 
 @dataclass(frozen=True)

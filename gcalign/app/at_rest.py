@@ -61,12 +61,9 @@ def zero_velocity_warnings(sc: Scenario, case, summary: dict) -> list[str]:
     filter's mean NIS when it lies above its 95 % band (from the `summary`)."""
     if case.aiding != "zero-velocity" or sc.imu_file is None:
         return []
-    from gcalign.app.data import scenario_data
-
-    imu = scenario_data(sc).imu  # the reader keeps the file it read last: no second read
     d = case.data
     ts = float(d.t[1] - d.t[0])
-    t0 = float(imu.t[0] - imu.ts)  # data time of sample 0
+    t0 = case.t0  # data time of sample 0
     why = evidence(sc, d.dtheta, d.dv, ts, np.asarray(d.start.pos, float), d.earth,
                    t0 + float(d.t[0]), t0 + float(d.t[-1]))
     nis = summary.get("nis") or {}

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 from gcalign.errors import ScenarioError
 
 if TYPE_CHECKING:
+    from gcalign.app.data import Recording
     from gcalign.io.scenario import Scenario
 
 #: The id of the process that runs one command and ends, set by the command line's ``main``
@@ -74,6 +75,19 @@ class Extent:
 
 
 @dataclass(frozen=True)
+class Inputs:
+    """What a run reads, loaded once (:func:`gcalign.app.preflight.preflight`) and passed
+    along: the scenario, its recorded file as read and validated (None for simulated data,
+    or for a command that reads no recording), and the extent of its data (None: it has
+    none). The checks and the cost take its scenario and extent, the run its recording, so
+    that a recorded file is read once per run."""
+
+    scenario: Scenario
+    recording: Recording | None = None
+    extent: Extent | None = None
+
+
+@dataclass(frozen=True)
 class Outcome:
     """What one run of a command produced, ready to be written and shown.
 
@@ -119,7 +133,7 @@ class Options:
     """How a command runs.
 
     recorded : it can run on recorded data (the command line adds the recorded-data
-        options, :func:`gcalign.cli.common.recorded_parameters`).
+        options, :mod:`gcalign.cli.options`).
     streams : its ``execute`` writes series into an open results file (``sink=``).
     self_contained : it simulates its own data from its section (no motion needed).
     batch_metrics : default metrics of a batch; () = not batchable.
@@ -171,9 +185,13 @@ class Command:
         raise NotImplementedError(f"{self.name} runs no scenario")
 
     def execute(self, sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-                **options: Any) -> Outcome:
+                *, recording: Recording | None = None, **options: Any) -> Outcome:
         """Run the scenario (after its preflight: :func:`gcalign.app.preflight.checked_execute`):
-        the summary and the writer of its results."""
+        the summary and the writer of its results. `recording`: the scenario's recorded file
+        as the preflight read it (:class:`Inputs`), for a command that reads recordings
+        (``options.recorded``); without it such a command reads the file itself."""
+        if recording is not None:
+            options["recording"] = recording
         return self.runner()(sc, seed, cache_key, **options)
 
     def accepts(self, option: str) -> bool:

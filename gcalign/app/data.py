@@ -120,6 +120,22 @@ def check_finite_block(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray) -> Non
                                 "per sample; check the biases, scale factors and noise")
 
 
+@dataclass(frozen=True)
+class Recording:
+    """A scenario's recorded file as read (:func:`read_recorded`): the increments in our
+    conventions (``imu.meta["recording"]``: what the reader assumed) and the truth, if the
+    file has it (a results file of ours)."""
+
+    imu: ImuData
+    truth: Truth | None = None
+
+
+def read_recorded(scenario: Scenario) -> Recording:
+    """The scenario's ``imu_file``, read and validated with its layout."""
+    assert scenario.imu_file is not None
+    return Recording(*read_data_file(Path(scenario.imu_file), scenario.recording_layout()))
+
+
 def read_data_file(path: Path, layout=None) -> tuple[ImuData, Truth | None]:
     """IMU (and truth, if the file has it) from our HDF5, or a recording of any layout
     (:func:`gcalign.io.recorded.read_recording`: PSINS .imu, PSINS MAT, KF-GINS text,
@@ -143,21 +159,22 @@ def read_data_file(path: Path, layout=None) -> tuple[ImuData, Truth | None]:
                             ) from None
 
 
-def recording_record(sc: Scenario) -> dict | None:
-    """What the reader of the scenario's recorded file assumed (``meta["recording"]``), or
-    None for simulated data and our own HDF5 files (the reader keeps the last file it read,
-    so this costs nothing after the run)."""
-    if sc.imu_file is None or Path(sc.imu_file).suffix.lower() in HDF5_SUFFIXES:
+def recording_record(sc: Scenario, recording: Recording | None) -> dict | None:
+    """What the reader of the scenario's recorded file assumed (``meta["recording"]`` of
+    the `recording` read for the run), or None for simulated data and our own HDF5 files."""
+    if recording is None or sc.imu_file is None or sc.reads_own_recording:
         return None
-    if sc.reads_own_recording:
+    if Path(sc.imu_file).suffix.lower() in HDF5_SUFFIXES:
         return None
-    imu, _ = read_data_file(sc.imu_file, sc.recording_layout())
-    return imu.meta.get("recording")
+    return recording.imu.meta.get("recording")
 
 
-def _recorded(scenario: Scenario) -> RunData:
-    assert scenario.imu_file is not None
-    imu, truth = read_data_file(scenario.imu_file, scenario.recording_layout())
+def _recorded(scenario: Scenario, recording: Recording | None = None) -> RunData:
+    """The recorded run: `recording` (the file as the preflight read it), else the file
+    read here."""
+    if recording is None:
+        recording = read_recorded(scenario)
+    imu, truth = recording.imu, recording.truth
     if scenario.site is not None:
         site = scenario.site.to_si()
     elif imu.site is not None:
@@ -187,13 +204,14 @@ def _simulation(scenario: Scenario):
 
 
 def scenario_stream(scenario: Scenario, seed: int | None = None,
-                    block: int | None = None) -> Stream:
-    """The scenario's data as blocks (simulated with its sensor errors, or recorded)."""
+                    block: int | None = None, recording: Recording | None = None) -> Stream:
+    """The scenario's data as blocks (simulated with its sensor errors, or recorded:
+    `recording` as the preflight read it, else the file read here)."""
     from gcalign.sim.ideal import ideal_blocks, initial_truth
 
     earth = scenario.earth_model
     if scenario.imu_file is not None:
-        return stream_of(_recorded(scenario), earth, block)
+        return stream_of(_recorded(scenario, recording), earth, block)
 
     motion, mech, site = _simulation(scenario)
     seed = scenario.imu.seed if seed is None else seed
@@ -299,15 +317,16 @@ def gather(stream: Stream) -> RunData:
 
 
 def scenario_data(scenario: Scenario, seed: int | None = None,
-                  cache_key: str | None = None) -> RunData:
-    """Simulate the scenario's motion with its IMU errors, or read its recorded IMU file.
+                  cache_key: str | None = None, recording: Recording | None = None) -> RunData:
+    """Simulate the scenario's motion with its IMU errors, or read its recorded IMU file
+    (`recording`: the file as the preflight read it).
 
     `seed` overrides ``imu.seed``; the same scenario and seed give the same numbers.
     `cache_key` (a batch variant) lets successive seeds share the noise-free simulation:
     it is computed once per key in this process (see :func:`cached_noise_free`).
     """
     if scenario.imu_file is not None:
-        return _recorded(scenario)
+        return _recorded(scenario, recording)
     if cache_key is not None:
         return with_errors(scenario, cached_noise_free(scenario, cache_key), seed)
     return gather(scenario_stream(scenario, seed))

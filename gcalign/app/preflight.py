@@ -12,79 +12,76 @@ so both take the same decisions. Nothing here imports numba or scipy.
 
 from __future__ import annotations
 
-import os
 import typing
-from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from gcalign import limits
-from gcalign.app.command import DOUBLE, Command, Cost, Extent, Outcome, loading
+from gcalign.app.command import DOUBLE, Command, Cost, Extent, Inputs, Outcome, loading
 from gcalign.app.registry import COMMANDS, command
 from gcalign.errors import GcalignError, ScenarioError
 from gcalign.io.paths import not_a_file
 from gcalign.io.scenario import Scenario
 
-__all__ = ["Extent", "budget", "check_seed", "checked_execute", "extent", "preflight",
+if TYPE_CHECKING:
+    from gcalign.app.data import Recording
+
+__all__ = ["Extent", "budget", "check_seed", "checked_execute", "checked_run", "extent", "load",
+           "preflight",
            "sensor_errors", "total_runs"]
 
 BATCH_DOUBLES = 30  #: per sample held by a batch variant: its noise-free run and its errors
-_RECORDED: dict[tuple[str, int, int, str], Extent] = {}  # path, size, mtime, layout -> extent
 
 
-def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
-    """Samples and interval of the scenario's data, or None if it has none. A recorded file
-    is read and validated when `read_recorded` (once per process and file version), else
-    only checked to exist."""
+def load(sc: Scenario, read_recorded: bool = True,
+         recording: Recording | None = None) -> Inputs:
+    """The scenario's inputs (:class:`~gcalign.app.command.Inputs`): a recorded file read
+    and validated when `read_recorded` (`recording`: as an earlier run of the same scenario
+    read it, a batch's), else only checked to exist; the extent of its data (None if it
+    has none)."""
     if sc.reads_own_recording:
-        return None
+        return Inputs(sc)
     if sc.imu_file is not None:
         if not read_recorded:
             if not sc.imu_file.is_file():
                 raise ScenarioError(f"imu_file: {sc.imu_file}: {not_a_file(sc.imu_file)}")
-            return None
-        ext = _recorded_extent(Path(sc.imu_file), sc.recording_layout())
+            return Inputs(sc)
+        from gcalign.app.data import read_recorded as read
+
+        recording = recording or read(sc)
+        imu = recording.imu
+        lat = None if imu.site is None else float(imu.site[0])
+        ext = Extent(len(imu), float(imu.ts), True, recording.truth is not None, lat)
         start_pos = sc.initial is not None and sc.initial.position() is not None
         if sc.site is None and ext.lat is None and sc.reference is None and not start_pos:
             raise ScenarioError(
                 f"site: missing: {sc.imu_file} does not give the site (a CSV file has no "
                 "header); give --lat/--lon/--height, a site section in the scenario, "
                 "initial: {lat_deg, lon_deg, height_m}, or a reference)")
-        return ext
+        return Inputs(sc, recording, ext)
     if sc.motion is None:
-        return None
+        return Inputs(sc)
     ts = sc.imu.ts
-    return Extent(int(round(sc.motion.duration() / ts)), ts, False, True)
+    return Inputs(sc, None, Extent(int(round(sc.motion.duration() / ts)), ts, False, True))
 
 
-def _recorded_extent(path: Path, layout=None) -> Extent:
-    from gcalign.app.data import read_data_file
-
-    try:
-        st = os.stat(path)
-        key = (str(path.resolve()), st.st_size, st.st_mtime_ns, repr(layout))
-    except OSError:
-        key = None
-    if key is not None and key in _RECORDED:
-        return _RECORDED[key]
-    imu, truth = read_data_file(path, layout)
-    lat = None if imu.site is None else float(imu.site[0])
-    ext = Extent(len(imu), float(imu.ts), True, truth is not None, lat)
-    if key is not None:
-        _RECORDED.clear()  # the last file only: a batch reads one file over and over
-        _RECORDED[key] = ext
-    return ext
+def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
+    """Samples and interval of the scenario's data, or None if it has none (:func:`load`)."""
+    return load(sc, read_recorded).extent
 
 
-def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True) -> None:
+def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True,
+              recording: Recording | None = None) -> Inputs:
     """Refuse (ScenarioError, one line naming the field) what the run of command `name`
     would refuse, and what would exceed a resource limit. ``name=None``: every section the
-    scenario has (``gcalign validate``)."""
+    scenario has (``gcalign validate``). Returns the inputs it loaded (:func:`load`), for
+    the run; `recording` as :func:`load`."""
     commands = [command(name)] if name else _commands_of(sc)
     if name is not None:
         recorded_defaults(sc, commands[0].section)
     check_seed(sc.imu.seed, "imu.seed")
     # recorded data are read only for a command that can use them (the others refuse them)
-    ext = extent(sc, read_recorded and any(c.options.recorded for c in commands))
+    inputs = load(sc, read_recorded and any(c.options.recorded for c in commands), recording)
+    ext = inputs.extent
     if ext is not None and not ext.recorded:
         sensor_errors(sc)
     if ext is None and sc.imu_file is None and not (
@@ -92,8 +89,8 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
         raise ScenarioError("motion: missing; the scenario needs 'motion' (simulated data) "
                             "or 'imu_file' (recorded data)"
                             + ("" if name else ", or a northfind/realtime section"))
-    if ext is not None and ext.recorded:
-        consistent(sc)
+    if inputs.recording is not None:
+        consistent(sc, inputs.recording)
     for c in commands:
         try:
             c.check(sc, ext)
@@ -102,9 +99,10 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True)
             raise
         except (ValueError, TypeError) as err:  # a settings object refused what it was given
             raise setup_error(c.section or c.name, err) from None
+    return inputs
 
 
-def consistent(sc: Scenario) -> None:
+def consistent(sc: Scenario, recording: Recording) -> None:
     """A recording against what else the scenario says of the same vehicle
     (:mod:`gcalign.io.recorded.consistency`): at rest, its gyros against the earth rate at
     the site (a PSINS header's site is checked as the file is read); a reference's attitude
@@ -113,12 +111,11 @@ def consistent(sc: Scenario) -> None:
     false`` and ``reference.check_attitude: false`` turn them off."""
     import numpy as np
 
-    from gcalign.app.data import read_data_file
     from gcalign.io.recorded import consistency as K
 
     layout = sc.recording_layout()
     assert sc.imu_file is not None
-    imu, _ = read_data_file(Path(sc.imu_file), layout)
+    imu = recording.imu
     record = imu.meta.get("recording") or {}
     if not record or not layout.check_consistency:
         return
@@ -197,18 +194,27 @@ def checked_execute(name: str, sc: Scenario, seed: int | None = None, *args: Any
     ``gcalign validate`` makes), with the seed checked to lie in [0, 2^63); the summary is
     checked to be finite. `progress` goes to a command whose ``execute`` takes it (asked
     after the preflight: the run's modules load only for a run that will happen)."""
+    return checked_run(name, sc, seed, *args, progress=progress, **options)[0]
+
+
+def checked_run(name: str, sc: Scenario, seed: int | None = None, *args: Any,
+                progress: Any = None, recording: Recording | None = None,
+                **options: Any) -> tuple[Outcome, Inputs]:
+    """:func:`checked_execute`, and the inputs the preflight loaded and the run used (the
+    recorded file read once, for both; `recording`: as an earlier run of the same scenario
+    read it, which a batch's runs of a variant pass along)."""
     from gcalign.io.results import finite_summary
 
     check_seed(seed)
-    preflight(sc, name)
+    inputs = preflight(sc, name, recording=recording)
     cmd = command(name)
     with loading():  # the run's modules, numba and its kernels with them
         takes_progress = cmd.accepts("progress")
     if progress is not None and takes_progress:
         options["progress"] = progress
-    outcome = cmd.execute(sc, seed, *args, **options)
+    outcome = cmd.execute(sc, seed, *args, recording=inputs.recording, **options)
     finite_summary(outcome.summary, name)
-    return outcome
+    return outcome, inputs
 
 
 def sensor_errors(sc: Scenario) -> None:

@@ -12,7 +12,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from gcalign.app.command import Outcome
-from gcalign.app.preflight import checked_execute
+from gcalign.app.preflight import checked_run
 from gcalign.app.registry import command
 from gcalign.errors import GcalignError, ScenarioError
 from gcalign.io import results
@@ -46,7 +46,7 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
             # preflight checks, the seed's range, a finite summary
             if cmd.options.streams:
                 kwargs["sink"] = f
-            outcome = checked_execute(name, sc, seed, **kwargs)
+            outcome, inputs = checked_run(name, sc, seed, **kwargs)
             if progress is not None:
                 progress(1.0, 1.0, "running")
             if on_outcome is not None:
@@ -54,7 +54,8 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
             if before_write is not None:
                 before_write()
             summary = outcome.summary
-            record = recording_record(sc)  # what the reader of a recorded file assumed
+            # what the reader of the recorded file assumed
+            record = recording_record(sc, inputs.recording)
             summary["warnings"] = list(dict.fromkeys(
                 [*notes, *sc.unused(cmd.section), *outcome.warnings,
                  *summary.get("warnings", []), *(record or {}).get("warnings", [])]))

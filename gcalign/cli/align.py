@@ -8,9 +8,22 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
+from gcalign.choices import ALIGN_MODES_ALL, COMPENSATIONS, listed
 from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
-from gcalign.cli.options import Json, Output, Seed, Sets
+from gcalign.cli.common import builtin_text, load_with_overrides, recorded, run_and_show
+from gcalign.cli.options import (
+    Height,
+    ImuAxes,
+    ImuFile,
+    ImuFormat,
+    Json,
+    Lat,
+    Lon,
+    Output,
+    Reference,
+    Seed,
+    Sets,
+)
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["align"].builtin or ""
@@ -61,9 +74,9 @@ def align(
         "(`gcalign example align` prints it)."
     ),
     mode: str | None = typer.Option(
-        None, "--mode", help="conventional | full-cycle | half-cycle | transfer"),
+        None, "--mode", help=listed(ALIGN_MODES_ALL)),
     compensation: str | None = typer.Option(
-        None, "--compensation", help="none | one-off | continued (T2 -> T3)"
+        None, "--compensation", help=f"{listed(COMPENSATIONS)} (T2 -> T3)"
     ),
     passes: int | None = typer.Option(
         None, "--passes", help="Forward and reverse passes in all (sets the last stage's "
@@ -76,8 +89,16 @@ def align(
     output: Output = None,
     as_json: Json = False,
     set_: Sets = None,
+    imu_file: ImuFile = None,
+    imu_format: ImuFormat = None,
+    imu_axes: ImuAxes = None,
+    reference: Reference = None,
+    lat: Lat = None,
+    lon: Lon = None,
+    height: Height = None,
 ):
     """Gyrocompass fine alignment with forward/reverse passes and T2 -> T3 compensation."""
+    given = recorded(imu_file, imu_format, imu_axes, reference, lat, lon, height)
     overrides = {
         "mode": mode,
         "compensation": compensation,
@@ -86,6 +107,6 @@ def align(
         "t2_s": t2,
         "t3_s": _t3(t3),
     }
-    sc, text, _ = load_with_overrides(scenario, BUILTIN, "align", overrides,
-                                      passes_into_stages, sets=set_)
-    run_and_show("align", sc, text, seed, output, as_json)
+    loaded = load_with_overrides(scenario, BUILTIN, "align", overrides, passes_into_stages,
+                                 sets=set_, recorded=given)
+    run_and_show("align", loaded, seed, output, as_json)

@@ -9,8 +9,20 @@ from pathlib import Path
 import typer
 
 from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import imu_file_given, load_with_overrides, run_and_show
-from gcalign.cli.options import Json, Output, Seed, Sets
+from gcalign.cli.common import load_with_overrides, recorded, run_and_show
+from gcalign.cli.options import (
+    Height,
+    ImuAxes,
+    ImuFile,
+    ImuFormat,
+    Json,
+    Lat,
+    Lon,
+    Output,
+    Reference,
+    Seed,
+    Sets,
+)
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
 
@@ -35,6 +47,13 @@ def allan(
     seed: Seed = None,
     as_json: Json = False,
     set_: Sets = None,
+    imu_file: ImuFile = None,
+    imu_format: ImuFormat = None,
+    imu_axes: ImuAxes = None,
+    reference: Reference = None,
+    lat: Lat = None,
+    lon: Lon = None,
+    height: Height = None,
 ):
     """Overlapping Allan deviation of every gyro and accelerometer axis (allantools), its 1σ
     interval from the number of clusters, and the IEEE Std 952 terms fitted to it:
@@ -48,7 +67,8 @@ def allan(
 
     if source is not None and not source.is_file():
         raise ScenarioError(f"{source}: {not_a_file(source)}")
-    if source is None and not imu_file_given():
+    given = recorded(imu_file, imu_format, imu_axes, reference, lat, lon, height)
+    if source is None and given.imu_file is None:
         raise ScenarioError("allan: give a recording, a results file or a scenario (SOURCE), "
                             "or --imu-file FILE")
     if scenario_out not in (None, "-") and output is not None and \
@@ -68,13 +88,13 @@ def allan(
             data["earth"] = stored["earth"]
         text = yaml.safe_dump(data)
     overrides = {"start_s": start, "duration_s": duration}
-    sc, text, _ = load_with_overrides(source, "", "allan", overrides, data=data, text=text,
-                                      sets=set_)
+    loaded = load_with_overrides(source, "", "allan", overrides, data=data, text=text,
+                                 sets=set_, recorded=given)
     if as_json and scenario_out == "-":
         raise ScenarioError("--scenario: '-' prints the scenario on stdout, where --json "
                             "prints its JSON; give --scenario FILE, or leave out --json")
     captured: dict = {}
-    run_and_show("allan", sc, text, seed, output, as_json, on_summary=captured.update,
+    run_and_show("allan", loaded, seed, output, as_json, on_summary=captured.update,
                  stdout_free=scenario_out == "-")
     if scenario_out is not None:
         from gcalign.app.allan.scenario import scenario_text

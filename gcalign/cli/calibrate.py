@@ -8,8 +8,20 @@ import typer
 
 from gcalign.app.registry import COMMANDS
 from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import load_with_overrides, run_and_show
-from gcalign.cli.options import Json, Output, Seed, Sets
+from gcalign.cli.common import Loaded, Recorded, load_with_overrides, recorded, run_and_show
+from gcalign.cli.options import (
+    Height,
+    ImuAxes,
+    ImuFile,
+    ImuFormat,
+    Json,
+    Lat,
+    Lon,
+    Output,
+    Reference,
+    Seed,
+    Sets,
+)
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["calibrate"].builtin or ""
@@ -19,11 +31,11 @@ MATCHING_HELP = ("Transfer alignment (align.mode: transfer): attitude+velocity |
                  "attitude (sets align.transfer.matching).")
 
 
-def load_checked(path: Path | None, section: str, overrides: dict, sets: list[str] | None):
-    """Scenario and text with the options written into `section` (the command's check
-    runs in its preflight)."""
-    sc, text, _ = load_with_overrides(path, BUILTIN, section, overrides, sets=sets)
-    return sc, text
+def load_checked(path: Path | None, section: str, overrides: dict, sets: list[str] | None,
+                 given: Recorded | None = None) -> Loaded:
+    """The scenario with the options written into `section` (the command's check runs in
+    its preflight)."""
+    return load_with_overrides(path, BUILTIN, section, overrides, sets=sets, recorded=given)
 
 
 @app.command()
@@ -42,12 +54,20 @@ def calibrate(
     output: Output = None,
     as_json: Json = False,
     set_: Sets = None,
+    imu_file: ImuFile = None,
+    imu_format: ImuFormat = None,
+    imu_axes: ImuAxes = None,
+    reference: Reference = None,
+    lat: Lat = None,
+    lon: Lon = None,
+    height: Height = None,
 ):
     """In-flight calibration: the 21-state Kalman filter aided by DGNSS (or zero velocity
     on recorded data); per state the injected truth, estimate, error and final σ."""
+    given = recorded(imu_file, imu_format, imu_axes, reference, lat, lon, height)
     overrides = {"measure": measure, "smoother": smoother, "truth": truth}
-    sc, text = load_checked(scenario, "calibrate", overrides, set_)
-    run_and_show("calibrate", sc, text, seed, output, as_json, compare=compare)
+    loaded = load_checked(scenario, "calibrate", overrides, set_, given)
+    run_and_show("calibrate", loaded, seed, output, as_json, compare=compare)
 
 
 @app.command()
@@ -69,10 +89,10 @@ def observability(
     overrides = {"measure": measure, "scaling": scaling}
     sets = list(set_ or [])
     if matching is not None:
-        sc, _ = load_checked(scenario, "observability", overrides, set_)
+        sc = load_checked(scenario, "observability", overrides, set_).scenario
         if sc.align is None or sc.align.mode != "transfer":
             raise ScenarioError(f"--matching: {matching!r} applies to a transfer-alignment "
                                 "scenario (align.mode: transfer); a flight takes --measure")
         sets.append(f"align.transfer.matching={matching}")
-    sc, text = load_checked(scenario, "observability", overrides, sets)
-    run_and_show("observability", sc, text, None, output, as_json)
+    run_and_show("observability", load_checked(scenario, "observability", overrides, sets),
+                 None, output, as_json)

@@ -3,33 +3,25 @@ output names, progress, warnings, saving and showing.
 
 Every command of the registry gets the same habits here, not by hand:
 
-* ``--seed``, ``-o/--output``, ``--json`` and ``--set KEY=VALUE`` (any scenario key,
-  dotted as in a sweep's grid) are declared once, as annotated types in
-  :mod:`gcalign.cli.options`, that each command names in its signature.
-* The recorded-data options (:func:`recorded_parameters`: ``--imu-file``, ``--lat``,
-  ``--lon``, ``--height``), one list for every command whose registry object reads recorded
-  data (``options.recorded``) and ``validate``: :func:`install` adds them, so that a new
-  option of recorded data is one line of that list. :func:`load_with_overrides` applies
-  them and the ``--set`` items.
+* ``--seed``, ``-o/--output``, ``--json``, ``--set KEY=VALUE`` (any scenario key,
+  dotted as in a sweep's grid) and the recorded-data options (``--imu-file``, ``--format``,
+  ``--axes``, ``--reference``, ``--lat``, ``--lon``, ``--height``) are declared once, as
+  annotated types in :mod:`gcalign.cli.options`, that each command names in its signature;
+  the recorded-data ones reach :func:`load_with_overrides` as one value (:func:`recorded`).
+* :func:`load_with_overrides` applies the options and the ``--set`` items and returns what
+  it loaded (:class:`Loaded`), which :func:`run_and_show` takes.
 * A default results file named after every override that changes the result
   (:func:`output_name`), and a warning when it replaces a run of other inputs.
 * A progress bar on stderr for long runs (:class:`ProgressBar`; a command whose ``execute``
   takes ``progress=`` reports to it), keys that cannot matter as warnings (stderr, table,
   JSON), the wall time beside what ``compute`` measured.
-
-The options reach :func:`load_with_overrides` and :func:`run_and_show` through one context
-variable set for the duration of a command (:data:`_INVOCATION`), so a command module only
-calls those two functions.
 """
 
 from __future__ import annotations
 
 import contextlib
-import contextvars
 import copy
-import functools
 import hashlib
-import inspect
 import os
 import re
 import shutil
@@ -53,106 +45,55 @@ if TYPE_CHECKING:  # loaded by the functions that use them: `gcalign --help` nee
 
 # --------------------------------------------------------------------------- options
 
-IMU_FILE_HELP = ("Recorded IMU data (PSINS .imu, CSV/text, gcalign HDF5; .gz/.xz "
-                 "compressed) instead of the scenario's simulation: it replaces the motion, "
-                 "mechanism, imu and site sections; the site then comes from the file's "
-                 "header or --lat/--lon/--height.")
-FORMAT_HELP = ("Layout of the --imu-file (or the scenario's imu_file): psins | psins-mat | "
-               "i2nav | csv | auto (from the suffix); see docs/how-to/file-formats.md.")
-REFERENCE_HELP = ("Reference solution of the recording (a master INS, a post-processed "
-                  "trajectory): .mat psins-mat avp, .csv csv, else i2nav-nav (KF-GINS); "
-                  "errors against it, and the initial state when the data have none.")
-AXES_HELP = ("Body axes of the recording, the file's x, y, z: three of F/B, R/L, U/D, e.g. "
-             "RFU (ours), FRD (KF-GINS), FLU (ROS).")
 
+@dataclass(frozen=True)
+class Recorded:
+    """The recorded-data options a command was given (:func:`recorded`)."""
 
-@dataclass
-class Invocation:
-    """The common options of the running command and what loading made of them."""
-
-    sets: list[str] = field(default_factory=list)
     imu_file: Path | None = None
     imu_layout: dict = field(default_factory=dict)  # --format, --axes
     reference: Path | None = None  # --reference
     site: dict = field(default_factory=dict)  # lat_deg, lon_deg, height_m given as options
-    applied: list[tuple[str, object]] = field(default_factory=list)  # (key, value), in order
-    notes: list[str] = field(default_factory=list)  # warnings found while loading
 
 
-_INVOCATION: contextvars.ContextVar[Invocation | None] = contextvars.ContextVar(
-    "gcalign_invocation", default=None)
+def recorded(imu_file: Path | None = None, imu_format: str | None = None,
+             imu_axes: str | None = None, reference: Path | None = None,
+             lat: float | None = None, lon: float | None = None,
+             height: float | None = None) -> Recorded:
+    """The recorded-data options (:mod:`gcalign.cli.options`: ``ImuFile``, ``ImuFormat``,
+    ``ImuAxes``, ``Reference``, ``Lat``, ``Lon``, ``Height``) as one value; ScenarioError
+    for --lat without --lon or the reverse."""
+    site = {k: v for k, v in (("lat_deg", lat), ("lon_deg", lon), ("height_m", height))
+            if v is not None}
+    if (lat is None) != (lon is None):
+        given, missing = ("--lat", "--lon") if lon is None else ("--lon", "--lat")
+        raise ScenarioError(f"{missing}: missing beside {given} (site.{missing[2:]}_deg); "
+                            "give both (and --height if it matters) or neither")
+    layout = {k: v for k, v in (("format", imu_format), ("axes", imu_axes)) if v is not None}
+    return Recorded(imu_file, layout, reference, site)
 
 
-def _option(name: str, annotation, metavar: str, *decls: str, help: str) -> inspect.Parameter:
-    return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, annotation=annotation,
-                             default=typer.Option(None, *decls, help=help, metavar=metavar))
+@dataclass(frozen=True)
+class Loaded:
+    """A scenario as a command line loaded it (:func:`load_with_overrides`): the validated
+    scenario, the text stored in its results file, its source name, the options that were
+    applied (key, value; in order: the results file's default name records them) and the
+    recorded-data options given."""
 
-
-def recorded_parameters(recorded: bool) -> list[inspect.Parameter]:
-    params: list[inspect.Parameter] = []
-    if recorded:
-        params += [
-            _option("imu_file", Path | None, "FILE", "--imu-file", help=IMU_FILE_HELP),
-            _option("imu_format", str | None, "FORMAT", "--format", help=FORMAT_HELP),
-            _option("imu_axes", str | None, "AXES", "--axes", help=AXES_HELP),
-            _option("reference", Path | None, "FILE", "--reference", help=REFERENCE_HELP),
-            _option("lat", float | None, "DEG", "--lat", help="Site latitude (deg); with "
-                    "--lon (and --height) replaces the site of the scenario or of the data "
-                    "file's header."),
-            _option("lon", float | None, "DEG", "--lon", help="Site longitude (deg)."),
-            _option("height", float | None, "M", "--height", help="Site height (m)."),
-        ]
-    return params
-
-
-def with_common_options(fn: Callable, recorded: bool) -> Callable:
-    """`fn` with the common options added to its signature (those it does not declare);
-    their values are kept in :data:`_INVOCATION` while `fn` runs."""
-    sig = inspect.signature(fn, eval_str=True)
-    extra = [p for p in recorded_parameters(recorded) if p.name not in sig.parameters]
-
-    @functools.wraps(fn)
-    def wrapper(*args, **kwargs):
-        given = {p.name: kwargs.pop(p.name, None) for p in extra}
-        site = {k: given.get(o) for k, o in (("lat_deg", "lat"), ("lon_deg", "lon"),
-                                             ("height_m", "height"))}
-        if (site["lat_deg"] is None) != (site["lon_deg"] is None):
-            given_, missing = ("--lat", "--lon") if site["lon_deg"] is None else ("--lon",
-                                                                                  "--lat")
-            sys.stderr.write(f"error: {missing}: missing beside {given_} "
-                             f"(site.{missing[2:]}_deg); give both (and --height if it "
-                             "matters) or neither\n")
-            raise typer.Exit(2)
-        inv = Invocation(imu_file=given.get("imu_file"),
-                         site={k: v for k, v in site.items() if v is not None},
-                         imu_layout={k: given[o] for k, o in (("format", "imu_format"),
-                                     ("axes", "imu_axes")) if given.get(o) is not None},
-                         reference=given.get("reference"))
-        token = _INVOCATION.set(inv)
-        try:
-            return fn(*args, **kwargs)
-        finally:
-            _INVOCATION.reset(token)
-
-    wrapper.__signature__ = sig.replace(  # type: ignore[attr-defined]
-        parameters=[*sig.parameters.values(), *extra])
-    return wrapper
+    scenario: Scenario
+    text: str
+    source: str
+    applied: list[tuple[str, object]] = field(default_factory=list)
+    recorded: Recorded = field(default_factory=Recorded)
 
 
 def install(app: typer.Typer) -> None:
-    """Give every scenario command registered on `app` the common options (see the module
-    docstring): the registry's commands except ``batch``, and ``validate``."""
+    """The command list shows each registry command's line (its ``help``)."""
     for info in app.registered_commands:
         name = info.name or (info.callback.__name__ if info.callback else "")
         cmd = COMMANDS.get(name)
-        if info.callback is None or getattr(info.callback, "_common", False):
-            continue
         if cmd is not None and info.help is None and info.short_help is None:
-            info.short_help = cmd.help  # the command list shows the registry's line
-        if (cmd is not None and name != "batch") or name == "validate":
-            recorded = cmd.options.recorded if cmd is not None else True
-            info.callback = with_common_options(info.callback, recorded)
-            info.callback._common = True  # type: ignore[attr-defined]
+            info.short_help = cmd.help
 
 
 # --------------------------------------------------------------------------- loading
@@ -188,7 +129,7 @@ def _apply_sets(data: dict, sets: list[str], taken: set[str], source: str,
         applied.append((key, value))
 
 
-def _apply_recorded(data: dict, inv: Invocation, applied: list) -> None:
+def _apply_recorded(data: dict, inv: Recorded, applied: list) -> None:
     """--imu-file replaces the motion, the mechanism and the site (the file's header, or
     --lat/--lon/--height, gives it); --lat/--lon/--height replace the site."""
     if inv.imu_file is not None:
@@ -219,11 +160,6 @@ def _apply_recorded(data: dict, inv: Invocation, applied: list) -> None:
         applied.extend((f"site.{k}", v) for k, v in inv.site.items())
 
 
-def imu_file_given() -> bool:
-    """Was ``--imu-file`` given to the running command?"""
-    return (_INVOCATION.get() or Invocation()).imu_file is not None
-
-
 def load_with_overrides(
     path: Path | None,
     builtin: str,
@@ -233,16 +169,18 @@ def load_with_overrides(
     data: dict | None = None,
     text: str | None = None,
     sets: Sequence[str] | None = None,
-) -> tuple[Scenario, str, str]:
+    recorded: Recorded | None = None,
+) -> Loaded:
     """Scenario (the file, the built-in one, or a given mapping `data` with its `text`),
     its text and its source name, with the options that were given written into `section`
     before validation, so that a bad option is reported like a bad key in the file; then
-    the ``--set KEY=VALUE`` items `sets` and the recorded-data options of the running
-    command (``--imu-file``, site).
+    the ``--set KEY=VALUE`` items `sets` and the recorded-data options `recorded`
+    (``--imu-file``, site: :func:`recorded`).
     `adjust(section, given)` may drop keys of the section that a given option replaces, and
     may take options out of `given` that it wrote elsewhere in the section. The text stored
     in results files records the overrides.
     """
+    inv = recorded or Recorded()
     with loading():  # yaml and the scenario models (pydantic builds each as it loads)
         import yaml
 
@@ -252,10 +190,10 @@ def load_with_overrides(
     if data is not None:
         source = str(path) if path is not None else f"<built-in {builtin}>"
         text = text or yaml.safe_dump(data, sort_keys=False)
-    elif path is None and (_INVOCATION.get() or Invocation()).imu_file is not None:
+    elif path is None and inv.imu_file is not None:
         from gcalign.io.scenario.recording import recorded_scenario  # a recording alone
 
-        imu_file = (_INVOCATION.get() or Invocation()).imu_file
+        imu_file = inv.imu_file
         data = recorded_scenario(section, imu_file)
         text, source = yaml.safe_dump(data, sort_keys=False), f"--imu-file {imu_file}"
     elif path is None:
@@ -265,11 +203,9 @@ def load_with_overrides(
         data, source = read_yaml(path), str(path)
         text = Path(path).read_text(encoding="utf-8")
     assert text is not None
-    inv = _INVOCATION.get() or Invocation()
-    inv.sets = list(sets or [])
     given = {k: v for k, v in overrides.items() if v is not None}
     named = dict(given)  # what the file name and the stored text record
-    recorded: list = []
+    done: list = []
     if isinstance(data, dict):
         if given:
             current = data.get(section)
@@ -278,18 +214,18 @@ def load_with_overrides(
                 adjust(merged, given)
             merged.update(given)
             data[section] = merged
-        _apply_recorded(data, inv, recorded)
-        _apply_sets(data, inv.sets, {f"{section}.{k}" for k in given} | {
-            k for k, _ in recorded}, source, recorded)
+        _apply_recorded(data, inv, done)
+        _apply_sets(data, list(sets or []), {f"{section}.{k}" for k in given} | {
+            k for k, _ in done}, source, done)
     sc = parse_scenario(data, source)
     if path is not None:
         sc.resolve_paths(Path(path).parent)  # imu_file, reference.path
-    inv.applied = [(f"{section}.{k}", v) for k, v in named.items()] + recorded
-    if inv.applied:
+    applied = [(f"{section}.{k}", v) for k, v in named.items()] + done
+    if applied:
         text += "\n# command-line overrides:\n" + yaml.safe_dump(
-            {k: (str(v) if isinstance(v, Path) else v) for k, v in inv.applied},
+            {k: (str(v) if isinstance(v, Path) else v) for k, v in applied},
             sort_keys=False)
-    return sc, text, source
+    return Loaded(sc, text, source, applied, inv)
 
 
 # --------------------------------------------------------------------------- output names
@@ -550,10 +486,10 @@ def _time_column():
 # --------------------------------------------------------------------------- run and show
 
 
-def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: Path | None,
+def run_and_show(name: str, loaded: Loaded, seed: int | None, output: Path | None,
                  as_json: bool, on_summary: Callable[[dict], None] | None = None,
                  stdout_free: bool = False, **options) -> None:
-    """Run command `name` on a loaded scenario (its preflight, then its execute), write the
+    """Run command `name` on a `loaded` scenario (its preflight, then its execute), write the
     results file and show its table. Default file name: :func:`output_name` with the
     overrides of the command line (and `options`, e.g. ``--init``). A streaming command
     writes its series into the (temporary) file while it runs; `options` go to its
@@ -563,13 +499,13 @@ def run_and_show(name: str, sc: Scenario, text: str, seed: int | None, output: P
     own output (the table goes to stderr, as under --json, without the JSON)."""
     from gcalign.app.runner import run_command
 
-    inv = _INVOCATION.get() or Invocation()
+    sc, text = loaded.scenario, loaded.text
     recorded = sc.imu_file is not None
     run_seed = None if recorded else (sc.imu.seed if seed is None else seed)
-    given = [*inv.applied, *((k, v) for k, v in options.items()
-                             if v is not None and v is not False)]  # a flag not given
+    given = [*loaded.applied, *((k, v) for k, v in options.items()
+                                if v is not None and v is not False)]  # a flag not given
     out = output or output_name(sc.name, name, run_seed, given)
-    notes = list(inv.notes)
+    notes: list[str] = []
     if recorded and seed is not None:
         notes.append("--seed: cannot matter with recorded data (no random numbers are drawn)")
     if output is None:

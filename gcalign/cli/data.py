@@ -9,8 +9,20 @@ import typer
 
 from gcalign.app.registry import COMMANDS
 from gcalign.cli.base import app, consoles, emit_json, user_errors
-from gcalign.cli.common import imu_file_given, load_with_overrides, run_and_show, warn
-from gcalign.cli.options import Json, Output, Seed, Sets
+from gcalign.cli.common import load_with_overrides, recorded, run_and_show, warn
+from gcalign.cli.options import (
+    Height,
+    ImuAxes,
+    ImuFile,
+    ImuFormat,
+    Json,
+    Lat,
+    Lon,
+    Output,
+    Reference,
+    Seed,
+    Sets,
+)
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
 
@@ -38,8 +50,8 @@ def simulate(
     set_: Sets = None,
 ):
     """Simulate truth and IMU data; write /truth and /imu."""
-    sc, text, _ = load_with_overrides(scenario, "", "", {}, sets=set_)
-    run_and_show("simulate", sc, text, seed, output, as_json)
+    run_and_show("simulate", load_with_overrides(scenario, "", "", {}, sets=set_), seed, output,
+                 as_json)
 
 
 @app.command()
@@ -61,6 +73,13 @@ def navigate(
     seed: Seed = None,
     as_json: Json = False,
     set_: Sets = None,
+    imu_file: ImuFile = None,
+    imu_format: ImuFormat = None,
+    imu_axes: ImuAxes = None,
+    reference: Reference = None,
+    lat: Lat = None,
+    lon: Lon = None,
+    height: Height = None,
 ):
     """Strapdown navigation, streamed block by block; errors against truth at every sample.
 
@@ -74,6 +93,7 @@ def navigate(
     from gcalign.io import results
     from gcalign.io.results import HDF5_SUFFIXES
 
+    given_options = recorded(imu_file, imu_format, imu_axes, reference, lat, lon, height)
     overrides = {"vertical": vertical, "start_s": start, "duration_s": duration}
     for what, given in (("--init", init), ("the source", source)):
         if output is not None and given not in (None, "truth", "header") and \
@@ -84,7 +104,7 @@ def navigate(
         raise ScenarioError(f"{source}: {not_a_file(source)}")
     suffix = "" if source is None else data_suffix(source)
     data = text = None
-    if source is None and not imu_file_given():
+    if source is None and given_options.imu_file is None:
         raise ScenarioError("navigate: give a scenario or a data file (SOURCE), or "
                             "--imu-file FILE")
     if source is not None and suffix in DATA_SUFFIXES | HDF5_SUFFIXES:
@@ -100,9 +120,9 @@ def navigate(
                 if key in stored:
                     data[key] = stored[key]
         text = text or yaml.safe_dump(data)
-    sc, text, _ = load_with_overrides(source, "", "navigation", overrides, data=data, text=text,
-                                      sets=set_)
-    run_and_show("navigate", sc, text, seed, output, as_json, init=init)
+    loaded = load_with_overrides(source, "", "navigation", overrides, data=data, text=text,
+                                 sets=set_, recorded=given_options)
+    run_and_show("navigate", loaded, seed, output, as_json, init=init)
 
 
 @app.command()
@@ -137,6 +157,13 @@ def validate(
     scenario: Path = typer.Argument(..., help="Scenario YAML, or a sweep YAML."),
     as_json: Json = False,
     set_: Sets = None,
+    imu_file: ImuFile = None,
+    imu_format: ImuFormat = None,
+    imu_axes: ImuAxes = None,
+    reference: Reference = None,
+    lat: Lat = None,
+    lon: Lon = None,
+    height: Height = None,
 ):
     """Check a scenario and print its resolved values in user units and SI, and the keys
     that cannot matter (as warnings). A sweep file (docs/batch.md): every variant checked
@@ -146,12 +173,13 @@ def validate(
     from gcalign.io.scenario.loader import read_yaml
     from gcalign.io.scenario.resolve import resolved_rows
 
+    given = recorded(imu_file, imu_format, imu_axes, reference, lat, lon, height)
     data = read_yaml(scenario)
     if isinstance(data, dict) and "base" in data:
         return _validate_sweep(scenario, set_, as_json)
-    sc, _, _ = load_with_overrides(scenario, "", "", {}, sets=set_)
-    preflight(sc)  # the checks every command runs first, for every section
-    rows = resolved_rows(sc)
+    sc = load_with_overrides(scenario, "", "", {}, sets=set_, recorded=given).scenario
+    inputs = preflight(sc)  # the checks every command runs first, for every section
+    rows = resolved_rows(sc, None if inputs.recording is None else inputs.recording.imu)
     sections = [c.section for c in COMMANDS.values() if c.section]
     warnings = list(dict.fromkeys(w for sec in sections for w in sc.unused(sec)))
     warn(warnings, as_json)

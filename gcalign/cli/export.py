@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 
+from gcalign.choices import EXPORT_FORMATS, listed
 from gcalign.cli.base import app, consoles, emit_json, user_errors
 from gcalign.cli.options import Json
 
@@ -16,7 +17,7 @@ from gcalign.cli.options import Json
 def export(
     file: Path = typer.Argument(..., help="A gcalign results file (.h5)."),
     fmt: str = typer.Option(..., "--format", metavar="FORMAT",
-                            help="csv | mat | i2nav-nav | psins-avp"),
+                            help=listed(EXPORT_FORMATS)),
     output: Path | None = typer.Option(
         None, "-o", "--output", help="File to write; default FILE with the format's suffix "
         "(.csv, .mat, .nav, .avp.mat)."),

@@ -21,9 +21,10 @@ def builtin_scenario_text() -> str:
 
 def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
                   dwell: float | None, sets: list[str] | None = None):
-    """Scenario and text with --scheme/--dwell written into ``mechanism`` and the other
-    options into ``modulate`` before validation. --scheme replaces the scenario's mechanism
-    (a table too; its timing keys stay) and, without --compare, is the one scheme run."""
+    """The scenario (:class:`~gcalign.cli.common.Loaded`) with --scheme/--dwell written
+    into ``mechanism`` and the other options into ``modulate`` before validation. --scheme
+    replaces the scenario's mechanism (a table too; its timing keys stay) and, without
+    --compare, is the one scheme run."""
     import yaml
 
     from gcalign.io.scenario.loader import read_yaml
@@ -46,9 +47,8 @@ def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
         data["mechanism"] = mech
         text += "\n# command-line overrides of mechanism:\n" + yaml.safe_dump(
             {"mechanism": given}, sort_keys=False)
-    sc, text, _ = load_with_overrides(path, BUILTIN, "modulate", overrides, data=data,
-                                      text=text, sets=sets)
-    return sc, text
+    return load_with_overrides(path, BUILTIN, "modulate", overrides, data=data, text=text,
+                               sets=sets)
 
 
 @app.command()
@@ -75,5 +75,5 @@ def modulate(
     the invariant report (mean C over the cycle, residual biases, Schuler warning)."""
     names = None if compare is None else [x.strip() for x in compare.split(",") if x.strip()]
     overrides = {"compare": names, "hours": hours}
-    sc, text = load_modulate(scenario, overrides, scheme, dwell, set_)
-    run_and_show("modulate", sc, text, seed, output, as_json)
+    run_and_show("modulate", load_modulate(scenario, overrides, scheme, dwell, set_), seed,
+                 output, as_json)

@@ -47,12 +47,10 @@ def _one_azimuth_source(section: dict, given: dict) -> None:
 
 
 def load_northfind(path: Path | None, overrides: dict, sets: list[str] | None = None):
-    """Scenario and text with the options written into ``northfind`` before validation (the
-    command's check runs in its preflight)."""
-    sc, text, _ = load_with_overrides(
-        path, BUILTIN, "northfind", overrides, _one_azimuth_source, sets=sets
-    )
-    return sc, text
+    """The scenario (:class:`~gcalign.cli.common.Loaded`) with the options written into
+    ``northfind`` before validation (the command's check runs in its preflight)."""
+    return load_with_overrides(path, BUILTIN, "northfind", overrides, _one_azimuth_source,
+                               sets=sets)
 
 
 @app.command()
@@ -95,5 +93,4 @@ def northfind(
         "sweep": parse_sweep(sweep),
         "repeats": repeats,
     }
-    sc, text = load_northfind(scenario, overrides, set_)
-    run_and_show("northfind", sc, text, seed, output, as_json)
+    run_and_show("northfind", load_northfind(scenario, overrides, set_), seed, output, as_json)

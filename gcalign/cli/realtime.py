@@ -21,10 +21,9 @@ def builtin_scenario_text() -> str:
 
 
 def load_realtime(path: Path | None, overrides: dict, sets: list[str] | None = None):
-    """Scenario and text with the options written into ``realtime`` before validation (the
-    command's check runs in its preflight)."""
-    sc, text, _ = load_with_overrides(path, BUILTIN, "realtime", overrides, sets=sets)
-    return sc, text
+    """The scenario (:class:`~gcalign.cli.common.Loaded`) with the options written into
+    ``realtime`` before validation (the command's check runs in its preflight)."""
+    return load_with_overrides(path, BUILTIN, "realtime", overrides, sets=sets)
 
 
 @app.command()
@@ -45,6 +44,6 @@ def realtime(
     set_: Sets = None,
 ):
     """Attitude at sync pulses: filter delay T + Δt, and prediction to the pulse time."""
-    sc, text = load_realtime(scenario, {"predictors": list(predictor) if predictor else None},
-                             set_)
-    run_and_show("realtime", sc, text, seed, output, as_json)
+    loaded = load_realtime(scenario, {"predictors": list(predictor) if predictor else None},
+                           set_)
+    run_and_show("realtime", loaded, seed, output, as_json)

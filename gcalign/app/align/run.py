@@ -24,7 +24,7 @@ from gcalign.align.gyrocompass import (
     truth_samples,
 )
 from gcalign.app.command import Outcome
-from gcalign.app.data import RunData, Stream, scenario_data, scenario_stream, stream_of
+from gcalign.app.data import Recording, RunData, Stream, scenario_data, scenario_stream, stream_of
 from gcalign.errors import InputError, ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import Aiding, AlignConfig
@@ -528,17 +528,18 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            progress: Progress | None = None) -> Outcome:
-    """Simulate (or read) the data, align, summarise; the registry's entry point."""
+            progress: Progress | None = None, recording: Recording | None = None) -> Outcome:
+    """Simulate (or read) the data, align, summarise; the registry's entry point.
+    `recording`: the recorded file as the preflight read it."""
     if sc.align is not None and sc.align.mode == "transfer":  # spec 006: its own room
         from gcalign.app.align import transfer
-        return transfer.execute(sc, seed, cache_key, progress)
+        return transfer.execute(sc, seed, cache_key, progress, recording)
     from gcalign.app.align.hdf5 import write_alignment
 
     if cache_key is not None:  # a batch: the noise-free simulation is shared by the seeds
         stream = stream_of(scenario_data(sc, seed, cache_key))
     else:
-        stream = scenario_stream(sc, seed)
+        stream = scenario_stream(sc, seed, recording=recording)
     run = run_alignment(sc, stream, progress)
     summary = alignment_summary(run, stream, sc.name)
     against = summary["error_source"] or "truth"

@@ -45,12 +45,12 @@ def reference_path(sc) -> Path:
     return path if path.is_absolute() else sc.imu_file.parent / path
 
 
-def load_inputs(sc):
+def load_inputs(sc, recording=None):
     """The slave's increments, the master series and the file's stored PSINS values
     (``eb0``, ``db0``, ``mu0`` in SI, those present), read by the recorded-data readers of
     the psins-mat format (:mod:`gcalign.io.recorded`): the slave as a recording with the
     scenario's layout (variable ``align.transfer.imu_variable``), the master as a reference
-    (10 columns, or 7 without attitude)."""
+    (10 columns, or 7 without attitude). `recording`: the slave as the preflight read it."""
     from gcalign.io.recorded import read_recording, read_reference
     from gcalign.io.recorded.mat import read_vectors
     from gcalign.transfer import MasterSeries
@@ -67,7 +67,7 @@ def load_inputs(sc):
         raise ScenarioError(f"align.transfer.imu_variable: {cfg.imu_variable!r} contradicts "
                             f"imu_file.variable {layout.variable!r}; give one of them")
     try:
-        imu = read_recording(sc.imu_file, layout)
+        imu = read_recording(sc.imu_file, layout) if recording is None else recording.imu
     except ScenarioError as err:
         text = str(err)
         field = ("align.transfer.imu_variable" if ": variable" in text
@@ -240,12 +240,12 @@ def cost(sc, runs: int = 1) -> Cost:
 
 
 def execute(sc, seed: int | None = None, cache_key: str | None = None,
-            progress=None) -> Outcome:
+            progress=None, recording=None) -> Outcome:
     """Read the slave and the master, align, summarise (the align room's mode transfer)."""
     from gcalign.transfer import transfer_align
 
     cfg = sc.align.transfer
-    dtheta, dv, t, master, stored, ref_path = load_inputs(sc)
+    dtheta, dv, t, master, stored, ref_path = load_inputs(sc, recording)
     _covered(sc, t, master, ref_path)
     start = time.process_time()
     result = transfer_align(dtheta, dv, t, master, cfg.settings(sc.earth_model))

@@ -156,13 +156,13 @@ def misfit_warnings(misfit: dict) -> list[str]:
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            progress=None) -> Outcome:
+            progress=None, recording=None) -> Outcome:
     """Allan deviation and noise terms of the scenario's data (the registry's entry)."""
     from gcalign.allan import analyse
     from gcalign.app.data import scenario_data
 
     t_start = time.perf_counter()
-    data = scenario_data(sc, seed, cache_key)
+    data = scenario_data(sc, seed, cache_key, recording)
     imu = data.imu
     if imu.q_bs is not None:
         raise ScenarioError("mechanism: the IMU turns on a mechanism; an Allan deviation "

@@ -24,6 +24,9 @@ class MetricError(Exception):
 
 
 _PARSED: dict[str, Any] = {}
+#: the recorded file of the variant run last, as its first run read it (vkey -> Recording):
+#: the variant's later seeds pass it along instead of reading the file again
+_RECORDING: dict[str, Any] = {}
 
 
 def _scenario(task: dict):
@@ -49,18 +52,24 @@ def noise_free_key(sc) -> str | None:
                      repr(float(sc.imu.rate_hz))))
 
 
-def run_summary(command: str, sc, seed: int, cache_key: str | None = None) -> dict:
+def run_summary(command: str, sc, seed: int, cache_key: str | None = None,
+                vkey: str | None = None) -> dict:
     """The summary dict a single run of `command` would print (through its room).
 
     `cache_key` (:func:`noise_free_key`) lets successive runs share the noise-free
-    simulation.
+    simulation; `vkey` (the variant) lets them share the recorded file as read.
     """
-    from gcalign.app.preflight import checked_execute
+    from gcalign.app.preflight import checked_run
     from gcalign.app.registry import COMMANDS
 
     if command not in COMMANDS:
         raise GcalignError(f"unknown command {command!r}; commands: {', '.join(COMMANDS)}")
-    return checked_execute(command, sc, seed, cache_key).summary
+    held = _RECORDING.get(vkey) if vkey is not None else None
+    outcome, inputs = checked_run(command, sc, seed, cache_key, recording=held)
+    if vkey is not None and held is None and inputs.recording is not None:
+        _RECORDING.clear()  # one variant's file at a time
+        _RECORDING[vkey] = inputs.recording
+    return outcome.summary
 
 
 def metric_value(summary: dict, path: str):
@@ -108,7 +117,8 @@ def run_task(task: dict) -> dict:
            "status": "ok", "metrics": {}, "error": ""}
     try:
         sc = _scenario(task)
-        summary = run_summary(task["command"], sc, task["seed"], noise_free_key(sc))
+        summary = run_summary(task["command"], sc, task["seed"], noise_free_key(sc),
+                              task["vkey"])
         rec["metrics"] = {m: metric_value(summary, m) for m in task["metrics"]}
     except MetricError as err:
         rec.update(status="bad-metric", error=str(err), metrics={})

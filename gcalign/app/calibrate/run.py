@@ -141,7 +141,8 @@ def simulated_case(sc: Scenario, seed: int | None = None, cache_key: str | None 
                 cfg.truth, None, window, output_stride=cfg.output_stride(sc.imu.rate_hz / n))
 
 
-def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
+def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None,
+                  recording=None) -> Case:
     """Recorded data: a coarse alignment over the start of the window when
     ``calibrate.coarse.method`` asks for one, then the filter to the end of the window,
     aided by the files at their own epochs (``aiding: file``) or by zero velocity at the
@@ -153,7 +154,7 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
 
     cfg = cfg or config_of(sc)
     cfg.check(sc)
-    run = scenario_data(sc)
+    run = scenario_data(sc, recording=recording)  # as the preflight read it, if it did
     imu, ts, site, earth = run.imu, run.imu.ts, run.site, run.earth
     rate = 1.0 / ts
     n = cfg.subsamples(rate)
@@ -193,9 +194,10 @@ def recorded_case(sc: Scenario, cfg: CalibrateConfig | None = None) -> Case:
                 cfg.output_stride(rate / n), reference, cfg.coarse.method != "none")
 
 
-def scenario_case(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Case:
+def scenario_case(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
+                  recording=None) -> Case:
     if sc.imu_file is not None:
-        return recorded_case(sc)
+        return recorded_case(sc, recording=recording)
     return simulated_case(sc, seed, cache_key)
 
 
@@ -489,7 +491,8 @@ def reference_errors(e: dict[str, np.ndarray] | None) -> dict:
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
-            compare: bool = False, progress: Progress | None = None, sink=None) -> Outcome:
+            compare: bool = False, progress: Progress | None = None, sink=None,
+            recording=None) -> Outcome:
     """Build the case, run the filter (or the six runs of `compare`), summarise; the
     Outcome's result is the :class:`~gcalign.calibrate.CalibrationResult` (with `compare`: the
     six, in the summary's order). With `sink` (an open results file) each run's solution at
@@ -498,7 +501,7 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
 
     if progress is not None:
         progress(0, 1, "simulating / reading the data")
-    case = scenario_case(sc, seed, cache_key)
+    case = scenario_case(sc, seed, cache_key, recording)
     if progress is not None and not compare:
         progress(0, 1, "filter run")
 

@@ -227,10 +227,11 @@ def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | Non
 
 
 def _run(sc: Scenario, seed: int | None, init: str | Path | None, sink, on_rows,
-         progress) -> tuple[dict, Stream, Navigation]:
-    """:func:`run_navigation` with the core's result."""
+         progress, recording=None) -> tuple[dict, Stream, Navigation]:
+    """:func:`run_navigation` with the core's result (`recording`: the recorded file as the
+    preflight read it)."""
     cfg = sc.navigation or NavigationConfig()
-    stream = scenario_stream(sc, seed)
+    stream = scenario_stream(sc, seed, recording=recording)
     ref = sc.reference.read() if sc.reference is not None else None
     kind = None if stream.header is None else stream.header.meta.get("motion_kind")
     vertical = vertical_of(cfg, sc, kind)
@@ -342,11 +343,11 @@ def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, str
 
 
 def execute(sc, seed: int | None = None, cache_key: str | None = None, sink=None,
-            init: str | Path | None = None, progress=None) -> Outcome:
+            init: str | Path | None = None, progress=None, recording=None) -> Outcome:
     """Navigate (streamed); the registry's entry point. With `sink` (an open results file)
     the decimated series go into its /navigate group as they are computed."""
     group = None if sink is None else sink.create_group("navigate")
-    summary, stream, nav = _run(sc, seed, init, group, None, progress)
+    summary, stream, nav = _run(sc, seed, init, group, None, progress, recording)
     warnings = duration_warnings(sc, summary, stream.ts)
     return Outcome(summary, lambda f: None, None, stream.seed, warnings, result=nav)
 

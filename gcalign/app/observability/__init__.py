@@ -38,12 +38,12 @@ class Observability(Command):
         return execute
 
     def execute(self, sc: Any, seed: int | None = None, cache_key: str | None = None,
-                **options: Any) -> Outcome:
-        if transfer_mode(sc):
+                *, recording: Any = None, **options: Any) -> Outcome:
+        if transfer_mode(sc):  # reads its files itself (it reads no recording in preflight)
             from gcalign.app.observability import transfer
 
             return transfer.execute(sc, seed, cache_key, **options)
-        return super().execute(sc, seed, cache_key, **options)
+        return super().execute(sc, seed, cache_key, recording=recording, **options)
 
     def table(self, summary: dict[str, Any]) -> Any:
         if summary.get("mode") == "transfer":

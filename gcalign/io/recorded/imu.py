@@ -42,7 +42,6 @@ import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 
@@ -597,9 +596,6 @@ def _up_axis(letters: str) -> tuple[int, float]:
 
 # --------------------------------------------------------------------------- reading
 
-_CACHE: dict[tuple, ImuData] = {}
-
-
 def read_recording(path, layout: Layout | None = None) -> ImuData:
     """Read a recording of any supported layout (module docstring) into increments in RFU.
 
@@ -617,30 +613,15 @@ def read_recording(path, layout: Layout | None = None) -> ImuData:
         ``t`` (N,) end time of each increment in the file's own time (s; GNSS seconds of
         week for i2nav), ``dtheta`` (N, 3) rad, ``dv`` (N, 3) m/s in body RFU, ``ts`` s;
         ``site``, ``att0``, ``v0_n`` from a PSINS header; ``meta["recording"]`` the record
-        of what was assumed (JSON-able). The last file read is kept (one entry, its
-        arrays read-only), so reading it again for its record costs nothing.
+        of what was assumed (JSON-able). Nothing is kept: a run reads its file once and
+        passes what it read along (:class:`gcalign.app.command.Inputs`).
 
     Raises
     ------
     ScenarioError
         One line naming the file (and row, or key) and what is allowed.
     """
-    layout = layout or Layout()
-    name = os.fspath(path)
-    try:
-        st = Path(name).stat()
-        key: tuple | None = (str(Path(name).resolve()), st.st_mtime_ns, st.st_size, layout)
-    except OSError:
-        key = None
-    if key is not None and key in _CACHE:
-        return _CACHE[key]
-    imu = _read(name, layout)
-    if key is not None:
-        for a in (imu.t, imu.dtheta, imu.dv):  # shared by the next reader: read-only
-            a.flags.writeable = False
-        _CACHE.clear()
-        _CACHE[key] = imu
-    return imu
+    return _read(os.fspath(path), layout or Layout())
 
 
 def _read(name: str, layout: Layout) -> ImuData:

@@ -85,7 +85,10 @@ class Model(BaseModel):
     would take them as 1), nor is text (``"0.2"`` or ``!!str 0.2``, which pydantic would
     convert) where the field takes numbers and no text."""
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True, allow_inf_nan=False)
+    # defer_build: a model's validator is built when it first validates, as part of the
+    # scenario's (one schema, not one per model at import: a start-up cost of every command)
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, allow_inf_nan=False,
+                              defer_build=True)
     _where: str = PrivateAttr(default="")  #: the dotted key of this section (locate)
 
     def __setattr__(self, name: str, value: Any) -> None:

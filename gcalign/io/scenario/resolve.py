@@ -15,8 +15,9 @@ def _v(x, digits=6) -> str:
     return text if a.size == 1 else f"[{text}]"
 
 
-def resolved_rows(sc: Scenario) -> list[tuple[str, str, str]]:
-    """``(field, value in user units, value in SI)`` for every setting the run will use."""
+def resolved_rows(sc: Scenario, imu=None) -> list[tuple[str, str, str]]:
+    """``(field, value in user units, value in SI)`` for every setting the run will use;
+    `imu`: the recorded file as the preflight read it (else read here)."""
     rows: list[tuple[str, str, str]] = [("name", sc.name, "")]
     if sc.site is not None:
         si = sc.site.to_si()
@@ -27,8 +28,14 @@ def resolved_rows(sc: Scenario) -> list[tuple[str, str, str]]:
         ]
     if sc.imu_file is not None:
         rows.append(("imu_file", str(sc.imu_file), "(recorded data; imu errors not applied)"))
-        rows += recording_rows(sc)
-        rows += reference_rows(sc)
+        from gcalign.io.results import HDF5_SUFFIXES
+
+        if imu is None and sc.imu_file.suffix.lower() not in HDF5_SUFFIXES:
+            from gcalign.io.recorded import read_recording
+
+            imu = read_recording(sc.imu_file, sc.recording_layout())
+        rows += recording_rows(sc, imu)
+        rows += reference_rows(sc, imu)
     else:
         imu, err = sc.imu, sc.imu.errors()
         rows += [
@@ -98,16 +105,15 @@ def motion_rows(sc: Scenario) -> list[tuple[str, str, str]]:
     return rows
 
 
-def recording_rows(sc: Scenario) -> list[tuple[str, str, str]]:
-    """What the reader assumes of the scenario's recorded file (format, axes, units, time,
-    rate, gaps, gravity), read from the file (a results file of ours says nothing here)."""
-    from gcalign.io.recorded import read_recording
+def recording_rows(sc: Scenario, imu) -> list[tuple[str, str, str]]:
+    """What the reader assumed of the scenario's recorded file `imu` as read (format, axes,
+    units, time, rate, gaps, gravity; a results file of ours says nothing here)."""
     from gcalign.io.results import HDF5_SUFFIXES
 
     assert sc.imu_file is not None
     if sc.imu_file.suffix.lower() in HDF5_SUFFIXES:
         return []
-    r = read_recording(sc.imu_file, sc.recording_layout()).meta["recording"]
+    r = imu.meta["recording"]
     gravity = r["gravity_check"]
     gaps = r["gaps"]
     return [
@@ -148,13 +154,12 @@ def _gyro_rows(check) -> tuple[str, str]:
             f"{check['windows']} windows{at_rest}")
 
 
-def reference_rows(sc: Scenario) -> list[tuple[str, str, str]]:
+def reference_rows(sc: Scenario, imu) -> list[tuple[str, str, str]]:
     """The reference file and initial keys, read and checked: the reference must cover the
     navigation window (``navigation.start_s``, ``duration_s``; the whole recording by
     default) of the recorded data (ScenarioError naming both spans otherwise) when the
     scenario navigates: it has a navigation section, or no align or calibrate section
-    (those check their own windows when they run)."""
-    from gcalign.io.recorded import read_recording
+    (those check their own windows when they run). `imu`: the recorded file as read."""
     from gcalign.io.recorded.reference import reference_at
 
     rows: list[tuple[str, str, str]] = []
@@ -166,7 +171,10 @@ def reference_rows(sc: Scenario) -> list[tuple[str, str, str]]:
         return rows
     ref = sc.reference.read()
     r = ref.record
-    imu = read_recording(sc.imu_file, sc.recording_layout())
+    if imu is None:  # a results file of ours
+        from gcalign.io.results import read_imu
+
+        imu = read_imu(sc.imu_file)
     nav = sc.navigation
     start = float(imu.t[0] - imu.ts) + (nav.start_s if nav is not None else 0.0)
     end = float(imu.t[-1]) if nav is None or nav.duration_s is None else min(
