@@ -28,6 +28,7 @@ import h5py
 import numpy as np
 
 from gcalign.errors import ScenarioError
+from gcalign.estimation.calibration import CalibrationResult, Smoothed
 from gcalign.estimation.degrees import ObservabilityTable
 from gcalign.io import results
 from gcalign.modulate.analysis import MechanismCycle
@@ -148,14 +149,9 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
         Block("calibrate/outages", {"start": times("O"), "end": times("O"),
                                     "length": num(("O",))}),
         Block("calibrate/runs/*", {
-            "t": times("K"), "estimate": STATES, "sigma": STATES, "truth?": STATES,
-            "nees?": num(("K",)), "innovation?": num(("U", "m")),
-            "standardized": num(("U", "m")), "nis": num(("U",)), "att": num(("K", 3)),
-            "updated?": num(("K",), whole=True), "update_t?": times("U"),
+            **from_fields(CalibrationResult), **from_fields(Smoothed, "smoothed/"),
+            "innovation?": num(("U", "m")), "nis": num(("U",)), "update_t?": times("U"),
             "sigma_z?": num(("U", "m")),
-            "v_n?": num(("K", 3)), "pos?": num(("K", 3)), "smoothed/estimate?": STATES,
-            "smoothed/sigma?": STATES, "smoothed/att?": num(("K", 3)),
-            "smoothed/v_n?": num(("K", 3)), "smoothed/pos?": num(("K", 3)),
             "smoothed/error/t?": times("D"), "smoothed/error/att?": num(("D", 3)),
             "smoothed/error/v_n?": num(("D", 3)), "smoothed/error/pos?": num(("D", 3)),
             "navigation/t?": times("R"), "navigation/t_run?": times("R"),

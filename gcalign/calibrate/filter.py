@@ -51,6 +51,7 @@ from gcalign.calibrate.data import FlightData, Trajectory
 from gcalign.calibrate.fixes import Fixes
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
+from gcalign.estimation.calibration import CalibrationResult, Smoothed
 from gcalign.estimation.ins_error import (
     DB,
     DKA,
@@ -142,73 +143,6 @@ class Settings:
         return (ie.initial_covariance(pos, self.p0_scale, sigma, earth),
                 ie.process_noise_density(self.arw, self.vrw),
                 ie.measurement_noise(self.measure, self.sigma_v, self.sigma_p, self.components))
-
-
-@dataclass(frozen=True)
-class Smoothed:
-    """RTS-smoothed estimates at the filter epochs: estimate and sigma (K+1, 21), as in
-    :class:`CalibrationResult` (IMU part: the sensor parameters, navigation part: the error
-    of the INS solution before the update at that epoch); att, v_n, pos (K+1, 3) the
-    smoothed navigation solution (that INS solution less its smoothed error)."""
-
-    estimate: np.ndarray
-    sigma: np.ndarray
-    att: np.ndarray
-    v_n: np.ndarray
-    pos: np.ndarray
-
-
-@dataclass(frozen=True)
-class CalibrationResult:
-    """A calibration run at the filter epochs ``t`` (K+1,), t[0] the start (no update).
-
-    estimate, sigma : (K+1, 21). IMU part (states 9–20): the estimated sensor parameters
-        ε, ∇, δKg, δKa of ``ω̃ = (I + diag δKg) ω + ε`` after the update at t (feed-forward:
-        the filter state). Navigation part: the estimated error of the INS solution at t
-        before the correction. σ: posterior standard deviation of the filter state.
-    truth : (K+1, 21) the same quantities from the truth (None for recorded data).
-    nees : (K+1,) NEES of the filter state against the truth (None without truth).
-    innovation, standardized : (U, m) z − H x⁻ and its whitened form (~ N(0, 1)) at the
-        U epochs with a measurement (``updated``; every epoch but the first on the seed's
-        schedule). nis : (U,) normalised innovation squared (~ χ²_m). sigma_z : (U, m) the
-        measurement σ used (R = diag σ²: the fix's own, or the settings').
-    att, v_n, pos : (K+1, 3) the corrected INS solution at the epochs.
-    measure_names : names of the m measurement components.
-    index : (K+1,) the navigation sample of each epoch (into the data's t).
-    updated : (K+1,) whether a measurement updated the filter at the epoch (in an outage
-        the filter only predicts, every filter period).
-    fixes_unused : fixes outside the run, or a second one within one navigation step.
-    """
-
-    t: np.ndarray
-    estimate: np.ndarray
-    sigma: np.ndarray
-    truth: np.ndarray | None
-    nees: np.ndarray | None
-    innovation: np.ndarray
-    standardized: np.ndarray
-    nis: np.ndarray
-    att: np.ndarray
-    v_n: np.ndarray
-    pos: np.ndarray
-    measure_names: tuple[str, ...]
-    settings: Settings
-    smoothed: Smoothed | None = None
-    names: tuple[str, ...] = field(default=ie.STATE_NAMES)
-    index: np.ndarray | None = None
-    updated: np.ndarray | None = None
-    sigma_z: np.ndarray | None = None
-    fixes_unused: int = 0
-
-    @property
-    def update_t(self) -> np.ndarray:
-        """(U,) the epochs with a measurement."""
-        return self.t[1:] if self.updated is None else self.t[self.updated]
-
-    @property
-    def error(self) -> np.ndarray | None:
-        """estimate − truth (K+1, 21), or None without truth."""
-        return None if self.truth is None else self.estimate - self.truth
 
 
 def _transition(q_nb: np.ndarray, v_n: np.ndarray, pos: np.ndarray, dtheta: np.ndarray,

@@ -484,6 +484,17 @@ def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None
     return ds
 
 
+def write_segments(f: h5py.File, truth, segments) -> None:
+    """/truth/segment (index of each sample's manoeuvre) and /truth/segment_names."""
+    if "truth" not in f or truth is None:
+        return
+    g = f["truth"]
+    if "segment" not in g and truth.segment is not None:
+        put(g, "segment", truth.segment, "1", description="index into segment_names")
+    g.create_dataset("segment_names", data=np.array([s.name for s in segments],
+                                                     dtype=h5py.string_dtype()))
+
+
 class Series:
     """Datasets that grow block by block: chunked, compressed (gzip + shuffle), resizable
     along axis 0, each with its units (and frame) attribute. ``append(name=array, …)``

@@ -18,6 +18,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -45,6 +46,9 @@ from gcalign.io.scenario.calibrate import CalibrateConfig
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.rotation import quat_to_euler
 from gcalign.sim.motions import Truth
+
+if TYPE_CHECKING:
+    import h5py
 
 MEASURES = ie.MEASUREMENTS
 Progress = Callable[[int, int, str], None]  # (done, total, what)
@@ -497,8 +501,6 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     Outcome's result is the :class:`~gcalign.calibrate.CalibrationResult` (with `compare`: the
     six, in the summary's order). With `sink` (an open results file) each run's solution at
     the output rate goes into ``/calibrate/runs/NN/navigation`` as it is computed."""
-    from gcalign.app.calibrate.hdf5 import write_calibration
-
     if progress is not None:
         progress(0, 1, "simulating / reading the data")
     case = scenario_case(sc, seed, cache_key, recording)
@@ -525,6 +527,75 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
                 *(() if case.aid is None else case.aid.warnings), *sigma_warnings(sc, case))
     return Outcome(out, lambda f: write_calibration(f, case, runs, compare, against),
                    case.truth(), case.seed, warnings, result=result)
+
+
+def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
+                      against: list[dict[str, np.ndarray] | None] | None = None) -> None:
+    """``/calibrate``: the run's settings, the flight's segments and outages, and per run
+    (``runs/NN``) the filter's result as its fields say
+    (:class:`~gcalign.calibrate.CalibrationResult`), the innovations in the measurement's
+    units, the errors of the smoothed solution and, with `against` (one per run, or None),
+    the INS solution's against a reference (:func:`reference_series`)."""
+    import h5py
+
+    from gcalign.io.results import put, write_segments
+    from gcalign.io.stored import write_fields
+
+    d = case.data
+    write_segments(f, case.truth(), d.segments)
+    g = f.require_group("calibrate")
+    g.attrs.update(aiding=case.aiding, navigation_rate_hz=case.navigation_rate,
+                   filter_rate_hz=case.settings.filter_rate, compare=compare,
+                   states=",".join(ie.STATE_NAMES), state_units=",".join(ie.STATE_UNITS),
+                   display_units=",".join(ie.DISPLAY_UNITS),
+                   display_scale=ie.display_scale(float(d.start.pos[0]),
+                                                  float(d.start.pos[2]), d.earth))
+    seg = g.create_group("segments")
+    seg.create_dataset("name", data=np.array([s.name for s in d.segments],
+                                             dtype=h5py.string_dtype()))
+    put(seg, "t0", [s.start for s in d.segments], "s")
+    put(seg, "t1", [s.end for s in d.segments], "s")
+    if case.aid is not None:
+        og = g.create_group("outages")
+        og.attrs.update(t0=case.t0, max_gap_s=case.aid.info["max_gap_s"], description=(
+            "stretches without a fix longer than max_gap_s (s from the run's sample 0; + t0: "
+            "the recording's time)"))
+        for name in ("start", "end", "length"):
+            put(og, name, [getattr(o, name) for o in case.aid.outages], "s")
+    for i, run in enumerate(runs):
+        rg, r = g.require_group(f"runs/{i:02d}"), run.result
+        rg.attrs.update(label=run.label, measure=r.settings.measure)
+        write_fields(rg, r)
+        units = {"velocity": "m/s", "position": "m"}.get(r.settings.measure, "m/s, m/s, m, m")
+        if r.updated is not None:
+            put(rg, "update_t", r.update_t, "s", description="the epochs with a measurement")
+        put(rg, "innovation", r.innovation, units, names=",".join(r.measure_names),
+            description="z - H x-, z = INS - reference")
+        put(rg, "nis", r.nis, "1", description=f"chi-square, {r.standardized.shape[1]} dof")
+        if r.sigma_z is not None:
+            put(rg, "sigma_z", r.sigma_z, units, names=",".join(r.measure_names),
+                description="the measurement sigma of each update (R = diag sigma^2)")
+        e = (run.epoch_errors or {}).get("smoothed_series")
+        if r.smoothed is not None and e is not None:
+            _put_errors(rg["smoothed"].create_group("error"), "the smoothed solution - the "
+                        "truth or the reference", e["t"], e["attitude"], e["velocity"],
+                        e["position"])
+        e = None if against is None else against[i]
+        if e is not None:
+            _put_errors(rg.create_group("reference_error"), "INS solution - reference, at "
+                        "the epochs it covers", e["t"], e["att"], e["v_n"], e["pos"])
+
+
+def _put_errors(g: h5py.Group, description: str, t, att, v_n, pos) -> None:
+    """A solution's errors at its epochs: t (s), att (Euler differences), v_n, pos (ENU)."""
+    from gcalign.io.results import put
+
+    g.attrs["description"] = description
+    put(g, "t", t, "s")
+    put(g, "att", att, "rad", description="Euler differences, roll and yaw wrapped: pitch, "
+        "roll, yaw")
+    put(g, "v_n", v_n, "m/s", "ENU")
+    put(g, "pos", pos, "m", "ENU")
 
 
 def sigma_warnings(sc: Scenario, case: Case) -> tuple[str, ...]:

@@ -15,8 +15,7 @@ from __future__ import annotations
 import h5py
 import numpy as np
 
-from gcalign.app.calibrate.hdf5 import write_segments
-from gcalign.io.results import put
+from gcalign.io.results import put, write_segments
 from gcalign.io.stored import write_fields
 
 
