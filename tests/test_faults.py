@@ -807,47 +807,109 @@ def test_no_room_for_numpys_openblas_buffer_is_one_line(tmp_path):
     assert "numpy's OpenBLAS needs 48 MB" in line
 
 
+#: A C call that keeps the GIL, as a numba kernel does for a whole run: the watcher thread
+#: of a worker inside it never runs. Each worker first leaves a file named by its id.
+_HOLD_THE_GIL = """
+import ctypes, os
+
+def hold(*args):
+    open(f"running.{os.getpid()}", "w").close()
+    ctypes.PyDLL(None).sleep(120)
+    return []
+"""
+
+
+def _running_workers(p: subprocess.Popen, folder: Path, n: int, wait_s: float) -> list[int]:
+    """The ids of the `n` workers of `p` once each is inside ``hold`` (waits on their files,
+    not on a clock: a loaded machine may take many seconds to start them)."""
+    deadline = time.monotonic() + wait_s
+    while time.monotonic() < deadline and p.poll() is None:
+        pids = [int(f.name.split(".")[1]) for f in folder.glob("running.*")]
+        if len(pids) == n:
+            return pids
+        time.sleep(0.05)
+    raise AssertionError(f"{n} workers did not start within {wait_s:g} s "
+                         f"(batch exit code {p.poll()})")
+
+
+def _outlive(pids: list[int], grace_s: float) -> list[int]:
+    """Those of `pids` still alive (not zombies) after up to `grace_s` s."""
+    deadline = time.monotonic() + grace_s
+    alive = pids
+    while alive and time.monotonic() < deadline:
+        time.sleep(0.05)
+        alive = [q for q in pids if _alive(q)]
+    return alive
+
+
+def _kill_all(p: subprocess.Popen, pids: list[int]) -> None:
+    p.kill()
+    p.wait()
+    for q in pids:
+        try:
+            os.kill(q, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+
 @pytest.mark.slow  # child processes, a few seconds
 def test_pool_workers_die_with_a_killed_batch_even_inside_a_long_kernel(tmp_path):
     """kill -9 of a batch: its workers must not compute on as orphans. A worker inside a
     long numba kernel holds the GIL, so its watcher thread never ran: a killed batch left its
     pool (three processes, 450 MB) running for nine minutes. Here each worker holds the GIL
-    in a C call for 60 s (what a kernel does) when the batch process is killed."""
-    code = """if True:
-        import ctypes, os, sys, time
-        from gcalign.app.batch.backends import LocalBackend
+    in a C call for 120 s (what a kernel does) when the batch process is killed."""
+    code = _HOLD_THE_GIL + """
+import time
+from gcalign.app.batch.backends import LocalBackend
 
-        def hold():
-            ctypes.PyDLL(None).sleep(60)  # a C call that keeps the GIL, as a kernel does
-
-        backend = LocalBackend(2, "simulate")
-        pids = [p.pid for p in backend._pool._processes.values()]
-        futures = [backend._pool.submit(hold) for _ in pids]
-        print(" ".join(map(str, pids)), flush=True)
-        time.sleep(60)
-    """
-    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
-                         cwd=tmp_path, env=_this_gcalign())
+backend = LocalBackend(2, "simulate")
+futures = [backend._pool.submit(hold) for _ in range(2)]
+time.sleep(120)
+"""
+    p = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, env=_this_gcalign())
     pids: list[int] = []
     try:
-        pids = [int(x) for x in p.stdout.readline().split()]
-        assert len(pids) == 2
-        time.sleep(1.0)  # the workers are inside hold()
+        pids = _running_workers(p, tmp_path, 2, wait_s=120.0)
         p.kill()
         p.wait()
-        deadline = time.monotonic() + 5.0
-        alive = pids
-        while alive and time.monotonic() < deadline:
-            time.sleep(0.1)
-            alive = [q for q in pids if _alive(q)]
-        assert alive == [], f"workers {alive} outlived the killed batch"
+        assert _outlive(pids, 10.0) == [], "workers outlived the killed batch"
     finally:
+        _kill_all(p, pids)
+
+
+@pytest.mark.slow  # a batch as a child process, a few seconds
+def test_a_gcalign_batch_killed_with_sigkill_leaves_no_worker_running(tmp_path):
+    """The command line itself (``gcalign batch SW.yaml -w 2``), killed with SIGKILL while
+    both its workers are inside a run that holds the GIL (the function each worker runs is
+    replaced by one, before the pool forks): the workers die with it, within 10 s (at once:
+    the kernel kills them); before, they ran their runs to the end as orphans."""
+    sweep(tmp_path)
+    code = _HOLD_THE_GIL + """
+import sys
+import gcalign.app.batch.backends as B
+from gcalign.cli import main
+
+B.run_chunk = hold
+sys.argv = ["gcalign", "batch", "SW.yaml", "-o", "b.h5", "-w", "2"]
+main()
+"""
+    p = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, env=_this_gcalign(),
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    pids: list[int] = []
+    try:
+        pids = _running_workers(p, tmp_path, 2, wait_s=120.0)
+        assert all(_parent(q) == p.pid for q in pids)  # the batch's own pool
         p.kill()
-        for q in pids:
-            try:
-                os.kill(q, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
+        p.wait()
+        assert _outlive(pids, 10.0) == [], "workers outlived the killed batch"
+        assert not (tmp_path / "b.h5").exists()
+    finally:
+        _kill_all(p, pids)
+
+
+def _parent(pid: int) -> int:
+    with open(f"/proc/{pid}/stat") as f:
+        return int(f.read().split(") ", 1)[1].split()[1])
 
 
 def _alive(pid: int) -> bool:
