@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 
 from gcalign import __version__, limits
 from gcalign.app import preflight, registry
-from gcalign.app.command import Command, Cost, Extent, Outcome
+from gcalign.app.command import Command, Cost, Inputs, Outcome
 from gcalign.app.registry import COMMANDS
 from gcalign.cli import app
 from gcalign.errors import ScenarioError
@@ -69,11 +69,13 @@ class Count(Command):
     help = "Count the samples of the motion (a toy)."
     layout = ("count",)
 
-    def check(self, sc, ext: Extent | None) -> None:
+    def check(self, inputs: Inputs) -> None:
+        ext = inputs.extent
         if ext is None or ext.samples * ext.ts < 1.0:
             raise ScenarioError("motion.duration_s: count needs at least 1 s of data")
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
+        ext = inputs.extent
         assert ext is not None
         return Cost(samples=ext.samples, memory_bytes=8.0, work=float(ext.samples),
                     work_what="samples")
@@ -170,7 +172,7 @@ def test_observability_on_millisecond_pieces_is_refused_before_work(tmp_path, mo
     the estimate is at least that, and a machine with 8 GB to spare refuses it."""
     sc = parse_scenario(yaml.safe_load(COMMANDS["observability"].builtin_text()), "b")
     sc.observability = sc.observability.model_copy(update={"piece_s": 0.001})
-    cost = COMMANDS["observability"].cost(sc, preflight.extent(sc))
+    cost = COMMANDS["observability"].cost(preflight.load(sc))
     assert cost.memory_bytes > 7.1e9
     monkeypatch.setenv("GCALIGN_MAX_MEMORY_MB", "8192")
     out = tmp_path / "out.h5"
@@ -248,7 +250,7 @@ def test_the_built_in_scenarios_fit_the_default_limits():
         if not c.builtin:
             continue
         sc = parse_scenario(yaml.safe_load(c.builtin_text()), name)
-        cost = preflight.budget(sc, c, preflight.extent(sc))
+        cost = preflight.budget(preflight.load(sc), c)
         assert 0 < cost.memory_bytes < 2**30, name
         assert 0 < cost.work < limits.MAX_WORK.value() / 10, name
 

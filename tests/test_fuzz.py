@@ -222,7 +222,7 @@ def test_a_value_error_of_a_check_is_exit_2_naming_the_section(fuzz_env, monkeyp
     input of its section, exit 2, not an internal error."""
     from gcalign.app.modulate import Modulate
 
-    def refuse(self, sc, ext):
+    def refuse(self, inputs):
         raise ValueError("period: cannot be negative")
 
     monkeypatch.setattr(Modulate, "check", refuse)
@@ -279,7 +279,7 @@ def test_numpy_warnings_do_not_print_before_the_error_line(fuzz_env, monkeypatch
     from gcalign.app.modulate import Modulate
     from gcalign.errors import ScenarioError
 
-    def overflowing(self, sc, ext):
+    def overflowing(self, inputs):
         np.float64(1e200) * np.float64(1e200)  # RuntimeWarning: overflow
         raise ScenarioError("modulate.hours: too long")
 

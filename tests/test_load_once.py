@@ -62,6 +62,18 @@ def test_a_recorded_file_is_parsed_once_per_run(command, short_recording, parses
         assert parses == [str(short_recording)] * i, f"run {i}: {parses}"
 
 
+def test_transfer_alignment_parses_its_slave_once(parses, tmp_path):
+    """align and observability in mode transfer: the preflight's reading of the slave
+    recording serves the check (the master's cover of the run) and the run."""
+    from conftest import ROOT
+
+    config = ROOT / "configs" / "psins_transfer_fog_mems.yaml"
+    for i, command in enumerate(("align", "observability"), 1):
+        res = runner.invoke(app, [command, str(config), "-o", str(tmp_path / f"{i}.h5")])
+        assert res.exit_code == 0, res.output
+        assert len(parses) == i, f"{command}: {parses}"
+
+
 def test_validate_parses_the_recording_once(short_recording, parses, tmp_path):
     """``gcalign validate``: the preflight of every section and the rows of what the reader
     assumed come from one reading."""

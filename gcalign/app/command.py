@@ -83,7 +83,9 @@ class Inputs:
     that a recorded file is read once per run."""
 
     scenario: Scenario
-    recording: Recording | None = None
+    #: a :class:`~gcalign.app.data.Recording`, or what a command reads itself
+    #: (:meth:`Command.read_own`)
+    recording: Recording | Any = None
     extent: Extent | None = None
 
 
@@ -162,9 +164,11 @@ class Command:
 
     # ------------------------------------------------------------------ checks and cost
 
-    def check(self, sc: Scenario, ext: Extent | None) -> None:
+    def check(self, inputs: Inputs) -> None:
         """Refuse (ScenarioError, one line naming the field) what the run would refuse;
-        `ext` is the scenario's data (None: it has none, or a recorded file not read)."""
+        ``inputs.extent`` is the scenario's data (None: it has none, or a recorded file not
+        read)."""
+        sc = inputs.scenario
         section = getattr(sc, self.section) if self.section else None
         if section is None and self.section_keys is not None:
             raise ScenarioError(f"{self.section}: missing; the scenario needs a "
@@ -173,9 +177,16 @@ class Command:
         if callable(check):
             check(sc)
 
-    def cost(self, sc: Scenario, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
         """What a run costs, checked against :mod:`gcalign.limits` before any work."""
+        ext = inputs.extent
         return Cost(samples=0.0 if ext is None else float(ext.samples))
+
+    def read_own(self, sc: Scenario) -> Any:
+        """What a run of `sc` reads from its files itself, where the generic reader does not
+        (``sc.reads_own_recording``: transfer alignment's slave and master), read once by
+        the preflight for the checks and the run (:attr:`Inputs.recording`); None: nothing."""
+        return None
 
     # ------------------------------------------------------------------ run
 

@@ -13,6 +13,7 @@ so both take the same decisions. Nothing here imports numba or scipy.
 from __future__ import annotations
 
 import typing
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from gcalign import limits
@@ -81,6 +82,8 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True,
     check_seed(sc.imu.seed, "imu.seed")
     # recorded data are read only for a command that can use them (the others refuse them)
     inputs = load(sc, read_recorded and any(c.options.recorded for c in commands), recording)
+    if name is not None and read_recorded and sc.reads_own_recording:
+        inputs = replace(inputs, recording=recording or commands[0].read_own(sc))
     ext = inputs.extent
     if ext is not None and not ext.recorded:
         sensor_errors(sc)
@@ -89,12 +92,12 @@ def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True,
         raise ScenarioError("motion: missing; the scenario needs 'motion' (simulated data) "
                             "or 'imu_file' (recorded data)"
                             + ("" if name else ", or a northfind/realtime section"))
-    if inputs.recording is not None:
+    if ext is not None and ext.recorded:
         consistent(sc, inputs.recording)
     for c in commands:
         try:
-            c.check(sc, ext)
-            budget(sc, c, ext)
+            c.check(inputs)
+            budget(inputs, c)
         except GcalignError:
             raise
         except (ValueError, TypeError) as err:  # a settings object refused what it was given
@@ -248,12 +251,12 @@ def sensor_errors(sc: Scenario) -> None:
                                     "input; check the units")
 
 
-def budget(sc: Scenario, cmd: Command, ext: Extent | None, workers: int = 1,
-           where: str | None = None, batch: bool = False) -> Cost:
+def budget(inputs: Inputs, cmd: Command, workers: int = 1, where: str | None = None,
+           batch: bool = False) -> Cost:
     """Refuse a run whose estimated cost (:meth:`Command.cost`) exceeds a limit: one line
     naming the estimate, the limit and the variable that raises it. `workers` runs at once
     (a batch: each holds its variant's noise-free simulation)."""
-    cost = cmd.cost(sc, ext)
+    cost, ext = cmd.cost(inputs), inputs.extent
     where = where or cmd.name
     seconds = "" if ext is None else f"{cost.samples * ext.ts:.3g} s of data at {1 / ext.ts:g} Hz"
     limits.MAX_SAMPLES.check(cost.samples, where, seconds)

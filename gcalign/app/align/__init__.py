@@ -15,6 +15,7 @@ from gcalign.app.command import (
     Command,
     Cost,
     Extent,
+    Inputs,
     Options,
     Outcome,
     stride,
@@ -86,15 +87,24 @@ class Align(Command):
 
         return figures(f, name)
 
-    def check(self, sc, ext: Extent | None) -> None:
+    def read_own(self, sc) -> Any:
+        """In mode transfer the slave and the master (:func:`transfer.load_inputs`)."""
+        if _config(sc).mode != "transfer":
+            return None
+        from gcalign.app.align.transfer import load_inputs
+
+        return load_inputs(sc)
+
+    def check(self, inputs: Inputs) -> None:
         """The latitude (the scenario's site, else the data file's), what needs truth, the
         times against the data, the stored-row stride; in mode transfer its files, settings
         and the master's cover of the run."""
+        sc, ext = inputs.scenario, inputs.extent
         cfg = _config(sc)
         if cfg.mode == "transfer":
             from gcalign.app.align import transfer
 
-            transfer.check(sc)
+            transfer.check(sc, inputs.recording)
             return
         lat = sc.site.lat_deg if sc.site is not None else (
             None if ext is None or ext.lat is None else math.degrees(ext.lat))
@@ -115,7 +125,8 @@ class Align(Command):
         window(sc, ext)
         stride(sc, ext)
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
+        sc, ext = inputs.scenario, inputs.extent
         if _config(sc).mode == "transfer":
             from gcalign.app.align import transfer
 

@@ -45,12 +45,12 @@ def reference_path(sc) -> Path:
     return path if path.is_absolute() else sc.imu_file.parent / path
 
 
-def load_inputs(sc, recording=None):
+def load_inputs(sc):
     """The slave's increments, the master series and the file's stored PSINS values
     (``eb0``, ``db0``, ``mu0`` in SI, those present), read by the recorded-data readers of
     the psins-mat format (:mod:`gcalign.io.recorded`): the slave as a recording with the
     scenario's layout (variable ``align.transfer.imu_variable``), the master as a reference
-    (10 columns, or 7 without attitude). `recording`: the slave as the preflight read it."""
+    (10 columns, or 7 without attitude)."""
     from gcalign.io.recorded import read_recording, read_reference
     from gcalign.io.recorded.mat import read_vectors
     from gcalign.transfer import MasterSeries
@@ -67,7 +67,7 @@ def load_inputs(sc, recording=None):
         raise ScenarioError(f"align.transfer.imu_variable: {cfg.imu_variable!r} contradicts "
                             f"imu_file.variable {layout.variable!r}; give one of them")
     try:
-        imu = read_recording(sc.imu_file, layout) if recording is None else recording.imu
+        imu = read_recording(sc.imu_file, layout)
     except ScenarioError as err:
         text = str(err)
         field = ("align.transfer.imu_variable" if ": variable" in text
@@ -196,11 +196,12 @@ def _covered(sc, t, master, ref_path) -> None:
                             ) from None
 
 
-def check(sc) -> None:
+def check(sc, loaded=None) -> None:
     """Refuse what the run would refuse (``gcalign validate``, the preflight of a run): the
     files and their variables, the matching against the reference's columns, the settings,
-    the reference's cover of the IMU run. Reads the files; loads no numba."""
-    dtheta, dv, t, master, _, ref_path = load_inputs(sc)
+    the reference's cover of the IMU run. Reads the files unless `loaded` (what
+    :func:`load_inputs` returned, the preflight's); loads no numba."""
+    dtheta, dv, t, master, _, ref_path = loaded or load_inputs(sc)
     sc.align.transfer.settings(sc.earth_model)
     _covered(sc, t, master, ref_path)
 
@@ -241,11 +242,12 @@ def cost(sc, runs: int = 1) -> Cost:
 
 def execute(sc, seed: int | None = None, cache_key: str | None = None,
             progress=None, recording=None) -> Outcome:
-    """Read the slave and the master, align, summarise (the align room's mode transfer)."""
+    """Read the slave and the master (`recording`: as the preflight read them,
+    :func:`load_inputs`), align, summarise (the align room's mode transfer)."""
     from gcalign.transfer import transfer_align
 
     cfg = sc.align.transfer
-    dtheta, dv, t, master, stored, ref_path = load_inputs(sc, recording)
+    dtheta, dv, t, master, stored, ref_path = recording or load_inputs(sc)
     _covered(sc, t, master, ref_path)
     start = time.process_time()
     result = transfer_align(dtheta, dv, t, master, cfg.settings(sc.earth_model))

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from gcalign.app.command import Command, Cost, Extent, Options, Outcome
+from gcalign.app.command import Command, Cost, Inputs, Options, Outcome
 from gcalign.errors import ScenarioError
 
 #: operations per sample and axis: the running sum and allantools' second differences at
@@ -36,14 +36,16 @@ class Allan(Command):
 
         return figures(f, name)
 
-    def check(self, sc, ext: Extent | None) -> None:
+    def check(self, inputs: Inputs) -> None:
+        sc, ext = inputs.scenario, inputs.extent
         if ext is None or sc.allan is None:
             return
         if int(round(sc.allan.start_s / ext.ts)) >= ext.samples:
             raise ScenarioError(f"allan.start_s: {sc.allan.start_s:g} s is past the end of the "
                                 f"data ({ext.samples * ext.ts:g} s)")
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
+        ext = inputs.extent
         if ext is None:
             return Cost()
         n = float(ext.samples)

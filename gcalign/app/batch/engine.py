@@ -147,15 +147,15 @@ def worker_count(workers: int | None, scheduler: str | None, runs: int) -> int:
 def budget_check(sweep: Sweep, workers: int) -> None:
     """The memory of `workers` runs held at once (each worker keeps its variant's
     noise-free simulation) against the limit, before anything runs."""
-    from gcalign.app.preflight import budget, extent
+    from gcalign.app.preflight import budget, load
     from gcalign.app.registry import command
     from gcalign.io.scenario import parse_scenario
 
     v = max(sweep.variants, key=lambda v: _duration(v.scenario))
     sc = parse_scenario(v.scenario, f"{sweep.source}: variant {v.label}")
-    ext = extent(sc, read_recorded=False)
-    if ext is not None:
-        budget(sc, command(sweep.command), ext, workers,
+    inputs = load(sc, read_recorded=False)
+    if inputs.extent is not None:
+        budget(inputs, command(sweep.command), workers,
                where=f"{sweep.source}: variant {v.label}", batch=True)
 
 

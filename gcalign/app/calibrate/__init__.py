@@ -13,6 +13,7 @@ from gcalign.app.command import (
     Command,
     Cost,
     Extent,
+    Inputs,
     Options,
     Outcome,
     warm_run,
@@ -90,12 +91,14 @@ class Calibrate(Command):
 
         return figures(f, name)
 
-    def check(self, sc, ext: Extent | None) -> None:
+    def check(self, inputs: Inputs) -> None:
+        sc = inputs.scenario
         config(sc).check(sc)
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
         """The simulation (or the recorded data) held whole, the flight at the navigation
         rate, the filter's epochs (and the smoother's P and Φ per epoch)."""
+        sc, ext = inputs.scenario, inputs.extent
         n, nav, epochs = steps(sc, ext)
         cfg = config(sc)
         recorded = ext is not None and ext.recorded

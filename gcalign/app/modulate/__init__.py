@@ -12,7 +12,7 @@ from gcalign.app.command import (
     STRAPDOWN_OPS,
     Command,
     Cost,
-    Extent,
+    Inputs,
     Options,
     Outcome,
 )
@@ -45,14 +45,16 @@ class Modulate(Command):
 
         return figures(f, name)
 
-    def check(self, sc, ext: Extent | None) -> None:
+    def check(self, inputs: Inputs) -> None:
+        sc = inputs.scenario
         from gcalign.io.scenario.modulate import plan_of
 
         plan_of(sc)
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
         """Each scheme simulates and navigates the plan's duration, streamed in blocks, and
         stores its series at ``output.rate_hz`` (default 1 Hz up to 4 h, 0.1 Hz beyond)."""
+        sc: Any = inputs.scenario  # its section is there: the check ran first
         from gcalign.io.scenario.modulate import default_rate_hz, plan_of
 
         plan = plan_of(sc)

@@ -11,7 +11,7 @@ from gcalign.app.command import (
     STRAPDOWN_OPS,
     Command,
     Cost,
-    Extent,
+    Inputs,
     Options,
     Outcome,
     stride,
@@ -43,7 +43,8 @@ class Navigate(Command):
 
         return figures(f, name)
 
-    def check(self, sc, ext: Extent | None) -> None:
+    def check(self, inputs: Inputs) -> None:
+        sc, ext = inputs.scenario, inputs.extent
         if ext is None:
             return
         from gcalign.io.scenario.navigation import NavigationConfig
@@ -54,7 +55,8 @@ class Navigate(Command):
                                 f"data ({ext.samples * ext.ts:g} s)")
         stride(sc, ext)
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
+        sc, ext = inputs.scenario, inputs.extent
         if ext is None:
             return Cost()
         n = float(ext.samples)

@@ -5,7 +5,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from gcalign.app.command import DOUBLE, SIMULATE_OPS, Command, Cost, Extent, Options, Outcome
+from gcalign.app.command import (
+    DOUBLE,
+    SIMULATE_OPS,
+    Command,
+    Cost,
+    Inputs,
+    Options,
+    Outcome,
+)
 
 READING_DOUBLES = 16  #: per dwell reading: gyro and accelerometer means, per method results
 
@@ -34,7 +42,8 @@ class Northfind(Command):
 
         return figures(f, name)
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
+        sc: Any = inputs.scenario  # its section is there: the check ran first
         cfg = sc.northfind
         readings = float(cfg.azimuths_deg().size * cfg.repeats * cfg.positions)
         per_dwell = float(round(cfg.dwell_s * sc.imu.rate_hz)) if cfg.samples else 1.0

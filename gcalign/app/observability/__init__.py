@@ -14,7 +14,7 @@ from gcalign.app.calibrate import (
     state_components,
     steps,
 )
-from gcalign.app.command import DOUBLE, KALMAN_OPS, Command, Cost, Extent, Options, Outcome
+from gcalign.app.command import DOUBLE, KALMAN_OPS, Command, Cost, Inputs, Options, Outcome
 
 N = 21  #: states
 PIECE_OPS = 40.0 * N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, its QR
@@ -39,10 +39,10 @@ class Observability(Command):
 
     def execute(self, sc: Any, seed: int | None = None, cache_key: str | None = None,
                 *, recording: Any = None, **options: Any) -> Outcome:
-        if transfer_mode(sc):  # reads its files itself (it reads no recording in preflight)
+        if transfer_mode(sc):
             from gcalign.app.observability import transfer
 
-            return transfer.execute(sc, seed, cache_key, **options)
+            return transfer.execute(sc, seed, cache_key, recording=recording, **options)
         return super().execute(sc, seed, cache_key, recording=recording, **options)
 
     def table(self, summary: dict[str, Any]) -> Any:
@@ -63,19 +63,30 @@ class Observability(Command):
 
         return figures(f, name)
 
-    def check(self, sc, ext: Extent | None) -> None:
+    def read_own(self, sc: Any) -> Any:
+        """A transfer-alignment scenario's slave and master (:func:`gcalign.app.align.
+        transfer.load_inputs`)."""
+        if not transfer_mode(sc):
+            return None
+        from gcalign.app.align.transfer import load_inputs
+
+        return load_inputs(sc)
+
+    def check(self, inputs: Inputs) -> None:
+        sc = inputs.scenario
         from gcalign.io.scenario.calibrate import ObservabilityConfig
 
         (sc.observability or ObservabilityConfig()).check(sc)
         if transfer_mode(sc):
             from gcalign.app.observability import transfer
 
-            transfer.check(sc)
+            transfer.check(sc, inputs.recording)
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
         """Per PWCS piece F, Φ, R and the stacked observability matrix (measurements × 21
         rows of 21) held at once, and their products; the flight at the navigation rate;
         the covariance run's epochs."""
+        sc, ext = inputs.scenario, inputs.extent
         from gcalign.io.scenario.calibrate import ObservabilityConfig
 
         if transfer_mode(sc):

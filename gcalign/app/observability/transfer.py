@@ -34,11 +34,12 @@ def _config(sc):
     return sc.observability or ObservabilityConfig()
 
 
-def check(sc) -> None:
-    """The transfer run's refusals (files, variables, matching, settings, cover)."""
+def check(sc, loaded=None) -> None:
+    """The transfer run's refusals (files, variables, matching, settings, cover); `loaded`:
+    the files as the preflight read them."""
     from gcalign.app.align import transfer
 
-    transfer.check(sc)
+    transfer.check(sc, loaded)
 
 
 def cost(sc) -> Cost:
@@ -60,7 +61,7 @@ def cost(sc) -> Cost:
 
 
 def execute(sc, seed: int | None = None, cache_key: str | None = None,
-            progress: Any = None) -> Outcome:
+            progress: Any = None, recording: Any = None) -> Outcome:
     """The filter's run and its table (no randomness: the seed only names the run)."""
     from gcalign.app.align.transfer import _covered, load_inputs
     from gcalign.transfer import transfer_align
@@ -69,7 +70,7 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None,
     cfg, tcfg = _config(sc), sc.align.transfer
     if progress is not None:
         progress(0, 2, f"transfer filter ({tcfg.matching})")
-    dtheta, dv, t, master, _, ref_path = load_inputs(sc)
+    dtheta, dv, t, master, _, ref_path = recording or load_inputs(sc)
     _covered(sc, t, master, ref_path)
     start = time.perf_counter()
     result = transfer_align(dtheta, dv, t, master, tcfg.settings(sc.earth_model))

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from gcalign.app.command import DOUBLE, Command, Cost, Extent, Options, Outcome
+from gcalign.app.command import DOUBLE, Command, Cost, Inputs, Options, Outcome
 
 NOTCH_OPS = 5.0  #: a second-order IIR section per sample
 SOLUTION_DOUBLES = 24  #: per attitude solution: truth, output and each predictor's error
@@ -36,9 +36,10 @@ class Realtime(Command):
 
         return figures(f, name)
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
         """Three gyro channels through the chain's FIR (taps × samples, a direct
         convolution) and notch; the attitude solutions held for the pulses."""
+        sc: Any = inputs.scenario  # its section is there: the check ran first
         cfg = sc.realtime
         s = cfg.to_settings()
         f = s.filter

@@ -10,7 +10,7 @@ from gcalign.app.command import (
     SIMULATE_OPS,
     Command,
     Cost,
-    Extent,
+    Inputs,
     Options,
     Outcome,
     stride,
@@ -35,11 +35,13 @@ class Simulate(Command):
 
         return simulate_table(summary)
 
-    def check(self, sc, ext: Extent | None) -> None:
+    def check(self, inputs: Inputs) -> None:
+        sc, ext = inputs.scenario, inputs.extent
         if ext is not None:
             stride(sc, ext)
 
-    def cost(self, sc, ext: Extent | None) -> Cost:
+    def cost(self, inputs: Inputs) -> Cost:
+        sc, ext = inputs.scenario, inputs.extent
         if ext is None:
             return Cost()
         n = float(ext.samples)
