@@ -374,3 +374,37 @@ def test_validate_lists_the_sections():
     values = json.loads(res.stdout)["values"]
     assert values["calibrate.navigation_rate_hz"]["value"] == "25 Hz"
     assert "observability.scaling" in values
+
+
+def test_batch_seeds_share_the_trajectory_and_keep_their_numbers():
+    """A batch's seeds (a cache key: the noise-free simulation shared) take the truth's
+    trajectory from the first seed's (computed once, read-only) and get the flight each
+    gets alone, field by field to the bit (the filter's runs: the slow test above)."""
+    from dataclasses import fields
+
+    from gcalign.app.batch.runs import noise_free_key
+    from gcalign.app.calibrate.run import simulated_case
+    from gcalign.io.scenario import parse_scenario
+
+    d = copy.deepcopy(SHORT_CAL)
+    d["calibrate"] |= {"truth": "draw", "p0_scale": 1}
+    sc = parse_scenario(d, "mc")
+    key = noise_free_key(sc)
+    cases = []
+    for seed in (3, 4):
+        shared, alone = simulated_case(sc, seed, key), simulated_case(sc, seed)
+        for f in fields(shared.data):
+            a, b = getattr(shared.data, f.name), getattr(alone.data, f.name)
+            if f.name == "truth":
+                for g in fields(a):
+                    assert np.array_equal(getattr(a, g.name), getattr(b, g.name)) \
+                        if isinstance(getattr(a, g.name), np.ndarray) else \
+                        getattr(a, g.name) == getattr(b, g.name), g.name
+            elif isinstance(a, np.ndarray):
+                assert np.array_equal(a, b), f.name
+        for name, value in vars(shared.data.start).items():  # the INS start, perturbed
+            assert np.array_equal(value, getattr(alone.data.start, name)), name
+        cases.append(shared)
+    assert cases[0].data.truth is cases[1].data.truth  # one trajectory for the seeds
+    assert not cases[0].data.truth.f_b.flags.writeable
+    assert not np.array_equal(cases[0].data.dtheta, cases[1].data.dtheta)

@@ -266,17 +266,20 @@ def trajectory(t: np.ndarray, att: np.ndarray, v_n: np.ndarray, pos: np.ndarray,
 
 def flight_from_ideal(truth: Truth, ideal: ImuData, x_true: np.ndarray, errors: ImuErrors,
                       rng: np.random.Generator, segments: tuple[Span, ...] = (),
-                      subsamples: int = 1, earth: EarthModel = WGS84) -> FlightData:
+                      subsamples: int = 1, earth: EarthModel = WGS84,
+                      traj: Trajectory | None = None) -> FlightData:
     """:class:`FlightData` from a truth (``Truth``, N+1 samples) and its ideal increments
     (``ImuData``, N) at the IMU rate with the errors `x_true`: its biases and scale factors
     replace those of `errors` (whose noise and unmodelled terms stay), the measured
     increments are combined `subsamples` to a navigation step, and the INS starts from the
     truth perturbed by ``x_true[:9]``. The Monte Carlo path: simulate once, corrupt per run.
+    `traj`: the truth's :func:`trajectory` (the part no run changes) if the caller has it.
     """
     stream = ErrorStream(imu_errors(x_true, errors), ideal.ts, rng, len(ideal.dtheta))
     dtheta, dv = combine_increments(*stream.apply(ideal.dtheta, ideal.dv), subsamples)
-    traj = trajectory(truth.t, truth.att, truth.v_n, truth.pos, ideal.dtheta, ideal.dv,
-                      earth, subsamples)
+    if traj is None:
+        traj = trajectory(truth.t, truth.att, truth.v_n, truth.pos, ideal.dtheta, ideal.dv,
+                          earth, subsamples)
     start = NavState.from_euler(traj.att[0], traj.v_n[0], traj.pos[0])
     return FlightData(t=traj.t, dtheta=dtheta, dv=dv, start=perturb(start, x_true),
                       ref_v_n=traj.v_n, ref_pos=traj.pos, segments=segments, truth=traj,

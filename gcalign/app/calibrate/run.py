@@ -28,6 +28,7 @@ from gcalign.calibrate import (
     CalibrationResult,
     FlightData,
     Settings,
+    Trajectory,
     calibrate,
     combine_increments,
     draw_truth,
@@ -35,6 +36,7 @@ from gcalign.calibrate import (
     motion_spans,
     parked_data,
     sampled_truth,
+    trajectory,
     zero_velocity_aiding,
 )
 from gcalign.calibrate.filter import warm_up
@@ -49,6 +51,8 @@ from gcalign.sim.motions import Truth
 
 if TYPE_CHECKING:
     import h5py
+
+    from gcalign.app.data import RunData
 
 MEASURES = ie.MEASUREMENTS
 Progress = Callable[[int, int, str], None]  # (done, total, what)
@@ -118,6 +122,30 @@ def injected_truth(sc: Scenario, cfg: CalibrateConfig, settings: Settings, site:
     return x
 
 
+_TRAJECTORIES: list[tuple[RunData, int, tuple, Trajectory]] = []  # noise-free data, subsamples,
+# earth, its trajectory: the last few, in this process
+
+
+def shared_trajectory(raw: RunData, n: int, earth: EarthModel) -> Trajectory:
+    """The :func:`gcalign.calibrate.trajectory` of a batch's cached noise-free simulation
+    (:func:`gcalign.app.data.cached_noise_free`), computed once per simulation, subsamples
+    and earth model in this process (the seeds of a variant share it; about a fifth of a
+    seed 002 run) and read-only like the simulation it comes from."""
+    key = tuple(earth.params().tolist())
+    for data, m, e, traj in _TRAJECTORIES:
+        if data is raw and m == n and e == key:
+            return traj
+    assert raw.truth is not None
+    tr = raw.truth
+    traj = trajectory(tr.t, tr.att, tr.v_n, tr.pos, raw.imu.dtheta, raw.imu.dv, earth, n)
+    for value in vars(traj).values():
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+    _TRAJECTORIES.insert(0, (raw, n, key, traj))
+    del _TRAJECTORIES[4:]
+    return traj
+
+
 def simulated_case(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
                    cfg: CalibrateConfig | None = None) -> Case:
     """The flight of a simulated scenario with its injected errors (see the module doc)."""
@@ -133,9 +161,10 @@ def simulated_case(sc: Scenario, seed: int | None = None, cache_key: str | None 
     n = cfg.subsamples(sc.imu.rate_hz)
     settings = cfg.settings(site, earth, sc=sc)
     x = injected_truth(sc, cfg, settings, site, earth, seed)
+    traj = None if cache_key is None else shared_trajectory(raw, n, earth)
     data = flight_from_ideal(raw.truth, raw.imu, x, sc.imu.errors(), np.random.default_rng(seed),
                              motion_spans(sc.motion.to_motion(), float(raw.truth.t[-1])), n,
-                             earth)
+                             earth, traj)
     window = cfg.window(sc.motion.duration(), 1.0 / sc.imu.rate_hz)
     if window[0] > 0 or window[2] < data.t[-1] - 1e-9:
         data = data.between(window[0], window[2])
