@@ -101,6 +101,28 @@ def test_streamed_chunks_equal_one_pass():
     np.testing.assert_allclose(np.concatenate(parts), y_all, rtol=0, atol=1e-14)
 
 
+def test_a_long_fir_through_ffts_is_scipys_lfilter_streamed_in_chunks():
+    """An FIR of more than DIRECT_TAPS taps is applied through FFTs (order 59999 on the
+    default cases ran over 5 minutes by direct convolution): the same output as scipy's
+    lfilter from rest, to round-off, in one pass and in chunks shorter than the FIR."""
+    from gcalign.realtime.filters import DIRECT_TAPS
+
+    order = 3 * DIRECT_TAPS
+    chain = FilterChain(FS, design_fir(order, 200.0, FS, "hamming"))
+    rng = np.random.default_rng(5)
+    x = rng.normal(size=(4 * order + 17, 3))
+    ref = signal.lfilter(chain.h, [1.0], x, axis=0)
+    y_all, _ = chain.apply(x, chain.initial_state(3))
+    np.testing.assert_allclose(y_all, ref, rtol=0, atol=1e-12)
+    state, parts, i = chain.initial_state(3), [], 0
+    for n in [1, 500, order + 3, 2 * order, len(x) - 1 - 500 - (order + 3) - 2 * order]:
+        y, state = chain.apply(x[i:i + n], state)
+        parts.append(y)
+        i += n
+    assert i == len(x)
+    np.testing.assert_allclose(np.concatenate(parts), ref, rtol=0, atol=1e-12)
+
+
 def test_initial_state_is_the_steady_state_of_a_constant():
     chain = navigation_chain(FilterSettings())
     y, _ = chain.apply(np.full((300, 1), 2.5), chain.initial_state(1, 2.5))
