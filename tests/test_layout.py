@@ -17,7 +17,7 @@ PKG = Path(__file__).resolve().parents[1] / "gcalign"
 # The packages in layers, lowest first. A module may import its own layer and the layers
 # below it, never one above, at the top of a file or inside a function alike.
 LAYERS = (
-    ("units", "errors", "limits", "gaps", "_version", "schema"),
+    ("units", "errors", "limits", "gaps", "_version", "schema", "choices"),
     ("nav",),
     ("sim", "estimation"),
     ("align", "northfind", "calibrate", "realtime", "modulate", "transfer",  # capabilities
