@@ -102,12 +102,20 @@ def test_the_fir_window_names_are_scipys_windows_without_parameters():
      "realtime.pulses.drift_ppm: mode 'solution'"),
     ({"mode": "async", "rate_hz": 0.5},
      "pulses.rate_hz: 0.5 Hz gives fewer than 2 pulses in the 1.5 s scored"),
+    ({"mode": "solution", "rate_hz": 100, "offset_us": None},
+     "realtime.pulses.offset_us: mode 'solution' puts each pulse this far after a solution "
+     "instant: within [0, 1000) µs at 1000 Hz (null, a random first edge, is for mode async), "
+     "got null"),
+    ({"mode": "solution", "rate_hz": 100, "offset_us": 5000},
+     "realtime.pulses.offset_us: mode 'solution' puts each pulse this far after a solution "
+     "instant: within [0, 1000) µs at 1000 Hz (null, a random first edge, is for mode async), "
+     "got 5000"),
 ])
 def test_a_pulse_jitter_that_cannot_matter_or_leaves_no_pulse_is_refused(tmp_path, pulses,
                                                                          message):
     """jitter_us 1e12 on an asynchronous case left no pulse to score (an internal error);
     a jitter in mode 'solution', where the pulses fall on solution instants, was accepted in
-    silence."""
+    silence; an offset in mode 'solution' was refused as the core's offset_s, in s."""
     import fuzz_cases as F
     from cli_checks import assert_bad_input
     from typer.testing import CliRunner

@@ -195,6 +195,19 @@ class PulsesConfig(Model):
                              f"the pulses), got {self.jitter_us:g}")
         return self
 
+    def check_offset(self, where: str, solution_hz: float) -> None:
+        """Mode ``solution``: ``offset_us`` is the pulse's fixed distance after each solution
+        instant, within one solution interval; ValueError naming `where`.offset_us in µs
+        (the core's check names its own offset_s, in s)."""
+        interval_us = 1e6 / solution_hz
+        if self.mode == "solution" and (self.offset_us is None
+                                        or not self.offset_us < interval_us):
+            got = "null" if self.offset_us is None else f"{self.offset_us:g}"
+            raise ValueError(f"{where}.offset_us: mode 'solution' puts each pulse this far "
+                             f"after a solution instant: within [0, {interval_us:g}) µs at "
+                             f"{solution_hz:g} Hz (null, a random first edge, is for mode "
+                             f"async), got {got}")
+
     def to_settings(self) -> PulseSettings:
         return PulseSettings(mode=self.mode, rate_hz=self.rate_hz,
                              offset_s=_us(self.offset_us), jitter_s=self.jitter_us * 1e-6,
@@ -264,6 +277,10 @@ class RealtimeConfig(Model):
             raise ValueError("pulses: semi_physical: true puts the pulses on every solution "
                              "instant (Δt = 0); remove realtime.pulses (a case may still "
                              "bring its own) or set semi_physical: false")
+        self.pulses.check_offset("pulses", self.solution_hz)
+        for i, c in enumerate(self.cases or ()):
+            if c.pulses is not None:
+                c.pulses.check_offset(f"cases.{i}.pulses", self.solution_hz)
         from gcalign.realtime.cases import check_case, check_filter
 
         settings = self.to_settings()  # the core's checks, one line naming the setting
