@@ -403,12 +403,7 @@ def test_the_batch_lock_dies_with_its_holder_not_with_its_forked_children(tmp_pa
         with OutputLock(out):
             pass
     finally:
-        holder.kill()
-        for pid in children:
-            try:
-                os.kill(pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
+        _kill_all(holder, children)
 
 
 def test_a_second_lock_on_the_same_output_in_one_process_is_refused(tmp_path):
