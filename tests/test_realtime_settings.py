@@ -129,3 +129,32 @@ def test_a_pulse_jitter_that_cannot_matter_or_leaves_no_pulse_is_refused(tmp_pat
                  ["validate", str(tmp_path / "rt.yaml")]):
         res = CliRunner().invoke(app, argv)
         assert_bad_input(res, out, message)
+
+
+@pytest.mark.parametrize("sets, keys", [
+    (["realtime.filter.align_order=1000000"], "realtime.filter.align_order"),
+    (["realtime.filter.chain=alignment", "realtime.filter.nav_order=30",
+      "realtime.filter.notch_hz=300"], "realtime.filter.nav_order, realtime.filter.notch_hz"),
+])
+def test_a_filter_key_of_the_chain_not_run_is_a_warning(tmp_path, sets, keys):
+    """An align_order of 1e6 beside the navigation chain ran in silence (the alignment FIR
+    is never designed then); the built-in Table 1, which sets only its chain's keys, warns of
+    nothing."""
+    import fuzz_cases as F
+    from typer.testing import CliRunner
+
+    from gcalign.cli import app
+
+    (tmp_path / "rt.yaml").write_text(F.emit(F.REALTIME))
+    args = [a for kv in sets for a in ("--set", kv)]
+    for argv in (["realtime", str(tmp_path / "rt.yaml"), *args, "-o", str(tmp_path / "o.h5")],
+                 ["validate", str(tmp_path / "rt.yaml"), *args]):
+        res = CliRunner().invoke(app, argv)
+        assert res.exit_code == 0, res.output
+        assert f"{keys}: cannot matter with filter.chain" in res.stderr.replace("\n", " "), \
+            res.stderr
+    import gcalign
+    from conftest import ROOT
+
+    for name in ("seed003_table1", "seed003_rate20_async", "realtime_beyond_seed"):
+        assert gcalign.load(ROOT / "configs" / f"{name}.yaml").realtime.unused() == [], name

@@ -292,6 +292,18 @@ class RealtimeConfig(Model):
             check_filter(c.to_case(), settings)
         return self
 
+    def unused(self, sc=None) -> list[str]:
+        """Keys of the chain that ``filter.chain`` does not run, one line (shown as a
+        warning): the alignment FIR's with the navigation chain; the navigation FIR's and
+        the notch with the alignment chain, which has none (an align_order of 1e6 beside
+        the navigation chain was accepted in silence)."""
+        f = self.filter
+        other = (("align_order", "align_cutoff_hz") if f.chain == "navigation"
+                 else ("nav_order", "nav_cutoff_hz", "notch_hz", "notch_q"))
+        keys = [f"realtime.filter.{k}" for k in other if k in f.model_fields_set]
+        return [f"{', '.join(keys)}: cannot matter with filter.chain {f.chain!r} (only its "
+                f"own FIR{' and notch' if f.chain == 'navigation' else ''} run)"] if keys else []
+
     # ---------------------------------------------------------------- resolved values
 
     @property
