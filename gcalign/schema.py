@@ -46,9 +46,11 @@ class Stored:
     inline : a nested result whose fields join its parent's group (no subgroup of its own).
     compress : stored compressed (gzip, shuffled): long series; True: level 1, a number:
         that level.
+    names : its ``names`` attribute (what its entries are, comma-separated), if any.
     summary : the unit the summary gives it in (:func:`summary_of`: the key
         ``<name>_<summary>``, e.g. ``"arcsec"``), or None (not in the summary, or summarised
         by its command).
+    label : its name in the summary, if not its own (``"attitude_t2"``: ``attitude_t2_deg``).
 
     What its values must be when a results file is read back (the checks of
     :mod:`gcalign.app.checked`):
@@ -73,7 +75,9 @@ class Stored:
     per: str | None = None
     inline: bool = False
     compress: bool | int = False
+    names: str | None = None
     summary: str | None = None
+    label: str | None = None
     dims: str | None = None
     optional: bool = False
     finite: bool = True
@@ -99,17 +103,22 @@ def spec(f: dataclasses.Field[Any]) -> Stored | None:
 
 
 #: SI per summary unit (:attr:`Stored.summary`): the summary divides the stored value by it
-SUMMARY_UNITS = {"s": 1.0, "m": 1.0, "deg": u.DEG, "arcsec": u.ARCSEC, "dph": u.DPH,
-                 "ug": u.UG}
+#: (degrees: ``numpy.degrees``)
+SUMMARY_UNITS = {"s": 1.0, "m": 1.0, "arcsec": u.ARCSEC, "dph": u.DPH, "ug": u.UG}
 
 
 def summary_of(result: Any) -> dict[str, Any]:
     """The fields of the dataclass `result` that name a summary unit, in field order, as
-    plain numbers in that unit: ``{"<name>_<unit>": value / SUMMARY_UNITS[unit]}``."""
+    plain numbers in that unit (None stays None): ``{"<label>_<unit>": value in unit}``."""
     out: dict[str, Any] = {}
     for f in dataclasses.fields(result):
         how = spec(f)
-        if how is not None and how.summary is not None:
-            v = np.asarray(getattr(result, f.name), dtype=float) / SUMMARY_UNITS[how.summary]
-            out[f"{f.name}_{how.summary}"] = v.tolist()
+        if how is None or how.summary is None:
+            continue
+        v = getattr(result, f.name)
+        if v is not None:
+            a = np.asarray(v, dtype=float)
+            v = (np.degrees(a) if how.summary == "deg" else a / SUMMARY_UNITS[how.summary]
+                 ).tolist()
+        out[f"{how.label or f.name}_{how.summary}"] = v
     return out

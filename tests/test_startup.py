@@ -58,7 +58,7 @@ def test_the_align_path_loads_no_plotting_no_scipy_linalg_no_dask():
     dask or pandas; of scipy only the top package numba asks for its version, not
     scipy.linalg (numba's BLAS probe would import it: gcalign.nav._kernels answers it)."""
     code = ("import gcalign.cli.align, gcalign.cli.common, gcalign.app.runner\n"
-            "import gcalign.app.align.run, gcalign.app.align.hdf5, gcalign.app.align.tables\n"
+            "import gcalign.app.align.run, gcalign.io.stored, gcalign.app.align.tables\n"
             "import numba.np.arraymath\n")  # what numba's first kernel call imports
     loaded = modules_after(code)
     assert {"numpy", "numba", "pydantic", "h5py", "yaml", "rich"} <= tops(loaded)

@@ -210,3 +210,23 @@ def test_a_filter_chains_response_comes_back(tmp_path, notch):
     for f_ in fields(ChainResponse):
         a, b = getattr(r, f_.name), getattr(back, f_.name)
         assert (a is None and b is None) or np.array_equal(a, b), f_.name
+
+
+def test_the_attitude_at_t1_t2_t3_is_summarised_and_checked_from_its_fields():
+    """``gcalign align``'s attitude keys come from :class:`AlignmentAt`'s fields: their
+    names and order in the JSON contract, degrees as ``numpy.degrees`` gives them, None
+    without truth; the checks of ``/align/result`` from the same fields."""
+    from gcalign.align.result import AlignmentAt
+    from gcalign.app.checked import from_fields
+    from gcalign.schema import summary_of
+
+    att = np.radians([1.0, -2.0, 30.0]) + 1e-7
+    at = AlignmentAt(att, att, None, None, att, None, None, None, None, 1.0, 2.0)
+    got = summary_of(at)
+    assert list(got) == ["coarse_attitude_deg", "attitude_t2_deg", "truth_t2_deg",
+                         "error_t2_deg", "attitude_t3_deg", "truth_t3_deg", "error_t3_deg",
+                         "misalignment_t2_deg", "misalignment_t3_deg"]
+    assert got["attitude_t3_deg"] == np.degrees(att).tolist() and got["truth_t3_deg"] is None
+    items = from_fields(AlignmentAt)
+    assert sorted(k for k in items if not k.endswith("?")) == ["att_t2", "att_t3", "coarse_att"]
+    assert all(d.shapes == ((3,),) for d in items.values())

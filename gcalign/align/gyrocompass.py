@@ -47,6 +47,7 @@ from gcalign.align.cycles import (
     with_samples,
 )
 from gcalign.align.gains import AZIMUTH_METHODS
+from gcalign.align.result import AlignmentAt, PassRows
 from gcalign.align.stages import Stage
 from gcalign.errors import InputError
 from gcalign.nav.earth import WGS84, EarthModel
@@ -361,6 +362,19 @@ class Alignment:
         """Euler-angle error at the end of pass i (rad)."""
         err = self.pass_error_rows(i, slice(-1, None))
         return None if err is None else err[0].copy()
+
+    def pass_rows(self) -> list[PassRows]:
+        """Every pass at its stored rows as the results file keeps it."""
+        return [PassRows(r.index, r.direction, r.kind, r.stage + 1, r.t, att, r.gains, err, phi)
+                for r, att, err, phi in zip(self.passes, self.pass_att, self.pass_errors,
+                                            self.pass_phi, strict=True)]
+
+    def at_times(self) -> AlignmentAt:
+        """The attitude at T1, T2 and T3 (the truth, errors and misalignment there) as the
+        results file keeps it and the summary gives it."""
+        return AlignmentAt(self.coarse_att, self.att_t2, self.truth_t2, self.error_t2,
+                           self.att_t3, self.truth_t3, self.error_t3, self.phi_t2,
+                           self.phi_t3, self.compute_s, self.equivalent_s)
 
     @property
     def pass_end_errors(self) -> list[Array | None]:

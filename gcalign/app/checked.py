@@ -27,6 +27,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from gcalign.align.result import AlignmentAt, PassRows
 from gcalign.errors import ScenarioError
 from gcalign.estimation.calibration import CalibrationResult, Smoothed
 from gcalign.estimation.degrees import ObservabilityTable
@@ -118,20 +119,14 @@ IMU = Block("imu", {"t": times("N"), "dtheta": V3, "dv": V3,
                     "q_bs?": num(("N", 4), rule="unit"), "component*?": INDEX})
 NAVIGATION = {"t": times("N"), "att?": V3, "v_n?": V3, "pos?": V3, "error/att?": V3,
               "error/v_n?": V3, "error/pos?": V3, "error/phi?": V3, "component*?": INDEX}
-RESULT_ATT = num((3,))
 
 SCHEMAS: dict[str, tuple[Block, ...]] = {
     "simulate": (TRUTH, IMU),
     "navigate": (Block("navigate", {**NAVIGATION, "att": V3, "v_n": V3, "pos": V3}), TRUTH,
                  REFERENCE),
     "align": (
-        Block("align/pass_*", {"t": num(("N",)), "att": V3, "gains?": num((10,)),
-                               "error?": V3, "phi?": V3, "component*?": INDEX}),
-        Block("align/result", {"coarse_att": RESULT_ATT, "att_t2": RESULT_ATT,
-                               "att_t3": RESULT_ATT, "truth_t2?": RESULT_ATT,
-                               "truth_t3?": RESULT_ATT, "error_t2?": RESULT_ATT,
-                               "error_t3?": RESULT_ATT, "phi_t2?": RESULT_ATT,
-                               "phi_t3?": RESULT_ATT}),
+        Block("align/pass_*", {**from_fields(PassRows), "component*?": INDEX}),
+        Block("align/result", from_fields(AlignmentAt)),
         Block("align/transfer", {"t": times("K"), "estimate": STATES, "sigma": STATES,
                                  "sigma0?": num(("S",)), "nis?": num(("K",)), "att?": num(("K", 3)),
                                  "v_n?": num(("K", 3)), "attitude_error?": num(("K", 3)),

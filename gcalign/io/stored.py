@@ -56,8 +56,8 @@ def write_fields(g: h5py.Group, result: Any) -> None:
 
 
 def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
-    extra = {k: v for k, v in (("shape", how.shape), ("description", how.description))
-             if v is not None}
+    extra = {k: v for k, v in (("shape", how.shape), ("description", how.description),
+                               ("names", how.names)) if v is not None}
     data = np.asarray(value)
     if how.axes is not None:
         data = np.transpose(data, how.axes)

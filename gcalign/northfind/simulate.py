@@ -8,12 +8,13 @@ sample by sample in the numba kernel :func:`gcalign.northfind._kernel.dwell_mean
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from gcalign.nav import earth
 from gcalign.northfind.geometry import _ideal_readings, _wrap_2pi, position_angles, table_dcm
+from gcalign.schema import stored
 
 __all__ = ["NorthfindSetup", "TableData", "simulate_table"]
 
@@ -90,21 +91,22 @@ class NorthfindSetup:
     """
 
     azimuths: np.ndarray
-    lat: float
-    positions: int = 24
-    dwell_s: float = 60.0
-    rate_hz: float = 100.0
+    lat: float = field(metadata=stored("rad", attr=True))
+    positions: int = field(default=24, metadata=stored("1", attr=True))
+    dwell_s: float = field(default=60.0, metadata=stored("s", attr=True))
+    rate_hz: float = field(default=100.0, metadata=stored("Hz", attr=True))
     tilt: float | np.ndarray = 0.0
     tilt_direction: float | np.ndarray = 0.0
-    tilt_direction_ref: str = "north"
-    repeats: int = 1
-    height: float = 0.0
-    gyro_bias: float = 0.0
-    gyro_arw: float = 0.0
-    gyro_scale: float = 0.0
-    accel_bias: float | tuple[float, float] | np.ndarray = 0.0
-    accel_vrw: float = 0.0
-    index_error: float = 0.0
+    tilt_direction_ref: str = field(default="north", metadata=stored(None, attr=True))
+    repeats: int = field(default=1, metadata=stored("1", attr=True))
+    height: float = field(default=0.0, metadata=stored("m", attr=True))
+    gyro_bias: float = field(default=0.0, metadata=stored("rad/s", attr=True))
+    gyro_arw: float = field(default=0.0, metadata=stored("rad/sqrt(s)", attr=True))
+    gyro_scale: float = field(default=0.0, metadata=stored("1", attr=True))
+    accel_bias: float | tuple[float, float] | np.ndarray = field(
+        default=0.0, metadata=stored("m/s^2", attr=True))
+    accel_vrw: float = field(default=0.0, metadata=stored("m/s/sqrt(s)", attr=True))
+    index_error: float = field(default=0.0, metadata=stored("rad", attr=True))
 
     def __post_init__(self) -> None:
         az = _finite("azimuths", np.atleast_1d(np.asarray(self.azimuths, dtype=float)))

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -30,7 +31,11 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import Aiding, AlignConfig
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.rotation import euler_to_dcm, quat_to_euler
+from gcalign.schema import ATT_FRAME, summary_of
 from gcalign.units import DPH, DPSH, angle_text
+
+if TYPE_CHECKING:
+    import h5py
 
 Progress = Callable[[float, float, str], None]
 
@@ -498,15 +503,7 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
         "t2_s": run.t2,
         "t3_s": run.t3,
         "t3_source": run.t3_source,
-        "coarse_attitude_deg": _deg(run.coarse_att),
-        "attitude_t2_deg": _deg(run.att_t2),
-        "truth_t2_deg": _deg(run.truth_t2),
-        "error_t2_deg": _deg(run.error_t2),
-        "attitude_t3_deg": _deg(run.att_t3),
-        "truth_t3_deg": _deg(run.truth_t3),
-        "error_t3_deg": _deg(run.error_t3),
-        "misalignment_t2_deg": _deg(run.phi_t2),
-        "misalignment_t3_deg": _deg(run.phi_t3),
+        **summary_of(run.at_times()),  # the attitude at T1, T2, T3 and its errors, in deg
         "last_pass_error": last,
         "passes": [
             {
@@ -534,8 +531,6 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     if sc.align is not None and sc.align.mode == "transfer":  # spec 006: its own room
         from gcalign.app.align import transfer
         return transfer.execute(sc, seed, cache_key, progress, recording)
-    from gcalign.app.align.hdf5 import write_alignment
-
     if cache_key is not None:  # a batch: the noise-free simulation is shared by the seeds
         stream = stream_of(scenario_data(sc, seed, cache_key))
     else:
@@ -543,5 +538,30 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     run = run_alignment(sc, stream, progress)
     summary = alignment_summary(run, stream, sc.name)
     against = summary["error_source"] or "truth"
-    return Outcome(summary, lambda f: write_alignment(f, run, stream, against), None,
+    return Outcome(summary, lambda f: write_alignment(f, run, against), None,
                    stream.seed, run.warnings, result=run)
+
+
+def write_alignment(f: h5py.File, run: Alignment, error_source: str = "truth") -> None:
+    """``/align``: the settings and times as attributes, every pass (``pass_NN``, NN from 01)
+    and the attitude at T1, T2 and T3 (``result``) as their fields say
+    (:mod:`gcalign.align.result`); the true attitude at the stored samples under ``/truth``
+    (t, att), or the reference's under ``/reference`` (`error_source` "reference")."""
+    from gcalign.io.results import put
+    from gcalign.io.stored import write_fields
+
+    if run.pass_truth is not None:
+        # every stored sample once, in time order (a later pass's row of a time kept, as a
+        # mapping from time to row would); not a Python loop over the 10^5 rows
+        t_all = np.concatenate([rec.t for rec in run.passes])
+        att_all = np.concatenate(run.pass_truth)
+        t, last = np.unique(t_all[::-1], return_index=True)
+        tg = f.create_group(error_source)
+        put(tg, "t", t, "s", description="the samples the passes stored (output rate)")
+        put(tg, "att", att_all[::-1][last], "rad", ATT_FRAME)
+    g = f.create_group("align")
+    g.attrs.update(error_source=error_source, mode=run.settings.mode,
+                   azimuth_poles=run.azimuth_poles, t1_s=run.t1, t2_s=run.t2, t3_s=run.t3)
+    for p in run.pass_rows():
+        write_fields(g.create_group(f"pass_{p.index + 1:02d}"), p)
+    write_fields(g.create_group("result"), run.at_times())

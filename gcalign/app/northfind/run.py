@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,6 +25,9 @@ from gcalign.app.command import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.northfind import NorthfindConfig, axis
+
+if TYPE_CHECKING:
+    import h5py
 
 __all__ = ["NorthfindRun", "execute", "northfind_summary", "run_northfind"]
 
@@ -168,8 +172,23 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None) -> Outcome:
     """Simulate the turntable, estimate, summarise; the registry's entry point."""
-    from gcalign.app.northfind.hdf5 import write_northfind
-
     run = run_northfind(sc, seed)
     return Outcome(northfind_summary(run, sc), lambda f: write_northfind(f, run), None, run.seed,
                    result=run.result)
+
+
+def write_northfind(f: h5py.File, run: NorthfindRun) -> None:
+    """/northfind: the setup and the result as their fields say (SI, radians), beside what
+    no field holds (the tilt of a single azimuth, the samples per dwell, gravity)."""
+    from gcalign.io.stored import write_fields
+
+    s = run.setup
+    g = f.create_group("northfind")
+    write_fields(g, s)
+    g.attrs.update(n_samples=s.n_samples, gravity=s.gravity, tilt=float(np.atleast_1d(s.tilt)[0]),
+                   tilt_direction=float(np.atleast_1d(s.tilt_direction)[0]),
+                   samples=bool(run.cfg.samples),
+                   units="lat, tilt, tilt_direction, index_error: rad; dwell_s: s; rate_hz: "
+                   "Hz; height: m; gyro_bias: rad/s; gyro_arw: rad/sqrt(s); accel_bias: m/s^2 "
+                   "[x, y]; accel_vrw: m/s/sqrt(s); gravity: m/s^2")
+    write_fields(g, run.result)

@@ -11,7 +11,7 @@ ranks, the null-space condition of seed eq. (12), and the covariance degree σ(0
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -31,6 +31,9 @@ from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
+
+if TYPE_CHECKING:
+    import h5py
 
 
 def flight_truth(sc: Scenario,
@@ -122,9 +125,21 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     """The table of the scenario's flight (a transfer alignment's is
     :func:`gcalign.app.observability.transfer.execute`); no randomness: the seed only names
     the run."""
-    from gcalign.app.observability.hdf5 import write_observability
-
     tab, traj, spans, compute_s = run_table(sc, cache_key, progress)
     truth = sampled_truth(traj, spans)
     return Outcome(summary(sc, tab, spans, compute_s),
                    lambda f: write_observability(f, tab, truth, spans), truth, None, result=tab)
+
+
+def write_observability(f: h5py.File, tab: ObservabilityTable, truth: Any,
+                        spans: tuple[Span, ...]) -> None:
+    """/observability: the table as its fields say (:class:`ObservabilityTable`), and each
+    segment's start and end; the segments of /truth."""
+    from gcalign.io.results import put, write_segments
+    from gcalign.io.stored import write_fields
+
+    write_segments(f, truth, spans)
+    g = f.create_group("observability")
+    write_fields(g, tab)
+    put(g, "t0", [s.start for s in spans], "s")
+    put(g, "t1", [s.end for s in spans], "s")

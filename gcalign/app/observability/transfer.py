@@ -21,7 +21,6 @@ import numpy as np
 
 from gcalign.app.align.transfer import DECIMALS, DISPLAY, SI_UNIT, group_of
 from gcalign.app.command import DOUBLE, Cost, Outcome
-from gcalign.app.observability.hdf5 import put_rows
 from gcalign.io.results import put
 
 PWCS_N = 15
@@ -279,3 +278,19 @@ def figures(f, name: str) -> dict:
         f"{name}: the filter's σ / σ0 ({how}); 1 = nothing learnt",
         [f"{label[gr]} σ/σ0" for gr in groups])
     return figs
+
+
+def put_rows(g: h5py.Group, tab, names, t0, t1, condition, *, shape: str, row: str,
+             t0_description: str | None = None) -> None:
+    """The rows of an observability table (a window each) and their ranks."""
+    g.create_dataset("segment_name", data=np.array(names, dtype=h5py.string_dtype()))
+    put(g, "t0", t0, "s", **({} if t0_description is None else
+                             {"description": t0_description}))
+    put(g, "t1", t1, "s")
+    put(g, "eta", tab.eta, "1", shape=shape, description=f"seed eq. 17 per {row}")
+    put(g, "eta_cum", tab.eta_cum, "1", shape=shape, description="from the start of the run")
+    put(g, "sigma_state", tab.sigma_state, "SOM units", shape=shape)
+    for name in ("rank", "tom_rank", "rank_cum", "tom_rank_cum", "null_residual"):
+        put(g, name, getattr(tab, name), "1")
+    put(g, "condition", condition.astype(np.int8), "1",
+        description="null(O_j) in null(F_j) for every piece (seed eq. 12)")
