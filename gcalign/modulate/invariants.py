@@ -87,6 +87,8 @@ class Harmonic:
 
 #: the frame of the stored invariants
 REF = "reference frame of the scheme (body or navigation), sensor axes in columns"
+#: how an error term over the cycle (rad per sensor axis) is stored and summarised
+_TERM = stored("rad", frame=REF, summary="arcsec", dims="3", optional=True)
 
 
 @dataclass(frozen=True)
@@ -131,22 +133,15 @@ class InvariantReport:
         metadata=stored("rad/s", frame=REF, dims="3", optional=True))
     residual_accel_bias: np.ndarray = field(
         metadata=stored("m/s^2", frame=REF, dims="3", optional=True))
-    gyro_bias_excursion: np.ndarray = field(
-        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
+    gyro_bias_excursion: np.ndarray = field(metadata=_TERM)
     gyro_bias_offset: np.ndarray = field(
         metadata=stored("rad", frame=REF, dims="3", optional=True))
-    scale_factor_net: np.ndarray = field(
-        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
-    scale_factor_peak: np.ndarray = field(
-        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
-    scale_factor_offset: np.ndarray = field(
-        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
-    misalignment_net: np.ndarray = field(
-        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
-    misalignment_peak: np.ndarray = field(
-        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
-    misalignment_offset: np.ndarray = field(
-        metadata=stored("rad", frame=REF, summary="arcsec", dims="3", optional=True))
+    scale_factor_net: np.ndarray = field(metadata=_TERM)
+    scale_factor_peak: np.ndarray = field(metadata=_TERM)
+    scale_factor_offset: np.ndarray = field(metadata=_TERM)
+    misalignment_net: np.ndarray = field(metadata=_TERM)
+    misalignment_peak: np.ndarray = field(metadata=_TERM)
+    misalignment_offset: np.ndarray = field(metadata=_TERM)
     abs_rate_integral: np.ndarray = field(
         metadata=stored("rad", frame=REF, dims="3 3", optional=True))
     asym_net: np.ndarray = field(metadata=stored("rad", frame=REF, dims="3", optional=True))
