@@ -108,7 +108,7 @@ def clean_stale_temps(folder: Path) -> list[Path]:
         if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
             try:
                 if p.is_file() and not p.is_symlink() and (
-                        p.name.endswith(TMP_SUFFIX) or _is_hdf5(p)):
+                        p.name.endswith(TMP_SUFFIX) or is_hdf5(p)):
                     p.unlink()
                     removed.append(p)
             except OSError:
@@ -116,7 +116,8 @@ def clean_stale_temps(folder: Path) -> list[Path]:
     return removed
 
 
-def _is_hdf5(p: Path) -> bool:
+def is_hdf5(p: Path) -> bool:
+    """Whether the file at `p` starts with the HDF5 signature."""
     with open(p, "rb") as f:
         return f.read(8) == _HDF5_SIGNATURE
 
@@ -709,7 +710,7 @@ def open_results(path: Path) -> h5py.File:
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: {not_a_file(path)}")
-    if _is_hdf5(path):
+    if is_hdf5(path):
         _probe(path)
     try:
         f = _ResultsFile(path, "r")
