@@ -20,6 +20,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import Any
 
 import h5py
 import numpy as np
@@ -473,10 +474,12 @@ def finite_summary(summary, where: str) -> None:
                          reversed(list(enumerate(x))))
 
 
-def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None, **attrs):
-    """Write one dataset with its units (and frame) attributes."""
+def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None,
+        create: Any = None, **attrs):
+    """Write one dataset with its units (and frame) attributes; `create`: h5py's
+    ``create_dataset`` options (compression, …)."""
     check_writes()
-    ds = group.create_dataset(name, data=np.asarray(data))
+    ds = group.create_dataset(name, data=np.asarray(data), **(create or {}))
     ds.attrs["units"] = units
     if frame:
         ds.attrs["frame"] = frame
