@@ -198,8 +198,7 @@ def test_a_long_fir_is_costed_as_the_ffts_it_runs_through():
     """Up to DIRECT_TAPS the chain convolves directly (taps operations a sample); above, three
     FFTs of N = chunk + 2 taps a chunk: 5e4 taps on 1 s chunks at 5 kHz cost about a tenth of
     their direct sum."""
-    from gcalign.app.realtime import fir_ops_per_sample
-    from gcalign.realtime.filters import DIRECT_TAPS
+    from gcalign.realtime.filters import DIRECT_TAPS, fir_ops_per_sample
 
     assert fir_ops_per_sample(41, 5000) == 41
     assert fir_ops_per_sample(DIRECT_TAPS, 5000) == DIRECT_TAPS

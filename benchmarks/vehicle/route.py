@@ -225,19 +225,19 @@ def _town(b: Builder, lap: int = 1) -> None:
     """The manoeuvres of the 30 min drive, from a stop; a second lap's marks numbered on
     (U-turns 3 and 4)."""
     u1, u2 = f"U-turn {2 * lap - 1}", f"U-turn {2 * lap}"
-    roundabout, eight = (("roundabout", "figure-eight") if lap == 1 else
-                         (f"roundabout {lap}", f"figure-eight {lap}"))
+    tag = "" if lap == 1 else f" {lap}"
     b.stop(40).speed(10, 8).cruise(25).speed(5, 5).turn(90, 15).speed(12, 6).cruise(35)
     b.turn(-30, 300).speed(18, 10).cruise(50).turn(20, 400).cruise(30).speed(0, 12).stop(20)
     b.speed(8, 6).turn(-90, 25).cruise(25).speed(4, 6).turn(180, 8, label=u1)
-    b.speed(12, 8).cruise(40).speed(7, 6).figure_eight(25, eight).speed(14, 8).cruise(35)
+    b.speed(12, 8).cruise(40).speed(7, 6).figure_eight(25, f"figure-eight{tag}")
+    b.speed(14, 8).cruise(35)
     b.turn(90, 80).cruise(40).speed(20, 8).cruise(60).turn(-45, 500).cruise(40)
     b.speed(5, 12).turn(-90, 15).speed(10, 6).cruise(30).speed(4, 6)
     b.turn(-180, 8, label=u2).speed(15, 10).cruise(45).speed(0, 12).stop(25)
     b.speed(11, 8).turn(60, 120).cruise(40).speed(6, 6).turn(90, 18).speed(16, 8).cruise(50)
     b.turn(-90, 80).cruise(30).speed(9, 6).turn(-90, 35).speed(13, 6).cruise(40)
     b.turn(8, 150).turn(-8, 150).cruise(30).speed(20, 10).cruise(70).turn(30, 600)
-    b.cruise(40).speed(0, 15).stop(30).speed(7, 7).turn(270, 20, label=roundabout)
+    b.cruise(40).speed(0, 15).stop(30).speed(7, 7).turn(270, 20, label=f"roundabout{tag}")
     b.speed(15, 8).cruise(60).turn(-60, 150).cruise(40).speed(6, 8).turn(90, 18)
     b.speed(12, 6).cruise(45).turn(10, 120).turn(-10, 120).speed(17, 8).cruise(80)
     b.speed(0, 14).stop(25).speed(10, 8).turn(-90, 40).cruise(50).turn(45, 200)

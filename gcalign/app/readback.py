@@ -53,7 +53,9 @@ def figures_for(path: Path) -> dict[str, Figure]:
     from gcalign.io import results
 
     path = Path(path)
-    if not _is_hdf5(path):
+    if not path.is_file():
+        raise ScenarioError(f"{path}: {not_a_file(path)}")
+    if not results.is_hdf5(path):
         return {"imu": _recorded_imu_figure(path)}
     from gcalign.app.checked import layout, read_checked
     from gcalign.app.plots import truth_and_imu
@@ -79,13 +81,6 @@ def figures_for(path: Path) -> dict[str, Figure]:
         raise ScenarioError(f"{path}: nothing to plot: this {kind!r} results file holds "
                             "none of the groups its figures are drawn from")
     return figs
-
-
-def _is_hdf5(path: Path) -> bool:
-    if not path.is_file():
-        raise ScenarioError(f"{path}: {not_a_file(path)}")
-    with open(path, "rb") as fh:
-        return fh.read(8) == b"\x89HDF\r\n\x1a\n"
 
 
 def _recorded_imu_figure(path: Path) -> Figure:

@@ -7,6 +7,8 @@ warnings.
 
 from __future__ import annotations
 
+import numpy as np
+
 from gcalign.calibrate.filter import CalibrationResult
 from gcalign.estimation import health
 from gcalign.estimation import ins_error as ie
@@ -25,7 +27,7 @@ def sigma_growth_warnings(r: CalibrationResult, label: str = "") -> list[str]:
     """One line per state whose σ grows past :data:`SIGMA_GROWTH` times its first σ, at the
     epochs with a measurement (in an outage the σ of what the fixes hold grows by design,
     and falls at the next fix)."""
-    sigma = r.sigma if r.updated is None or r.updated[1:].all() else r.sigma[r.updated]
+    sigma = r.sigma if r.updated is None else r.sigma[np.r_[True, r.updated[1:]]]
     return health.sigma_growth_warnings(r.sigma[0], sigma, r.names, ie.STATE_UNITS, label)
 
 

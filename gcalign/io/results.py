@@ -20,6 +20,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import Any
 
 import h5py
 import numpy as np
@@ -108,7 +109,7 @@ def clean_stale_temps(folder: Path) -> list[Path]:
         if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
             try:
                 if p.is_file() and not p.is_symlink() and (
-                        p.name.endswith(TMP_SUFFIX) or _is_hdf5(p)):
+                        p.name.endswith(TMP_SUFFIX) or is_hdf5(p)):
                     p.unlink()
                     removed.append(p)
             except OSError:
@@ -116,7 +117,8 @@ def clean_stale_temps(folder: Path) -> list[Path]:
     return removed
 
 
-def _is_hdf5(p: Path) -> bool:
+def is_hdf5(p: Path) -> bool:
+    """Whether the file at `p` starts with the HDF5 signature."""
     with open(p, "rb") as f:
         return f.read(8) == _HDF5_SIGNATURE
 
@@ -472,10 +474,12 @@ def finite_summary(summary, where: str) -> None:
                          reversed(list(enumerate(x))))
 
 
-def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None, **attrs):
-    """Write one dataset with its units (and frame) attributes."""
+def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None,
+        create: Any = None, **attrs):
+    """Write one dataset with its units (and frame) attributes; `create`: h5py's
+    ``create_dataset`` options (compression, …)."""
     check_writes()
-    ds = group.create_dataset(name, data=np.asarray(data))
+    ds = group.create_dataset(name, data=np.asarray(data), **(create or {}))
     ds.attrs["units"] = units
     if frame:
         ds.attrs["frame"] = frame
@@ -709,7 +713,7 @@ def open_results(path: Path) -> h5py.File:
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: {not_a_file(path)}")
-    if _is_hdf5(path):
+    if is_hdf5(path):
         _probe(path)
     try:
         f = _ResultsFile(path, "r")

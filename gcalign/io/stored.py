@@ -64,16 +64,11 @@ def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
     if how.flag:
         data = data.astype(np.int8)
     units = "1" if how.units is None else how.units  # ("": a pure number, as stored)
-    if not how.compress:
-        put(g, name, data, units, how.frame, **extra)
-        return
-    check_writes()
-    ds = g.create_dataset(name, data=data, compression="gzip",
-                          compression_opts=int(how.compress), shuffle=True)
-    ds.attrs["units"] = units
-    for k, v in (("frame", how.frame), *extra.items()):
-        if v:
-            ds.attrs[k] = v
+    create = {}
+    if how.compress:  # (its empty attributes left out, as these files have always had them)
+        create = {"compression": "gzip", "compression_opts": int(how.compress), "shuffle": True}
+        extra = {k: v for k, v in extra.items() if v}
+    put(g, name, data, units, how.frame, create=create, **extra)
 
 
 def _get(ds: h5py.Dataset, how: Stored) -> np.ndarray:

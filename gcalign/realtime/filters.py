@@ -26,6 +26,7 @@ pieces with the same numbers as in one piece (tested).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from types import ModuleType
 
@@ -41,6 +42,7 @@ __all__ = [
     "alignment_chain",
     "design_fir",
     "design_notch",
+    "fir_ops_per_sample",
     "first_moment",
     "navigation_chain",
     "notch_dc_delay",
@@ -48,6 +50,17 @@ __all__ = [
 
 #: FIRs of more taps than this are applied through FFTs (the seed's 41 and 181 directly)
 DIRECT_TAPS = 1024
+
+
+def fir_ops_per_sample(taps: float, chunk: float) -> float:
+    """Operations per sample and channel of an FIR as :meth:`FilterChain.apply` runs it on
+    chunks of `chunk` samples: the taps of a direct convolution, or, above ``DIRECT_TAPS``,
+    three FFTs of the chunk with its carried inputs (about 5 N log2 N each, N = chunk + 2
+    taps) spread over the chunk's samples."""
+    if taps <= DIRECT_TAPS:
+        return taps
+    N = chunk + 2.0 * taps
+    return 15.0 * N * math.log2(N) / max(chunk, 1.0)
 
 
 def _signal() -> ModuleType:

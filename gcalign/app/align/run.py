@@ -140,12 +140,15 @@ def collect(stream: Stream, tl: Timeline, aiding: Aiding,
     memo = None
     known = False  # the truth rows and the position at T1 are the shared ones
     if shared is not None and stream.truth0 is not None and reference is None:
-        token = (stream.truth0.att.ctypes.data, lo, hi, i1, len(samples),
+        # the truth's memory (each seed holds its own view of the cached simulation), kept
+        # alive in the memo so that no other array can take its address meanwhile
+        held = stream.truth0.att
+        token = (held.ctypes.data, lo, hi, i1, len(samples),
                  int(samples[0]) if len(samples) else -1,
                  int(samples[-1]) if len(samples) else -1)
         if shared.get("token") != token:  # another truth: start again
             shared.clear()
-            shared.update(token=token, speeds={})
+            shared.update(token=token, held=held, speeds={})
         memo = shared
         known = "truth_att" in shared
         if known:

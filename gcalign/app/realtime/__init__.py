@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any
 
@@ -38,8 +37,10 @@ class Realtime(Command):
         return figures(f, name)
 
     def cost(self, inputs: Inputs) -> Cost:
-        """Three gyro channels through the chain's FIR (:func:`fir_ops_per_sample`) and
-        notch; the attitude solutions held for the pulses."""
+        """Three gyro channels through the chain's FIR (as it is applied: directly or
+        through FFTs) and notch; the attitude solutions held for the pulses."""
+        from gcalign.realtime.filters import fir_ops_per_sample
+
         sc: Any = inputs.scenario  # its section is there: the check ran first
         cfg = sc.realtime
         s = cfg.to_settings()
@@ -55,19 +56,6 @@ class Realtime(Command):
                     work=3 * n * (fir_ops_per_sample(taps, chunk) + NOTCH_OPS),
                     work_what="3 channels × FIR operations × samples",
                     memory_what="the attitude solutions")
-
-
-def fir_ops_per_sample(taps: float, chunk: float) -> float:
-    """Operations per sample and channel of the chain's FIR as `FilterChain.apply` runs it:
-    the taps of a direct convolution, or, above ``DIRECT_TAPS``, three FFTs of the chunk
-    with its carried inputs (about 5 N log2 N each, N = chunk + 2 taps) spread over the
-    chunk's samples."""
-    from gcalign.realtime.filters import DIRECT_TAPS
-
-    if taps <= DIRECT_TAPS:
-        return taps
-    N = chunk + 2.0 * taps
-    return 15.0 * N * math.log2(N) / max(chunk, 1.0)
 
 
 COMMAND = Realtime()

@@ -54,11 +54,11 @@ import numpy as np
 
 from gcalign import units as u
 from gcalign.errors import ScenarioError
+from gcalign.nav.earth import OMEGA_IE
 
-__all__ = ["OMEGA_IE", "check_gyros", "earth_rate_at_rest", "forward_axis", "gyro_fit",
+__all__ = ["check_gyros", "earth_rate_at_rest", "forward_axis", "gyro_fit",
            "reference_against_gyros"]
 
-OMEGA_IE = 7.2921151467e-5  #: rad/s (WGS-84)
 BLOCK_S = 1.0  #: specific force and rates averaged over blocks (vibration out)
 WINDOW_S = 10.0  #: the window over which the specific force turns
 HIGHPASS_S = 60.0  #: the moving mean taken off the gyro rates (earth rate, bias)
