@@ -495,6 +495,7 @@ def write_segments(f: h5py.File, truth, segments) -> None:
     g = f["truth"]
     if "segment" not in g and truth.segment is not None:
         put(g, "segment", truth.segment, "1", description="index into segment_names")
+    check_writes()
     g.create_dataset("segment_names", data=np.array([s.name for s in segments],
                                                      dtype=h5py.string_dtype()))
 
