@@ -86,23 +86,42 @@ def aggregate_of(path: Path) -> dict:
 # --------------------------------------------------------------------------- single runs
 
 
+def layout(path: Path) -> dict[str, tuple[int, ...]]:
+    """Every dataset of an HDF5 file with its shape: what a complete result has."""
+    found: dict[str, tuple[int, ...]] = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: found.update({name: obj.shape})
+                     if isinstance(obj, h5py.Dataset) else None)
+    return found
+
+
 @pytest.mark.slow  # several seconds of child processes
-def test_kill_9_of_a_run_leaves_no_file_and_the_next_run_removes_its_temp(tmp_path):
-    """kill -9 of simulate at random points (seeded): never a file under the final name; a
+def test_kill_9_of_a_run_leaves_no_partial_file_and_the_next_run_removes_its_temp(tmp_path):
+    """kill -9 of simulate at random points of its write (seeded): a file under the final name is
+    only ever a complete one (the kill can land after the rename, in the interpreter's exit); a
     temp file may remain (nothing can remove it at SIGKILL), and the next run into the folder
     removes it; then that run completes."""
     rng = random.Random(14)
-    scenario(tmp_path, duration_s=3000.0, name="L.yaml")  # long enough to be killed in flight
-    for _ in range(3):
+    scenario(tmp_path, duration_s=3000.0, name="L.yaml")
+    assert cli(["simulate", "L.yaml", "-o", "ref/l.h5"], tmp_path).returncode == 0
+    complete = layout(tmp_path / "ref/l.h5")
+    in_flight = 0
+    for _ in range(4):
         p = spawn(["simulate", "L.yaml", "-o", "out/l.h5"], tmp_path)
         deadline = time.monotonic() + 60
-        while not temps(tmp_path / "out") and time.monotonic() < deadline:
-            time.sleep(0.02)  # the temp file exists once the run has started writing
-        time.sleep(rng.uniform(0.0, 1.0))
+        while not temps(tmp_path / "out") and p.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.001)  # the temp file exists once the run has started writing
+        # The write lasts ~0.3 s on an idle machine: kill within its first 50 ms.
+        time.sleep(rng.uniform(0.0, 0.05))
         p.kill()
         p.wait()
-        assert not (tmp_path / "out/l.h5").exists()
-    assert temps(tmp_path / "out")  # SIGKILL leaves them (at least the last one)
+        final = tmp_path / "out/l.h5"
+        if final.exists():
+            assert layout(final) == complete  # finished before the kill: whole, never partial
+            final.unlink()
+        else:
+            in_flight += 1
+    assert in_flight >= 1 and temps(tmp_path / "out")  # SIGKILL in flight leaves its temp file
     scenario(tmp_path)
     res = cli(["simulate", "S.yaml", "-o", "out/s.h5"], tmp_path)
     assert res.returncode == 0, res.stderr
@@ -152,6 +171,32 @@ def test_a_sigterm_lost_in_a_finaliser_still_keeps_the_file_from_its_name(tmp_pa
     finally:
         errors.TERMINATE_REQUESTED[0] = False
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("turned_into", [TypeError, OSError, "GcalignError"])
+def test_a_sigterm_a_library_turned_into_its_own_error_is_still_exit_143(capsys, turned_into):
+    """Seen: SIGTERM inside h5py's write, which raised "TypeError: Operation not defined for
+    data type class" in its place; that was an internal error, exit 1, "a bug"."""
+    import typer
+
+    from gcalign import errors
+    from gcalign.cli.base import user_errors
+
+    error = errors.GcalignError if turned_into == "GcalignError" else turned_into
+
+    @user_errors
+    def write():
+        try:
+            signal.raise_signal(signal.SIGTERM)  # the command line's handler raises here
+        except errors.Terminated:
+            raise error("the library's own words") from None
+
+    with pytest.raises(typer.Exit) as ex:
+        write()
+    assert ex.value.exit_code == 143
+    assert capsys.readouterr().err == "error: terminated (SIGTERM)\n"
+    assert errors.TERMINATE_REQUESTED[0]  # reset by the next command's wrapper
+    errors.TERMINATE_REQUESTED[0] = False
 
 
 @pytest.fixture(scope="module")

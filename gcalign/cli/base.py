@@ -15,7 +15,7 @@ import signal
 import sys
 import threading
 import warnings
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NoReturn
 
 import typer
 from typer.core import TyperGroup
@@ -151,6 +151,11 @@ def _unraisable(info) -> None:
         sys.__unraisablehook__(info)
 
 
+def _terminated() -> NoReturn:
+    sys.stderr.write("error: terminated (SIGTERM)\n")
+    raise typer.Exit(143) from None
+
+
 def user_errors(fn):
     """Turn GcalignError into one line on stderr and its exit code; Ctrl-C into exit 130,
     SIGTERM into 143 (both after the temporary files are gone); anything unexpected into
@@ -174,17 +179,23 @@ def user_errors(fn):
             check_terminated()  # one whose exception a finaliser swallowed (_unraisable)
             return out
         except GcalignError as err:
+            if TERMINATE_REQUESTED[0]:
+                # The SIGTERM's exception landed inside a library, which turned it into an
+                # error of its own (h5py: a TypeError or an OSError; a writer turns that into
+                # a GcalignError): what failed after it is its consequence, not a bug.
+                _terminated()
             sys.stderr.write(f"error: {error_line(str(err))}\n")
             raise typer.Exit(err.exit_code) from None
         except KeyboardInterrupt:
             sys.stderr.write("error: interrupted\n")
             raise typer.Exit(130) from None
         except Terminated:
-            sys.stderr.write("error: terminated (SIGTERM)\n")
-            raise typer.Exit(143) from None
+            _terminated()
         except (typer.Exit, typer.Abort, click_errors.ClickException):
             raise
         except Exception as err:
+            if TERMINATE_REQUESTED[0]:  # as above
+                _terminated()
             from gcalign.app.runner import OUT_OF_MEMORY, out_of_memory
 
             if isinstance(err, StdoutError):
