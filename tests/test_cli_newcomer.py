@@ -133,23 +133,23 @@ def test_a_silent_stage_is_drawn_after_the_delay(monkeypatch):
     from gcalign.cli.common import ProgressBar
 
     monkeypatch.setenv("GCALIGN_PROGRESS", "auto")
-    bar = ProgressBar("x", delay_s=0.05)
+    bar = ProgressBar("x", delay_s=0.3)
     bar.enabled = True  # as on a terminal
     try:
         bar(0, 1, "starting")
         assert bar.bar is None  # not yet: short runs stay quiet
-        for _ in range(100):
-            if "starting" in bar.tasks:
-                break
+        deadline = time.monotonic() + 30  # waits on the state, not on a clock
+        while "starting" not in bar.tasks and time.monotonic() < deadline:
             time.sleep(0.01)
         assert bar.bar is not None and "starting" in bar.tasks
     finally:
         bar.close()
-    late = ProgressBar("y", delay_s=0.05)
+    late = ProgressBar("y", delay_s=60.0)
     late.enabled = True
     late(0, 1, "starting")
     late.close()  # done before the delay: never drawn
-    time.sleep(0.1)
+    assert late.timer is not None and late.timer.finished.is_set()  # cancelled
+    late._late_start()  # a timer that fired as close() ran: it draws nothing either
     assert late.bar is None
 
 

@@ -397,11 +397,13 @@ def test_a_second_batch_on_the_same_output_is_refused(tmp_path):
     first = spawn(["batch", "SW.yaml", "-o", "b.h5", "-w", "1"], tmp_path)
     try:
         deadline = time.monotonic() + 60
-        while not (tmp_path / ".b.h5.lock").exists() and time.monotonic() < deadline:
-            time.sleep(0.02)
+        lock = tmp_path / ".b.h5.lock"
+        while time.monotonic() < deadline and not (lock.exists() and lock.read_text()):
+            time.sleep(0.02)  # its pid is written once the lock is taken
+        first.send_signal(signal.SIGSTOP)  # holds the lock however fast it would finish
         res = cli(["batch", "SW.yaml", "-o", "b.h5", "-w", "1"], tmp_path)
         assert res.returncode == 1
-        assert "another batch (pid" in one_error_line(res.stderr)
+        assert f"another batch (pid {first.pid})" in one_error_line(res.stderr)
     finally:
         first.kill()
         first.wait()
@@ -567,7 +569,7 @@ def test_a_bad_scheduler_address_is_exit_2_at_once(tmp_path, address, why):
     assert res.exit_code == 2, res.output
     line = one_error_line(res.stderr)
     assert line.startswith("error: --scheduler: ") and why in line, line
-    assert time.perf_counter() - t0 < 1.0
+    assert time.perf_counter() - t0 < 3.0  # not after Dask's 4 s of trying (a loaded CI: not 1)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["S.yaml", "SW.yaml"]
 
 

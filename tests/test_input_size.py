@@ -60,7 +60,7 @@ def test_a_2_gb_sparse_gnss_file_is_refused_from_its_size(tmp_path):
     t0 = time.perf_counter()
     with pytest.raises(ScenarioError, match="GCALIGN_MAX_INPUT_MB"):
         read_gnss(p)
-    assert time.perf_counter() - t0 < 1.0
+    assert time.perf_counter() - t0 < 5.0  # from its size, before reading any of its 2 GB
 
 
 def test_nul_bytes_where_text_is_expected_stop_at_the_first_block(tmp_path):
