@@ -17,6 +17,9 @@ line in one file. No h5py, no pydantic: the core may import this module.
 from __future__ import annotations
 
 import dataclasses
+import math
+import sys
+import typing
 from dataclasses import dataclass
 from typing import Any
 
@@ -102,23 +105,83 @@ def spec(f: dataclasses.Field[Any]) -> Stored | None:
     return f.metadata.get(KEY)
 
 
-#: SI per summary unit (:attr:`Stored.summary`): the summary divides the stored value by it
-#: (degrees: ``numpy.degrees``)
-SUMMARY_UNITS = {"s": 1.0, "m": 1.0, "arcsec": u.ARCSEC, "dph": u.DPH, "ug": u.UG}
+def field_type(cls: type, f: dataclasses.Field[Any]) -> Any:
+    """The type of field `f` of `cls` (its annotation evaluated in the module of `cls`), or
+    Any where it cannot be evaluated here."""
+    if not isinstance(f.type, str):
+        return f.type
+    try:
+        return eval(f.type, vars(sys.modules[cls.__module__]))  # noqa: S307 - an annotation
+    except (NameError, AttributeError, SyntaxError, TypeError):
+        return Any
 
 
-def summary_of(result: Any) -> dict[str, Any]:
-    """The fields of the dataclass `result` that name a summary unit, in field order, as
-    plain numbers in that unit (None stays None): ``{"<label>_<unit>": value in unit}``."""
+def nested(cls: type, f: dataclasses.Field[Any]) -> tuple[type | None, bool]:
+    """The result dataclass field `f` of `cls` holds (itself, optional, or a list of them;
+    None if none) and whether it is a list of them."""
+    kind = field_type(cls, f)
+    inner = next((a for a in typing.get_args(kind) if dataclasses.is_dataclass(a)), kind)
+    listed = typing.get_origin(kind) in (list, tuple)
+    return (inner if isinstance(inner, type) and dataclasses.is_dataclass(inner) else None,
+            listed)
+
+
+#: How the summary gives a value in each summary unit (:attr:`Stored.summary`) from the SI
+#: one, and the unit the key ends in: degrees as ``numpy.degrees`` gives them (``deg360``
+#: wrapped to [0, 360)), the other units by dividing by their SI value, so that the JSON
+#: keeps its bits; ``""``: as it is (text, counts, flags), the key without a unit.
+SUMMARY_UNITS: dict[str, tuple[str, Any]] = {
+    "": ("", None), "deg": ("deg", np.degrees),
+    "deg360": ("deg", lambda a: np.mod(np.degrees(a), 360.0)),
+    **{k: (k, lambda a, s=si: a / s) for k, si in (
+        ("s", 1.0), ("m", 1.0), ("arcsec", u.ARCSEC), ("dph", u.DPH), ("ug", u.UG))},
+}
+
+
+def summary_of(result: Any) -> Any:
+    """The summary of the dataclass `result` (a list of them: a list of their summaries):
+    its fields that name a summary unit, in field order, as plain numbers in that unit,
+    ``{"<label>_<unit>": value}``. A field holding a result or a list of results gives its
+    summary under ``<label>``; a field stored per entry (:attr:`Stored.per`) goes into
+    ``<per>: {entry: {...}}``, placed where the first such field stands. Arrays of more than
+    one axis are flattened in their stored order (:attr:`Stored.axes`); None and numbers
+    that are not finite give None (JSON has no NaN)."""
+    if isinstance(result, (list, tuple)):
+        return [summary_of(r) for r in result]
     out: dict[str, Any] = {}
     for f in dataclasses.fields(result):
         how = spec(f)
         if how is None or how.summary is None:
             continue
         v = getattr(result, f.name)
-        if v is not None:
-            a = np.asarray(v, dtype=float)
-            v = (np.degrees(a) if how.summary == "deg" else a / SUMMARY_UNITS[how.summary]
-                 ).tolist()
-        out[f"{how.label or f.name}_{how.summary}"] = v
+        name = how.label or f.name
+        if dataclasses.is_dataclass(v) or (isinstance(v, (list, tuple)) and v
+                                           and dataclasses.is_dataclass(v[0])):
+            out[name] = summary_of(v)
+            continue
+        suffix, to = SUMMARY_UNITS[how.summary]
+        key = f"{name}_{suffix}" if suffix else name
+        if how.per is None:
+            out[key] = _plain(v, to, how.axes)
+            continue
+        entries = out.setdefault(how.per, {})
+        for entry, part in zip(getattr(result, how.per), v, strict=True):
+            entries.setdefault(entry, {})[key] = _plain(part, to, how.axes)
     return out
+
+
+def _plain(v: Any, to: Any, axes: tuple[int, ...] | None) -> Any:
+    """A value of the summary: plain numbers (`to`: from SI), flattened, non-finite as None."""
+    if v is None or isinstance(v, str):
+        return v
+    a = np.asarray(v, dtype=float) if to is not None else np.asarray(v)
+    if axes is not None and a.ndim == len(axes):
+        a = np.transpose(a, axes)
+    if to is not None:
+        a = to(a)
+    if a.ndim > 1:
+        a = a.ravel()
+    plain = a.tolist()
+    if a.dtype.kind != "f" or np.isfinite(a).all():
+        return plain
+    return None if a.ndim == 0 else [x if math.isfinite(x) else None for x in plain]

@@ -230,3 +230,73 @@ def test_the_attitude_at_t1_t2_t3_is_summarised_and_checked_from_its_fields():
     items = from_fields(AlignmentAt)
     assert sorted(k for k in items if not k.endswith("?")) == ["att_t2", "att_t3", "coarse_att"]
     assert all(d.shapes == ((3,),) for d in items.values())
+
+
+@dataclass(frozen=True)
+class Pass:  # (at module level: the annotations of a result are evaluated in its module)
+    direction: str = field(metadata=stored(None, attr=True, summary=""))
+    t: np.ndarray = field(metadata=stored("s", dims="N", summary="s"))
+    end_rate: np.ndarray = field(metadata=stored("rad/s", dims="3", summary="dph"))  # the line
+
+
+@dataclass(frozen=True)
+class Run:
+    name: str = field(metadata=stored(None, attr=True, summary=""))
+    passes: list[Pass] = field(metadata=stored("", summary=""))
+
+
+def test_a_new_per_pass_field_is_written_checked_and_summarised_from_its_one_line(tmp_path):
+    """The one line of `end_rate` below, on the result of one pass, reaches every pass of a
+    result holding a list of them: written under each numbered group (``passes/01``),
+    checked there (``passes/*/end_rate``), read back, and in the summary of each pass in
+    °/h, in field order, beside the pass's other summarised fields."""
+    from gcalign.app.checked import from_fields
+    from gcalign.schema import summary_of
+    from gcalign.units import DPH
+
+    rates = [np.array([1.0, 2.0, 3.0]) * DPH, np.array([-4.0, 0.5, 0.0]) * DPH]
+    run = Run("fwd-rev", [Pass("forward", np.array([0.0, 1.0]), rates[0]),
+                          Pass("reverse", np.array([1.0, 0.0]), rates[1])])
+    with h5py.File(tmp_path / "p.h5", "w") as f:
+        write_fields(f.create_group("run"), run)
+    with h5py.File(tmp_path / "p.h5") as f:
+        assert f["run/passes/01/end_rate"].attrs["units"] == "rad/s"
+        back = [read_fields(g, Pass) for g in f["run/passes"].values()]
+    assert [p.direction for p in back] == ["forward", "reverse"]
+    assert np.array_equal(back[1].end_rate, rates[1])
+    assert from_fields(Run)["passes/*/end_rate"].shapes == ((3,),)
+    got = summary_of(run)
+    assert list(got) == ["name", "passes"]
+    assert [list(p) for p in got["passes"]] == [["direction", "t_s", "end_rate_dph"]] * 2
+    assert got["passes"][1]["direction"] == "reverse"
+    assert np.allclose(got["passes"][0]["end_rate_dph"], [1.0, 2.0, 3.0], rtol=1e-14)
+    assert got["passes"][1]["t_s"] == [1.0, 0.0]
+
+
+def test_a_summary_per_entry_is_grouped_flattened_and_has_no_nan():
+    """Fields stored per entry of another field (per method) are summarised per entry under
+    that field's name, where the first of them stands; an array of two axes flattened in
+    its stored order; NaN (no value) as None, as JSON needs; degrees wrapped to [0, 360)
+    where the field says so."""
+    from gcalign.schema import summary_of
+
+    @dataclass(frozen=True)
+    class R:
+        methods: tuple[str, ...] = field(metadata=stored(None, attr=True))
+        spread: np.ndarray = field(metadata=stored("rad", summary="deg"))
+        error: np.ndarray = field(metadata=stored("rad", per="methods", axes=(1, 0),
+                                                  summary="deg"))
+        pred: np.ndarray = field(metadata=stored("rad", per="methods", summary="deg"))
+        heading: np.ndarray = field(metadata=stored("rad", summary="deg360"))
+
+    err = np.radians(np.arange(12.0).reshape(2, 3, 2))  # (methods, M=3, R=2)
+    r = R(("a", "b"), np.radians([1.0, np.nan]), err, np.radians([[1.0, np.nan, 2.0]] * 2),
+          np.radians([-90.0, 370.0]))
+    got = summary_of(r)
+    assert list(got) == ["spread_deg", "methods", "heading_deg"]
+    assert got["spread_deg"] == [np.degrees(np.radians(1.0)), None]
+    assert list(got["methods"]) == ["a", "b"] and list(got["methods"]["b"]) == ["error_deg",
+                                                                                 "pred_deg"]
+    assert got["methods"]["b"]["error_deg"] == np.degrees(err[1].T).ravel().tolist()
+    assert got["methods"]["a"]["pred_deg"][1] is None
+    assert np.allclose(got["heading_deg"], [270.0, 10.0])

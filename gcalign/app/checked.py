@@ -29,14 +29,14 @@ import numpy as np
 
 from gcalign.align.result import AlignmentAt, PassRows
 from gcalign.errors import ScenarioError
-from gcalign.estimation.calibration import CalibrationResult, Smoothed
+from gcalign.estimation.calibration import CalibrationResult
 from gcalign.estimation.degrees import ObservabilityTable
 from gcalign.io import results
-from gcalign.modulate.analysis import MechanismCycle
-from gcalign.modulate.invariants import InvariantReport
+from gcalign.modulate.analysis import SchemeAnalysis
 from gcalign.modulate.linear import LinearSeries
 from gcalign.northfind.run import NorthfindResult
 from gcalign.realtime.filters import ChainResponse
+from gcalign.schema import nested
 from gcalign.schema import spec as stored_spec
 
 #: kinds whose every dataset has units and finite values when written (north-finding stores
@@ -91,11 +91,16 @@ class Block:
 
 def from_fields(cls: type, under: str = "") -> dict[str, Data]:
     """A block's entries from the stored fields of a result dataclass that say their dims
-    (:class:`gcalign.schema.Stored`), in its subgroup `under` (``"linear/"``), if any: a new
-    field is checked as it is declared."""
-    items = {}
+    (:class:`gcalign.schema.Stored`), in its subgroup `under` (``"linear/"``), if any, and
+    those of the results it holds (in their subgroup, ``*/`` for a list): a new field is
+    checked as it is declared."""
+    items: dict[str, Data] = {}
     for f in dataclasses.fields(cls):
         how = stored_spec(f)
+        inner, listed = nested(cls, f)
+        if how is not None and inner is not None:
+            items |= from_fields(inner, under if how.inline else
+                                 under + (how.name or f.name) + "/" + ("*/" if listed else ""))
         if how is None or how.dims is None:
             continue
         key = (under + ("*/" if how.per else "") + (how.name or f.name)
@@ -144,7 +149,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
         Block("calibrate/outages", {"start": times("O"), "end": times("O"),
                                     "length": num(("O",))}),
         Block("calibrate/runs/*", {
-            **from_fields(CalibrationResult), **from_fields(Smoothed, "smoothed/"),
+            **from_fields(CalibrationResult),
             "innovation?": num(("U", "m")), "nis": num(("U",)), "update_t?": times("U"),
             "sigma_z?": num(("U", "m")),
             "smoothed/error/t?": times("D"), "smoothed/error/att?": num(("D", 3)),
@@ -175,8 +180,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
         Block("realtime/filter", from_fields(ChainResponse), counts=(("H", "order", 1),))),
     "modulate": (Block("modulate/*", {
         **NAVIGATION, "error/pos": V3, "error/phi": V3,
-        **from_fields(MechanismCycle, "mechanism/"), "mechanism/component*?": INDEX,
-        **from_fields(InvariantReport, "invariants/"), "invariants/*?": num((3,)),
+        **from_fields(SchemeAnalysis), "mechanism/component*?": INDEX, "invariants/*?": num((3,)),
         **from_fields(LinearSeries, "linear/"), "linear/component*?": INDEX}),),
     "allan": (Block("allan/*", {
         "tau": times("M"), "adev": num(("M", 3)), "adev_lo": num(("M", 3)),

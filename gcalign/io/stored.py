@@ -12,7 +12,6 @@ not stored (what the run derives again, or what the command stores itself).
 from __future__ import annotations
 
 import dataclasses
-import sys
 import typing
 from typing import Any, TypeVar
 
@@ -20,7 +19,7 @@ import h5py
 import numpy as np
 
 from gcalign.io.results import check_writes, put
-from gcalign.schema import Stored, spec
+from gcalign.schema import Stored, field_type, spec
 
 T = TypeVar("T")
 
@@ -88,7 +87,7 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
         if how is None or f.name in given:
             continue
         name = how.name or f.name
-        kind = _type(cls, f)
+        kind = field_type(cls, f)
         inner = next((a for a in typing.get_args(kind) if dataclasses.is_dataclass(a)), kind)
         if how.attr:
             if name in g.attrs:
@@ -115,17 +114,6 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
                 f.default_factory is dataclasses.MISSING:
             values[f.name] = None  # not in the file (an optional series the run did not make)
     return cls(**values, **given)
-
-
-def _type(cls: type, f: dataclasses.Field[Any]) -> Any:
-    """The type of field `f` of `cls` (its annotation evaluated in the module of `cls`), or
-    Any where it cannot be evaluated here."""
-    if not isinstance(f.type, str):
-        return f.type
-    try:
-        return eval(f.type, vars(sys.modules[cls.__module__]))  # noqa: S307 - an annotation
-    except (NameError, AttributeError, SyntaxError, TypeError):
-        return Any
 
 
 def _plain(v: Any) -> Any:
