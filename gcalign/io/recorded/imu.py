@@ -45,7 +45,6 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.imu_files import (
     _HDF5_MAGIC,
@@ -60,18 +59,13 @@ from gcalign.io.imu_files import (
 )
 from gcalign.io.recorded import consistency, mat
 from gcalign.io.recorded.axes import axes_text, rotation_to_rfu
+from gcalign.io.recorded.consistency import GYRO_UNITS
 from gcalign.sim.imu import ImuData
 
 __all__ = ["FORMATS", "Layout", "read_recording", "GYRO_UNITS", "ACCEL_UNITS"]
 
 G_STANDARD = 9.80665  #: m/s² per g for accelerometer data in g (sensor data sheets' g)
 
-#: gyro units -> (SI factor, quantity)
-GYRO_UNITS = {
-    "rad": (1.0, "increments"), "deg": (u.DEG, "increments"),
-    "arcsec": (u.ARCSEC, "increments"),
-    "rad/s": (1.0, "rates"), "deg/s": (u.DEG, "rates"), "deg/h": (u.DPH, "rates"),
-}
 #: accelerometer units -> (SI factor, quantity)
 ACCEL_UNITS = {
     "m/s": (1.0, "increments"), "m/s^2": (1.0, "rates"), "g": (G_STANDARD, "rates"),
