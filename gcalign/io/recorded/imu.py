@@ -45,7 +45,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from gcalign.errors import ScenarioError
+from gcalign.errors import ScenarioError, clip
 from gcalign.io.imu_files import (
     _HDF5_MAGIC,
     ImuFileError,
@@ -399,10 +399,6 @@ def _header_layout(header: list[str] | None) -> tuple[tuple[str, ...], dict] | N
     return tuple(cols), {k: v.pop() for k, v in units.items()}
 
 
-def _clip(text: str, n: int = 60) -> str:
-    return text if len(text) <= n else text[:n - 3] + "..."
-
-
 def _read_csv(name: str, data: bytes, layout: Layout) -> _Raw:
     lines = _text_lines(name, data)
     cols = _columns(layout)
@@ -419,7 +415,7 @@ def _read_csv(name: str, data: bytes, layout: Layout) -> _Raw:
         elif layout.gyro_units is None and layout.accel_units is None:
             # an unrecognised header row would otherwise be read as rad and m/s increments
             raise ImuFileError(
-                f"{name}: header row {_clip(first)!r} does not name the columns as gcalign "
+                f"{name}: header row {clip(first, 60)!r} does not name the columns as gcalign "
                 "knows them (time, gyro_x (deg/s), ..., accel_z (m/s^2)); declare the "
                 "layout in a scenario: imu_file: {path: ..., columns: [t, gx, gy, gz, ax, "
                 "ay, az], units: {gyro: "
