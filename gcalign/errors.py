@@ -1,6 +1,12 @@
 """Errors that the command line turns into one line and an exit code, without a traceback."""
 
 
+def clip(text: str, n: int) -> str:
+    """`text` cut to `n` characters, "..." marking the cut (a bad value echoed in a message
+    can be megabytes long)."""
+    return text if len(text) <= n else text[:n - 3] + "..."
+
+
 class GcalignError(Exception):
     """A failure the user can act on (exit code 1)."""
 

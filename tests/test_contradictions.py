@@ -198,6 +198,37 @@ def test_the_real_recordings_agree_with_themselves(laser, mems):
     assert track["judged"] and track["best"] == "+y"
 
 
+def _vertical_reference(th, f, h):
+    """The carried vertical of ``consistency._vertical`` as a NumPy loop (its first form)."""
+    u = f[:max(1, int(round(5.0 / h)))].mean(axis=0)
+    u /= np.linalg.norm(u)
+    gain = h / K.VERTICAL_TAU_S
+    out = np.empty_like(f)
+    norms = np.linalg.norm(f, axis=1)
+    for k in range(len(f)):
+        u = u - np.cross(th[k], u)
+        if norms[k] > 0:
+            u = u + gain * (f[k] / norms[k] - u)
+        u /= np.linalg.norm(u)
+        out[k] = u
+    return out
+
+
+def test_the_vertical_kernel_is_the_numpy_loop(mems):
+    """The numba kernel of the carried vertical against its NumPy transcription, on the
+    rolling MEMS vehicle (with a block of zero specific force); and, as a closed form, a
+    body that does not turn under a constant specific force keeps the force's direction."""
+    imu, _ = mems
+    th, f, h = K._blocks(imu.dtheta, imu.dv, imu.ts, K.TRACK_BLOCK_S)
+    f[100] = 0.0
+    np.testing.assert_allclose(K._vertical(th, f, h), _vertical_reference(th, f, h),
+                               rtol=0, atol=1e-12)
+    f_b = np.tile([0.3, -0.2, 9.8], (50, 1))
+    U = K._vertical(np.zeros((50, 3)), f_b, 0.1)
+    np.testing.assert_allclose(U, np.tile(f_b[0] / np.linalg.norm(f_b[0]), (50, 1)),
+                               rtol=0, atol=1e-15)
+
+
 def test_every_proper_axes_rewriting_of_the_mems_vehicle_declared_rightly_passes(mems):
     """The MEMS vehicle written in each of the 24 proper axes layouts and declared so: the
     gyros, the reference and the track agree with it in every one."""

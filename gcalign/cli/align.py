@@ -9,21 +9,9 @@ import typer
 
 from gcalign.app.registry import COMMANDS
 from gcalign.choices import ALIGN_MODES_ALL, COMPENSATIONS, listed
+from gcalign.cli import options as opt
 from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import builtin_text, load_with_overrides, recorded, run_and_show
-from gcalign.cli.options import (
-    Height,
-    ImuAxes,
-    ImuFile,
-    ImuFormat,
-    Json,
-    Lat,
-    Lon,
-    Output,
-    Reference,
-    Seed,
-    Sets,
-)
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["align"].builtin or ""
@@ -85,17 +73,17 @@ def align(
         None, "--t1", help="End of the coarse window T1 (s); the fine block starts there."),
     t2: float | None = typer.Option(None, "--t2", help="End of the stored data block T2 (s)."),
     t3: str | None = typer.Option(None, "--t3", help="Result time T3 (s) or 'measured'."),
-    seed: Seed = None,
-    output: Output = None,
-    as_json: Json = False,
-    set_: Sets = None,
-    imu_file: ImuFile = None,
-    imu_format: ImuFormat = None,
-    imu_axes: ImuAxes = None,
-    reference: Reference = None,
-    lat: Lat = None,
-    lon: Lon = None,
-    height: Height = None,
+    seed: opt.Seed = None,
+    output: opt.Output = None,
+    as_json: opt.Json = False,
+    set_: opt.Sets = None,
+    imu_file: opt.ImuFile = None,
+    imu_format: opt.ImuFormat = None,
+    imu_axes: opt.ImuAxes = None,
+    reference: opt.Reference = None,
+    lat: opt.Lat = None,
+    lon: opt.Lon = None,
+    height: opt.Height = None,
 ):
     """Gyrocompass fine alignment with forward/reverse passes and T2 -> T3 compensation."""
     given = recorded(imu_file, imu_format, imu_axes, reference, lat, lon, height)

@@ -2,27 +2,14 @@
 
 from __future__ import annotations
 
-import re
 import sys
 from pathlib import Path
 
 import typer
 
+from gcalign.cli import options as opt
 from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show
-from gcalign.cli.options import (
-    Height,
-    ImuAxes,
-    ImuFile,
-    ImuFormat,
-    Json,
-    Lat,
-    Lon,
-    Output,
-    Reference,
-    Seed,
-    Sets,
-)
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
 
@@ -43,17 +30,17 @@ def allan(
     duration: float | None = typer.Option(None, "--duration", help="Window length (s)."),
     scenario_out: str | None = typer.Option(None, "--scenario", metavar="FILE",
                                             help=SCENARIO_HELP),
-    output: Output = None,
-    seed: Seed = None,
-    as_json: Json = False,
-    set_: Sets = None,
-    imu_file: ImuFile = None,
-    imu_format: ImuFormat = None,
-    imu_axes: ImuAxes = None,
-    reference: Reference = None,
-    lat: Lat = None,
-    lon: Lon = None,
-    height: Height = None,
+    output: opt.Output = None,
+    seed: opt.Seed = None,
+    as_json: opt.Json = False,
+    set_: opt.Sets = None,
+    imu_file: opt.ImuFile = None,
+    imu_format: opt.ImuFormat = None,
+    imu_axes: opt.ImuAxes = None,
+    reference: opt.Reference = None,
+    lat: opt.Lat = None,
+    lon: opt.Lon = None,
+    height: opt.Height = None,
 ):
     """Overlapping Allan deviation of every gyro and accelerometer axis (allantools), its 1σ
     interval from the number of clusters, and the IEEE Std 952 terms fitted to it:
@@ -61,9 +48,8 @@ def allan(
     walk (+½), each with its τ range and interval, named as the scenario's imu keys."""
     import yaml
 
-    from gcalign.cli.data import DATA_SUFFIXES, data_suffix
+    from gcalign.cli.data import data_file
     from gcalign.io import results
-    from gcalign.io.results import HDF5_SUFFIXES
 
     if source is not None and not source.is_file():
         raise ScenarioError(f"{source}: {not_a_file(source)}")
@@ -76,17 +62,8 @@ def allan(
         raise ScenarioError(f"--scenario: {scenario_out} is also the results file (-o)")
     if scenario_out not in (None, "-"):
         results.check_output(scenario_out, "--scenario")
-    suffix = "" if source is None else data_suffix(source)
-    data = text = None
-    if source is not None and suffix in DATA_SUFFIXES | HDF5_SUFFIXES:
-        text = results.read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
-        stored = yaml.safe_load(text) if text else None
-        name = stored.get("name") if isinstance(stored, dict) else None
-        name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.name.split(".")[0]) or "data"
-        data = {"name": name, "imu_file": str(source.resolve())}
-        if isinstance(stored, dict) and "earth" in stored:
-            data["earth"] = stored["earth"]
-        text = yaml.safe_dump(data)
+    data, _ = data_file(source, ("earth",))
+    text = None if data is None else yaml.safe_dump(data)
     overrides = {"start_s": start, "duration_s": duration}
     loaded = load_with_overrides(source, "", "allan", overrides, data=data, text=text,
                                  sets=set_, recorded=given)

@@ -7,21 +7,9 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
+from gcalign.cli import options as opt
 from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import Loaded, Recorded, load_with_overrides, recorded, run_and_show
-from gcalign.cli.options import (
-    Height,
-    ImuAxes,
-    ImuFile,
-    ImuFormat,
-    Json,
-    Lat,
-    Lon,
-    Output,
-    Reference,
-    Seed,
-    Sets,
-)
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["calibrate"].builtin or ""
@@ -50,17 +38,17 @@ def calibrate(
         None, "--smoother/--no-smoother", help="Also run the RTS smoother (post-flight)."),
     truth: str | None = typer.Option(
         None, "--truth", help="Injected errors: scenario | draw (from P0 with the seed)."),
-    seed: Seed = None,
-    output: Output = None,
-    as_json: Json = False,
-    set_: Sets = None,
-    imu_file: ImuFile = None,
-    imu_format: ImuFormat = None,
-    imu_axes: ImuAxes = None,
-    reference: Reference = None,
-    lat: Lat = None,
-    lon: Lon = None,
-    height: Height = None,
+    seed: opt.Seed = None,
+    output: opt.Output = None,
+    as_json: opt.Json = False,
+    set_: opt.Sets = None,
+    imu_file: opt.ImuFile = None,
+    imu_format: opt.ImuFormat = None,
+    imu_axes: opt.ImuAxes = None,
+    reference: opt.Reference = None,
+    lat: opt.Lat = None,
+    lon: opt.Lon = None,
+    height: opt.Height = None,
 ):
     """In-flight calibration: the 21-state Kalman filter aided by DGNSS (or zero velocity
     on recorded data); per state the injected truth, estimate, error and final σ."""
@@ -79,9 +67,9 @@ def observability(
         None, "--scaling",
         help="p0 (default: columns × initial σ, unit-free ranks) | none (the paper: unscaled)."),
     matching: str | None = typer.Option(None, "--matching", help=MATCHING_HELP),
-    output: Output = None,
-    as_json: Json = False,
-    set_: Sets = None,
+    output: opt.Output = None,
+    as_json: opt.Json = False,
+    set_: opt.Sets = None,
 ):
     """Observability of the flight's manoeuvres: PWCS pieces, SOM/TOM ranks and the seed's
     SVD degree η per segment and cumulative (Table 1 analogue); on a transfer-alignment

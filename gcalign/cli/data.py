@@ -8,21 +8,9 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
+from gcalign.cli import options as opt
 from gcalign.cli.base import app, consoles, emit_json, user_errors
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show, warn
-from gcalign.cli.options import (
-    Height,
-    ImuAxes,
-    ImuFile,
-    ImuFormat,
-    Json,
-    Lat,
-    Lon,
-    Output,
-    Reference,
-    Seed,
-    Sets,
-)
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
 
@@ -38,16 +26,36 @@ def data_suffix(path: Path) -> str:
     return suffixes[-1] if suffixes else ""
 
 
+def data_file(source: Path | None, keep: tuple[str, ...]) -> tuple[dict | None, str]:
+    """A data file given as SOURCE stands for the scenario ``imu_file: SOURCE``, and its
+    scenario text ("" but for our own results file); (None, "") for anything else. Our own
+    results file keeps the name of the scenario that made it and its sections `keep`."""
+    import yaml
+
+    from gcalign.io import results
+    from gcalign.io.results import HDF5_SUFFIXES
+
+    suffix = "" if source is None else data_suffix(source)
+    if source is None or suffix not in DATA_SUFFIXES | HDF5_SUFFIXES:
+        return None, ""
+    text = results.read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
+    stored = yaml.safe_load(text) if text else None
+    name = stored.get("name") if isinstance(stored, dict) else None
+    name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.name.split(".")[0]) or "data"
+    data = {"name": name, "imu_file": str(source.resolve())}
+    if isinstance(stored, dict):
+        data |= {key: stored[key] for key in keep if key in stored}
+    return data, text
 
 
 @app.command()
 @user_errors
 def simulate(
     scenario: Path = typer.Argument(..., help="Scenario YAML."),
-    output: Output = None,
-    seed: Seed = None,
-    as_json: Json = False,
-    set_: Sets = None,
+    output: opt.Output = None,
+    seed: opt.Seed = None,
+    as_json: opt.Json = False,
+    set_: opt.Sets = None,
 ):
     """Simulate truth and IMU data; write /truth and /imu."""
     run_and_show("simulate", load_with_overrides(scenario, "", "", {}, sets=set_), seed, output,
@@ -69,17 +77,17 @@ def navigate(
         None, "--vertical", help="Vertical channel: auto | free | hold | damped."),
     start: float | None = typer.Option(None, "--start", help="Data time to start at (s)."),
     duration: float | None = typer.Option(None, "--duration", help="How long to navigate (s)."),
-    output: Output = None,
-    seed: Seed = None,
-    as_json: Json = False,
-    set_: Sets = None,
-    imu_file: ImuFile = None,
-    imu_format: ImuFormat = None,
-    imu_axes: ImuAxes = None,
-    reference: Reference = None,
-    lat: Lat = None,
-    lon: Lon = None,
-    height: Height = None,
+    output: opt.Output = None,
+    seed: opt.Seed = None,
+    as_json: opt.Json = False,
+    set_: opt.Sets = None,
+    imu_file: opt.ImuFile = None,
+    imu_format: opt.ImuFormat = None,
+    imu_axes: opt.ImuAxes = None,
+    reference: opt.Reference = None,
+    lat: opt.Lat = None,
+    lon: opt.Lon = None,
+    height: opt.Height = None,
 ):
     """Strapdown navigation, streamed block by block; errors against truth at every sample.
 
@@ -90,9 +98,6 @@ def navigate(
     """
     import yaml
 
-    from gcalign.io import results
-    from gcalign.io.results import HDF5_SUFFIXES
-
     given_options = recorded(imu_file, imu_format, imu_axes, reference, lat, lon, height)
     overrides = {"vertical": vertical, "start_s": start, "duration_s": duration}
     for what, given in (("--init", init), ("the source", source)):
@@ -102,24 +107,11 @@ def navigate(
                                 "under another name (it would replace its own input)")
     if source is not None and not source.is_file():
         raise ScenarioError(f"{source}: {not_a_file(source)}")
-    suffix = "" if source is None else data_suffix(source)
-    data = text = None
     if source is None and given_options.imu_file is None:
         raise ScenarioError("navigate: give a scenario or a data file (SOURCE), or "
                             "--imu-file FILE")
-    if source is not None and suffix in DATA_SUFFIXES | HDF5_SUFFIXES:
-        # A bare data file stands for the scenario `imu_file: SOURCE`; our own results
-        # file keeps the name and text of the scenario that made it.
-        text = results.read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
-        stored = yaml.safe_load(text) if text else None
-        name = stored.get("name") if isinstance(stored, dict) else None
-        name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.name.split(".")[0]) or "data"
-        data = {"name": name, "imu_file": str(source.resolve())}
-        if isinstance(stored, dict):
-            for key in ("earth", "navigation", "output"):
-                if key in stored:
-                    data[key] = stored[key]
-        text = text or yaml.safe_dump(data)
+    data, stored = data_file(source, ("earth", "navigation", "output"))
+    text = None if data is None else stored or yaml.safe_dump(data)
     loaded = load_with_overrides(source, "", "navigation", overrides, data=data, text=text,
                                  sets=set_, recorded=given_options)
     run_and_show("navigate", loaded, seed, output, as_json, init=init)
@@ -129,7 +121,7 @@ def navigate(
 @user_errors
 def show(
     file: Path = typer.Argument(..., help="A gcalign results file."),
-    as_json: Json = False,
+    as_json: opt.Json = False,
 ):
     """Print the summary of a results file again, from the file alone."""
     from gcalign.app.checked import read_checked
@@ -155,15 +147,15 @@ def show(
 @user_errors
 def validate(
     scenario: Path = typer.Argument(..., help="Scenario YAML, or a sweep YAML."),
-    as_json: Json = False,
-    set_: Sets = None,
-    imu_file: ImuFile = None,
-    imu_format: ImuFormat = None,
-    imu_axes: ImuAxes = None,
-    reference: Reference = None,
-    lat: Lat = None,
-    lon: Lon = None,
-    height: Height = None,
+    as_json: opt.Json = False,
+    set_: opt.Sets = None,
+    imu_file: opt.ImuFile = None,
+    imu_format: opt.ImuFormat = None,
+    imu_axes: opt.ImuAxes = None,
+    reference: opt.Reference = None,
+    lat: opt.Lat = None,
+    lon: opt.Lon = None,
+    height: opt.Height = None,
 ):
     """Check a scenario and print its resolved values in user units and SI, and the keys
     that cannot matter (as warnings). A sweep file (docs/batch.md): every variant checked

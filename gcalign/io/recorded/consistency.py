@@ -68,22 +68,25 @@ FACTOR_TOL = 0.3  #: a scale within 30 % of a unit's factor names that unit
 REST_STD_MPS2 = 0.05  #: 1-s means of the specific force vary less than this at rest
 REST_ANGLE_DEG = 10.0  #: the mean rate within this of the earth rate's direction
 
-#: gyro units by quantity, with their SI factors: those a layout takes
-#: (``io.recorded.imu.GYRO_UNITS``) and arc-seconds per second, which some FOGs give
-_RATES = {"rad/s": 1.0, "deg/s": u.DEG, "deg/h": u.DPH, "arcsec/s": u.ARCSEC}
-_INCREMENTS = {"rad": 1.0, "deg": u.DEG, "arcsec": u.ARCSEC}
-ACCEPTED = ("rad/s", "deg/s", "deg/h", "rad", "deg", "arcsec")
+#: gyro units -> (SI factor, quantity): those a layout takes (:mod:`~.imu` reads them here)
+GYRO_UNITS = {
+    "rad": (1.0, "increments"), "deg": (u.DEG, "increments"),
+    "arcsec": (u.ARCSEC, "increments"),
+    "rad/s": (1.0, "rates"), "deg/s": (u.DEG, "rates"), "deg/h": (u.DPH, "rates"),
+}
+#: the units a check may name: those a layout takes, and arc-seconds per second (some FOGs)
+_NAMED = {**GYRO_UNITS, "arcsec/s": (u.ARCSEC, "rates")}
 
 
-def _blocks(dtheta: np.ndarray, dv: np.ndarray, ts: float):
-    """Rates (n, 3) rad/s and specific forces (n, 3) m/s² averaged over blocks of about
-    :data:`BLOCK_S`, and the block length, s."""
-    m = max(1, int(round(BLOCK_S / ts)))
+def _blocks(dtheta: np.ndarray, dv: np.ndarray, ts: float, block_s: float = BLOCK_S):
+    """Rotation vectors (n, 3) rad and mean specific forces (n, 3) m/s² of blocks of about
+    `block_s`, and the block length, s."""
+    m = max(1, int(round(block_s / ts)))
     n = len(dtheta) // m
     h = m * ts
-    th = dtheta[:n * m].reshape(n, m, 3).sum(1)
-    f = dv[:n * m].reshape(n, m, 3).sum(1)
-    return th / h, f / h, h
+    th = np.asarray(dtheta, float)[:n * m].reshape(n, m, 3).sum(1)
+    f = np.asarray(dv, float)[:n * m].reshape(n, m, 3).sum(1)
+    return th, f / h, h
 
 
 def _moving_mean(x: np.ndarray, n: int) -> np.ndarray:
@@ -115,7 +118,8 @@ def gyro_fit(dtheta: np.ndarray, dv: np.ndarray, ts: float) -> dict | None:
     permutations P of the gyro axes: ``{"rho", "k", "windows", "fits": [(rho, k, P)]}``
     (fits sorted by rho, best first; P maps the read gyro axes to the accelerometers'),
     or None when the recording is too short to judge."""
-    w, f, h = _blocks(np.asarray(dtheta, float), np.asarray(dv, float), ts)
+    th, f, h = _blocks(dtheta, dv, ts)
+    w = th / h
     L = int(round(WINDOW_S / h))
     if L < 1 or len(w) < L * (MIN_WINDOWS + 1):
         return None
@@ -140,12 +144,13 @@ def gyro_fit(dtheta: np.ndarray, dv: np.ndarray, ts: float) -> dict | None:
 def _unit_for(declared: str, k: float) -> str | None:
     """The gyro unit whose factor is the declared one's times `k` (within
     :data:`FACTOR_TOL`), of the same quantity; None if none is."""
-    table = _RATES if declared in _RATES else _INCREMENTS if declared in _INCREMENTS else None
-    if table is None:
+    if declared not in _NAMED:
         return None
-    target = table[declared] * k
-    for name, factor in table.items():
-        if name != declared and abs(math.log(target / factor)) < math.log(1 + FACTOR_TOL):
+    factor, quantity = _NAMED[declared]
+    target = factor * k
+    for name, (other, q) in _NAMED.items():
+        if q == quantity and name != declared and \
+                abs(math.log(target / other)) < math.log(1 + FACTOR_TOL):
             return name
     return None
 
@@ -156,8 +161,9 @@ def _fix(fmt: str, unit: str) -> str:
         return "check the header's gyro scale factors (arcsec per count)"
     if fmt in ("psins-mat", "i2nav"):
         return f"convert the gyro columns to rad ({fmt} holds increments in rad)"
-    if unit not in ACCEPTED:
-        return f"convert the gyro columns to one of {', '.join(ACCEPTED)}"
+    if unit not in GYRO_UNITS:  # rates first, as a FOG's data sheet gives them
+        accepted = sorted(GYRO_UNITS, key=lambda k: GYRO_UNITS[k][1] != "rates")
+        return f"convert the gyro columns to one of {', '.join(accepted)}"
     return f"give units: {{gyro: {unit}}}"
 
 
@@ -225,7 +231,8 @@ def earth_rate_at_rest(name: str, dtheta: np.ndarray, dv: np.ndarray, ts: float,
                        *, gyro_units: str, fmt: str) -> dict:
     """Relation 2 of the module docstring (`lat` in rad): ScenarioError when the mean rate
     of a recording at rest is the earth rate in other units. Returns what was found."""
-    w, f, _ = _blocks(np.asarray(dtheta, float), np.asarray(dv, float), ts)
+    th, f, h = _blocks(dtheta, dv, ts)
+    w = th / h
     if len(w) < 10:
         return {"judged": False, "why": "shorter than 10 s"}
     if float(f.std(axis=0).max()) > REST_STD_MPS2:
@@ -341,19 +348,11 @@ def _vertical(th: np.ndarray, f: np.ndarray, h: float) -> np.ndarray:
     rotations of the gyros (a vector fixed in the navigation frame turns as ``u − θ × u`` in
     the body) and pulled toward the specific force with the time constant
     :data:`VERTICAL_TAU_S`, so that a tilt the vehicle holds is followed and its
-    accelerations average out."""
-    u = f[:max(1, int(round(5.0 / h)))].mean(axis=0)
-    u /= np.linalg.norm(u)
-    gain = h / VERTICAL_TAU_S
-    out = np.empty_like(f)
-    norms = np.linalg.norm(f, axis=1)
-    for k in range(len(f)):
-        u = u - np.cross(th[k], u)
-        if norms[k] > 0:
-            u = u + gain * (f[k] / norms[k] - u)
-        u /= np.linalg.norm(u)
-        out[k] = u
-    return out
+    accelerations average out (a numba kernel: a Python loop took 0.6 s an hour of data)."""
+    from gcalign.io.recorded._kernel import carried_vertical
+
+    u0 = f[:max(1, int(round(5.0 / h)))].mean(axis=0)
+    return carried_vertical(th, f, u0 / np.linalg.norm(u0), h / VERTICAL_TAU_S)
 
 
 def forward_axis(name: str, imu_t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray,
@@ -374,14 +373,11 @@ def forward_axis(name: str, imu_t: np.ndarray, dtheta: np.ndarray, dv: np.ndarra
     record: dict = {"judged": False}
     vel_t, v_n = np.asarray(vel_t, float), np.asarray(v_n, float)
     ts = float(np.median(np.diff(imu_t)))
-    m = max(1, int(round(TRACK_BLOCK_S / ts)))
-    n = len(dtheta) // m
-    h = m * ts
+    th, f, h = _blocks(dtheta, dv, ts, TRACK_BLOCK_S)
+    n = len(th)
     if n < int(30 / h) or len(vel_t) < 3:
         record["why"] = "too short to judge"
         return record
-    th = np.asarray(dtheta, float)[:n * m].reshape(n, m, 3).sum(1)
-    f = np.asarray(dv, float)[:n * m].reshape(n, m, 3).sum(1) / h
     t_b = imu_t[0] - ts + h * (np.arange(n) + 0.5)
     U = _vertical(th, f, h)
     f_h = f - (f * U).sum(1)[:, None] * U

@@ -45,12 +45,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from gcalign import units as u
-from gcalign.errors import ScenarioError
+from gcalign.errors import ScenarioError, clip
 from gcalign.io.imu_files import (
     _HDF5_MAGIC,
     ImuFileError,
     _data_lineno,
+    _fields,
+    _increasing,
+    _is_number,
     _parse_block,
     check_increments,
     data_suffix,
@@ -60,18 +62,13 @@ from gcalign.io.imu_files import (
 )
 from gcalign.io.recorded import consistency, mat
 from gcalign.io.recorded.axes import axes_text, rotation_to_rfu
+from gcalign.io.recorded.consistency import GYRO_UNITS
 from gcalign.sim.imu import ImuData
 
 __all__ = ["FORMATS", "Layout", "read_recording", "GYRO_UNITS", "ACCEL_UNITS"]
 
 G_STANDARD = 9.80665  #: m/s² per g for accelerometer data in g (sensor data sheets' g)
 
-#: gyro units -> (SI factor, quantity)
-GYRO_UNITS = {
-    "rad": (1.0, "increments"), "deg": (u.DEG, "increments"),
-    "arcsec": (u.ARCSEC, "increments"),
-    "rad/s": (1.0, "rates"), "deg/s": (u.DEG, "rates"), "deg/h": (u.DPH, "rates"),
-}
 #: accelerometer units -> (SI factor, quantity)
 ACCEL_UNITS = {
     "m/s": (1.0, "increments"), "m/s^2": (1.0, "rates"), "g": (G_STANDARD, "rates"),
@@ -197,11 +194,19 @@ def _text_lines(name: str, data: bytes) -> list[str]:
     if data.startswith(_HDF5_MAGIC):
         raise ImuFileError(f"{name}: is an HDF5 file, not text (a gcalign results file is "
                            "read without format; a MAT v7.3 file: format psins-mat)")
-    out = []
-    for line in text_of(name, data).splitlines():
-        cut = min((i for i in (line.find("#"), line.find("%")) if i >= 0), default=-1)
-        out.append(line if cut < 0 else line[:cut])
-    return out
+    return [_uncommented(line) for line in text_of(name, data).splitlines()]
+
+
+def _uncommented(line: str) -> str:
+    cut = min((i for i in (line.find("#"), line.find("%")) if i >= 0), default=-1)
+    return line if cut < 0 else line[:cut]
+
+
+def _header(first: str) -> list[str] | None:
+    """The fields of a table's first line if it is a header row of names (letters, and not
+    every field a number), else None."""
+    parts = _fields(first, "," if "," in first else None)
+    return parts if any(c.isalpha() for c in first) and not all(map(_is_number, parts)) else None
 
 
 def _table(name: str, lines: list[str], ncols: int, labels
@@ -216,10 +221,8 @@ def _table(name: str, lines: list[str], ncols: int, labels
                            f"({', '.join(labels)})")
     first = lines[i].strip()
     delimiter = "," if "," in first else None
-    parts = [p.strip() for p in first.split(delimiter)] if delimiter else first.split()
-    header = None
-    if any(c.isalpha() for c in first) and not all(_number(p) for p in parts):
-        header = parts
+    header = _header(first)
+    if header is not None:
         i += 1
     data = _parse_block(name, lines, i, ncols, "\x00", delimiter, tuple(labels))
     start = i
@@ -262,14 +265,10 @@ def _blocks(name: str, data: bytes, ncols: int):
     while text_start < len(data):  # the first line with content: a header of names?
         end = data.find(b"\n", text_start)
         end = len(data) if end < 0 else end
-        line = data[text_start:end].decode("utf-8", errors="replace")
-        cut = min((i for i in (line.find("#"), line.find("%")) if i >= 0), default=-1)
-        first = (line if cut < 0 else line[:cut]).strip()
+        first = _uncommented(data[text_start:end].decode("utf-8", errors="replace")).strip()
         if first:
-            parts = ([p.strip() for p in first.split(",")] if "," in first
-                     else first.split())
-            if any(c.isalpha() for c in first) and not all(_number(p) for p in parts):
-                header = parts
+            header = _header(first)
+            if header is not None:
                 text_start = end + 1
             break
         text_start = end + 1
@@ -295,14 +294,6 @@ def _blocks(name: str, data: bytes, ncols: int):
     if n == 0:
         return None
     return out[:n], header
-
-
-def _number(s: str) -> bool:
-    try:
-        float(s)
-    except ValueError:
-        return False
-    return True
 
 
 def _read_psins(name: str, path) -> _Raw:
@@ -405,17 +396,13 @@ def _header_layout(header: list[str] | None) -> tuple[tuple[str, ...], dict] | N
     return tuple(cols), {k: v.pop() for k, v in units.items()}
 
 
-def _clip(text: str, n: int = 60) -> str:
-    return text if len(text) <= n else text[:n - 3] + "..."
-
-
 def _read_csv(name: str, data: bytes, layout: Layout) -> _Raw:
     lines = _text_lines(name, data)
     cols = _columns(layout)
     first = next((ln.strip() for ln in lines if ln.strip()), "")
     parts = [p.strip() for p in first.split(",")] if "," in first else first.split()
     named = None
-    if layout.columns is None and not all(_number(p) for p in parts):
+    if layout.columns is None and not all(_is_number(p) for p in parts):
         try:
             named = _header_layout(parts)
         except ImuFileError as err:
@@ -425,7 +412,7 @@ def _read_csv(name: str, data: bytes, layout: Layout) -> _Raw:
         elif layout.gyro_units is None and layout.accel_units is None:
             # an unrecognised header row would otherwise be read as rad and m/s increments
             raise ImuFileError(
-                f"{name}: header row {_clip(first)!r} does not name the columns as gcalign "
+                f"{name}: header row {clip(first, 60)!r} does not name the columns as gcalign "
                 "knows them (time, gyro_x (deg/s), ..., accel_z (m/s^2)); declare the "
                 "layout in a scenario: imu_file: {path: ..., columns: [t, gx, gy, gz, ax, "
                 "ay, az], units: {gyro: "
@@ -504,11 +491,8 @@ def _unwrap_week(t: np.ndarray) -> tuple[np.ndarray, int]:
 def _regular(name: str, t, gyro, accel, ts: float, max_gap_s: float, where):
     """Check the steps (see the module docstring, point 3); fill accepted gaps. Returns
     (t, gyro, accel, jitter (max |step/ts - 1| of the accepted steps), gaps)."""
+    _increasing(name, t, where)
     dt = np.diff(t)
-    if (dt <= 0).any():
-        k = int(np.argmax(dt <= 0)) + 1
-        raise ImuFileError(f"{name}{where(k)}: time must increase strictly, got t = "
-                           f"{float(t[k])!r} after {float(t[k - 1])!r}")
     rel = dt / ts - 1.0
     short = rel < -JITTER
     if short.any():

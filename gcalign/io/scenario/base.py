@@ -17,6 +17,8 @@ from pydantic import (
     model_validator,
 )
 
+from gcalign.errors import ScenarioError, clip
+
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 NonNegVec3 = Annotated[list[Annotated[float, Field(ge=0)]], Field(min_length=3, max_length=3)]
 PosVec3 = Annotated[list[Annotated[float, Field(gt=0)]], Field(min_length=3, max_length=3)]
@@ -101,8 +103,6 @@ class Model(BaseModel):
         try:
             super().__setattr__(name, value)
         except ValidationError as err:
-            from gcalign.errors import ScenarioError
-
             prefix = f"{self._where}." if self._where else ""
             raise ScenarioError("; ".join(prefix + _one_line(e) for e in err.errors())
                                 ) from None
@@ -122,14 +122,10 @@ class Model(BaseModel):
                         and not _takes(field.annotation, (str, PurePath))):
                     text = _number_text(value)
                     if text is not None:
-                        raise ValueError(f"{name}: a number written as text ({_cut(text)}, "
-                                         "quoted or tagged !!str in the YAML); write the "
+                        raise ValueError(f"{name}: a number written as text ({clip(text, 40)!r}"
+                                         ", quoted or tagged !!str in the YAML); write the "
                                          "number itself")
         return data
-
-
-def _cut(text: str, n: int = 40) -> str:
-    return repr(text if len(text) <= n else text[: n - 3] + "...")
 
 
 def _yaml_bool(value: Any) -> str:
@@ -145,9 +141,8 @@ def _one_line(e: Any) -> str:
     models)."""
     where = ".".join(str(x) for x in e["loc"])
     msg = str(e["msg"]).removeprefix("Value error, ")
-    value = repr(e.get("input"))
     got = "" if e["type"] in ("missing", "model_type", "value_error") else (
-        f", got {value if len(value) <= 60 else value[:57] + '...'}")
+        f", got {clip(repr(e.get('input')), 60)}")
     return f"{where}: {msg}{got}"
 
 

@@ -8,6 +8,7 @@ import reprlib
 
 from pydantic import ValidationError
 
+from gcalign.errors import clip
 from gcalign.io.scenario.motion import MOTION_KINDS
 from gcalign.io.scenario.walk import keys_at
 
@@ -34,7 +35,7 @@ def _cut(value) -> str:
     can be megabytes long, or an alias bomb)."""
     text = value if isinstance(value, str) else _REPR.repr(value)
     if isinstance(value, str):
-        text = repr(value if len(value) <= CUT else value[:CUT - 3] + "...")
+        text = repr(clip(value, CUT))
     return text if len(text) <= CUT + 2 else text[:CUT - 3] + "..."
 
 
