@@ -309,8 +309,48 @@ def calibrate(data: FlightData, settings: Settings | None = None,
     `rng` draws the measurement noise (needed when ``settings.gnss_noise``). `on_rows`, if
     given, receives the navigation solution at every navigation sample (:data:`Rows`), the
     start included, so a caller can store it as it comes without the run holding it.
+
+    On the seed's schedule (a reference at every filter period, no lever arm, random-constant
+    sensor states, accumulated Φ, no smoother) the epochs run in one numba kernel
+    (:mod:`gcalign.calibrate._kernel`, the one :func:`gcalign.calibrate.lockstep.
+    calibrate_runs` steps several seeds through); otherwise in the loop below.
     """
-    s = settings or Settings()
+    plan = _plan(data, settings or Settings(), rng)
+    if kernel_route(plan):
+        ep = _kernel_epochs([plan], on_rows)[0]
+        if isinstance(ep, Exception):
+            raise ep
+    else:
+        ep = _loop(plan, on_rows)
+    return _finish(plan, ep)
+
+
+@dataclass
+class _Plan:
+    """A run's inputs as the epochs take them (:func:`_plan`)."""
+
+    data: FlightData
+    s: Settings
+    S: int
+    stops: list[_Stop]
+    dropped: int
+    P0: np.ndarray
+    Qc: np.ndarray
+    R_fixed: np.ndarray
+    names: tuple[str, ...]
+    procs: SensorProcesses | None
+    noise: np.ndarray
+    truth: Trajectory | None
+    lever_v: np.ndarray
+    lever_p: np.ndarray
+
+    @property
+    def levered(self) -> bool:
+        return bool(self.lever_v.any() or self.lever_p.any())
+
+
+def _plan(data: FlightData, s: Settings, rng: np.random.Generator | None) -> _Plan:
+    """Check the run's inputs and set up what its epochs need (the noise drawn)."""
     ts = data.ts
     S = s.steps_per_update(ts)
     N = len(data.dtheta)
@@ -328,9 +368,7 @@ def calibrate(data: FlightData, settings: Settings | None = None,
     if K < 1:
         raise ScenarioError(f"data: {N} navigation steps are fewer than one "
                             f"filter step ({S})")
-    earth = data.earth
-    E = earth.params()
-    P0, Qc, R_fixed = s.covariances(data.start.pos, earth)
+    P0, Qc, R_fixed = s.covariances(data.start.pos, data.earth)
     names = ie.measurement_names(s.measure, s.components)
     m = len(names)
     procs = s.processes if s.processes is not None and not s.processes.constant else None
@@ -339,45 +377,79 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         if rng is None:
             raise ValueError("calibrate: gnss_noise needs an rng (numpy.random.Generator)")
         noise = rng.standard_normal((K, m)) * _noise_sigma(s)
-    truth, x_true = data.truth, data.x_true
-    if truth is None or x_true is None:
-        truth = x_true = None
+    truth = data.truth if data.truth is not None and data.x_true is not None else None
     if fixes is None:
         lever_v = _lever_arm(data.lever_arm_v_b, "v")
         lever_p = _lever_arm(data.lever_arm_p_b, "p")
     else:
         lever_v = _lever_arm(fixes.lever_arm_v_b, "v")
         lever_p = _lever_arm(fixes.lever_arm_p_b, "p")
-    levered = bool(lever_v.any() or lever_p.any())
     need_v, need_p = s.measure != "position", s.measure != "velocity"
     if fixes is not None and ((need_v and fixes.v_n is None) or (need_p and fixes.pos is None)):
         raise ScenarioError(f"calibrate.measure: {s.measure!r} needs "
                             f"{'velocities' if need_v and fixes.v_n is None else 'positions'}"
                             " the aiding does not have")
+    return _Plan(data, s, S, stops, dropped, P0, Qc, R_fixed, names, procs, noise, truth,
+                 lever_v, lever_p)
 
+
+def kernel_route(plan: _Plan) -> bool:
+    """Do the run's epochs go through the kernel (:func:`calibrate`)?"""
+    s = plan.s
+    return (plan.data.fixes is None and not plan.levered and plan.procs is None
+            and s.discretization == "accumulated" and not s.smoother)
+
+
+@dataclass
+class _Epochs:
+    """What the epochs leave for :func:`_finish` (rows 0 … K: the start, then each epoch)."""
+
+    index: np.ndarray
+    updated: np.ndarray
+    est: np.ndarray
+    sig: np.ndarray
+    innov: np.ndarray  # (U, m) at the U updates, and stdz, nis, r_sig alike
+    stdz: np.ndarray
+    nis: np.ndarray
+    r_sig: np.ndarray
+    corrected: np.ndarray  # (K+1, 10) q_nb, v_n, pos after each correction
+    pre: np.ndarray  # (K+1, 10) before it
+    in_force: np.ndarray
+    x_all: np.ndarray
+    P_all: np.ndarray | None
+    hist: _History | None = None
+
+
+def _loop(plan: _Plan, on_rows: Rows | None) -> _Epochs:
+    """The epochs one by one, every option (fixes at their own epochs, lever arms, sensor
+    processes, Van Loan, the smoother's history)."""
+    data, s, stops = plan.data, plan.s, plan.stops
+    ts, earth, fixes = data.ts, data.earth, data.fixes
+    E = earth.params()
+    K, m = len(stops), len(plan.names)
+    procs, noise, R_fixed = plan.procs, plan.noise, plan.R_fixed
     index = np.zeros(K + 1, np.int64)
     updated = np.zeros(K + 1, dtype=bool)
     est, sig = np.zeros((K + 1, N_STATES)), np.zeros((K + 1, N_STATES))
     innov, stdz, nis, r_sig = [], [], [], []
-    quat, vel, posn = np.zeros((K + 1, 4)), np.zeros((K + 1, 3)), np.zeros((K + 1, 3))
+    corrected, pre = np.zeros((K + 1, 10)), np.zeros((K + 1, 10))
     # what the errors against the truth need, evaluated after the loop in whole arrays:
     # the INS solution before each correction, the compensation in force, x⁺ and (with a
     # truth only: a recording's run keeps no P per epoch) P⁺ for the NEES
-    pre_q, pre_v, pre_p = np.zeros((K + 1, 4)), np.zeros((K + 1, 3)), np.zeros((K + 1, 3))
     in_force, x_all = np.zeros((K + 1, N_STATES)), np.zeros((K + 1, N_STATES))
-    P_all = np.zeros((K + 1, N_STATES, N_STATES)) if truth is not None else None
+    P_all = np.zeros((K + 1, N_STATES, N_STATES)) if plan.truth is not None else None
     hist = _History() if s.smoother else None
 
     q, v, p = (np.asarray(data.start.q_nb, float), np.asarray(data.start.v_n, float),
                np.asarray(data.start.pos, float))
-    x, P = np.zeros(N_STATES), P0
+    x, P = np.zeros(N_STATES), plan.P0
     imu = np.zeros(N_STATES)  # sensor parameters in force (closed loop), states 9–20
-    sig[0] = np.sqrt(np.diag(P0))
-    quat[0], vel[0], posn[0] = pre_q[0], pre_v[0], pre_p[0] = q, v, p
+    sig[0] = np.sqrt(np.diag(P))
+    corrected[0] = pre[0] = np.concatenate([q, v, p])
     if P_all is not None:
-        P_all[0] = P0
+        P_all[0] = P
     if hist is not None:
-        hist.P_post.append(P0)
+        hist.P_post.append(P)
         hist.x_post.append(np.zeros(N_STATES))
         hist.imu_pre.append(np.zeros(N_STATES))
     if on_rows is not None:
@@ -393,14 +465,14 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         sol = navigate(data.t[b + 1: e + 1], dth, dvb, ts, NavState(q, v, p), earth=earth)
         q, v, p = sol.q_nb[-1], sol.v_n[-1], sol.pos[-1]
         # 3–4. Φ, Q_d along the navigation (and the sensors' own processes); predict
-        Phi, Qd = _transition(sol.q_nb, sol.v_n, sol.pos, dth, dvb, ts, Qc, s.discretization,
-                              E, procs)
+        Phi, Qd = _transition(sol.q_nb, sol.v_n, sol.pos, dth, dvb, ts, plan.Qc,
+                              s.discretization, E, procs)
         x_prior, P_prior = predict(x, P, Phi, Qd)
         if procs is not None and s.feedback:  # the parameters in force follow their model
             imu = imu.copy()
             imu[IMU] *= procs.discrete((e - b) * ts)[0]
         imu_step = imu  # the compensation the state x⁻ is the error of
-        index[k + 1], pre_q[k + 1], pre_v[k + 1], pre_p[k + 1] = e, q, v, p
+        index[k + 1], pre[k + 1] = e, np.concatenate([q, v, p])
         x_post, P = x_prior, P_prior
         if stop.fix is not None:
             # the INS at the fix's time: inside the last navigation step, linearly (a few ms;
@@ -425,10 +497,10 @@ def calibrate(data: FlightData, settings: Settings | None = None,
                              np.zeros(3) if ref_v is None else ref_v,
                              np.zeros(3) if ref_p is None else ref_p, earth) - noise[k]
             H = ie.measurement_matrix(s.measure, p, earth, s.components)
-            if levered:  # the fixes are the antenna's: z and H of the INS's antenna
+            if plan.levered:  # the fixes are the antenna's: z and H of the INS's antenna
                 off, H_l = ie.lever_arm_terms(s.measure, quat_to_dcm(q), dth[-1] / ts,
-                                              earth.omega_ie_n(p[0]), lever_v, lever_p,
-                                              s.components)
+                                              earth.omega_ie_n(p[0]), plan.lever_v,
+                                              plan.lever_p, s.components)
                 z, H = z + off, H + H_l
             u = update(x_prior, P_prior, z, H, R)
             innov.append(u.innovation)
@@ -460,16 +532,106 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         else:
             est[k + 1, IMU] = x_post[IMU]
             x = x_post
-        quat[k + 1], vel[k + 1], posn[k + 1] = q_c, v_c, p_c
+        corrected[k + 1] = np.concatenate([q_c, v_c, p_c])
         if on_rows is not None:
             rq, rv, rp = sol.q_nb[1:].copy(), sol.v_n[1:].copy(), sol.pos[1:].copy()
             rq[-1], rv[-1], rp[-1] = q_c, v_c, p_c
             on_rows(data.t[b + 1: e + 1], rq, rv, rp)
         b = e
+    rows = (np.array(innov), np.array(stdz)) if innov else (np.zeros((0, m)),) * 2
+    return _Epochs(index, updated, est, sig, rows[0], rows[1], np.array(nis, float),
+                   np.array(r_sig) if r_sig else np.zeros((0, m)), corrected, pre, in_force,
+                   x_all, P_all, hist)
 
-    smoothed = None if hist is None else _smooth(hist, s.feedback, pre_q, pre_v, pre_p)
+
+#: filter epochs per kernel call when the solution goes out as the run goes (``on_rows``)
+ROWS_EPOCHS = 64
+
+
+def _kernel_epochs(plans: list[_Plan], on_rows: Rows | None = None
+                   ) -> list[_Epochs | Exception]:
+    """The epochs of runs that share their schedule, reference, settings and earth model
+    (one run, or the seeds of a variant: :func:`gcalign.calibrate.lockstep.calibrate_runs`)
+    in the kernel, all lanes at once; `on_rows` (one run) hears of the solution every
+    :data:`ROWS_EPOCHS` epochs. A run whose update failed (S not positive definite) has
+    numpy.linalg.LinAlgError in its place."""
+    from gcalign.calibrate._kernel import epochs
+
+    p0 = plans[0]
+    data, s = p0.data, p0.s
+    assert data.ref_v_n is not None and data.ref_pos is not None
+    L, K, m = len(plans), len(p0.stops), len(p0.names)
+    ends = np.array([0] + [st.end for st in p0.stops], np.int64)
+    N = int(ends[-1])
+    dtheta = np.empty((L, N, 3))
+    dv = np.empty((L, N, 3))
+    noise = np.empty((L, K, m))
+    nav = np.empty((L, 10))
+    P = np.empty((L, N_STATES, N_STATES))
+    for ln, pl in enumerate(plans):
+        dtheta[ln], dv[ln], noise[ln] = pl.data.dtheta[:N], pl.data.dv[:N], pl.noise
+        st = pl.data.start
+        nav[ln] = np.concatenate([np.asarray(st.q_nb, float), np.asarray(st.v_n, float),
+                                  np.asarray(st.pos, float)])
+        P[ln] = pl.P0
+    x, imu = np.zeros((L, N_STATES)), np.zeros((L, N_STATES))
+    est, sig = np.zeros((L, K + 1, N_STATES)), np.zeros((L, K + 1, N_STATES))
+    in_force, x_all = np.zeros((L, K + 1, N_STATES)), np.zeros((L, K + 1, N_STATES))
+    innov, stdz, nis = np.zeros((L, K, m)), np.zeros((L, K, m)), np.zeros((L, K))
+    corrected, pre = np.zeros((L, K + 1, 10)), np.zeros((L, K + 1, 10))
+    P_all = np.zeros((L, K + 1 if p0.truth is not None else 0, N_STATES, N_STATES))
+    for ln, pl in enumerate(plans):
+        sig[ln, 0] = np.sqrt(np.diag(pl.P0))
+        corrected[ln, 0] = pre[ln, 0] = nav[ln]
+        if P_all.shape[1]:
+            P_all[ln, 0] = pl.P0
+    alive = np.ones(L, dtype=bool)
+    rv, rp = (np.array(r, np.int64) for r in ie._rows(s.measure, s.components))
+    args = (ends, dtheta, dv, data.ts, data.earth.params(),
+            np.ascontiguousarray(np.diag(p0.Qc)), rv, rp,
+            np.ascontiguousarray(data.ref_v_n, float), np.ascontiguousarray(data.ref_pos, float),
+            noise, np.ascontiguousarray(p0.R_fixed), s.feedback, 2.0, alive,
+            nav, x, P, imu, est, sig, innov, stdz, nis, corrected, pre, in_force, x_all, P_all)
+    if on_rows is None:
+        epochs(0, K, *args, np.zeros((L, 0, 10)))
+    else:
+        on_rows(data.t[:1], nav[:1, :4].copy(), nav[:1, 4:7].copy(), nav[:1, 7:].copy())
+        for k0 in range(0, K, ROWS_EPOCHS):
+            k1 = min(k0 + ROWS_EPOCHS, K)
+            rows = np.empty((1, ends[k1] - ends[k0], 10))
+            epochs(k0, k1, *args, rows)
+            if not alive[0]:
+                break
+            for k in range(k0, k1):  # as the loop hands them: epoch by epoch
+                r = rows[0, ends[k] - ends[k0]: ends[k + 1] - ends[k0]]
+                on_rows(data.t[ends[k] + 1: ends[k + 1] + 1], *(np.ascontiguousarray(r[:, a:b])
+                        for a, b in ((0, 4), (4, 7), (7, 10))))
+    updated = np.ones(K + 1, dtype=bool)
+    updated[0] = False
+    r_sig = np.broadcast_to(np.sqrt(np.diag(p0.R_fixed)), (K, m)).copy()
+    out: list[_Epochs | Exception] = []
+    for ln in range(L):
+        if not alive[ln]:
+            out.append(np.linalg.LinAlgError("Matrix is not positive definite"))
+            continue
+        out.append(_Epochs(ends.copy(), updated.copy(), est[ln], sig[ln], innov[ln], stdz[ln],
+                           nis[ln], r_sig.copy(), corrected[ln], pre[ln], in_force[ln],
+                           x_all[ln], P_all[ln] if P_all.shape[1] else None))
+    return out
+
+
+def _finish(plan: _Plan, ep: _Epochs) -> CalibrationResult:
+    """The result of a run from its epochs: the truth's filter state and the NEES (with a
+    truth), the smoother (with its history)."""
+    data, s = plan.data, plan.s
+    K = len(plan.stops)
+    index, x_true = ep.index, data.x_true
+    pre_q, pre_v, pre_p = (np.ascontiguousarray(ep.pre[:, a:b]) for a, b in ((0, 4), (4, 7),
+                                                                            (7, 10)))
+    smoothed = None if ep.hist is None else _smooth(ep.hist, s.feedback, pre_q, pre_v, pre_p)
+    truth = plan.truth
     tru = nees = None
-    if truth is not None and x_true is not None and P_all is not None:
+    if truth is not None and x_true is not None and ep.P_all is not None:
         # the true filter state at every epoch: the error of the INS solution before the
         # correction and of the compensation in force; epoch 0 is x_true itself
         sensors = (np.broadcast_to(x_true, (K + 1, N_STATES)) if data.sensor_truth is None
@@ -478,17 +640,18 @@ def calibrate(data: FlightData, settings: Settings | None = None,
         tru[:, PHI] = _phi(pre_q, euler_to_quat(truth.att[index]))
         tru[:, DV] = pre_v - truth.v_n[index]
         tru[:, DP] = pre_p - truth.pos[index]
-        tru[:, IMU] = _imu_residual(sensors, in_force)
+        tru[:, IMU] = _imu_residual(sensors, ep.in_force)
         tru[0] = sensors[0]
-        nees = nees_of(tru - x_all, P_all)
+        nees = nees_of(tru - ep.x_all, ep.P_all)
         tru[:, IMU] = sensors[:, IMU]  # reported: the sensor errors themselves
-    m_rows = (np.array(innov), np.array(stdz)) if innov else (np.zeros((0, m)),) * 2
+    c = ep.corrected
     return CalibrationResult(
-        t=data.t[index], estimate=est, sigma=sig, truth=tru,
-        nees=nees, innovation=m_rows[0], standardized=m_rows[1], nis=np.array(nis, float),
-        att=quat_to_euler(quat), v_n=vel, pos=posn,
-        measure_names=names, settings=s, smoothed=smoothed, index=index, updated=updated,
-        sigma_z=np.array(r_sig) if r_sig else np.zeros((0, m)), fixes_unused=dropped)
+        t=data.t[index], estimate=ep.est, sigma=ep.sig, truth=tru,
+        nees=nees, innovation=ep.innov, standardized=ep.stdz, nis=ep.nis,
+        att=quat_to_euler(np.ascontiguousarray(c[:, :4])), v_n=np.ascontiguousarray(c[:, 4:7]),
+        pos=np.ascontiguousarray(c[:, 7:]),
+        measure_names=plan.names, settings=s, smoothed=smoothed, index=index,
+        updated=ep.updated, sigma_z=ep.r_sig, fixes_unused=plan.dropped)
 
 
 def _fix_noise(s: Settings, fixes: Fixes, j: int, R_fixed: np.ndarray) -> np.ndarray:

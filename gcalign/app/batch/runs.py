@@ -130,16 +130,21 @@ def run_task(task: dict) -> dict:
     return rec
 
 
+#: the commands whose room steps a variant's seeds together: ``lockstep_ok(sc)`` and
+#: ``summaries_of_seeds(sc, seeds, cache_key)`` in the module
+LOCKSTEP = {"align": "gcalign.app.align.run", "calibrate": "gcalign.app.calibrate.run"}
+
+
 def run_chunk(tasks: list[dict]) -> list[dict]:
-    """Several runs in one worker call (amortises the per-call overhead). The seeds of an
-    align variant that allows it run in lockstep (:func:`run_seeds`), the rest one by one;
-    the records come back in the order of `tasks`."""
+    """Several runs in one worker call (amortises the per-call overhead). The seeds of a
+    variant that allows it (align, calibrate) run in lockstep (:func:`run_seeds`), the rest
+    one by one; the records come back in the order of `tasks`."""
     out: list[dict | None] = [None] * len(tasks)
     groups: dict[tuple[str, str], list[int]] = {}
     for i, t in enumerate(tasks):
         groups.setdefault((t["command"], t["vkey"]), []).append(i)
     for (command, _), idx in groups.items():
-        recs = run_seeds([tasks[i] for i in idx]) if command == "align" and len(idx) > 1 \
+        recs = run_seeds([tasks[i] for i in idx]) if command in LOCKSTEP and len(idx) > 1 \
             else None
         if recs is None:
             recs = [run_task(tasks[i]) for i in idx]
@@ -172,19 +177,24 @@ def keep_freed_memory() -> None:
 
 
 def run_seeds(tasks: list[dict]) -> list[dict] | None:
-    """The records of several seeds of one align variant, aligned in lockstep
-    (:func:`gcalign.app.align.run.summaries_of_seeds`: each seed's summary and metrics
-    those of its own run, to the bit), or None when the variant cannot share a lockstep
-    (then each runs alone). ``wall_s`` of each is the group's wall time per run."""
-    from gcalign.app.align.run import lockstep_ok, summaries_of_seeds
+    """The records of several seeds of one variant of a :data:`LOCKSTEP` command, run in
+    lockstep (the room's ``summaries_of_seeds``, e.g. :func:`gcalign.app.align.run.
+    summaries_of_seeds`: each seed's summary and metrics those of its own run, to the bit),
+    or None when the variant cannot share a lockstep (then each runs alone). ``wall_s`` of
+    each is the group's wall time per run."""
+    import importlib
+
     from gcalign.app.preflight import check_seed, preflight
+
+    command = tasks[0]["command"]
+    room = importlib.import_module(LOCKSTEP[command])
 
     t0 = time.perf_counter()
     try:
         sc = _scenario(tasks[0])
     except Exception:  # noqa: BLE001 - each run records its own failure
         return None
-    if not lockstep_ok(sc):
+    if not room.lockstep_ok(sc):
         return None
     keep_freed_memory()
     recs = [{"variant": t["variant"], "vkey": t["vkey"], "seed": t["seed"], "status": "ok",
@@ -198,13 +208,13 @@ def run_seeds(tasks: list[dict]) -> list[dict] | None:
         except Exception as err:  # noqa: BLE001
             results[i] = err
     try:
-        preflight(sc, "align")
+        preflight(sc, command)
     except Exception as err:  # noqa: BLE001 - the variant's runs fail alike
         for i in todo:
             results[i] = err
     else:
-        for i, res in zip(todo, summaries_of_seeds(sc, [tasks[i]["seed"] for i in todo],
-                                                   noise_free_key(sc)), strict=True):
+        for i, res in zip(todo, room.summaries_of_seeds(sc, [tasks[i]["seed"] for i in todo],
+                                                        noise_free_key(sc)), strict=True):
             results[i] = res
     for rec, t, res in zip(recs, tasks, results, strict=True):
         try:

@@ -295,6 +295,51 @@ def run_filter(case: Case, measure: str | None = None, data: FlightData | None =
     return Run(label, data, result, compute, stats, at_epochs)
 
 
+def summaries_of_seeds(sc: Scenario, seeds: list[int],
+                       cache_key: str | None) -> list[dict | Exception]:
+    """The summary of each seed's run of a simulated scenario, as :func:`execute` would give
+    it, the seeds' filters stepped together (:func:`gcalign.calibrate.lockstep.
+    calibrate_runs`: each seed's numbers to the bit those of its own run; ``compute_s`` is
+    the lockstep's time per run). A seed whose run fails has its exception in its place. For
+    a batch: the noise-free simulation and its trajectory are shared through `cache_key`,
+    and the caller has made the variant's preflight."""
+    from gcalign.calibrate.lockstep import calibrate_runs
+    from gcalign.io.results import finite_summary
+
+    out: list[dict | Exception] = []
+    cases, where = [], []
+    for seed in seeds:
+        try:
+            cases.append(simulated_case(sc, seed, cache_key))
+        except Exception as err:  # noqa: BLE001 - recorded for this seed, as a run would be
+            out.append(err)
+            continue
+        where.append(len(out))
+        out.append(ScenarioError("not run"))
+    warm_up()
+    t0 = time.perf_counter()
+    results = calibrate_runs([(c.data, c.settings,
+                               np.random.default_rng([0 if c.seed is None else c.seed, 3]))
+                              for c in cases])
+    compute = (time.perf_counter() - t0) / max(len(cases), 1)
+    for i, case, res in zip(where, cases, results, strict=True):
+        try:
+            if isinstance(res, Exception):
+                raise res
+            s = summary(sc, case, [Run("", case.data, res, compute)], False, [None])
+            finite_summary(s, "calibrate")
+            out[i] = s
+        except Exception as err:  # noqa: BLE001 - as above
+            out[i] = err
+    return out
+
+
+def lockstep_ok(sc: Scenario) -> bool:
+    """Can a batch run this variant's seeds in lockstep (:func:`summaries_of_seeds`)? A
+    simulated flight (the seeds share its truth)."""
+    return sc.imu_file is None and sc.motion is not None
+
+
 def _epoch_errors(case: Case, r: CalibrationResult, errors) -> dict:
     """The forward filter's and (with it) the smoother's solutions at the filter epochs
     against the truth or the reference, inside and outside the outages (the smoothed
