@@ -79,7 +79,7 @@ def _numba_loads_without_compiler_setup() -> None:
     does so itself), so a kernel that is not in the cache, or a new signature, compiles
     as before.
     """
-    from numba.core import caching, cpu
+    from numba.core import caching, cpu, environment
     from numba.core.runtime import rtsys
 
     cache, context = caching.Cache, cpu.CPUContext
@@ -87,7 +87,6 @@ def _numba_loads_without_compiler_setup() -> None:
         return  # already done, or a numba whose cache works otherwise: its own way
 
     def load_overload(self, sig, target_context):
-        _arraymath_without_scipy()
         rtsys.initialize(target_context)  # what cached machine code links against
         with self._guard_against_spurious_io_errors():
             return self._load_overload(sig, target_context)
@@ -98,8 +97,28 @@ def _numba_loads_without_compiler_setup() -> None:
         _arraymath_without_scipy()
         registries(self)
 
+    def rebuild_env(modname, consts, env_name):
+        """numba's ``_rebuild_env`` without importing a module of numba's own that is not
+        loaded yet: the environment of compiled code keeps its module's globals for object
+        mode only (our kernels are nopython), so numba's implementation modules that a
+        cached kernel was built from (array allocation, the random generators, ...) are
+        not imported to load it."""
+        env = environment.lookup_environment(env_name)
+        if env is not None:
+            return env
+        module = sys.modules.get(modname)
+        if module is None and modname.split(".")[0] != "numba":
+            module = importlib.import_module(modname)
+        env = environment.Environment(
+            module.__dict__ if module is not None else {"__name__": modname})
+        env.consts[:] = consts
+        env.env_name = env_name
+        environment.Environment._memo[env_name] = env
+        return env
+
     cache.load_overload = load_overload
     context.load_additional_registries = load_additional_registries
+    environment._rebuild_env = rebuild_env
     cache._gcalign_load = True
 
 
