@@ -30,25 +30,25 @@ import importlib.util
 import math
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numba import njit
 
 
-def _numba_targets_without_scipy() -> None:
-    """Initialise numba's array functions without importing scipy.linalg.
+def _arraymath_without_scipy() -> None:
+    """Import ``numba.np.arraymath`` without importing scipy.linalg.
 
-    On its first kernel call (cached or compiled) numba imports ``numba.np.arraymath``,
-    whose module-level BLAS probe imports ``scipy.linalg.cython_blas`` and with it all of
-    scipy.linalg: a quarter of a second of every command's start-up, for a probe whose
-    answer only says whether the BLAS extension is there. The probe is given that answer
-    (the extension file in scipy's install) while the module loads; the linear algebra
-    inside kernels, if any, still imports and checks scipy's BLAS when it is compiled.
+    Its module-level BLAS probe imports ``scipy.linalg.cython_blas`` and with it all of
+    scipy.linalg: a quarter of a second of start-up, for a probe whose answer only says
+    whether the BLAS extension is there. The probe is given that answer (the extension
+    file in scipy's install) while the module loads; the linear algebra inside kernels, if
+    any, still imports and checks scipy's BLAS when it is compiled.
     """
-    import numba.np.linalg as nb_linalg
-
     if "numba.np.arraymath" in sys.modules:
         return
+    import numba.np.linalg as nb_linalg
+
     spec = importlib.util.find_spec("scipy")
     linalg = Path(spec.origin).parent / "linalg" if spec and spec.origin else None
     has_blas = linalg is not None and any(
@@ -67,7 +67,63 @@ def _numba_targets_without_scipy() -> None:
         nb_linalg.ensure_blas = real
 
 
-_numba_targets_without_scipy()
+def _numba_loads_without_compiler_setup() -> None:
+    """Load cached kernels without setting up numba's compiler.
+
+    Before loading a kernel from its cache numba refreshes its compiler: it imports and
+    registers the typing and lowering of everything it can compile (lists, sets, dicts,
+    NumPy's random generators, ...), and loading a kernel's environment imports the
+    modules of numba it was built from: together about 80 ms of a warm ``gcalign align``
+    (its first kernel call, 80 -> 28 ms), for nothing a cached kernel uses: its machine
+    code is linked against the numba runtime (NRT) and the C helpers only. Here a cached
+    load initialises the runtime and loads; a compilation still refreshes everything first
+    (numba's compiler does so itself), so a kernel that is not in the cache, or a new
+    signature, compiles as before (``numba.np.arraymath`` then imported without scipy).
+    """
+    from numba.core import caching, cpu, environment
+    from numba.core.runtime import rtsys
+
+    cache, context = caching.Cache, cpu.CPUContext
+    if getattr(cache, "_gcalign_load", False) or not hasattr(cache, "_load_overload"):
+        return  # already done, or a numba whose cache works otherwise: its own way
+
+    def load_overload(self: Any, sig: Any, target_context: Any) -> Any:
+        rtsys.initialize(target_context)  # what cached machine code links against
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+
+    registries = context.load_additional_registries
+
+    def load_additional_registries(self: Any) -> None:
+        _arraymath_without_scipy()
+        registries(self)
+
+    def rebuild_env(modname: str, consts: Any, env_name: str) -> Any:
+        """numba's ``_rebuild_env`` without importing a module of numba's own that is not
+        loaded yet: the environment of compiled code keeps its module's globals for object
+        mode only (our kernels are nopython), so numba's implementation modules that a
+        cached kernel was built from (array allocation, the random generators, ...) are
+        not imported to load it."""
+        env = environment.lookup_environment(env_name)
+        if env is not None:
+            return env
+        module = sys.modules.get(modname)
+        if module is None and modname.split(".")[0] != "numba":
+            module = importlib.import_module(modname)
+        env = environment.Environment(
+            module.__dict__ if module is not None else {"__name__": modname})
+        env.consts[:] = consts
+        env.env_name = env_name
+        environment.Environment._memo[env_name] = env
+        return env
+
+    setattr(cache, "load_overload", load_overload)  # noqa: B010 - a method replaced
+    setattr(context, "load_additional_registries", load_additional_registries)  # noqa: B010
+    setattr(environment, "_rebuild_env", rebuild_env)  # noqa: B010
+    setattr(cache, "_gcalign_load", True)  # noqa: B010
+
+
+_numba_loads_without_compiler_setup()
 
 #: An earth model's float vector (:meth:`gcalign.nav.earth.EarthModel.params`), or the same
 #: numbers as a tuple (a kernel that reads them at every step of a vectorised loop).
