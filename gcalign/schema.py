@@ -170,6 +170,12 @@ def summary_of(result: Any) -> Any:
     return out
 
 
+def plain(v: Any, unit: str = "", axes: tuple[int, ...] | None = None) -> Any:
+    """`v` as the summary gives a value in the summary unit `unit` (:data:`SUMMARY_UNITS`):
+    plain numbers, an array in its `axes` order flattened, numbers not finite as None."""
+    return _plain(v, SUMMARY_UNITS[unit][1], axes)
+
+
 def _plain(v: Any, to: Any, axes: tuple[int, ...] | None) -> Any:
     """A value of the summary: plain numbers (`to`: from SI), flattened, non-finite as None."""
     if v is None or isinstance(v, str):

@@ -31,6 +31,7 @@ from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
+from gcalign.schema import summary_of
 
 if TYPE_CHECKING:
     import h5py
@@ -92,7 +93,7 @@ def summary(sc: Scenario, tab: ObservabilityTable, spans: tuple[Span, ...],
     """Plain numbers: the JSON contract of ``gcalign observability``."""
     segs, cum = [], []
     for i, sp in enumerate(spans):
-        seg = {"name": sp.name, "t0_s": sp.start, "t1_s": sp.end, "rank": int(tab.rank[i]),
+        seg = {**summary_of(sp), "rank": int(tab.rank[i]),
                "rank_margin": _finite(tab.margin[i]), "tom_rank": int(tab.tom_rank[i]),
                "null_residual": float(tab.null_residual[i]),
                "condition": bool(tab.condition[i]), "degree": _degrees(tab.eta[i])}
