@@ -31,7 +31,7 @@ from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
-from gcalign.schema import summary_of
+from gcalign.schema import plain, summary_of
 
 if TYPE_CHECKING:
     import h5py
@@ -83,22 +83,17 @@ def _degrees(values: np.ndarray) -> dict:
     return {n: float(v) for n, v in zip(ie.STATE_NAMES, values, strict=True)}
 
 
-def _finite(x: float) -> float | None:
-    """A margin for JSON: None when nothing is near the cut-off (inf)."""
-    return float(x) if np.isfinite(x) else None
-
-
 def summary(sc: Scenario, tab: ObservabilityTable, spans: tuple[Span, ...],
             compute_s: float) -> dict:
     """Plain numbers: the JSON contract of ``gcalign observability``."""
     segs, cum = [], []
     for i, sp in enumerate(spans):
         seg = {**summary_of(sp), "rank": int(tab.rank[i]),
-               "rank_margin": _finite(tab.margin[i]), "tom_rank": int(tab.tom_rank[i]),
+               "rank_margin": plain(tab.margin[i]), "tom_rank": int(tab.tom_rank[i]),
                "null_residual": float(tab.null_residual[i]),
                "condition": bool(tab.condition[i]), "degree": _degrees(tab.eta[i])}
         c = {"name": sp.name, "t0_s": spans[0].start, "t1_s": sp.end,
-             "rank": int(tab.rank_cum[i]), "rank_margin": _finite(tab.margin_cum[i]),
+             "rank": int(tab.rank_cum[i]), "rank_margin": plain(tab.margin_cum[i]),
              "tom_rank": int(tab.tom_rank_cum[i]),
              "degree": _degrees(tab.eta_cum[i])}
         if tab.cov_degree is not None and tab.cov_degree_segment is not None:

@@ -22,6 +22,7 @@ import numpy as np
 from gcalign.app.align.transfer import DECIMALS, DISPLAY, SI_UNIT, group_of
 from gcalign.app.command import DOUBLE, Cost, Outcome
 from gcalign.io.results import put
+from gcalign.schema import plain
 
 PWCS_N = 15
 PIECE_OPS = 40.0 * PWCS_N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, QR
@@ -91,20 +92,18 @@ def _per_state(names, values) -> dict:
 
 def summary(sc, obs, compute_s: float) -> dict:
     """Plain numbers: the JSON contract of ``gcalign observability`` on a transfer run."""
-    from gcalign.app.observability.run import _finite
-
     tab, pw, names = obs.table, obs.pwcs, obs.names
     segs, cum = [], []
     for i in range(len(obs.t0)):
         name = f"{obs.t0[i]:.0f}–{obs.t1[i]:.0f} s"
         segs.append({"name": name, "t0_s": float(obs.t0[i]), "t1_s": float(obs.t1[i]),
-                     "rank": int(tab.rank[i]), "rank_margin": _finite(tab.margin[i]),
+                     "rank": int(tab.rank[i]), "rank_margin": plain(tab.margin[i]),
                      "tom_rank": int(tab.tom_rank[i]),
                      "null_residual": float(tab.null_residual[i]),
                      "condition": bool(obs.condition[i]), "degree": _per_state(pw, tab.eta[i]),
                      "covariance_degree": _per_state(names, obs.cov_degree_segment[i])})
         cum.append({"name": name, "t0_s": float(obs.t0[0]), "t1_s": float(obs.t1[i]),
-                    "rank": int(tab.rank_cum[i]), "rank_margin": _finite(tab.margin_cum[i]),
+                    "rank": int(tab.rank_cum[i]), "rank_margin": plain(tab.margin_cum[i]),
                     "tom_rank": int(tab.tom_rank_cum[i]),
                     "degree": _per_state(pw, tab.eta_cum[i]),
                     "covariance_degree": _per_state(names, obs.cov_degree[i])})
