@@ -25,7 +25,7 @@ from gcalign.app.command import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.northfind import NorthfindConfig, axis
-from gcalign.schema import plain, summary_of
+from gcalign.schema import placed, plain, summary_of
 
 if TYPE_CHECKING:
     import h5py
@@ -94,16 +94,14 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
     methods = fields.pop("methods")
     for i, (name, d) in enumerate(methods.items()):
         e, pred = err[i], res.error_pred[i]
-        methods[name] = {
-            "max_abs_error_deg": float(np.degrees(np.abs(e).max())),
-            "rms_error_deg": float(np.degrees(np.sqrt(np.mean(e * e)))),
-            "errors_deg": d["errors_deg"], "estimates_deg": d["estimates_deg"],
-            "mean_deg": plain(np.mod(truth_deg + np.degrees(mean_err[i]), 360.0)),
-            "std_deg": plain(std[i], "deg"), "bias_deg": plain(mean_err[i], "deg"),
-            "std_pred_deg": d["std_pred_deg"], "error_pred_deg": d["error_pred_deg"],
-            "max_abs_error_pred_deg": (None if np.all(np.isnan(pred))
-                                       else float(np.degrees(np.nanmax(np.abs(pred))))),
-        }
+        methods[name] = placed(d, {  # the figures derived from the fields, in their places
+            "errors_deg": {"max_abs_error_deg": float(np.degrees(np.abs(e).max())),
+                           "rms_error_deg": float(np.degrees(np.sqrt(np.mean(e * e))))},
+            "std_pred_deg": {
+                "mean_deg": plain(np.mod(truth_deg + np.degrees(mean_err[i]), 360.0)),
+                "std_deg": plain(std[i], "deg"), "bias_deg": plain(mean_err[i], "deg")}},
+            {"max_abs_error_pred_deg": None if np.all(np.isnan(pred))
+             else float(np.degrees(np.nanmax(np.abs(pred))))})
     tilt, direction = cfg.tilt_rad()
     n_dwell = setup.n_samples
     dwell_time = n_dwell / setup.rate_hz
