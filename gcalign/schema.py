@@ -170,6 +170,24 @@ def summary_of(result: Any) -> Any:
     return out
 
 
+def placed(summary: dict[str, Any], before: dict[str, dict[str, Any]],
+           end: dict[str, Any] | None = None) -> dict[str, Any]:
+    """`summary` (:func:`summary_of`) with a command's derived figures among its keys:
+    ``before[key]`` just before `key`, `end` after the last; a field summarised later still
+    joins (after the keys that were there before it, in field order)."""
+    out: dict[str, Any] = {}
+    for key, value in summary.items():
+        out |= before.get(key, {})
+        out[key] = value
+    return out | (end or {})
+
+
+def plain(v: Any, unit: str = "", axes: tuple[int, ...] | None = None) -> Any:
+    """`v` as the summary gives a value in the summary unit `unit` (:data:`SUMMARY_UNITS`):
+    plain numbers, an array in its `axes` order flattened, numbers not finite as None."""
+    return _plain(v, SUMMARY_UNITS[unit][1], axes)
+
+
 def _plain(v: Any, to: Any, axes: tuple[int, ...] | None) -> Any:
     """A value of the summary: plain numbers (`to`: from SI), flattened, non-finite as None."""
     if v is None or isinstance(v, str):

@@ -300,3 +300,36 @@ def test_a_summary_per_entry_is_grouped_flattened_and_has_no_nan():
     assert got["methods"]["b"]["error_deg"] == np.degrees(err[1].T).ravel().tolist()
     assert got["methods"]["a"]["pred_deg"][1] is None
     assert np.allclose(got["heading_deg"], [270.0, 10.0])
+
+
+def test_a_new_per_method_field_reaches_the_northfind_json_from_its_one_line():
+    """North-finding's summary per method is its fields' summary with the figures the
+    command derives placed among them: a per-method field declared in one line (a spread
+    per azimuth, in arc-seconds) is in every method's entry of the JSON, after the fields
+    before it, and every key that was there keeps its value and place."""
+    from dataclasses import replace
+
+    from gcalign.api import example
+    from gcalign.app.northfind.run import northfind_summary, run_northfind
+    from gcalign.northfind.run import NorthfindResult
+    from gcalign.units import ARCSEC
+
+    @dataclass(frozen=True, eq=False)
+    class Wider(NorthfindResult):
+        spread: np.ndarray | None = field(default=None, metadata=stored(
+            "rad", per="methods", dims="M", summary="arcsec"))
+
+    sc = example("northfind")
+    run = run_northfind(sc, 1)
+    res = run.result
+    p, m, _ = res.azimuth_est.shape
+    spread = np.arange(p * m, dtype=float).reshape(p, m) * ARCSEC
+    wider = Wider(**{f.name: getattr(res, f.name) for f in fields(res)}, spread=spread)
+    before = northfind_summary(run, sc)["methods"]
+    after = northfind_summary(replace(run, result=wider), sc)["methods"]
+    assert list(after) == list(before) == list(res.methods)
+    for i, name in enumerate(res.methods):
+        assert list(after[name]) == [*list(before[name])[:-1], "spread_arcsec",
+                                     "max_abs_error_pred_deg"]
+        assert all(after[name][k] == v for k, v in before[name].items())
+        assert np.allclose(after[name]["spread_arcsec"], np.arange(m) + i * m, rtol=1e-12)

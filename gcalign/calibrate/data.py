@@ -29,6 +29,7 @@ from gcalign.nav.rotation import (
     rotvec_to_quat,
 )
 from gcalign.nav.strapdown import NavState
+from gcalign.schema import stored
 from gcalign.sim.errors import ErrorStream, ImuErrors, SensorErrors
 from gcalign.sim.imu import ImuData
 from gcalign.sim.motions import MotionType, Truth
@@ -39,9 +40,9 @@ from gcalign.units import ARCMIN, ARCSEC, DPH, PPM, UG
 class Span:
     """A named stretch of the run (a manoeuvre): start and end time (s)."""
 
-    name: str
-    start: float
-    end: float
+    name: str = field(metadata=stored(None, summary=""))
+    start: float = field(metadata=stored("s", summary="s", label="t0"))
+    end: float = field(metadata=stored("s", summary="s", label="t1"))
 
 
 @dataclass(frozen=True)

@@ -55,23 +55,24 @@ class NorthfindResult:
     tilt_true: np.ndarray = field(metadata=stored(
         "rad", frame="table normal from the vertical", dims="M", optional=True))
     tilt_direction_true: np.ndarray = field(metadata=stored(
-        "rad", frame=DESCENT, dims="M", optional=True))
-    azimuth_est: np.ndarray = field(metadata=stored(
-        "rad", frame=AZIMUTH, shape=RM, axes=(1, 0), per="methods", name="estimate",
-        dims="R M | M", optional=True))
+        "rad", frame=DESCENT, dims="M", optional=True, summary="deg360"))
     azimuth_error: np.ndarray = field(metadata=stored(
         "rad", frame="estimate - true, wrapped to [-pi, pi)", shape=RM, axes=(1, 0),
-        per="methods", name="error", dims="R M | M"))
-    error_pred: np.ndarray = field(metadata=stored(
-        "rad", frame="noise-free closed form (NaN: none)", per="methods", dims="M",
-        optional=True, finite=False))
+        per="methods", name="error", dims="R M | M", summary="deg", label="errors"))
+    azimuth_est: np.ndarray = field(metadata=stored(
+        "rad", frame=AZIMUTH, shape=RM, axes=(1, 0), per="methods", name="estimate",
+        dims="R M | M", optional=True, summary="deg360", label="estimates"))
     azimuth_std_pred: np.ndarray = field(metadata=stored(
         "rad", frame="linearised 1-sigma prediction", per="methods", name="std_pred",
-        dims="M", optional=True, finite=False))
+        dims="M", optional=True, finite=False, summary="deg", label="std_pred"))
+    error_pred: np.ndarray = field(metadata=stored(
+        "rad", frame="noise-free closed form (NaN: none)", per="methods", dims="M",
+        optional=True, finite=False, summary="deg"))
     tilt_est: np.ndarray = field(metadata=stored("rad", shape=RM, axes=(1, 0), dims="R M",
-                                                 optional=True))
+                                                 optional=True, summary="deg"))
     tilt_direction_est: np.ndarray = field(metadata=stored(
-        "rad", frame=DESCENT, shape=RM, axes=(1, 0), dims="R M", optional=True))
+        "rad", frame=DESCENT, shape=RM, axes=(1, 0), dims="R M", optional=True,
+        summary="deg360"))
     pitch_est: np.ndarray = field(metadata=stored(
         "rad", frame=ATT_FRAME, shape=RM, axes=(1, 0), dims="R M", optional=True))
     roll_est: np.ndarray = field(metadata=stored(

@@ -31,7 +31,7 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import Aiding, AlignConfig
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.rotation import euler_to_dcm, quat_to_euler
-from gcalign.schema import ATT_FRAME, summary_of
+from gcalign.schema import ATT_FRAME, plain, summary_of
 from gcalign.units import DPH, DPSH, angle_text
 
 if TYPE_CHECKING:
@@ -471,10 +471,6 @@ def lockstep_ok(sc: Scenario) -> bool:
             and cfg.mode != "transfer" and cfg.aiding.source != "file")
 
 
-def _deg(x):
-    return None if x is None else np.degrees(x).tolist()
-
-
 def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> dict:
     """Plain-number summary (degrees, seconds): the JSON contract of `gcalign align --json`."""
     if isinstance(stream, RunData):
@@ -490,7 +486,7 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
     last = None if spread is None else {
         "window_s": [aligned_time(spread.t_from), aligned_time(spread.t_to)],
         "rows": spread.rows,
-        **{f"{k}_deg": _deg(getattr(spread, k)) for k in ("mean", "std", "max")}}
+        **{f"{k}_deg": plain(getattr(spread, k), "deg") for k in ("mean", "std", "max")}}
     return {
         "scenario": name,
         "seed": stream.seed,
@@ -515,7 +511,7 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
                 "kind": r.kind,
                 "stage": r.stage + 1,
                 "t_end_s": aligned_time(float(r.t[-1])),
-                "error_deg": _deg(run.pass_end_error(r.index)),
+                "error_deg": plain(run.pass_end_error(r.index), "deg"),
                 "attitude_deg": np.degrees(quat_to_euler(r.q_nb[-1])).tolist(),
             }
             for r in run.passes

@@ -47,6 +47,7 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.rotation import quat_to_euler
+from gcalign.schema import summary_of
 from gcalign.sim.motions import Truth
 
 if TYPE_CHECKING:
@@ -413,7 +414,7 @@ def run_summary(run: Run) -> dict:
         "measure": r.settings.measure,
         "duration_s": float(r.t[-1] - r.t[0]),
         "epochs": len(r.t),
-        "segments": [{"name": s.name, "t0_s": s.start, "t1_s": s.end} for s in data.segments],
+        "segments": summary_of(data.segments),
         "states": states,
         "normalized_error": None if r.error is None
         else (r.error[-1] / r.sigma[-1]).tolist(),

@@ -35,7 +35,7 @@ from gcalign.modulate.analysis import SchemeAnalysis, analyse_scheme
 from gcalign.modulate.invariants import InvariantReport
 from gcalign.modulate.linear import REPORT_HOURS, LinearErrors
 from gcalign.modulate.terms import ErrorTerms
-from gcalign.schema import summary_of
+from gcalign.schema import plain, summary_of
 from gcalign.units import ARCSEC, DPH, DPSH, HOUR, PPM, UG, UGPSHZ
 
 Progress = Callable[[float, float, str], None]  # (done, total, what)
@@ -139,10 +139,6 @@ def error_terms(sc: Scenario, entry: Entry) -> ErrorTerms:
     return ErrorTerms.of_sensors(e.gyro, e.accel, (0.0, 0.0, 0.0) if lever is None else lever)
 
 
-def _arcsec(v: np.ndarray) -> list[float]:
-    return (np.asarray(v, dtype=float) / ARCSEC).tolist()
-
-
 def _clean(v: np.ndarray, scale: float) -> np.ndarray:
     """Entries below 1e-12 of `scale` (round-off of a cancelling sum) as 0."""
     return np.where(np.abs(v) <= 1e-12 * scale, 0.0, v)
@@ -178,7 +174,7 @@ def linear_summary(lin: LinearErrors, hours: list[float]) -> dict:
         "horizontal_error_m": {hour_key(h): _linear_at(lin, h) for h in hours},
         "max_horizontal_error_m": float(lin.horizontal.max()),
         "final_horizontal_error_m": float(lin.horizontal[-1]),
-        "max_misalignment_arcsec": _arcsec(np.abs(lin.phi).max(0)),
+        "max_misalignment_arcsec": plain(np.abs(lin.phi).max(0), "arcsec"),
         "sigma_horizontal_final_m": float(lin.sigma_horizontal[-1]),
     }
 

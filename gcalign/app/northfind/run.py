@@ -25,6 +25,7 @@ from gcalign.app.command import Outcome
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.northfind import NorthfindConfig, axis
+from gcalign.schema import placed, plain, summary_of
 
 if TYPE_CHECKING:
     import h5py
@@ -73,24 +74,6 @@ def run_northfind(sc: Scenario, seed: int | None = None) -> NorthfindRun:
                         compute_s=time.perf_counter() - t0)
 
 
-def _num(x: float) -> float | None:
-    x = float(x)
-    return None if math.isnan(x) else x
-
-
-def _list(a: np.ndarray) -> list:
-    """Plain floats (NaN -> None) of any array, flattened in C order."""
-    return [_num(v) for v in np.asarray(a, float).ravel()]
-
-
-def _deg(a: np.ndarray) -> list:
-    return _list(np.degrees(a))
-
-
-def _deg360(a: np.ndarray) -> list:
-    return _list(np.mod(np.degrees(a), 360.0))
-
-
 def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
     """Plain-number summary (degrees): the JSON contract of ``gcalign northfind --json``.
 
@@ -103,28 +86,22 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
     """
     res, setup, cfg = run.result, run.setup, run.cfg
     p, m, r = res.azimuth_est.shape
-    est = np.swapaxes(res.azimuth_est, 1, 2)  # (P, R, M)
-    err = np.swapaxes(res.azimuth_error, 1, 2)
+    err = np.swapaxes(res.azimuth_error, 1, 2)  # (P, R, M)
     mean_err = err.mean(1)  # (P, M)
     truth_deg = np.mod(cfg.azimuths_deg(), 360.0)  # as configured, no round trip through rad
     std = err.std(1, ddof=1) if r > 1 else np.full((p, m), np.nan)
-    methods = {}
-    for i, name in enumerate(res.methods):
-        e = err[i]
-        pred = res.error_pred[i]
-        methods[name] = {
-            "max_abs_error_deg": float(np.degrees(np.abs(e).max())),
-            "rms_error_deg": float(np.degrees(np.sqrt(np.mean(e * e)))),
-            "errors_deg": _deg(e),
-            "estimates_deg": _deg360(est[i]),
-            "mean_deg": _list(np.mod(truth_deg + np.degrees(mean_err[i]), 360.0)),
-            "std_deg": _deg(std[i]),
-            "bias_deg": _deg(mean_err[i]),
-            "std_pred_deg": _deg(res.azimuth_std_pred[i]),
-            "error_pred_deg": _deg(pred),
-            "max_abs_error_pred_deg": (None if np.all(np.isnan(pred))
-                                       else float(np.degrees(np.nanmax(np.abs(pred))))),
-        }
+    fields = summary_of(res)  # the tilts; per method its errors, estimates and predictions
+    methods = fields.pop("methods")
+    for i, (name, d) in enumerate(methods.items()):
+        e, pred = err[i], res.error_pred[i]
+        methods[name] = placed(d, {  # the figures derived from the fields, in their places
+            "errors_deg": {"max_abs_error_deg": float(np.degrees(np.abs(e).max())),
+                           "rms_error_deg": float(np.degrees(np.sqrt(np.mean(e * e))))},
+            "std_pred_deg": {
+                "mean_deg": plain(np.mod(truth_deg + np.degrees(mean_err[i]), 360.0)),
+                "std_deg": plain(std[i], "deg"), "bias_deg": plain(mean_err[i], "deg")}},
+            {"max_abs_error_pred_deg": None if np.all(np.isnan(pred))
+             else float(np.degrees(np.nanmax(np.abs(pred))))})
     tilt, direction = cfg.tilt_rad()
     n_dwell = setup.n_samples
     dwell_time = n_dwell / setup.rate_hz
@@ -144,14 +121,12 @@ def northfind_summary(run: NorthfindRun, sc: Scenario) -> dict:
         "repeats": r,
         "shape": [r, m],
         "index_error_arcsec": cfg.index_error_arcsec,
-        "azimuth_true_deg": _list(truth_deg),
+        "azimuth_true_deg": plain(truth_deg),
         "sweep": None if cfg.sweep is None else cfg.sweep.model_dump(),
         "tilt_deg": float(np.degrees(tilt)),
         "tilt_direction_deg": float(np.degrees(direction)),
         "tilt_reference": cfg.reference,
-        "tilt_direction_true_deg": _deg360(res.tilt_direction_true),
-        "tilt_est_deg": _deg(res.tilt_est.T),
-        "tilt_direction_est_deg": _deg360(res.tilt_direction_est.T),
+        **fields,  # tilt_direction_true_deg, tilt_est_deg, tilt_direction_est_deg
         "gyro": {
             "axis": "body y (in the table plane)",
             "bias_dph": axis(g.bias_dph, 1), "arw_dprh": axis(g.arw_dprh, 1),

@@ -11,6 +11,8 @@ ranks, the null-space condition of seed eq. (12), and the covariance degree σ(0
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -31,6 +33,7 @@ from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
+from gcalign.schema import plain, summary_of
 
 if TYPE_CHECKING:
     import h5py
@@ -78,33 +81,38 @@ def run_table(sc: Scenario, cache_key: str | None = None, progress: Any = None
     return tab, traj, spans, time.perf_counter() - t0
 
 
-def _degrees(values: np.ndarray) -> dict:
-    return {n: float(v) for n, v in zip(ie.STATE_NAMES, values, strict=True)}
+def per_state(names: Sequence[str], values: np.ndarray) -> dict:
+    return {n: float(v) for n, v in zip(names, values, strict=True)}
 
 
-def _finite(x: float) -> float | None:
-    """A margin for JSON: None when nothing is near the cut-off (inf)."""
-    return float(x) if np.isfinite(x) else None
+def table_rows(tab: ObservabilityTable, spans: Sequence[Span], condition: np.ndarray,
+               states: Sequence[str], cov: tuple | None = None) -> tuple[list, list]:
+    """The JSON's ``segments`` and ``cumulative`` rows of `tab` over `spans`: the SOM's
+    degrees named by `states`, whether seed eq. 12 holds (`condition`) and, with `cov`
+    (names, per segment, cumulative), the covariance's degrees."""
+    segs, cum = [], []
+    for i, sp in enumerate(spans):
+        segs.append({**summary_of(sp), "rank": int(tab.rank[i]),
+                     "rank_margin": plain(tab.margin[i]), "tom_rank": int(tab.tom_rank[i]),
+                     "null_residual": float(tab.null_residual[i]),
+                     "condition": bool(condition[i]), "degree": per_state(states, tab.eta[i])})
+        cum.append({**summary_of(replace(sp, start=spans[0].start)),
+                    "rank": int(tab.rank_cum[i]), "rank_margin": plain(tab.margin_cum[i]),
+                    "tom_rank": int(tab.tom_rank_cum[i]),
+                    "degree": per_state(states, tab.eta_cum[i])})
+        if cov is not None:
+            segs[-1]["covariance_degree"] = per_state(cov[0], cov[1][i])
+            cum[-1]["covariance_degree"] = per_state(cov[0], cov[2][i])
+    return segs, cum
 
 
 def summary(sc: Scenario, tab: ObservabilityTable, spans: tuple[Span, ...],
             compute_s: float) -> dict:
     """Plain numbers: the JSON contract of ``gcalign observability``."""
-    segs, cum = [], []
-    for i, sp in enumerate(spans):
-        seg = {"name": sp.name, "t0_s": sp.start, "t1_s": sp.end, "rank": int(tab.rank[i]),
-               "rank_margin": _finite(tab.margin[i]), "tom_rank": int(tab.tom_rank[i]),
-               "null_residual": float(tab.null_residual[i]),
-               "condition": bool(tab.condition[i]), "degree": _degrees(tab.eta[i])}
-        c = {"name": sp.name, "t0_s": spans[0].start, "t1_s": sp.end,
-             "rank": int(tab.rank_cum[i]), "rank_margin": _finite(tab.margin_cum[i]),
-             "tom_rank": int(tab.tom_rank_cum[i]),
-             "degree": _degrees(tab.eta_cum[i])}
-        if tab.cov_degree is not None and tab.cov_degree_segment is not None:
-            seg["covariance_degree"] = _degrees(tab.cov_degree_segment[i])
-            c["covariance_degree"] = _degrees(tab.cov_degree[i])
-        segs.append(seg)
-        cum.append(c)
+    names = ie.STATE_NAMES
+    segs, cum = table_rows(tab, spans, tab.condition, names, None if tab.cov_degree is None
+                           or tab.cov_degree_segment is None
+                           else (names, tab.cov_degree_segment, tab.cov_degree))
     return {
         "scenario": sc.name,
         "measure": tab.measure,

@@ -85,29 +85,16 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None,
     return Outcome(out, lambda f: write(f, obs, result), None, None, warnings, result=obs)
 
 
-def _per_state(names, values) -> dict:
-    return {n: float(v) for n, v in zip(names, values, strict=True)}
-
-
 def summary(sc, obs, compute_s: float) -> dict:
     """Plain numbers: the JSON contract of ``gcalign observability`` on a transfer run."""
-    from gcalign.app.observability.run import _finite
+    from gcalign.app.observability.run import per_state, table_rows
+    from gcalign.calibrate.data import Span
 
     tab, pw, names = obs.table, obs.pwcs, obs.names
-    segs, cum = [], []
-    for i in range(len(obs.t0)):
-        name = f"{obs.t0[i]:.0f}–{obs.t1[i]:.0f} s"
-        segs.append({"name": name, "t0_s": float(obs.t0[i]), "t1_s": float(obs.t1[i]),
-                     "rank": int(tab.rank[i]), "rank_margin": _finite(tab.margin[i]),
-                     "tom_rank": int(tab.tom_rank[i]),
-                     "null_residual": float(tab.null_residual[i]),
-                     "condition": bool(obs.condition[i]), "degree": _per_state(pw, tab.eta[i]),
-                     "covariance_degree": _per_state(names, obs.cov_degree_segment[i])})
-        cum.append({"name": name, "t0_s": float(obs.t0[0]), "t1_s": float(obs.t1[i]),
-                    "rank": int(tab.rank_cum[i]), "rank_margin": _finite(tab.margin_cum[i]),
-                    "tom_rank": int(tab.tom_rank_cum[i]),
-                    "degree": _per_state(pw, tab.eta_cum[i]),
-                    "covariance_degree": _per_state(names, obs.cov_degree[i])})
+    spans = [Span(f"{a:.0f}–{b:.0f} s", float(a), float(b))
+             for a, b in zip(obs.t0, obs.t1, strict=True)]
+    segs, cum = table_rows(tab, spans, obs.condition, pw,
+                           (names, obs.cov_degree_segment, obs.cov_degree))
     return {
         "scenario": sc.name,
         "mode": "transfer",
@@ -125,13 +112,13 @@ def summary(sc, obs, compute_s: float) -> dict:
         "rank_final": int(tab.rank_cum[-1]),
         "tom_rank_final": int(tab.tom_rank_cum[-1]),
         "degree_final": [float(v) for v in tab.eta_cum[-1]],
-        "separation": _per_state(pw, obs.separation),
+        "separation": per_state(pw, obs.separation),
         "singular_values": [float(v) for v in obs.singular_values],
         "unobservable": [n for n, z in zip(pw, obs.unobservable, strict=True) if z],
-        "weakest": {"ratio": obs.weakest_ratio, "vector": _per_state(pw, obs.weakest)},
-        "sigma0": _per_state(names, obs.sigma0),
-        "sigma_final": _per_state(names, obs.sigma_end[-1]),
-        "covariance_degree_final": _per_state(names, obs.cov_degree[-1]),
+        "weakest": {"ratio": obs.weakest_ratio, "vector": per_state(pw, obs.weakest)},
+        "sigma0": per_state(names, obs.sigma0),
+        "sigma_final": per_state(names, obs.sigma_end[-1]),
+        "covariance_degree_final": per_state(names, obs.cov_degree[-1]),
         "units": {n: SI_UNIT[group_of(n)] for n in names},
         "display_units": {n: DISPLAY[group_of(n)][0] for n in names},
         "display_scale": {n: DISPLAY[group_of(n)][1] for n in names},
