@@ -46,13 +46,6 @@ def _one_azimuth_source(section: dict, given: dict) -> None:
         section.pop("azimuth_deg", None)
 
 
-def load_northfind(path: Path | None, overrides: dict, sets: list[str] | None = None):
-    """The scenario (:class:`~gcalign.cli.common.Loaded`) with the options written into
-    ``northfind`` before validation (the command's check runs in its preflight)."""
-    return load_with_overrides(path, BUILTIN, "northfind", overrides, _one_azimuth_source,
-                               sets=sets)
-
-
 @app.command()
 @user_errors
 def northfind(
@@ -93,4 +86,6 @@ def northfind(
         "sweep": parse_sweep(sweep),
         "repeats": repeats,
     }
-    run_and_show("northfind", load_northfind(scenario, overrides, set_), seed, output, as_json)
+    loaded = load_with_overrides(scenario, BUILTIN, "northfind", overrides, _one_azimuth_source,
+                                 sets=set_)
+    run_and_show("northfind", loaded, seed, output, as_json)

@@ -20,12 +20,6 @@ def builtin_scenario_text() -> str:
     return builtin_text(BUILTIN)
 
 
-def load_realtime(path: Path | None, overrides: dict, sets: list[str] | None = None):
-    """The scenario (:class:`~gcalign.cli.common.Loaded`) with the options written into
-    ``realtime`` before validation (the command's check runs in its preflight)."""
-    return load_with_overrides(path, BUILTIN, "realtime", overrides, sets=sets)
-
-
 @app.command()
 @user_errors
 def realtime(
@@ -44,6 +38,6 @@ def realtime(
     set_: Sets = None,
 ):
     """Attitude at sync pulses: filter delay T + Δt, and prediction to the pulse time."""
-    loaded = load_realtime(scenario, {"predictors": list(predictor) if predictor else None},
-                           set_)
+    overrides = {"predictors": list(predictor) if predictor else None}
+    loaded = load_with_overrides(scenario, BUILTIN, "realtime", overrides, sets=set_)
     run_and_show("realtime", loaded, seed, output, as_json)
