@@ -8,16 +8,12 @@ import typer
 
 from gcalign.app.registry import COMMANDS
 from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
+from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["northfind"].builtin or ""
 
-
-def builtin_scenario_text() -> str:
-    """The built-in seed 001 §3.1 simulation scenario (YAML text)."""
-    return builtin_text(BUILTIN)
 
 
 def parse_sweep(text: str | None) -> dict | None:

@@ -9,15 +9,11 @@ import typer
 
 from gcalign.app.registry import COMMANDS
 from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
+from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 
 BUILTIN = COMMANDS["realtime"].builtin or ""
 
-
-def builtin_scenario_text() -> str:
-    """The built-in seed 003 Table 1 scenario (YAML text)."""
-    return builtin_text(BUILTIN)
 
 
 @app.command()
