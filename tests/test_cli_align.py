@@ -18,9 +18,10 @@ runner = CliRunner()
 
 
 def test_builtin_equals_configs_copy():
-    from gcalign.cli.align import builtin_scenario_text
+    from gcalign.app.registry import COMMANDS, builtin_text
 
-    assert builtin_scenario_text() == (ROOT / "configs/seed000_moving_full_cycle.yaml").read_text()
+    text = (ROOT / "configs/seed000_moving_full_cycle.yaml").read_text()
+    assert builtin_text(COMMANDS["align"].builtin or "") == text
 
 
 def test_align_json_contract_and_show(tmp_path):

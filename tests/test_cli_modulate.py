@@ -40,9 +40,10 @@ def _scenario(tmp_path: Path, name: str = "case", **changes) -> Path:
 
 
 def test_builtin_equals_configs_copy():
-    from gcalign.cli.modulate import builtin_scenario_text
+    from gcalign.app.registry import COMMANDS, builtin_text
 
-    assert builtin_scenario_text() == (ROOT / "configs/seed004_modulation.yaml").read_text()
+    text = (ROOT / "configs/seed004_modulation.yaml").read_text()
+    assert builtin_text(COMMANDS["modulate"].builtin or "") == text
     assert BASE["modulate"]["compare"] == DEFAULT and BASE["modulate"]["hours"] == 72
     assert BASE["imu"]["rate_hz"] == 100 and BASE["earth"] == "seed004"
 

@@ -44,9 +44,10 @@ def _run(*args: str):
 
 
 def test_builtin_equals_configs_copy():
-    from gcalign.cli.northfind import builtin_scenario_text
+    from gcalign.app.registry import COMMANDS, builtin_text
 
-    assert builtin_scenario_text() == (ROOT / "configs/seed001_simulation.yaml").read_text()
+    text = (ROOT / "configs/seed001_simulation.yaml").read_text()
+    assert builtin_text(COMMANDS["northfind"].builtin or "") == text
 
 
 def test_builtin_run_json_contract(tmp_path):

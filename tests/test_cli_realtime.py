@@ -71,9 +71,10 @@ def _small(tmp_path: Path, name="small", **realtime) -> Path:
 # ---------------------------------------------------------------------------- built-in
 
 def test_builtin_equals_configs_copy():
-    from gcalign.cli.realtime import builtin_scenario_text
+    from gcalign.app.registry import COMMANDS, builtin_text
 
-    assert builtin_scenario_text() == (ROOT / "configs/seed003_table1.yaml").read_text()
+    text = (ROOT / "configs/seed003_table1.yaml").read_text()
+    assert builtin_text(COMMANDS["realtime"].builtin or "") == text
 
 
 @pytest.mark.slow

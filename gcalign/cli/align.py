@@ -11,15 +11,11 @@ from gcalign.app.registry import COMMANDS
 from gcalign.choices import ALIGN_MODES_ALL, COMPENSATIONS, listed
 from gcalign.cli import options as opt
 from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import builtin_text, load_with_overrides, recorded, run_and_show
+from gcalign.cli.common import load_with_overrides, recorded, run_and_show
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["align"].builtin or ""
 
-
-def builtin_scenario_text() -> str:
-    """The built-in seed 000 §5.3 moving-base full-cycle scenario (YAML text)."""
-    return builtin_text(BUILTIN)
 
 
 def _t3(value: str | None):

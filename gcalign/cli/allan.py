@@ -80,25 +80,7 @@ def allan(
         if scenario_out == "-":
             sys.stdout.write(out)
         else:
-            _write_atomically(Path(scenario_out), out)
+            with results.atomic_file(scenario_out, "w") as f:  # whole or not at all
+                f.write(out)
             sys.stderr.write(f"wrote {scenario_out}\n")
 
-
-def _write_atomically(path: Path, text: str) -> None:
-    """`text` under `path` whole or not at all (a temporary file beside it, renamed); a
-    refused write is one line (:func:`gcalign.io.results.write_error`)."""
-    import os
-
-    from gcalign.io.results import make_temp, write_error
-
-    fd, tmp = make_temp(path)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except OSError as err:
-        tmp.unlink(missing_ok=True)
-        raise write_error(path, err) from None
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise

@@ -57,10 +57,9 @@ def load_batch(files: list[Path], command: str | None, seeds: int | None,
     file, --seeds and --seed-start replace the file's (said in `notes`); --set changes the
     base scenario of a sweep, or every file of a list."""
     from gcalign.app.batch.sweep import sweep_from_files
-    from gcalign.cli.common import parse_set
-    from gcalign.io.scenario.loader import read_yaml
+    from gcalign.io.scenario.loader import parse_override, read_yaml
 
-    pairs = [parse_set(item) for item in sets or []]
+    pairs = [parse_override(item) for item in sets or []]
     list_options = {"--command": command, "--metric": metrics or None}
     if len(files) == 1:
         data = read_yaml(files[0])
@@ -88,11 +87,11 @@ def _named(sw, seeds: int | None, seed_start: int | None, sets: list[str] | None
     """The options that change a batch's results beside its sweep file, for its default
     file name: --set, and --seeds/--seed-start on a sweep file."""
     from gcalign.app.batch.sweep import FILE_KEY
-    from gcalign.cli.common import parse_set
+    from gcalign.io.scenario.loader import parse_override
 
     sweep = FILE_KEY not in sw.grid
     return [*((k, v) for k, v in (("seeds", seeds), ("seed_start", seed_start))
-              if sweep and v is not None), *(parse_set(x) for x in sets or [])]
+              if sweep and v is not None), *(parse_override(x) for x in sets or [])]
 
 
 def bar_label(sw) -> str:

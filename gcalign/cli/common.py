@@ -99,26 +99,20 @@ def install(app: typer.Typer) -> None:
 # --------------------------------------------------------------------------- loading
 
 
-def parse_set(item: str) -> tuple[str, object]:
-    """``KEY=VALUE`` -> (key, YAML value); ScenarioError names the option."""
-    from gcalign.io.scenario.loader import parse_override
-
-    return parse_override(item)
-
-
 def _apply_sets(data: dict, sets: list[str], taken: set[str], source: str,
                 applied: list) -> None:
     if not sets:  # nothing to apply: no scenario validated for them
         return
     from gcalign.app.batch.overrides import apply_override
     from gcalign.io.scenario import parse_scenario
+    from gcalign.io.scenario.loader import parse_override
 
     try:
         base = parse_scenario(copy.deepcopy(data), source)
     except ScenarioError:
         base = None  # the file may need the --set to become valid
     for item in sets:
-        key, value = parse_set(item)
+        key, value = parse_override(item)
         if key in taken:
             raise ScenarioError(f"--set {key}: also given by an option; give it once")
         try:

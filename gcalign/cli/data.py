@@ -15,15 +15,6 @@ from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
 
 DATA_SUFFIXES = {".imu", ".csv", ".txt", ".mat"}
-COMPRESSED = (".gz", ".xz")
-
-
-def data_suffix(path: Path) -> str:
-    """The suffix that says what a file holds, under a compression suffix (x.imu.xz: .imu)."""
-    suffixes = [x.lower() for x in path.suffixes]
-    if suffixes and suffixes[-1] in COMPRESSED:
-        suffixes = suffixes[:-1]
-    return suffixes[-1] if suffixes else ""
 
 
 def data_file(source: Path | None, keep: tuple[str, ...]) -> tuple[dict | None, str]:
@@ -33,6 +24,7 @@ def data_file(source: Path | None, keep: tuple[str, ...]) -> tuple[dict | None, 
     import yaml
 
     from gcalign.io import results
+    from gcalign.io.imu_files import data_suffix
     from gcalign.io.results import HDF5_SUFFIXES
 
     suffix = "" if source is None else data_suffix(source)

@@ -14,10 +14,6 @@ from gcalign.cli.options import Json, Output, Seed, Sets
 BUILTIN = COMMANDS["modulate"].builtin or ""
 
 
-def builtin_scenario_text() -> str:
-    """The built-in seed 004 simulation scenario (YAML text)."""
-    return builtin_text(BUILTIN)
-
 
 def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
                   dwell: float | None, sets: list[str] | None = None):

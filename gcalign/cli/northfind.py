@@ -8,16 +8,12 @@ import typer
 
 from gcalign.app.registry import COMMANDS
 from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
+from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
 
 BUILTIN = COMMANDS["northfind"].builtin or ""
 
-
-def builtin_scenario_text() -> str:
-    """The built-in seed 001 §3.1 simulation scenario (YAML text)."""
-    return builtin_text(BUILTIN)
 
 
 def parse_sweep(text: str | None) -> dict | None:
@@ -44,13 +40,6 @@ def _one_azimuth_source(section: dict, given: dict) -> None:
         section.pop("sweep", None)
     if "sweep" in given and "azimuth_deg" not in given:
         section.pop("azimuth_deg", None)
-
-
-def load_northfind(path: Path | None, overrides: dict, sets: list[str] | None = None):
-    """The scenario (:class:`~gcalign.cli.common.Loaded`) with the options written into
-    ``northfind`` before validation (the command's check runs in its preflight)."""
-    return load_with_overrides(path, BUILTIN, "northfind", overrides, _one_azimuth_source,
-                               sets=sets)
 
 
 @app.command()
@@ -93,4 +82,6 @@ def northfind(
         "sweep": parse_sweep(sweep),
         "repeats": repeats,
     }
-    run_and_show("northfind", load_northfind(scenario, overrides, set_), seed, output, as_json)
+    loaded = load_with_overrides(scenario, BUILTIN, "northfind", overrides, _one_azimuth_source,
+                                 sets=set_)
+    run_and_show("northfind", loaded, seed, output, as_json)

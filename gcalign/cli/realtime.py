@@ -9,21 +9,11 @@ import typer
 
 from gcalign.app.registry import COMMANDS
 from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
+from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 
 BUILTIN = COMMANDS["realtime"].builtin or ""
 
-
-def builtin_scenario_text() -> str:
-    """The built-in seed 003 Table 1 scenario (YAML text)."""
-    return builtin_text(BUILTIN)
-
-
-def load_realtime(path: Path | None, overrides: dict, sets: list[str] | None = None):
-    """The scenario (:class:`~gcalign.cli.common.Loaded`) with the options written into
-    ``realtime`` before validation (the command's check runs in its preflight)."""
-    return load_with_overrides(path, BUILTIN, "realtime", overrides, sets=sets)
 
 
 @app.command()
@@ -44,6 +34,6 @@ def realtime(
     set_: Sets = None,
 ):
     """Attitude at sync pulses: filter delay T + Δt, and prediction to the pulse time."""
-    loaded = load_realtime(scenario, {"predictors": list(predictor) if predictor else None},
-                           set_)
+    overrides = {"predictors": list(predictor) if predictor else None}
+    loaded = load_with_overrides(scenario, BUILTIN, "realtime", overrides, sets=set_)
     run_and_show("realtime", loaded, seed, output, as_json)

@@ -201,12 +201,11 @@ _INTERVAL_HELP = ("use only the epochs at whole multiples of this many seconds (
                   "solution as 1 Hz fixes); default every epoch")
 
 
-class VelocityFile(Model):
-    """A measured velocity: a velocity CSV (ENU/NED) or a reference solution's velocity."""
+class _AidingFile(Model):
+    """The keys of a velocity and a position file (their formats differ)."""
 
     path: Path
-    format: Literal["velocity-enu", "velocity-ned", "psins-mat", "i2nav-nav",
-                    "reference-csv"]
+    format: str
     columns: list[str] | None = None
     variable: str | None = None
     lever_arm_m: LeverArm = Field(default_factory=lambda: [0.0, 0.0, 0.0],
@@ -214,20 +213,21 @@ class VelocityFile(Model):
     interval_s: float | None = Field(None, gt=0, description=_INTERVAL_HELP)
 
 
-class PositionFile(Model):
+class VelocityFile(_AidingFile):
+    """A measured velocity: a velocity CSV (ENU/NED) or a reference solution's velocity."""
+
+    format: Literal["velocity-enu", "velocity-ned", "psins-mat", "i2nav-nav",
+                    "reference-csv"]
+
+
+class PositionFile(_AidingFile):
     """Measured positions: GNSS fixes (KF-GINS text, RTKLIB .pos, CSV) or a reference
     solution's positions (the formats of a velocity file's reference). R is each fix's own
     σ where the file states them (KF-GINS σN σE σD, RTKLIB sdn sde sdu, declared CSV
     columns), else ``calibrate.sigma_p_m``."""
 
-    path: Path
     format: Literal["i2nav-gnss", "rtklib-pos", "csv", "psins-mat", "i2nav-nav",
                     "reference-csv"] = "i2nav-gnss"
-    columns: list[str] | None = None
-    variable: str | None = None
-    lever_arm_m: LeverArm = Field(default_factory=lambda: [0.0, 0.0, 0.0],
-                                  description=_LEVER_HELP)
-    interval_s: float | None = Field(None, gt=0, description=_INTERVAL_HELP)
 
 
 class AidingFiles(Model):

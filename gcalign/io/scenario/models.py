@@ -121,21 +121,9 @@ class Gyro(Model):
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
     def to_si(self) -> SensorErrors:
-        bias_std, bias_tau = gauss_markov_si(self.bias_gm, u.DPH)
-        scale_std, scale_tau = gauss_markov_si(self.scale_gm, u.PPM)
-        return SensorErrors(
-            bias=per_axis(self.bias_dph) * u.DPH,
-            noise=per_axis(self.arw_dprh) * u.DPSH,
-            scale=per_axis(self.scale_ppm) * u.PPM,
-            misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
-            quantum=self.quantum_arcsec * u.ARCSEC,
-            asym=per_axis(self.asym_ppm) * u.PPM,
-            bias_gm_std=bias_std, bias_gm_tau=bias_tau,
-            bias_rw=per_axis(self.bias_rw_dphrh) * u.DPH / math.sqrt(u.HOUR),
-            scale_gm_std=scale_std, scale_gm_tau=scale_tau,
-            instability=per_axis(self.bias_instability_dph) * u.DPH,
-            instability_tau=_span(self.bias_instability_tau_s),
-        )
+        return _sensor_si(self, u.DPH, u.DPSH, self.bias_dph, self.arw_dprh,
+                          self.quantum_arcsec * u.ARCSEC, self.bias_rw_dphrh,
+                          self.bias_instability_dph)
 
 
 class Accel(Model):
@@ -167,21 +155,27 @@ class Accel(Model):
     _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
     def to_si(self) -> SensorErrors:
-        bias_std, bias_tau = gauss_markov_si(self.bias_gm, u.UG)
-        scale_std, scale_tau = gauss_markov_si(self.scale_gm, u.PPM)
-        return SensorErrors(
-            bias=per_axis(self.bias_ug) * u.UG,
-            noise=per_axis(self.vrw_ugrhz) * u.UGPSHZ,
-            scale=per_axis(self.scale_ppm) * u.PPM,
-            misalignment=_misalignment(self.misalignment_arcsec or np.zeros((3, 3))),
-            quantum=self.quantum_ugs * u.UG,
-            asym=per_axis(self.asym_ppm) * u.PPM,
-            bias_gm_std=bias_std, bias_gm_tau=bias_tau,
-            bias_rw=per_axis(self.bias_rw_ughrh) * u.UG / math.sqrt(u.HOUR),
-            scale_gm_std=scale_std, scale_gm_tau=scale_tau,
-            instability=per_axis(self.bias_instability_ug) * u.UG,
-            instability_tau=_span(self.bias_instability_tau_s),
-        )
+        return _sensor_si(self, u.UG, u.UGPSHZ, self.bias_ug, self.vrw_ugrhz,
+                          self.quantum_ugs * u.UG, self.bias_rw_ughrh, self.bias_instability_ug)
+
+
+def _sensor_si(sensor: Gyro | Accel, unit: float, noise_unit: float, bias, noise,
+               quantum: float, bias_rw, instability) -> SensorErrors:
+    """A triad's errors in SI: `bias`, its random walk `bias_rw` (per √h) and its
+    `instability` in the sensor's `unit`, `noise` in `noise_unit`, `quantum` in SI."""
+    bias_std, bias_tau = gauss_markov_si(sensor.bias_gm, unit)
+    scale_std, scale_tau = gauss_markov_si(sensor.scale_gm, u.PPM)
+    return SensorErrors(
+        bias=per_axis(bias) * unit, noise=per_axis(noise) * noise_unit, quantum=quantum,
+        scale=per_axis(sensor.scale_ppm) * u.PPM,
+        misalignment=_misalignment(sensor.misalignment_arcsec or np.zeros((3, 3))),
+        asym=per_axis(sensor.asym_ppm) * u.PPM,
+        bias_gm_std=bias_std, bias_gm_tau=bias_tau,
+        bias_rw=per_axis(bias_rw) * unit / math.sqrt(u.HOUR),
+        scale_gm_std=scale_std, scale_gm_tau=scale_tau,
+        instability=per_axis(instability) * unit,
+        instability_tau=_span(sensor.bias_instability_tau_s),
+    )
 
 
 class Imu(Model):
