@@ -11,7 +11,7 @@ Loop parameters come in *stages* (seed §6.1): each stage covers a number of pas
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -21,6 +21,7 @@ from gcalign.align.gains import azimuth_gains, level_gains
 from gcalign.align.stages import Stage, stage_of_passes
 from gcalign.choices import ALIGN_MODES
 from gcalign.nav.earth import WGS84, EarthModel
+from gcalign.schema import stored
 
 MODES = ALIGN_MODES
 
@@ -61,11 +62,12 @@ class Block:
 class PassRecord:
     """One pass: its direction, kind ("compass" or "attitude"), stage, gains, and the
     attitude at the samples it kept (processing order; a reverse pass's `t` decreases):
-    record times `t`, q_nb, and the record samples there."""
+    record times `t`, q_nb, and the record samples there. Its direction and kind are
+    summarised as they are (:func:`gcalign.schema.summary_of`)."""
 
     index: int
-    direction: str
-    kind: str
+    direction: str = field(metadata=stored(None, summary=""))
+    kind: str = field(metadata=stored(None, summary=""))
     stage: int
     gains: np.ndarray
     t: np.ndarray

@@ -31,7 +31,7 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.align import Aiding, AlignConfig
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.rotation import euler_to_dcm, quat_to_euler
-from gcalign.schema import ATT_FRAME, plain, summary_of
+from gcalign.schema import ATT_FRAME, placed, plain, summary_of
 from gcalign.units import DPH, DPSH, angle_text
 
 if TYPE_CHECKING:
@@ -504,18 +504,11 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
         "t3_source": run.t3_source,
         **summary_of(run.at_times()),  # the attitude at T1, T2, T3 and its errors, in deg
         "last_pass_error": last,
-        "passes": [
-            {
-                "pass": r.index + 1,
-                "direction": r.direction,
-                "kind": r.kind,
-                "stage": r.stage + 1,
-                "t_end_s": aligned_time(float(r.t[-1])),
-                "error_deg": plain(run.pass_end_error(r.index), "deg"),
-                "attitude_deg": np.degrees(quat_to_euler(r.q_nb[-1])).tolist(),
-            }
-            for r in run.passes
-        ],
+        "passes": [placed(summary_of(r), {"direction": {"pass": r.index + 1}}, {
+            "stage": r.stage + 1, "t_end_s": aligned_time(float(r.t[-1])),
+            "error_deg": plain(run.pass_end_error(r.index), "deg"),
+            "attitude_deg": np.degrees(quat_to_euler(r.q_nb[-1])).tolist()})
+            for r in run.passes],
         "equivalent_s": run.equivalent_s,
         "data_used_s": run.t3 if realtime else run.t2,
         "compute_s": run.compute_s,
