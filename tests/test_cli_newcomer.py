@@ -353,21 +353,41 @@ def test_unknown_key_lists_the_keys_of_its_mapping(tmp_path, data, where, keys):
 
 
 @pytest.mark.slow
-def test_a_first_run_says_it_is_compiling(tmp_path):
+def test_a_first_run_says_it_is_compiling_and_a_cached_load_gives_the_same_file(tmp_path):
     """With an empty numba cache the run says, above its bar, that it compiles the kernels
-    once; the second run loads them and says nothing of it."""
+    once; the second run loads them (through the cached-load shortcut of nav/_kernels where
+    the numba version is one it was checked on), says nothing of it and writes the same
+    numbers."""
     import os
     import subprocess
     import sys
 
+    import h5py
+    import numba
+    import numpy as np
+
     from gcalign.cli.common import COMPILING
+    from gcalign.nav import _kernels
 
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "GCALIGN_PROGRESS": "always"}
-    args = [sys.executable, "-m", "gcalign", "align", str(small_align(tmp_path)),
-            "-o", str(tmp_path / "a.h5")]
-    first = subprocess.run(args, env=env, capture_output=True, text=True, timeout=600)
+    args = [sys.executable, "-m", "gcalign", "align", str(small_align(tmp_path)), "-o"]
+    first = subprocess.run(args + [str(tmp_path / "a.h5")], env=env, capture_output=True,
+                           text=True, timeout=600)
     assert first.returncode == 0, first.stderr
     assert COMPILING[:60] in first.stderr.replace("\n", " ")
-    second = subprocess.run(args, env=env, capture_output=True, text=True, timeout=600)
+    second = subprocess.run(args + [str(tmp_path / "b.h5")], env=env, capture_output=True,
+                            text=True, timeout=600)
     assert second.returncode == 0, second.stderr
     assert "compiling" not in second.stderr
+    datasets: dict[str, list] = {"a": [], "b": []}
+    for name in datasets:
+        with h5py.File(tmp_path / f"{name}.h5", "r") as f:
+            f.visititems(lambda key, obj, out=datasets[name]: out.append((key, obj[()]))
+                         if isinstance(obj, h5py.Dataset) else None)
+    assert [k for k, _ in datasets["a"]] == [k for k, _ in datasets["b"]]
+    for (key, a), (_, b) in zip(datasets["a"], datasets["b"], strict=True):
+        assert np.array_equal(a, b, equal_nan=a.dtype.kind == "f"), key
+    from numba.core import caching
+
+    shortcut = tuple(map(int, numba.__version__.split(".")[:2])) in _kernels.SHORTCUT_NUMBA
+    assert getattr(caching.Cache, "_gcalign_load", False) == shortcut
