@@ -50,14 +50,15 @@ def case_figure(t: np.ndarray, scored: np.ndarray, before: np.ndarray,
               (after, f"after prediction, {ref}")]
     if truth_after is not None:
         panels.append((truth_after, "after prediction, against the truth"))
-    for ax, (series, what) in zip(axes, panels, strict=True):
+    for i, (ax, (series, what)) in enumerate(zip(axes, panels, strict=True)):
         for name, e in series.items():
             ax.plot(t, e / ARCSEC, linewidth=0.6, label=name)
         _limits(ax, [e[scored] / ARCSEC for e in series.values()])
         ax.set_title(what, fontsize="small", loc="left")
         ax.set_ylabel(f"{component} error (″)")
         if (~scored).any():
-            ax.axvspan(t[0], t[~scored][-1], color="0.85", label="_not scored")
+            ax.axvspan(t[0], t[~scored][-1], color="0.85",  # said once, in the first legend
+                       label="_settling" if i else "settling: not in the metrics")
     return finish(fig, axes, "pulse time (s)", title)
 
 
