@@ -525,11 +525,11 @@ def test_calibrate_figures_estimates_sigma_errors_innovations(calibrate_file):
                          "navigation_errors", "innovations", "solution_errors"}
     with results.open_results(path) as f:
         runs, attrs = read_runs(f)
-    run = runs[0]
+    run = runs[0].result
     names = attrs["states"].split(",")
     units = attrs["display_units"].split(",")
     scale = np.asarray(attrs["display_scale"])
-    t = run["t"]
+    t = run.t
     for fig_name, states in (("sensor_biases", ["ebx", "eby", "ebz", "dbx", "dby", "dbz"]),
                              ("scale_factors", ["dKgx", "dKgy", "dKgz", "dKax", "dKay",
                                                 "dKaz"])):
@@ -539,12 +539,12 @@ def test_calibrate_figures_estimates_sigma_errors_innovations(calibrate_file):
             assert ax.get_title() == name
             est = data_series(ax)[0]
             assert est.get_label() == "estimate"
-            np.testing.assert_allclose(est.get_ydata(), run["estimate"][:, i] * scale[i])
+            np.testing.assert_allclose(est.get_ydata(), run.estimate[:, i] * scale[i])
             np.testing.assert_allclose(est.get_xdata(), t)
             truth = [ln for ln in ax.lines if ln.get_label() == "truth"][0]
-            assert truth.get_ydata()[0] == pytest.approx(run["truth"][0, i] * scale[i])
+            assert truth.get_ydata()[0] == pytest.approx(run.truth[0, i] * scale[i])
             band = ax.collections[0].get_paths()[0].vertices[:, 1]
-            top = run["estimate"][:, i] * scale[i] + 3 * run["sigma"][:, i] * scale[i]
+            top = run.estimate[:, i] * scale[i] + 3 * run.sigma[:, i] * scale[i]
             assert band.max() == pytest.approx(top.max())
             lo, hi = ax.get_ylim()
             assert lo == pytest.approx(-hi)  # symmetric about zero: the sign reads at once
@@ -558,15 +558,15 @@ def test_calibrate_figures_estimates_sigma_errors_innovations(calibrate_file):
     groups = ("gyro bias ε", "accelerometer bias ∇", "gyro scale factor δKg",
               "accelerometer scale factor δKa")
     stems = ("eb", "db", "dKg", "dKa")
-    held = [min(float(np.min(run["sigma"][:, names.index(st + a)]
-                             / run["sigma"][0, names.index(st + a)])) for a in "xyz") > 0.99
+    held = [min(float(np.min(run.sigma[:, names.index(st + a)]
+                             / run.sigma[0, names.index(st + a)])) for a in "xyz") > 0.99
             for st in stems]
     assert [ax.get_title() for ax in sig.axes] == [
         g + (" — σ within 1 % of P0" if h else "") for g, h in zip(groups, held, strict=True)]
     ln = data_series(sig.axes[0])[2]  # gyro bias z
     assert ln.get_label() == "z" and sig.axes[0].get_yscale() == "log"
     i = names.index("ebz")
-    ratio = run["sigma"][:, i] / run["sigma"][0, i]
+    ratio = run.sigma[:, i] / run.sigma[0, i]
     want = np.maximum(1.0 - ratio, 1e-16) if held[0] else ratio
     np.testing.assert_allclose(ln.get_ydata(), want)
     nav = figs["navigation_errors"]
@@ -575,14 +575,14 @@ def test_calibrate_figures_estimates_sigma_errors_innovations(calibrate_file):
         err = data_series(ax)[0]
         assert err.get_label() == "error"
         np.testing.assert_allclose(err.get_ydata(),
-                                   (run["estimate"][:, i] - run["truth"][:, i]) * scale[i])
+                                   (run.estimate[:, i] - run.truth[:, i]) * scale[i])
         assert ax.get_ylabel() in ("arcsec", "arcmin", "m/s")
     inn = figs["innovations"]
     z = data_series(inn.axes[0])
-    assert [ln.get_label() for ln in z] == run["measure_names"]
-    np.testing.assert_allclose(z[0].get_ydata(), run["standardized"][:, 0])
+    assert [ln.get_label() for ln in z] == list(run.measure_names)
+    np.testing.assert_allclose(z[0].get_ydata(), run.standardized[:, 0])
     np.testing.assert_allclose(data_series(inn.axes[1])[0].get_ydata(),
-                               np.maximum(run["nis"], 1e-6))
+                               np.maximum(run.nis, 1e-6))
     assert inn.axes[1].get_yscale() == "log"
     traj = figs["trajectory"]
     track, height = traj.axes[:2]

@@ -138,7 +138,7 @@ class RealtimeResult:
     settings : the settings the cases ran with. chain : the filter chain (taps, notch).
     chain_delay : s, the chain's low-frequency group delay (FIR ``N/(2 Fs)`` plus the
     notch's). delay : s, the T the predictors used (``settings.delay_s`` or `chain_delay`).
-    cases : per case its pulse records (:class:`~gcalign.realtime.chain.CaseResult`).
+    cases : per case its pulse records (:class:`~gcalign.realtime.result.CaseResult`).
     rows : per case its row of our Table 1 (:class:`CaseSummary`).
     """
 

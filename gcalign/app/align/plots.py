@@ -11,11 +11,12 @@ dotted lines.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import replace
 
 import numpy as np
 from matplotlib.figure import Figure
 
+from gcalign.align.result import PassRows
 from gcalign.app.plots import ANGLES, _s, angle_scale, legend_below, new_figure, suptitle
 from gcalign.errors import ScenarioError
 
@@ -24,22 +25,7 @@ PASS_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "
 XLABEL = "equivalent time (s): passes laid end to end; dotted lines: pass boundaries"
 
 
-@dataclass(frozen=True)
-class PassSeries:
-    """One pass read from ``/align/pass_NN``: its number (from 1), times in processing
-    order (s), attitude and error (rad, (n, 3)); direction, kind ("compass"/"attitude") and
-    stage (from 1)."""
-
-    number: int
-    direction: str
-    kind: str
-    stage: int
-    t: np.ndarray
-    att: np.ndarray
-    error: np.ndarray | None
-
-
-def equivalent_time(passes: list[PassSeries]) -> tuple[list[np.ndarray], list[float]]:
+def equivalent_time(passes: list[PassRows]) -> tuple[list[np.ndarray], list[float]]:
     """Each pass's time on the equivalent axis (passes end to end; the first pass keeps its
     data time) and the boundaries between passes (s)."""
     xs, bounds = [], []
@@ -52,13 +38,13 @@ def equivalent_time(passes: list[PassSeries]) -> tuple[list[np.ndarray], list[fl
     return xs, bounds[:-1]
 
 
-def _pass_label(p: PassSeries) -> str:
+def _pass_label(p: PassRows) -> str:
     kind = "" if p.kind == "compass" else f" {p.kind} only"
-    return f"pass {p.number} {p.direction}{kind} (stage {p.stage})"
+    return f"pass {p.index + 1} {p.direction}{kind} (stage {p.stage})"
 
 
-def _color(p: PassSeries) -> str:
-    return PASS_COLORS[(p.number - 1) % len(PASS_COLORS)]
+def _color(p: PassRows) -> str:
+    return PASS_COLORS[p.index % len(PASS_COLORS)]
 
 
 def _mark_boundaries(ax, bounds, lo: float = -np.inf, hi: float = np.inf) -> None:
@@ -67,7 +53,7 @@ def _mark_boundaries(ax, bounds, lo: float = -np.inf, hi: float = np.inf) -> Non
             ax.axvline(b, color="0.45", linestyle=":", linewidth=1.0, label="_pass boundary")
 
 
-def zoom_of(xs: list[np.ndarray], passes: list[PassSeries]) -> tuple[float, str]:
+def zoom_of(xs: list[np.ndarray], passes: list[PassRows]) -> tuple[float, str]:
     """Where the zoom starts on the equivalent axis, and what it shows: after the first
     pass, or the second half of a single pass."""
     if len(passes) > 1:
@@ -76,15 +62,15 @@ def zoom_of(xs: list[np.ndarray], passes: list[PassSeries]) -> tuple[float, str]
     return float(x[len(x) // 2]), "second half of the pass"
 
 
-def _zoomed(x: np.ndarray, p: PassSeries, start: float, n_passes: int) -> np.ndarray:
+def _zoomed(x: np.ndarray, p: PassRows, start: float, n_passes: int) -> np.ndarray:
     """The rows of a pass in the zoom: every pass after the first, or the second half of a
     single pass."""
     if n_passes > 1:
-        return np.full(len(x), p.number > 1)
+        return np.full(len(x), p.index > 0)
     return x >= start
 
 
-def align_error_figure(passes: list[PassSeries], title: str = "alignment error") -> Figure:
+def align_error_figure(passes: list[PassRows], title: str = "alignment error") -> Figure:
     """Error of every pass against equivalent time: one row per angle; left all passes,
     right the zoom (:func:`zoom_of`); linear axes, deg / arcmin / arcsec per panel."""
     xs_all, bounds = equivalent_time(passes)
@@ -123,7 +109,7 @@ def align_error_figure(passes: list[PassSeries], title: str = "alignment error")
     return fig
 
 
-def align_attitude_figure(passes: list[PassSeries], truth_t: np.ndarray | None = None,
+def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = None,
                           truth_att: np.ndarray | None = None,
                           title: str = "attitude estimate", label: str = "truth") -> Figure:
     """Attitude estimate (deg) of every pass and, if known, the truth (or the reference:
@@ -150,22 +136,19 @@ def align_attitude_figure(passes: list[PassSeries], truth_t: np.ndarray | None =
     return fig
 
 
-def read_passes(f) -> list[PassSeries]:
-    """The passes of ``/align`` (numbered from 1; files written before gcalign numbered
-    them from 1 start at ``pass_00`` and stage 0, and are renumbered)."""
+def read_passes(f) -> list[PassRows]:
+    """The passes of ``/align`` read back (:class:`~gcalign.align.result.PassRows`); files
+    written before gcalign numbered them from 1 start at ``pass_00`` and stage 0, may lack
+    direction and kind, and are renumbered."""
+    from gcalign.io.stored import read_fields
+
     g = f["align"]
     names = sorted(k for k in g if k.startswith("pass_"))
     shift = 1 if "pass_00" in names else 0
-    out = []
-    for name in names:
-        p = g[name]
-        out.append(PassSeries(
-            number=int(name.split("_")[1]) + shift,
-            direction=_s(p.attrs.get("direction", "forward")),
-            kind=_s(p.attrs.get("kind", "compass")),
-            stage=int(p.attrs.get("stage", 1 - shift)) + shift,
-            t=p["t"][()], att=p["att"][()], error=p["error"][()] if "error" in p else None))
-    return out
+    passes = [read_fields(g[n], PassRows, index=int(n[5:]) + shift - 1) for n in names]
+    return [replace(p, direction=p.direction or "forward", kind=p.kind or "compass",
+                    stage=(1 - shift if p.stage is None else p.stage) + shift)
+            for p in passes]
 
 
 def figures(f, name: str) -> dict[str, Figure]:

@@ -16,11 +16,14 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.app.plots import _s, finish, legend_below, legend_right, new_figure, suptitle
 from gcalign.app.report import UNIT_TEXT
+from gcalign.estimation.calibration import CalibrationResult
 from gcalign.units import ANGLE_UNITS, angle_unit
 
 STYLE = {"both": dict(color="tab:red", linestyle="--"),
@@ -29,31 +32,42 @@ STYLE = {"both": dict(color="tab:red", linestyle="--"),
 AXES = ("x", "y", "z")
 
 
-def read_runs(f) -> tuple[list[dict], dict]:
+@dataclass(frozen=True)
+class ShownRun:
+    """A run of a calibrate file as its figures draw it: the filter's result read back by
+    the generic reader (:class:`~gcalign.estimation.calibration.CalibrationResult`), and
+    what the command keeps beside its fields: its label and measurement, and the errors
+    (t, att, v_n, pos) of the solution at every navigation sample (with ``t0``, the run's
+    start in the file's time), of the smoothed solution and against a reference."""
+
+    result: CalibrationResult
+    label: str
+    measure: str
+    navigation: dict | None
+    smoothed: dict | None
+    reference_error: dict | None
+
+
+def _errors(g) -> dict[str, np.ndarray]:
+    return {k: g[k][()] for k in ("t", "att", "v_n", "pos")}
+
+
+def read_runs(f) -> tuple[list[ShownRun], dict]:
     """The runs of a calibrate file (arrays SI) and the group's attributes."""
+    from gcalign.io.stored import read_fields
+
     g = f["calibrate"]
     attrs = {k: (_s(v) if isinstance(v, (bytes, str)) else v) for k, v in g.attrs.items()}
     runs = []
     for key in sorted(g["runs"]):
         r = g["runs"][key]
-        run: dict = {"label": _s(r.attrs.get("label", "")), "measure": _s(r.attrs["measure"]),
-               "measure_names": _s(r.attrs.get("measure_names", "")).split(",")}
-        for name in ("t", "estimate", "sigma", "truth", "nees", "standardized", "nis", "att",
-                     "update_t"):
-            run[name] = r[name][()] if name in r else None
-        if run["update_t"] is None:  # the seed's schedule: an update at every epoch but 0
-            run["update_t"] = run["t"][1:]
-        nav = r.get("navigation")
-        run["navigation"] = None if nav is None or "error" not in nav else {
-            k: nav["error"][k][()] for k in ("t", "att", "v_n", "pos")} | {
+        nav, sm, e = r.get("navigation"), r.get("smoothed/error"), r.get("reference_error")
+        navigation = None if nav is None or "error" not in nav else _errors(nav["error"]) | {
             "t0": float(nav["t"][0] - nav["t_run"][0]) if len(nav["t"]) else 0.0}
-        sm = r.get("smoothed/error")
-        run["smoothed"] = None if sm is None else {k: sm[k][()] for k in
-                                                   ("t", "att", "v_n", "pos")}
-        e = r.get("reference_error")
-        run["reference_error"] = None if e is None else {k: e[k][()] for k in
-                                                         ("t", "att", "v_n", "pos")}
-        runs.append(run)
+        runs.append(ShownRun(
+            read_fields(r, CalibrationResult, innovation=None, nis=r["nis"][()], settings=None),
+            _s(r.attrs.get("label", "")), _s(r.attrs["measure"]), navigation,
+            None if sm is None else _errors(sm), None if e is None else _errors(e)))
     seg = g["segments"]
     attrs["segments"] = [(_s(n), float(a), float(b)) for n, a, b in
                          zip(seg["name"][()], seg["t0"][()], seg["t1"][()], strict=True)]
@@ -110,7 +124,7 @@ def _finish(fig, axes, xlabel: str, title: str) -> Figure:
     return fig
 
 
-def estimates_figure(runs, attrs, states: list[str], title: str) -> Figure:
+def estimates_figure(runs: list[ShownRun], attrs, states: list[str], title: str) -> Figure:
     """Estimates of `states` (2 rows × 3 axes) against time with ±3σ and the truth."""
     names = attrs["states"].split(",")
     units = attrs["display_units"].split(",")
@@ -121,13 +135,13 @@ def estimates_figure(runs, attrs, states: list[str], title: str) -> Figure:
         k = scale[i]
         lim = 0.0
         for r in runs:
-            t, minutes = r["t"], False
+            t, minutes = r.result.t, False
             tx, xlabel = _time_axis(t)
             minutes = xlabel.endswith("(min)")
-            est, sig = r["estimate"][:, i] * k, r["sigma"][:, i] * k
-            style = STYLE[r["measure"]] if len(runs) > 1 else dict(color="tab:blue",
+            est, sig = r.result.estimate[:, i] * k, r.result.sigma[:, i] * k
+            style = STYLE[r.measure] if len(runs) > 1 else dict(color="tab:blue",
                                                                    linestyle="-")
-            lab = r["measure"] if len(runs) > 1 else "estimate"
+            lab = r.measure if len(runs) > 1 else "estimate"
             ax.plot(tx, est, linewidth=1.1, label=lab, **style)
             if len(runs) == 1:
                 ax.fill_between(tx, est - 3 * sig, est + 3 * sig, color=style["color"],
@@ -136,17 +150,17 @@ def estimates_figure(runs, attrs, states: list[str], title: str) -> Figure:
                 for sign in (1, -1):
                     ax.plot(tx, est + sign * 3 * sig, linewidth=0.7, alpha=0.7,
                             label="_3s", **style)
-            truth = None if r["truth"] is None else r["truth"][:, i] * k
+            truth = None if r.result.truth is None else r.result.truth[:, i] * k
             lim = max(lim, _ylim(est, sig, truth, t))
-        if runs[0]["truth"] is not None:
-            ax.axhline(runs[0]["truth"][0, i] * k, color="black", linewidth=0.9,
+        if runs[0].result.truth is not None:
+            ax.axhline(runs[0].result.truth[0, i] * k, color="black", linewidth=0.9,
                        linestyle=(0, (4, 2)), label="truth")
         _segment_lines(ax, attrs["segments"], minutes)
         _panel(ax, name, units[i], lim)
     return _finish(fig, axes, xlabel, title)
 
 
-def sigma_figure(runs, attrs, title: str) -> Figure:
+def sigma_figure(runs: list[ShownRun], attrs, title: str) -> Figure:
     """σ/σ0 of the twelve sensor errors against time (log scale), one panel per group."""
     names = attrs["states"].split(",")
     fig, axes = new_figure(2, 2, width=11.0, height=6.5)
@@ -154,20 +168,20 @@ def sigma_figure(runs, attrs, title: str) -> Figure:
               ("gyro scale factor δKg", "dKg"), ("accelerometer scale factor δKa", "dKa"))
     colors = ("tab:blue", "tab:orange", "tab:green")
     for ax, (label, stem) in zip(axes, groups, strict=True):
-        ratio = [r["sigma"][:, names.index(stem + a)] / r["sigma"][0, names.index(stem + a)]
-                 for r in runs for a in AXES]
+        ratio = [r.result.sigma[:, names.index(stem + a)]
+                 / r.result.sigma[0, names.index(stem + a)] for r in runs for a in AXES]
         # a group that learnt (almost) nothing, e.g. scale factors held at a 1 ppm prior:
         # σ/σ0 would read 1.000000 on every tick; draw what was learnt, 1 − σ/σ0
         held = min(float(np.min(x)) for x in ratio) > 0.99
         for r in runs:
-            tx, xlabel = _time_axis(r["t"])
-            ls = STYLE[r["measure"]]["linestyle"] if len(runs) > 1 else "-"
+            tx, xlabel = _time_axis(r.result.t)
+            ls = STYLE[r.measure]["linestyle"] if len(runs) > 1 else "-"
             for c, axis in zip(colors, AXES, strict=True):
                 i = names.index(stem + axis)
-                y = r["sigma"][:, i] / r["sigma"][0, i]
+                y = r.result.sigma[:, i] / r.result.sigma[0, i]
                 ax.semilogy(tx, np.maximum(1.0 - y, 1e-16) if held else y, color=c,
                             linestyle=ls, linewidth=1.0,
-                            label=f"{axis}" + (f" {r['measure']}" if len(runs) > 1 else ""))
+                            label=f"{axis}" + (f" {r.measure}" if len(runs) > 1 else ""))
         _segment_lines(ax, attrs["segments"], xlabel.endswith("(min)"))
         ax.set_title(label + (" — σ within 1 % of P0" if held else ""), fontsize="medium")
         ax.set_ylabel("1 − σ / σ0" if held else "σ / σ0")
@@ -195,72 +209,73 @@ def _plain_log_ticks(ax) -> None:
         ax.yaxis.set_major_formatter(plain)
 
 
-def navigation_figure(run, attrs, title: str) -> Figure:
+def navigation_figure(run: CalibrationResult, attrs, title: str) -> Figure:
     """φ and δv of the corrected INS solution (estimate − truth: what the closed loop
     leaves; feed-forward: the error of the estimate) with the filter's ±3σ."""
     names = attrs["states"].split(",")
     units = attrs["display_units"].split(",")
     scale = np.asarray(attrs["display_scale"])
+    assert run.truth is not None  # drawn only with truth
     fig, axes = new_figure(2, 3, width=12.0, height=6.0)
-    tx, xlabel = _time_axis(run["t"])
+    tx, xlabel = _time_axis(run.t)
     for ax, name in zip(axes, names[:6], strict=True):
         i = names.index(name)
         k = scale[i]
-        err = (run["estimate"][:, i] - run["truth"][:, i]) * k
-        sig = run["sigma"][:, i] * k
+        err = (run.estimate[:, i] - run.truth[:, i]) * k
+        sig = run.sigma[:, i] * k
         ax.fill_between(tx, -3 * sig, 3 * sig, color="tab:blue", alpha=0.18, linewidth=0,
                         label="±3σ")
         ax.plot(tx, err, color="black", linewidth=0.8, label="error")
-        _panel(ax, name, units[i], _ylim(err, sig, None, run["t"]))
+        _panel(ax, name, units[i], _ylim(err, sig, None, run.t))
     return _finish(fig, axes, xlabel, title)
 
 
-def innovations_figure(run, title: str, outages=()) -> Figure:
+def innovations_figure(run: CalibrationResult, title: str, outages=()) -> Figure:
     """Standardized innovations (each ~ N(0, 1)) with ±3, NEES with the χ²₂₁ 95 % band, NIS."""
     from scipy.stats import chi2
 
-    has_nees = run["nees"] is not None
+    has_nees = run.nees is not None
     fig, axes = new_figure(3 if has_nees else 2, height=7.5 if has_nees else 5.5)
-    t = run["t"]
+    t = run.t
     tx, xlabel = _time_axis(t)
-    z = run["standardized"]
-    tu = _time_axis(np.concatenate([t[:1], run["update_t"]]))[0][1:]  # the epochs with a fix
-    for j, name in enumerate(run["measure_names"]):
+    z = run.standardized
+    tu = _time_axis(np.concatenate([t[:1], run.update_t]))[0][1:]  # the epochs with a fix
+    for j, name in enumerate(run.measure_names):
         axes[0].plot(tu, z[:, j], ".", markersize=2, label=name)
     for y in (-3, 3):
         axes[0].axhline(y, color="black", linewidth=0.7, linestyle="--", label="_3")
     axes[0].set_ylabel("standardized\ninnovation")
     m = z.shape[1]
     lo, hi = chi2.ppf([0.025, 0.975], m)
-    axes[1].semilogy(tu, np.maximum(run["nis"], 1e-6), ".", markersize=2, label="NIS")
+    axes[1].semilogy(tu, np.maximum(run.nis, 1e-6), ".", markersize=2, label="NIS")
     for ax in axes:
         shade_outages(ax, outages, xlabel.endswith("(min)"))
     axes[1].axhspan(lo, hi, color="tab:green", alpha=0.15, label=f"χ²({m}) 95 %")
     axes[1].set_ylabel("NIS")
     if has_nees:
         lo, hi = chi2.ppf([0.025, 0.975], 21)
-        axes[2].plot(tx, run["nees"], linewidth=0.9, label="NEES")
+        axes[2].plot(tx, run.nees, linewidth=0.9, label="NEES")
         axes[2].axhspan(lo, hi, color="tab:green", alpha=0.15,
                         label="χ²(21) 95 % (truth drawn from P0)")
         axes[2].set_ylabel("NEES")
     return finish(fig, axes, xlabel, title)
 
 
-def attitude_figure(run, title: str) -> Figure:
+def attitude_figure(run: CalibrationResult, title: str) -> Figure:
     """Recorded data: the corrected INS attitude (deg) with ±3σ of the misalignment."""
     fig, axes = new_figure(3, height=7.0)
-    tx, xlabel = _time_axis(run["t"])
-    sig = run["sigma"][:, :3]
+    tx, xlabel = _time_axis(run.t)
+    sig = run.sigma[:, :3]
     # ±3σ of φ as an attitude band: φE, φN for pitch and roll (small angles), φU for yaw
     for ax, j, name, s in zip(axes, range(3), ("pitch", "roll", "yaw"),
                               (sig[:, 0], sig[:, 1], sig[:, 2]), strict=True):
-        a = np.degrees(run["att"][:, j])
+        a = np.degrees(run.att[:, j])
         ax.plot(tx, a, color="tab:blue", linewidth=1.0, label=name)
         ax.fill_between(tx, a - 3 * np.degrees(s), a + 3 * np.degrees(s), color="tab:blue",
                         alpha=0.15, label="±3σ")
         # the whole curve and, where it is narrow enough to read, its band: the ±3σ of the
         # first epochs (P0: tens of degrees in yaw) would flatten the curve
-        half = run["t"] >= run["t"][0] + 0.5 * (run["t"][-1] - run["t"][0])
+        half = run.t >= run.t[0] + 0.5 * (run.t[-1] - run.t[0])
         band = float(np.max(3 * np.degrees(s[half])))
         lo, hi = float(np.min(a)) - band, float(np.max(a)) + band
         pad = 0.05 * (hi - lo) if hi > lo else 0.5
@@ -284,28 +299,29 @@ def reference_figure(e: dict, title: str) -> Figure:
                                               "position (m)"])
 
 
-def solution_figure(run, attrs, title: str) -> Figure:
+def solution_figure(run: ShownRun, attrs, title: str) -> Figure:
     """The solution at every navigation sample minus the truth or the reference: position
     and velocity east, north, up and the attitude, with the filter's ±3σ at its epochs (φ
     for the attitude), the smoothed solution at the epochs where there is one, and the
     outages shaded."""
-    e = run["navigation"]
+    e = run.navigation
+    assert e is not None  # drawn only where the file holds it
     scale = np.asarray(attrs["display_scale"])
     t_run = e["t"] - e["t0"]
     tx, xlabel = _time_axis(t_run)
     minutes = xlabel.endswith("(min)")
-    te = _time_axis(run["t"])[0] if not minutes else run["t"] / 60.0
+    te = _time_axis(run.result.t)[0] if not minutes else run.result.t / 60.0
     unit = angle_unit(float(np.max(np.abs(e["att"]))))
     k_att = 1.0 / ANGLE_UNITS[unit][0]
     fig, axes = new_figure(3, 3, width=13.0, height=8.5, sharex=True)
-    sig_pos = run["sigma"][:, [7, 6, 8]] * scale[[7, 6, 8]]  # east, north, up in metres
-    sig_v = run["sigma"][:, 3:6]
-    sig_att = run["sigma"][:, 0:3] * k_att
+    sig_pos = run.result.sigma[:, [7, 6, 8]] * scale[[7, 6, 8]]  # east, north, up in metres
+    sig_v = run.result.sigma[:, 3:6]
+    sig_att = run.result.sigma[:, 0:3] * k_att
     rows = (("position", e["pos"], sig_pos, ("east", "north", "up"), "m"),
             ("velocity", e["v_n"], sig_v, ("east", "north", "up"), "m/s"),
             ("attitude", e["att"] * k_att, sig_att, ("pitch", "roll", "yaw"),
              UNIT_WORD.get(unit, unit)))
-    sm = run.get("smoothed")
+    sm = run.smoothed
     sm_rows = None if sm is None else (sm["pos"], sm["v_n"], sm["att"] * k_att)
     ts = None if sm is None else (sm["t"] / 60.0 if minutes else sm["t"])
     for r, (what, err, sig, labels, u) in enumerate(rows):
@@ -403,9 +419,9 @@ def figures(f, name: str) -> dict[str, Figure]:
     if "calibrate" not in f:
         return figs
     runs, attrs = read_runs(f)
-    shown = [r for r in runs if r["label"] in ("", "designed")]
+    shown = [r for r in runs if r.label in ("", "designed")]
     what = ("designed flight, velocity / position / both" if len(shown) > 1
-            else f"{shown[0]['measure']} matching")
+            else f"{shown[0].measure} matching")
     figs["sensor_biases"] = estimates_figure(
         shown, attrs, ["ebx", "eby", "ebz", "dbx", "dby", "dbz"],
         f"{name}: gyro biases ε and accelerometer biases ∇, estimate ±3σ ({what})")
@@ -415,26 +431,26 @@ def figures(f, name: str) -> dict[str, Figure]:
     figs["sigma"] = sigma_figure(shown, attrs, f"{name}: σ of the sensor errors relative to P0 "
                                                f"({what})")
     first = shown[0]
-    if first["truth"] is not None:
+    if first.result.truth is not None:
         figs["navigation_errors"] = navigation_figure(
-            first, attrs, f"{name}: misalignment φ and velocity error of the corrected INS "
-            f"(estimate − truth) with ±3σ ({first['measure']})")
+            first.result, attrs, f"{name}: misalignment φ and velocity error of the corrected "
+            f"INS (estimate − truth) with ±3σ ({first.measure})")
     else:
         aiding = attrs.get("aiding", "")
         how = ("zero-velocity updates" if aiding == "zero-velocity" else
-               f"{AIDED.get(first['measure'], first['measure'])} from a file" if aiding == "file"
-               else f"{first['measure']} aiding")
-        figs["attitude"] = attitude_figure(first, f"{name}: INS attitude with ±3σ ({how})")
-    if first["reference_error"] is not None:
+               f"{AIDED.get(first.measure, first.measure)} from a file" if aiding == "file"
+               else f"{first.measure} aiding")
+        figs["attitude"] = attitude_figure(first.result, f"{name}: INS attitude with ±3σ ({how})")
+    if first.reference_error is not None:
         figs["reference_errors"] = reference_figure(
-            first["reference_error"], f"{name}: INS solution against the reference "
-            f"(est − reference; {AIDED[first['measure']]} aiding)")
+            first.reference_error, f"{name}: INS solution against the reference "
+            f"(est − reference; {AIDED[first.measure]} aiding)")
     figs["innovations"] = innovations_figure(
-        first, f"{name}: standardized innovations, NIS and NEES ({first['measure']})",
+        first.result, f"{name}: standardized innovations, NIS and NEES ({first.measure})",
         attrs["outages"])
-    if first["navigation"] is not None and len(first["navigation"]["t"]):
-        against = "truth" if first["truth"] is not None else "reference"
+    if first.navigation is not None and len(first.navigation["t"]):
+        against = "truth" if first.result.truth is not None else "reference"
         figs["solution_errors"] = solution_figure(
             first, attrs, f"{name}: solution − {against} at every navigation sample "
-            f"({AIDED[first['measure']]} aiding)")
+            f"({AIDED[first.measure]} aiding)")
     return figs

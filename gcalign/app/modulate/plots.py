@@ -119,7 +119,13 @@ def mechanism_figure(cycles: dict, title: str) -> Figure:
 
 
 def figures(f, name: str) -> dict:
-    """The figures of a modulate results file."""
+    """The figures of a modulate results file: the linear model and the mechanism's cycle
+    read back (:class:`~gcalign.modulate.linear.LinearSeries`,
+    :class:`~gcalign.modulate.analysis.MechanismCycle`)."""
+    from gcalign.io.stored import read_fields
+    from gcalign.modulate.analysis import MechanismCycle
+    from gcalign.modulate.linear import LinearSeries
+
     if "modulate" not in f:
         return {}
     root = f["modulate"]
@@ -132,12 +138,13 @@ def figures(f, name: str) -> dict:
         e = g["error/pos"][()]
         lin = None
         if "linear" in g:
-            lin = (g["linear/t"][()], g["linear/horizontal"][()])
+            ls = read_fields(g["linear"], LinearSeries)
+            lin = (ls.t, ls.horizontal)
         pos[s] = (t, np.hypot(e[:, 0], e[:, 1]), lin, rep)
         att[s] = (t, g["error/phi"][()])
         if g.attrs.get("mechanism", True) and "mechanism" in g:
-            m = g["mechanism"]
-            cyc[s] = (m["t"][()], m["angle"][()], m["C_diag"][()], _s(g.attrs["reference"]))
+            m = read_fields(g["mechanism"], MechanismCycle)
+            cyc[s] = (m.t, m.angle, m.C_diag, _s(g.attrs["reference"]))
     out = {
         "modulate_position_error": position_error_figure(
             pos, f"{name}: horizontal position error"),

@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 from gcalign.app.plots import ANGLES, _s, finish, legend_right, new_figure, suptitle
 from gcalign.io.stored import read_fields
 from gcalign.realtime.filters import ChainResponse
+from gcalign.realtime.result import CaseResult
 from gcalign.units import ARCSEC
 
 REFERENCE = {"seed": "against the INS's output T later (the seed's reference)",
@@ -49,14 +50,15 @@ def case_figure(t: np.ndarray, scored: np.ndarray, before: np.ndarray,
               (after, f"after prediction, {ref}")]
     if truth_after is not None:
         panels.append((truth_after, "after prediction, against the truth"))
-    for ax, (series, what) in zip(axes, panels, strict=True):
+    for i, (ax, (series, what)) in enumerate(zip(axes, panels, strict=True)):
         for name, e in series.items():
             ax.plot(t, e / ARCSEC, linewidth=0.6, label=name)
         _limits(ax, [e[scored] / ARCSEC for e in series.values()])
         ax.set_title(what, fontsize="small", loc="left")
         ax.set_ylabel(f"{component} error (″)")
         if (~scored).any():
-            ax.axvspan(t[0], t[~scored][-1], color="0.85", label="_not scored")
+            ax.axvspan(t[0], t[~scored][-1], color="0.85",  # said once, in the first legend
+                       label="_settling" if i else "settling: not in the metrics")
     return finish(fig, axes, "pulse time (s)", title)
 
 
@@ -130,11 +132,13 @@ def figures(f, name: str) -> dict[str, Figure]:
     for key in sorted(g["cases"]):
         c = g["cases"][key]
         cname, kind, comp = _s(c.attrs["name"]), _s(c.attrs["kind"]), int(c.attrs["component"])
-        t = c["t"][()]
+        # its per-pulse records; what the run knew besides (the case, the settings, the
+        # site) is not kept in the file: the case's attributes stand for it
+        res = read_fields(c, CaseResult, case=None, settings=None, site=None, earth=None,
+                          chain_delay=None, delay=None, t_update=None)
+        t, truth, latched, pred = res.pulses.t, res.truth, res.latched, res.predicted
         keep = t >= settle
-        truth, ins_ref, latched = c["truth"][()], c["ins_ref"][()], c["latched"][()]
-        ref = ins_ref if reference == "seed" else truth
-        pred = {p: c["predicted"][p][()] for p in c["predicted"]}
+        ref = res.ins_ref if reference == "seed" else truth
         after = {p: _wrap(a - ref)[:, comp] for p, a in pred.items() if p != "none"}
         truth_after = None
         if reference == "seed":
