@@ -53,3 +53,11 @@ def test_sigma_panels_read_plain_numbers(figs):
     assert [ax.get_title().split(" —")[0] for ax in held] == [
         "gyro scale factor δKg", "accelerometer scale factor δKa"]
     assert all(ax.get_ylabel() == "1 − σ / σ0" for ax in held)
+
+
+def test_innovations_title_names_the_panels_drawn_and_the_aiding(figs):
+    """A recording has no truth, so no NEES panel: the title must not promise one."""
+    fig = figs[0]["innovations"]
+    title = fig.texts[0].get_text()
+    assert len(fig.axes) == 2 and "NEES" not in title
+    assert "NIS (velocity and position from a file)" in title

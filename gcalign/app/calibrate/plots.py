@@ -431,23 +431,22 @@ def figures(f, name: str) -> dict[str, Figure]:
     figs["sigma"] = sigma_figure(shown, attrs, f"{name}: σ of the sensor errors relative to P0 "
                                                f"({what})")
     first = shown[0]
+    aiding, aided = attrs.get("aiding", ""), AIDED.get(first.measure, first.measure)
+    how = ("zero-velocity updates" if aiding == "zero-velocity" else
+           f"{aided} from a file" if aiding == "file" else f"{aided} aiding")
     if first.result.truth is not None:
         figs["navigation_errors"] = navigation_figure(
             first.result, attrs, f"{name}: misalignment φ and velocity error of the corrected "
             f"INS (estimate − truth) with ±3σ ({first.measure})")
     else:
-        aiding = attrs.get("aiding", "")
-        how = ("zero-velocity updates" if aiding == "zero-velocity" else
-               f"{AIDED.get(first.measure, first.measure)} from a file" if aiding == "file"
-               else f"{first.measure} aiding")
         figs["attitude"] = attitude_figure(first.result, f"{name}: INS attitude with ±3σ ({how})")
     if first.reference_error is not None:
         figs["reference_errors"] = reference_figure(
             first.reference_error, f"{name}: INS solution against the reference "
             f"(est − reference; {AIDED[first.measure]} aiding)")
     figs["innovations"] = innovations_figure(
-        first.result, f"{name}: standardized innovations, NIS and NEES ({first.measure})",
-        attrs["outages"])
+        first.result, f"{name}: standardized innovations, NIS"
+        + (" and NEES" if first.result.nees is not None else "") + f" ({how})", attrs["outages"])
     if first.navigation is not None and len(first.navigation["t"]):
         against = "truth" if first.result.truth is not None else "reference"
         figs["solution_errors"] = solution_figure(
