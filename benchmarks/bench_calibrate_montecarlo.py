@@ -129,7 +129,7 @@ def batch(tree: Path, seeds: int, out: Path) -> dict:
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-m", "gcalign", "batch", str(sweep), "--workers", "2",
                     "-o", str(out), "--json"], check=True, env=env, cwd=tree,
-                   stdout=subprocess.DEVNULL)
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     wall = time.perf_counter() - t0
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     return {"wall": wall, "cpu": r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime}

@@ -18,8 +18,9 @@ import numpy as np
 import pytest
 from calibrate_cases import SHORT, short, site
 
-from gcalign.calibrate import Settings, calibrate, draw_truth
+from gcalign.calibrate import Settings, calibrate, combine_increments, draw_truth
 from gcalign.calibrate import filter as F
+from gcalign.calibrate.data import combine_increments_numpy
 from gcalign.calibrate.lockstep import LANES, calibrate_runs
 from gcalign.estimation import ins_error as ie
 
@@ -37,6 +38,22 @@ def flights():
     P0 = ie.initial_covariance(site("short"), 1.0)
     rng = np.random.default_rng(11)
     return [short(draw_truth(P0, rng), noise=True, seed=40 + i) for i in range(4)]
+
+
+def _differ_by_round_off(pairs) -> None:
+    """Each (name, got, want) equal within 1e-13 of its scale; xfail (saying which) when one
+    is not equal to the bit, which a NumPy whose transcendental functions are not the C
+    library's would cause."""
+    differ = []
+    for name, x, y in pairs:
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        assert x.shape == y.shape, name
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-13 * max(np.abs(y).max(), 1e-300),
+                                   err_msg=name)
+        if not np.array_equal(x, y):
+            differ.append(name)
+    if differ:
+        pytest.xfail(f"round-off only (NumPy's sin/cos/atan2 are not libm's here): {differ}")
 
 
 def _loop_route(data, s, rng, on_rows=None):
@@ -66,19 +83,30 @@ def test_the_kernel_is_the_general_loop(flights, change):
     s = Settings(**change)
     d = flights[0]
     a, b = calibrate(d, s, np.random.default_rng(2)), _loop_route(d, s, np.random.default_rng(2))
-    differ = []
-    for f in FIELDS:
-        x, y = getattr(a, f), getattr(b, f)
-        if x is None and y is None:
-            continue
-        x, y = np.asarray(x, float), np.asarray(y, float)
-        assert x.shape == y.shape, f
-        np.testing.assert_allclose(x, y, rtol=0, atol=1e-13 * max(np.abs(y).max(), 1e-300),
-                                   err_msg=f)
-        if not np.array_equal(x, y):
-            differ.append(f)
-    if differ:  # within round-off, but not to the bit: NumPy's sine is not libm's here
-        pytest.xfail(f"round-off only (NumPy's scalar sin/cos differ from libm): {differ}")
+    _differ_by_round_off([(f, getattr(a, f), getattr(b, f)) for f in FIELDS
+                          if getattr(b, f) is not None])
+
+
+@pytest.mark.parametrize("n", [2, 4, 5])
+def test_increments_combined_by_the_kernel_are_the_numpy_form(n):
+    """combine_increments (numba) against its NumPy form, rotations from 1e-9 to 1e-2 rad
+    a sample (both branches of the rotation vector's series; 1e-2 rad is 57 °/s at 100 Hz),
+    a trailing incomplete group: to the bit where NumPy's transcendental functions are the
+    C library's. Beyond (0.01–0.3 rad a sample) NumPy's vector arctan2 leaves libm's by an
+    ulp in a few per cent of its calls (decision 015): there the two agree to round-off."""
+    rng = np.random.default_rng(n)
+    N = 4000 * n + n - 1
+    dv = rng.standard_normal((N, 3)) * 0.05 + [0.0, 0.0, 0.098]
+    pairs = []
+    for lo, hi in ((-9, -2), (-2, -0.5)):
+        dth = rng.standard_normal((N, 3)) * 10.0 ** rng.uniform(lo, hi, (N, 1))
+        phi, out = combine_increments(dth, dv, n)
+        want_phi, want_dv = combine_increments_numpy(dth, dv, n)
+        assert phi.shape == (4000, 3)
+        pairs += [(f"phi 1e{lo}", phi, want_phi), (f"dv 1e{lo}", out, want_dv)]
+    for name, x, y in pairs[2:]:
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-13 * np.abs(y).max(), err_msg=name)
+    _differ_by_round_off(pairs[:2])
 
 
 def test_the_solution_rows_are_the_loop_s(flights):

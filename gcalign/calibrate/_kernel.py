@@ -1,5 +1,6 @@
-"""Numba kernel: the calibration filter's epochs on the seed's schedule, for one run or
-several runs in lockstep (the seeds of a Monte Carlo variant).
+"""Numba kernels: the calibration filter's epochs on the seed's schedule, for one run or
+several runs in lockstep (the seeds of a Monte Carlo variant), and the navigation
+increments combined from IMU ones (:func:`combine`).
 
 Private: :func:`gcalign.calibrate.filter.calibrate` and
 :func:`gcalign.calibrate.lockstep.calibrate_runs` call it. One loop over the filter epochs;
@@ -216,3 +217,58 @@ def epochs(k0: int, k1: int, ends: np.ndarray, dtheta: np.ndarray, dv: np.ndarra
                     est[ln, k + 1, j] = x_post[j]
                 for j in range(n_states):
                     x[ln, j] = x_post[j]
+
+
+@njit(cache=True, inline="always")
+def _rotvec_quat(rx: float, ry: float, rz: float) -> tuple[float, float, float, float]:
+    """:func:`gcalign.nav.rotation.rotvec_to_quat` of one vector, in its operations."""
+    th = math.sqrt(rx * rx + ry * ry + rz * rz)
+    half = 0.5 * th
+    ratio = 0.5 - th * th / 48.0 if th < 1e-4 else math.sin(half) / th
+    return math.cos(half), rx * ratio, ry * ratio, rz * ratio
+
+
+@njit(cache=True, inline="always")
+def _turn(w: float, x: float, y: float, z: float, v0: float, v1: float,
+          v2: float) -> tuple[float, float, float]:
+    """The DCM of q = (w, x, y, z) (:func:`gcalign.nav.rotation.quat_to_dcm`) times v, each
+    row's sum in the order ``np.einsum("...ij,...j->...i")`` takes (its two-lane pairs:
+    (c0 v0 + c2 v2) + c1 v1)."""
+    c00, c01, c02 = w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)
+    c10, c11, c12 = 2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)
+    c20, c21, c22 = 2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z
+    return ((c00 * v0 + c02 * v2) + c01 * v1, (c10 * v0 + c12 * v2) + c11 * v1,
+            (c20 * v0 + c22 * v2) + c21 * v1)
+
+
+@njit(cache=True)
+def combine(dtheta: np.ndarray, dv: np.ndarray, n: int, phi: np.ndarray,
+            out: np.ndarray) -> None:
+    """:func:`gcalign.calibrate.data.combine_increments` for n ≥ 2 into phi, out (N // n, 3):
+    per group, ``ΔV = Σ_i C(q_{i−1}) R(θ_i/2) Δv_i`` with ``q_i = q_{i−1} ⊗ q(θ_i)``, then
+    ``φ = rotvec(q_n)`` and ``Δv = R(−φ/2) ΔV``, in the NumPy form's operations and order."""
+    for g in range(dtheta.shape[0] // n):
+        qw, qx, qy, qz = 1.0, 0.0, 0.0, 0.0
+        V0 = V1 = V2 = 0.0
+        for i in range(n):
+            r = g * n + i
+            w0, w1, w2 = dtheta[r, 0], dtheta[r, 1], dtheta[r, 2]
+            hw, hx, hy, hz = _rotvec_quat(0.5 * w0, 0.5 * w1, 0.5 * w2)
+            u0, u1, u2 = _turn(hw, hx, hy, hz, dv[r, 0], dv[r, 1], dv[r, 2])
+            t0, t1, t2 = _turn(qw, qx, qy, qz, u0, u1, u2)
+            V0, V1, V2 = V0 + t0, V1 + t1, V2 + t2
+            pw, px, py, pz = _rotvec_quat(w0, w1, w2)
+            qw, qx, qy, qz = (qw * pw - qx * px - qy * py - qz * pz,
+                              qw * px + qx * pw + qy * pz - qz * py,
+                              qw * py - qx * pz + qy * pw + qz * px,
+                              qw * pz + qx * py - qy * px + qz * pw)
+        # φ = rotvec(q) (gcalign.nav.rotation.quat_to_rotvec)
+        sgn = -1.0 if qw < 0 else 1.0
+        qw, qx, qy, qz = qw * sgn, qx * sgn, qy * sgn, qz * sgn
+        nn = math.sqrt(qx * qx + qy * qy + qz * qz)
+        th = 2.0 * math.atan2(nn, qw)
+        ratio = 2.0 / qw if nn < 1e-12 else th / nn
+        f0, f1, f2 = qx * ratio, qy * ratio, qz * ratio
+        phi[g, 0], phi[g, 1], phi[g, 2] = f0, f1, f2
+        bw, bx, by, bz = _rotvec_quat(-0.5 * f0, -0.5 * f1, -0.5 * f2)
+        out[g, 0], out[g, 1], out[g, 2] = _turn(bw, bx, by, bz, V0, V1, V2)

@@ -231,13 +231,27 @@ def combine_increments(dtheta: np.ndarray, dv: np.ndarray,
     (``∫ω dt``) for the coning within the group; gcalign's simulated gyro increments are the
     exact rotation vectors between samples (a one-sample step reproduces the truth), for
     which the composition is exact and the cone factors over-correct by θ_i × θ_j / 6
-    (``tests/test_calibrate.py``). A trailing incomplete group is dropped.
+    (``tests/test_calibrate.py``). A trailing incomplete group is dropped. A numba kernel
+    (:func:`gcalign.calibrate._kernel.combine`) with the operations of the NumPy form
+    (:func:`combine_increments_numpy`), in its order.
     """
     if n < 1:
         raise ValueError(f"subsamples: at least 1 IMU increment per navigation step, got {n}")
     k = len(dtheta) // n
     if n == 1:  # the increments themselves (views: a long recording is not copied)
         return np.asarray(dtheta, float)[:k], np.asarray(dv, float)[:k]
+    from gcalign.calibrate._kernel import combine
+
+    phi, out = np.empty((k, 3)), np.empty((k, 3))
+    combine(np.ascontiguousarray(dtheta, float), np.ascontiguousarray(dv, float), n, phi, out)
+    return phi, out
+
+
+def combine_increments_numpy(dtheta: np.ndarray, dv: np.ndarray,
+                             n: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`combine_increments` as NumPy expressions (its numba kernel's reference, n ≥ 2;
+    ``tests/test_calibrate_lockstep.py``)."""
+    k = len(dtheta) // n
     w = np.asarray(dtheta, float)[: k * n].reshape(k, n, 3)
     v = np.asarray(dv, float)[: k * n].reshape(k, n, 3)
     q = np.zeros((k, 4))
