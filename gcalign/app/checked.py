@@ -149,9 +149,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
         Block("calibrate/outages", {"start": times("O"), "end": times("O"),
                                     "length": num(("O",))}),
         Block("calibrate/runs/*", {
-            **from_fields(CalibrationResult),
-            "innovation?": num(("U", "m")), "nis": num(("U",)), "update_t?": times("U"),
-            "sigma_z?": num(("U", "m")),
+            **from_fields(CalibrationResult), "update_t?": times("U"),
             "smoothed/error/t?": times("D"), "smoothed/error/att?": num(("D", 3)),
             "smoothed/error/v_n?": num(("D", 3)), "smoothed/error/pos?": num(("D", 3)),
             "navigation/t?": times("R"), "navigation/t_run?": times("R"),

@@ -12,6 +12,8 @@ not stored (what the run derives again, or what the command stores itself).
 from __future__ import annotations
 
 import dataclasses
+import functools
+import re
 import typing
 from typing import Any, TypeVar
 
@@ -51,7 +53,20 @@ def write_fields(g: h5py.Group, result: Any) -> None:
             for entry, part in zip(getattr(result, how.per), value, strict=True):
                 _put(g.require_group(entry), name, part, how)
         else:
-            _put(g, name, value, how)
+            _put(g, name, value, _filled(how, result))
+
+
+def _filled(how: Stored, result: Any) -> Stored:
+    """`how` with each ``{name}`` of its units, names and description replaced by that
+    attribute of `result` (a tuple joined by commas): what follows the result's settings."""
+    texts = {k: getattr(how, k) for k in ("units", "names", "description")}
+    texts = {k: re.sub(r"\{(\w+)\}", lambda m: _text(getattr(result, m.group(1))), v)
+             for k, v in texts.items() if v is not None and "{" in v}
+    return dataclasses.replace(how, **texts) if texts else how
+
+
+def _text(v: Any) -> str:
+    return ",".join(v) if isinstance(v, tuple) else str(v)
 
 
 def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
@@ -82,13 +97,10 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
     fields the file does not hold. A field stored as a flag comes back as bool, one stored
     as names as a tuple of str."""
     values: dict[str, Any] = {}
-    for f in dataclasses.fields(cls):  # type: ignore[arg-type]
-        how = spec(f)
-        if how is None or f.name in given:
+    for f, how, kind, inner in _stored_fields(cls):
+        if f.name in given:
             continue
         name = how.name or f.name
-        kind = field_type(cls, f)
-        inner = next((a for a in typing.get_args(kind) if dataclasses.is_dataclass(a)), kind)
         if how.attr:
             if name in g.attrs:
                 v = g.attrs[name]
@@ -114,6 +126,20 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
                 f.default_factory is dataclasses.MISSING:
             values[f.name] = None  # not in the file (an optional series the run did not make)
     return cls(**values, **given)
+
+
+@functools.cache
+def _stored_fields(cls: type) -> tuple[tuple[dataclasses.Field[Any], Stored, Any, Any], ...]:
+    """``(field, how it is stored, its type, the dataclass it holds or its type)`` of each
+    stored field of `cls`, its annotations evaluated once per class."""
+    out = []
+    for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+        how = spec(f)
+        if how is not None:
+            kind = field_type(cls, f)
+            out.append((f, how, kind, next((a for a in typing.get_args(kind)
+                                             if dataclasses.is_dataclass(a)), kind)))
+    return tuple(out)
 
 
 def _plain(v: Any) -> Any:

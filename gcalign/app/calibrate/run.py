@@ -641,15 +641,8 @@ def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
         rg, r = g.require_group(f"runs/{i:02d}"), run.result
         rg.attrs.update(label=run.label, measure=r.settings.measure)
         write_fields(rg, r)
-        units = {"velocity": "m/s", "position": "m"}.get(r.settings.measure, "m/s, m/s, m, m")
         if r.updated is not None:
             put(rg, "update_t", r.update_t, "s", description="the epochs with a measurement")
-        put(rg, "innovation", r.innovation, units, names=",".join(r.measure_names),
-            description="z - H x-, z = INS - reference")
-        put(rg, "nis", r.nis, "1", description=f"chi-square, {r.standardized.shape[1]} dof")
-        if r.sigma_z is not None:
-            put(rg, "sigma_z", r.sigma_z, units, names=",".join(r.measure_names),
-                description="the measurement sigma of each update (R = diag sigma^2)")
         e = (run.epoch_errors or {}).get("smoothed_series")
         if r.smoothed is not None and e is not None:
             _put_errors(rg["smoothed"].create_group("error"), "the smoothed solution - the "
