@@ -43,7 +43,7 @@ RUNS = [
     ("seed001_table", "northfind {c}/seed001_table_experiment.yaml"),
     ("seed003_async", "realtime {c}/seed003_rate20_async.yaml"),
     ("realtime_beyond", "realtime {c}/realtime_beyond_seed.yaml"),
-    ("batch_tilt", "batch {c}/sweeps/seed001_tilt.yaml --set seeds=2 -w 1"),
+    ("batch_tilt", "batch {c}/sweeps/seed001_tilt.yaml --seeds 2 -w 1"),
     ("batch_windows", "batch {c}/sweeps/lasergyro_windows.yaml -w 1"),
 ] + [(p[:-5], f"align {{c}}/{p}") for p in sorted(
     x.name for x in (Path(__file__).resolve().parents[1] / "configs").glob("seed000_*.yaml"))]

@@ -26,8 +26,10 @@ from gcalign.schema import Stored, field_type, spec
 T = TypeVar("T")
 
 
-def write_fields(g: h5py.Group, result: Any) -> None:
-    """Write the stored fields of the dataclass `result` into the group `g`."""
+def write_fields(g: h5py.Group, result: Any, outer: Any = None) -> None:
+    """Write the stored fields of the dataclass `result` into the group `g`; the ``{name}``
+    of a field's texts are attributes of `result`, or of the result that holds it (`outer`)."""
+    outer = result if outer is None else outer
     for f in dataclasses.fields(result):
         how = spec(f)
         value = getattr(result, f.name)
@@ -37,7 +39,7 @@ def write_fields(g: h5py.Group, result: Any) -> None:
         if how.attr:
             g.attrs[name] = ",".join(value) if isinstance(value, tuple) else value
         elif dataclasses.is_dataclass(value):
-            write_fields(g if how.inline else g.create_group(name), value)
+            write_fields(g if how.inline else g.create_group(name), value, outer)
         elif isinstance(value, list) and value and dataclasses.is_dataclass(value[0]):
             h = g.create_group(name)
             for i, item in enumerate(value):
@@ -53,15 +55,18 @@ def write_fields(g: h5py.Group, result: Any) -> None:
             for entry, part in zip(getattr(result, how.per), value, strict=True):
                 _put(g.require_group(entry), name, part, how)
         else:
-            _put(g, name, value, _filled(how, result))
+            _put(g, name, value, _filled(how, result, outer))
 
 
-def _filled(how: Stored, result: Any) -> Stored:
-    """`how` with each ``{name}`` of its units, names and description replaced by that
-    attribute of `result` (a tuple joined by commas): what follows the result's settings."""
-    texts = {k: getattr(how, k) for k in ("units", "names", "description")}
-    texts = {k: re.sub(r"\{(\w+)\}", lambda m: _text(getattr(result, m.group(1))), v)
-             for k, v in texts.items() if v is not None and "{" in v}
+def _filled(how: Stored, result: Any, outer: Any) -> Stored:
+    """`how` with each ``{name}`` of its texts replaced by that attribute of `result` (else
+    of `outer`; a tuple joined by commas): what follows the result's settings."""
+    def value(m: re.Match[str]) -> str:
+        return _text(getattr(result, m.group(1), None) or getattr(outer, m.group(1)))
+
+    texts = {k: getattr(how, k) for k in ("units", "shape", "names", "description")}
+    texts = {k: re.sub(r"\{(\w+)\}", value, v) for k, v in texts.items()
+             if v is not None and "{" in v}
     return dataclasses.replace(how, **texts) if texts else how
 
 
@@ -98,7 +103,7 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
     as names as a tuple of str."""
     values: dict[str, Any] = {}
     for f, how, kind, inner in _stored_fields(cls):
-        if f.name in given:
+        if f.name in given or not f.init:
             continue
         name = how.name or f.name
         if how.attr:
