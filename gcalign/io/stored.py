@@ -102,7 +102,7 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
     fields the file does not hold. A field stored as a flag comes back as bool, one stored
     as names as a tuple of str."""
     values: dict[str, Any] = {}
-    for f, how, kind, inner in _stored_fields(cls):
+    for f, how, kind, inner in _stored_fields(cls):  # type: ignore[arg-type]
         if f.name in given or not f.init:
             continue
         name = how.name or f.name
