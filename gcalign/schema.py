@@ -50,6 +50,7 @@ class Stored:
     compress : stored compressed (gzip, shuffled): long series; True: level 1, a number:
         that level.
     names : its ``names`` attribute (what its entries are, comma-separated), if any.
+    what : its ``what`` attribute (how its values come about), if any.
     summary : the unit the summary gives it in (:func:`summary_of`: the key
         ``<name>_<summary>``, e.g. ``"arcsec"``), or None (not in the summary, or summarised
         by its command).
@@ -83,6 +84,7 @@ class Stored:
     inline: bool = False
     compress: bool | int = False
     names: str | None = None
+    what: str | None = None
     summary: str | None = None
     label: str | None = None
     dims: str | None = None

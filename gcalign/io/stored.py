@@ -47,7 +47,10 @@ def write_fields(g: h5py.Group, result: Any, outer: Any = None) -> None:
         elif isinstance(value, dict):
             h = g.create_group(name)
             for key, part in value.items():
-                _put(h, key, part, how)
+                if dataclasses.is_dataclass(part):
+                    write_fields(h.create_group(key), part, outer)
+                else:
+                    _put(h, key, part, how)
         elif how.units is None:  # text
             check_writes()
             g.create_dataset(name, data=np.array(value, dtype=h5py.string_dtype()))
@@ -76,7 +79,7 @@ def _text(v: Any) -> str:
 
 def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
     extra = {k: v for k, v in (("shape", how.shape), ("description", how.description),
-                               ("names", how.names)) if v is not None}
+                               ("names", how.names), ("what", how.what)) if v is not None}
     data = np.asarray(value)
     if how.axes is not None:
         data = np.transpose(data, how.axes)
@@ -115,7 +118,9 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
         elif dataclasses.is_dataclass(inner) and (how.inline or name in g):
             values[f.name] = read_fields(g if how.inline else g[name], inner)  # type: ignore[arg-type]
         elif dict in (kind, typing.get_origin(kind)) and name in g:
-            values[f.name] = {k: _get(ds, how) for k, ds in g[name].items()}
+            part = (typing.get_args(kind) or (None, None))[1]
+            values[f.name] = {k: read_fields(x, part) if isinstance(x, h5py.Group) else
+                              _get(x, how) for k, x in g[name].items()}
         elif how.per is not None:
             entries = values.get(how.per) or given.get(how.per) or ()
             parts = [g[e][name] for e in entries if e in g and name in g[e]]
