@@ -19,6 +19,20 @@ LLH = "[latitude, longitude, height]"  #: the frame of a position
 
 
 @dataclass(frozen=True)
+class Errors:
+    """A solution's errors at its epochs t (D,): att (Euler differences), v_n, pos (ENU m),
+    (D, 3); what : what they are the errors of."""
+
+    what: str = field(metadata=stored(None, attr=True, name="description"))
+    t: np.ndarray = field(metadata=stored("s", dims="D", rule="increasing", optional=True))
+    att: np.ndarray = field(metadata=stored(
+        "rad", description="Euler differences, roll and yaw wrapped: pitch, roll, yaw",
+        dims="D 3", optional=True))
+    v_n: np.ndarray = field(metadata=stored("m/s", frame="ENU", dims="D 3", optional=True))
+    pos: np.ndarray = field(metadata=stored("m", frame="ENU", dims="D 3", optional=True))
+
+
+@dataclass(frozen=True)
 class Smoothed:
     """RTS-smoothed estimates at the filter epochs: estimate and sigma (K+1, 21), as in
     :class:`CalibrationResult` (IMU part: the sensor parameters, navigation part: the error
