@@ -59,9 +59,9 @@ INTERVAL = "1 sigma, 1/sqrt(2(K-1))"
 
 @dataclass(frozen=True)
 class TermRecord:
-    """One fitted term as the results file keeps it (``terms/<name>``), in `units` (SI)."""
+    """One fitted term as the results file keeps it (``terms/<name>``), in `units` (SI;
+    not read back: the datasets' units attributes say it)."""
 
-    units: str
     slope: float = field(metadata=stored("1", attr=True))
     meaning: str = field(metadata=stored(None, attr=True))
     value: np.ndarray = field(metadata=stored("{units}", frame=AXES, what="NaN: not resolved",
@@ -72,14 +72,15 @@ class TermRecord:
         "{units}", frame=AXES, what="not resolved: the largest coefficient the curve allows; "
         "NaN where resolved", dims="3", finite=False))
     tau_range: np.ndarray = field(metadata=stored("s", frame=AXES, dims="3 2", finite=False))
+    units: str = ""
 
 
 @dataclass(frozen=True)
 class TriadRecord:
     """A triad's curve (τ, σ, its 1σ interval, the clusters), the fitted model and each
-    term, as the results file keeps them (``gyro``, ``accel``); σ in `units` (SI)."""
+    term, as the results file keeps them (``gyro``, ``accel``); σ in `units` (SI, as
+    :class:`TermRecord`'s)."""
 
-    units: str
     tau: np.ndarray = field(metadata=stored("s", dims="M", rule="increasing"))
     adev: np.ndarray = field(metadata=stored("{units}", frame=AXES, dims="M 3"))
     adev_lo: np.ndarray = field(metadata=stored("{units}", frame=AXES, what=INTERVAL,
@@ -91,14 +92,16 @@ class TriadRecord:
     model: np.ndarray = field(metadata=stored(
         "{units}", frame=AXES, what="sqrt of the sum of the four fitted terms", dims="M 3"))
     terms: dict[str, TermRecord] = field(metadata=stored(""))
+    units: str = ""
 
     @classmethod
     def of(cls, curve: AllanCurve, fit: NoiseFit, units: dict[str, str]) -> TriadRecord:
-        return cls(units["sigma"], curve.tau, curve.adev, curve.lo, curve.hi,
-                   curve.clusters.astype(np.int64), fit.model(curve.tau), {
-                       name: TermRecord(units[name], t.slope, MEANING[name], t.value,
-                                        np.stack([t.lo, t.hi], axis=1), t.bound, t.tau_range)
-                       for name, t in fit.terms.items()})
+        return cls(curve.tau, curve.adev, curve.lo, curve.hi, curve.clusters.astype(np.int64),
+                   fit.model(curve.tau), {
+                       name: TermRecord(t.slope, MEANING[name], t.value,
+                                        np.stack([t.lo, t.hi], axis=1), t.bound, t.tau_range,
+                                        units[name]) for name, t in fit.terms.items()},
+                   units["sigma"])
 
 
 @dataclass(frozen=True)

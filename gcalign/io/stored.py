@@ -147,8 +147,9 @@ def _stored_fields(cls: type) -> tuple[tuple[dataclasses.Field[Any], Stored, Any
         how = spec(f)
         if how is not None:
             kind = field_type(cls, f)
-            out.append((f, how, kind, next((a for a in typing.get_args(kind)
-                                             if dataclasses.is_dataclass(a)), kind)))
+            held = () if typing.get_origin(kind) is dict else typing.get_args(kind)
+            out.append((f, how, kind, next((a for a in held if dataclasses.is_dataclass(a)),
+                                           kind)))
     return tuple(out)
 
 
