@@ -123,11 +123,11 @@ def field_type(cls: type, f: dataclasses.Field[Any]) -> Any:
 
 
 def nested(cls: type, f: dataclasses.Field[Any]) -> tuple[type | None, bool]:
-    """The result dataclass field `f` of `cls` holds (itself, optional, or a list of them;
-    None if none) and whether it is a list of them."""
+    """The result dataclass field `f` of `cls` holds (itself, optional, or a list or a
+    mapping of them; None if none) and whether it is a list or a mapping of them."""
     kind = field_type(cls, f)
     inner = next((a for a in typing.get_args(kind) if dataclasses.is_dataclass(a)), kind)
-    listed = typing.get_origin(kind) in (list, tuple)
+    listed = typing.get_origin(kind) in (list, tuple, dict)
     return (inner if isinstance(inner, type) and dataclasses.is_dataclass(inner) else None,
             listed)
 

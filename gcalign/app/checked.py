@@ -28,7 +28,7 @@ import h5py
 import numpy as np
 
 from gcalign.align.result import AlignmentAt, PassRows
-from gcalign.allan import TermRecord, TriadRecord
+from gcalign.allan import TriadRecord
 from gcalign.errors import ScenarioError
 from gcalign.estimation.calibration import CalibrationResult, Errors
 from gcalign.estimation.degrees import ObservabilityTable
@@ -178,8 +178,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
         **NAVIGATION, "error/pos": V3, "error/phi": V3,
         **from_fields(SchemeAnalysis), "mechanism/component*?": INDEX, "invariants/*?": num((3,)),
         **from_fields(LinearSeries, "linear/"), "linear/component*?": INDEX}),),
-    "allan": (Block("allan/*", {**from_fields(TriadRecord),
-                                **from_fields(TermRecord, "terms/*/")}),),
+    "allan": (Block("allan/*", from_fields(TriadRecord)),),
     "batch": (
         Block("batch/runs", {
             "variant": num(("R",), whole=True), "seed": num(("R",), whole=True),
