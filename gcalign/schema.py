@@ -50,10 +50,15 @@ class Stored:
     compress : stored compressed (gzip, shuffled): long series; True: level 1, a number:
         that level.
     names : its ``names`` attribute (what its entries are, comma-separated), if any.
+    what : its ``what`` attribute (how its values come about), if any.
     summary : the unit the summary gives it in (:func:`summary_of`: the key
         ``<name>_<summary>``, e.g. ``"arcsec"``), or None (not in the summary, or summarised
         by its command).
     label : its name in the summary, if not its own (``"attitude_t2"``: ``attitude_t2_deg``).
+
+    A ``{name}`` in its units, shape, names or description is that attribute of the result,
+    or of the result that holds it (a tuple joined by commas): ``stored("{measure_units}")``,
+    units that follow the measurement.
 
     What its values must be when a results file is read back (the checks of
     :mod:`gcalign.app.checked`):
@@ -79,6 +84,7 @@ class Stored:
     inline: bool = False
     compress: bool | int = False
     names: str | None = None
+    what: str | None = None
     summary: str | None = None
     label: str | None = None
     dims: str | None = None
@@ -117,11 +123,11 @@ def field_type(cls: type, f: dataclasses.Field[Any]) -> Any:
 
 
 def nested(cls: type, f: dataclasses.Field[Any]) -> tuple[type | None, bool]:
-    """The result dataclass field `f` of `cls` holds (itself, optional, or a list of them;
-    None if none) and whether it is a list of them."""
+    """The result dataclass field `f` of `cls` holds (itself, optional, or a list or a
+    mapping of them; None if none) and whether it is a list or a mapping of them."""
     kind = field_type(cls, f)
     inner = next((a for a in typing.get_args(kind) if dataclasses.is_dataclass(a)), kind)
-    listed = typing.get_origin(kind) in (list, tuple)
+    listed = typing.get_origin(kind) in (list, tuple, dict)
     return (inner if isinstance(inner, type) and dataclasses.is_dataclass(inner) else None,
             listed)
 

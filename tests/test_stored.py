@@ -122,6 +122,36 @@ def test_nested_mapped_and_compressed_fields_come_back(tmp_path):
     assert np.array_equal(back.predicted["kalman"], np.ones((5, 3)))
 
 
+@dataclass(frozen=True)
+class Term:
+    value: np.ndarray = field(metadata=stored("{units}", what="NaN: not resolved",
+                                              description="per {kind}"))
+    units: str = ""  # (not read back: the dataset's units attribute says it)
+
+
+@dataclass(frozen=True)
+class Triad:
+    kind: str = field(metadata=stored(None, attr=True))
+    terms: dict[str, Term] = field(metadata=stored(""))
+
+
+def test_units_and_texts_follow_the_result_and_a_mapping_of_results_comes_back(tmp_path):
+    """``{units}`` is the result's own attribute, ``{kind}`` that of the result holding it;
+    a mapping of results is a subgroup per key, read back as results."""
+    tri = Triad("gyro", {"white": Term(np.array([1e-6, np.nan, 2e-6]), "rad/sqrt(s)"),
+                         "instability": Term(np.array([3e-7, 4e-7, np.nan]), "rad/s")})
+    with h5py.File(tmp_path / "a.h5", "w") as f:
+        write_fields(f.create_group("gyro"), tri)
+    with h5py.File(tmp_path / "a.h5") as f:
+        ds = f["gyro/terms/white/value"]
+        assert dict(ds.attrs) == {"units": "rad/sqrt(s)", "what": "NaN: not resolved",
+                                  "description": "per gyro"}
+        assert f["gyro/terms/instability/value"].attrs["units"] == "rad/s"
+        back = read_fields(f["gyro"], Triad)
+    assert back.kind == "gyro" and sorted(back.terms) == ["instability", "white"]
+    assert np.array_equal(back.terms["white"].value, tri.terms["white"].value, equal_nan=True)
+
+
 def test_a_new_north_finding_field_is_written_read_and_checked_from_its_one_line(tmp_path):
     """The one line of `spread` below is all it takes for the results file to hold it, for
     the reader to give it back and for the checks of a file read back to hold it to its

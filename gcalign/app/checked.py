@@ -28,8 +28,9 @@ import h5py
 import numpy as np
 
 from gcalign.align.result import AlignmentAt, PassRows
+from gcalign.allan import TriadRecord
 from gcalign.errors import ScenarioError
-from gcalign.estimation.calibration import CalibrationResult
+from gcalign.estimation.calibration import CalibrationResult, Errors
 from gcalign.estimation.degrees import ObservabilityTable
 from gcalign.io import results
 from gcalign.modulate.analysis import SchemeAnalysis
@@ -38,6 +39,7 @@ from gcalign.northfind.run import NorthfindResult
 from gcalign.realtime.filters import ChainResponse
 from gcalign.schema import nested
 from gcalign.schema import spec as stored_spec
+from gcalign.sim.motions import Truth
 
 #: kinds whose every dataset has units and finite values when written (north-finding stores
 #: NaN for a prediction it cannot make, a batch for a failed run's metrics, navigation for
@@ -89,11 +91,12 @@ class Block:
     counts: tuple[tuple[str, str, int], ...] = ()  #: (size, attribute of the group, + k)
 
 
-def from_fields(cls: type, under: str = "") -> dict[str, Data]:
+def from_fields(cls: type, under: str = "", **sizes: str) -> dict[str, Data]:
     """A block's entries from the stored fields of a result dataclass that say their dims
     (:class:`gcalign.schema.Stored`), in its subgroup `under` (``"linear/"``), if any, and
-    those of the results it holds (in their subgroup, ``*/`` for a list): a new field is
-    checked as it is declared."""
+    those of the results it holds (in their subgroup, ``*/`` for a list or a mapping), a size
+    named otherwise in that block by `sizes` (``D="Q"``): a new field is checked as it is
+    declared."""
     items: dict[str, Data] = {}
     for f in dataclasses.fields(cls):
         how = stored_spec(f)
@@ -105,7 +108,7 @@ def from_fields(cls: type, under: str = "") -> dict[str, Data]:
             continue
         key = (under + ("*/" if how.per else "") + (how.name or f.name)
                + ("?" if how.optional else ""))
-        shapes = tuple(tuple(int(d) if d.isdigit() else d for d in alt.split())
+        shapes = tuple(tuple(int(d) if d.isdigit() else sizes.get(d, d) for d in alt.split())
                        for alt in how.dims.split("|"))
         items[key] = Data(shapes, text=how.units is None, finite=how.finite, whole=how.whole,
                           rule=how.rule)
@@ -116,9 +119,8 @@ V3 = num(("N", 3))
 STATES = num(("K", "S"))
 INDEX = num(("_",), rule="range")  # the dimension scales of HDF5's netCDF view
 
-TRUTH = Block("truth", {"t": times("N"), "att": V3, "v_n?": V3, "pos?": V3,
-                        "segment?": num(("N",), whole=True, rule="index<G"),
-                        "segment_names?": text(("G",)), "component*?": INDEX})
+TRUTH = Block("truth", {**from_fields(Truth), "segment_names?": text(("G",)),
+                        "component*?": INDEX})
 REFERENCE = Block("reference", {"t": times("N"), "att": V3, "component*?": INDEX})
 IMU = Block("imu", {"t": times("N"), "dtheta": V3, "dv": V3,
                     "q_bs?": num(("N", 4), rule="unit"), "component*?": INDEX})
@@ -149,21 +151,15 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
         Block("calibrate/outages", {"start": times("O"), "end": times("O"),
                                     "length": num(("O",))}),
         Block("calibrate/runs/*", {
-            **from_fields(CalibrationResult),
-            "innovation?": num(("U", "m")), "nis": num(("U",)), "update_t?": times("U"),
-            "sigma_z?": num(("U", "m")),
-            "smoothed/error/t?": times("D"), "smoothed/error/att?": num(("D", 3)),
-            "smoothed/error/v_n?": num(("D", 3)), "smoothed/error/pos?": num(("D", 3)),
+            **from_fields(CalibrationResult), "update_t?": times("U"),
+            **from_fields(Errors, "smoothed/error/"),
             "navigation/t?": times("R"), "navigation/t_run?": times("R"),
             "navigation/att?": num(("R", 3)), "navigation/v_n?": num(("R", 3)),
-            "navigation/pos?": num(("R", 3)), "navigation/error/t?": times("Q"),
-            "navigation/error/att?": num(("Q", 3)), "navigation/error/v_n?": num(("Q", 3)),
-            "navigation/error/pos?": num(("Q", 3)), "navigation/component*?": INDEX,
+            "navigation/pos?": num(("R", 3)), **from_fields(Errors, "navigation/error/", D="Q"),
+            "navigation/component*?": INDEX,
             "navigation/error/component*?": INDEX, "smoothed/error/component*?": INDEX,
             "reference_error/component*?": INDEX,
-            "reference_error/t?": times("E"),
-            "reference_error/att?": num(("E", 3)), "reference_error/v_n?": num(("E", 3)),
-            "reference_error/pos?": num(("E", 3)), "component*?": INDEX},
+            **from_fields(Errors, "reference_error/", D="E"), "component*?": INDEX},
             names=(("S", "calibrate", "states"), ("m", ".", "measure_names"))),
         TRUTH, REFERENCE),
     "observability": (
@@ -182,12 +178,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
         **NAVIGATION, "error/pos": V3, "error/phi": V3,
         **from_fields(SchemeAnalysis), "mechanism/component*?": INDEX, "invariants/*?": num((3,)),
         **from_fields(LinearSeries, "linear/"), "linear/component*?": INDEX}),),
-    "allan": (Block("allan/*", {
-        "tau": times("M"), "adev": num(("M", 3)), "adev_lo": num(("M", 3)),
-        "adev_hi": num(("M", 3)), "clusters": num(("M",), whole=True), "model": num(("M", 3)),
-        "terms/*/value": num((3,), finite=False), "terms/*/interval": num((3, 2), finite=False),
-        "terms/*/bound": num((3,), finite=False),
-        "terms/*/tau_range": num((3, 2), finite=False)}),),
+    "allan": (Block("allan/*", from_fields(TriadRecord)),),
     "batch": (
         Block("batch/runs", {
             "variant": num(("R",), whole=True), "seed": num(("R",), whole=True),

@@ -35,6 +35,7 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
     result).
     """
     from gcalign.app.data import recording_record
+    from gcalign.io.stored import write_fields
 
     cmd = command(name)
     kwargs = dict(options, progress=progress)
@@ -65,7 +66,7 @@ def run_command(name: str, sc: Scenario, text: str, seed: int | None, out: Path,
             if record is not None:
                 results.write_recording(f, record)
             if outcome.truth is not None:
-                results.write_truth(f, outcome.truth)
+                write_fields(f.create_group("truth"), outcome.truth)
             outcome.write(f)
             results.add_dimension_scales(f)
     except OSError as err:

@@ -19,6 +19,20 @@ LLH = "[latitude, longitude, height]"  #: the frame of a position
 
 
 @dataclass(frozen=True)
+class Errors:
+    """A solution's errors at its epochs t (D,): att (Euler differences), v_n, pos (ENU m),
+    (D, 3); what : what they are the errors of."""
+
+    what: str = field(metadata=stored(None, attr=True, name="description"))
+    t: np.ndarray = field(metadata=stored("s", dims="D", rule="increasing", optional=True))
+    att: np.ndarray = field(metadata=stored(
+        "rad", description="Euler differences, roll and yaw wrapped: pitch, roll, yaw",
+        dims="D 3", optional=True))
+    v_n: np.ndarray = field(metadata=stored("m/s", frame="ENU", dims="D 3", optional=True))
+    pos: np.ndarray = field(metadata=stored("m", frame="ENU", dims="D 3", optional=True))
+
+
+@dataclass(frozen=True)
 class Smoothed:
     """RTS-smoothed estimates at the filter epochs: estimate and sigma (K+1, 21), as in
     :class:`CalibrationResult` (IMU part: the sensor parameters, navigation part: the error
@@ -71,10 +85,12 @@ class CalibrationResult:
                                                      optional=True))
     nees: np.ndarray | None = field(metadata=stored(
         "1", description="chi-square, 21 degrees of freedom", dims="K", optional=True))
-    innovation: np.ndarray
+    innovation: np.ndarray = field(metadata=stored(
+        "{measure_units}", names="{measure_names}", description="z - H x-, z = INS - reference",
+        dims="U m", optional=True))
     standardized: np.ndarray = field(metadata=stored(
         "1", description="L^-1 innovation, S = L L^T", dims="U m"))
-    nis: np.ndarray
+    nis: np.ndarray = field(metadata=stored("1", description="chi-square, {dof} dof", dims="U"))
     att: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME, dims="K 3"))
     v_n: np.ndarray = field(metadata=stored("m/s", frame="ENU", dims="K 3", optional=True))
     pos: np.ndarray = field(metadata=stored("rad, rad, m", frame=LLH, dims="K 3",
@@ -87,8 +103,21 @@ class CalibrationResult:
     updated: np.ndarray | None = field(default=None, metadata=stored(
         "1", flag=True, dims="K", whole=True, optional=True,
         description="1: a measurement updated the filter at the epoch, 0: predict only"))
-    sigma_z: np.ndarray | None = None
+    sigma_z: np.ndarray | None = field(default=None, metadata=stored(
+        "{measure_units}", names="{measure_names}", dims="U m", optional=True,
+        description="the measurement sigma of each update (R = diag sigma^2)"))
     fixes_unused: int = 0
+
+    @property
+    def measure_units(self) -> str:
+        """The units of the measurement: m/s (velocity), m (position), or per component."""
+        return {"velocity": "m/s", "position": "m"}.get(self.settings.measure,
+                                                         "m/s, m/s, m, m")
+
+    @property
+    def dof(self) -> int:
+        """The measurement's components (m), the NIS's degrees of freedom."""
+        return int(self.standardized.shape[1])
 
     @property
     def update_t(self) -> np.ndarray:

@@ -33,11 +33,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
+
+from gcalign.schema import stored
 
 RANK_RTOL_DEFAULT = 1e-12
 """Singular values below ``rtol · σ_max`` count as zero (rank and degree)."""
@@ -222,6 +224,10 @@ def column_separation(Q: np.ndarray) -> np.ndarray:
     return out
 
 
+#: the shape of a table's degrees (``{row}``: what a row is, said by the result that holds it)
+_SHAPE = "({row}s, states) in the order of the 'states' attribute"
+
+
 @dataclass(frozen=True)
 class SegmentTable:
     """SOM/TOM degrees of a run cut into S segments of PWCS pieces (n states).
@@ -235,14 +241,16 @@ class SegmentTable:
         by `scale` (their singular values and right vectors; :func:`column_separation`).
     """
 
-    eta: np.ndarray
-    sigma_state: np.ndarray
-    rank: np.ndarray
-    tom_rank: np.ndarray
-    null_residual: np.ndarray
-    eta_cum: np.ndarray
-    rank_cum: np.ndarray
-    tom_rank_cum: np.ndarray
+    eta: np.ndarray = field(metadata=stored("1", shape=_SHAPE, description="seed eq. 17 per "
+                                                                       "{row}"))
+    sigma_state: np.ndarray = field(metadata=stored("SOM units", shape=_SHAPE))
+    rank: np.ndarray = field(metadata=stored("1"))
+    tom_rank: np.ndarray = field(metadata=stored("1"))
+    null_residual: np.ndarray = field(metadata=stored("1"))
+    eta_cum: np.ndarray = field(metadata=stored("1", shape=_SHAPE,
+                                                description="from the start of the run"))
+    rank_cum: np.ndarray = field(metadata=stored("1"))
+    tom_rank_cum: np.ndarray = field(metadata=stored("1"))
     margin: np.ndarray
     margin_cum: np.ndarray
     R_som_cum: np.ndarray

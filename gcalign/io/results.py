@@ -489,15 +489,12 @@ def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None
 
 
 def write_segments(f: h5py.File, truth, segments) -> None:
-    """/truth/segment (index of each sample's manoeuvre) and /truth/segment_names."""
+    """/truth/segment_names: the manoeuvres that /truth/segment indexes."""
     if "truth" not in f or truth is None:
         return
-    g = f["truth"]
-    if "segment" not in g and truth.segment is not None:
-        put(g, "segment", truth.segment, "1", description="index into segment_names")
     check_writes()
-    g.create_dataset("segment_names", data=np.array([s.name for s in segments],
-                                                     dtype=h5py.string_dtype()))
+    f["truth"].create_dataset("segment_names", data=np.array([s.name for s in segments],
+                                                             dtype=h5py.string_dtype()))
 
 
 class Series:
@@ -574,14 +571,6 @@ def write_header(f: h5py.File, kind: str, scenario_yaml: str, seed: int | None, 
     f.attrs["seed"] = -1 if seed is None else int(seed)
     f.attrs["created_utc"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
     f.attrs["summary_json"] = json.dumps(summary)
-
-
-def write_truth(f: h5py.File, truth: Truth):
-    g = f.create_group("truth")
-    put(g, "t", truth.t, "s")
-    put(g, "att", truth.att, "rad", ATT_FRAME)
-    put(g, "v_n", truth.v_n, "m/s", "ENU")
-    put(g, "pos", truth.pos, "rad, rad, m", "[latitude, longitude, height], WGS-84")
 
 
 def write_recording(f: h5py.File, record: dict) -> None:

@@ -12,6 +12,8 @@ not stored (what the run derives again, or what the command stores itself).
 from __future__ import annotations
 
 import dataclasses
+import functools
+import re
 import typing
 from typing import Any, TypeVar
 
@@ -24,8 +26,10 @@ from gcalign.schema import Stored, field_type, spec
 T = TypeVar("T")
 
 
-def write_fields(g: h5py.Group, result: Any) -> None:
-    """Write the stored fields of the dataclass `result` into the group `g`."""
+def write_fields(g: h5py.Group, result: Any, outer: Any = None) -> None:
+    """Write the stored fields of the dataclass `result` into the group `g`; the ``{name}``
+    of a field's texts are attributes of `result`, or of the result that holds it (`outer`)."""
+    outer = result if outer is None else outer
     for f in dataclasses.fields(result):
         how = spec(f)
         value = getattr(result, f.name)
@@ -35,7 +39,7 @@ def write_fields(g: h5py.Group, result: Any) -> None:
         if how.attr:
             g.attrs[name] = ",".join(value) if isinstance(value, tuple) else value
         elif dataclasses.is_dataclass(value):
-            write_fields(g if how.inline else g.create_group(name), value)
+            write_fields(g if how.inline else g.create_group(name), value, outer)
         elif isinstance(value, list) and value and dataclasses.is_dataclass(value[0]):
             h = g.create_group(name)
             for i, item in enumerate(value):
@@ -43,7 +47,10 @@ def write_fields(g: h5py.Group, result: Any) -> None:
         elif isinstance(value, dict):
             h = g.create_group(name)
             for key, part in value.items():
-                _put(h, key, part, how)
+                if dataclasses.is_dataclass(part):
+                    write_fields(h.create_group(key), part, outer)
+                else:
+                    _put(h, key, part, how)
         elif how.units is None:  # text
             check_writes()
             g.create_dataset(name, data=np.array(value, dtype=h5py.string_dtype()))
@@ -51,12 +58,28 @@ def write_fields(g: h5py.Group, result: Any) -> None:
             for entry, part in zip(getattr(result, how.per), value, strict=True):
                 _put(g.require_group(entry), name, part, how)
         else:
-            _put(g, name, value, how)
+            _put(g, name, value, _filled(how, result, outer))
+
+
+def _filled(how: Stored, result: Any, outer: Any) -> Stored:
+    """`how` with each ``{name}`` of its texts replaced by that attribute of `result` (else
+    of `outer`; a tuple joined by commas): what follows the result's settings."""
+    def value(m: re.Match[str]) -> str:
+        return _text(getattr(result, m.group(1), None) or getattr(outer, m.group(1)))
+
+    texts = {k: getattr(how, k) for k in ("units", "shape", "names", "description")}
+    texts = {k: re.sub(r"\{(\w+)\}", value, v) for k, v in texts.items()
+             if v is not None and "{" in v}
+    return dataclasses.replace(how, **texts) if texts else how
+
+
+def _text(v: Any) -> str:
+    return ",".join(v) if isinstance(v, tuple) else str(v)
 
 
 def _put(g: h5py.Group, name: str, value: Any, how: Stored) -> None:
     extra = {k: v for k, v in (("shape", how.shape), ("description", how.description),
-                               ("names", how.names)) if v is not None}
+                               ("names", how.names), ("what", how.what)) if v is not None}
     data = np.asarray(value)
     if how.axes is not None:
         data = np.transpose(data, how.axes)
@@ -82,13 +105,10 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
     fields the file does not hold. A field stored as a flag comes back as bool, one stored
     as names as a tuple of str."""
     values: dict[str, Any] = {}
-    for f in dataclasses.fields(cls):  # type: ignore[arg-type]
-        how = spec(f)
-        if how is None or f.name in given:
+    for f, how, kind, inner in _stored_fields(cls):  # type: ignore[arg-type]
+        if f.name in given or not f.init:
             continue
         name = how.name or f.name
-        kind = field_type(cls, f)
-        inner = next((a for a in typing.get_args(kind) if dataclasses.is_dataclass(a)), kind)
         if how.attr:
             if name in g.attrs:
                 v = g.attrs[name]
@@ -98,7 +118,9 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
         elif dataclasses.is_dataclass(inner) and (how.inline or name in g):
             values[f.name] = read_fields(g if how.inline else g[name], inner)  # type: ignore[arg-type]
         elif dict in (kind, typing.get_origin(kind)) and name in g:
-            values[f.name] = {k: _get(ds, how) for k, ds in g[name].items()}
+            part = (typing.get_args(kind) or (None, None))[1]
+            values[f.name] = {k: read_fields(x, part) if isinstance(x, h5py.Group) else
+                              _get(x, how) for k, x in g[name].items()}
         elif how.per is not None:
             entries = values.get(how.per) or given.get(how.per) or ()
             parts = [g[e][name] for e in entries if e in g and name in g[e]]
@@ -114,6 +136,21 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
                 f.default_factory is dataclasses.MISSING:
             values[f.name] = None  # not in the file (an optional series the run did not make)
     return cls(**values, **given)
+
+
+@functools.cache
+def _stored_fields(cls: type) -> tuple[tuple[dataclasses.Field[Any], Stored, Any, Any], ...]:
+    """``(field, how it is stored, its type, the dataclass it holds or its type)`` of each
+    stored field of `cls`, its annotations evaluated once per class."""
+    out = []
+    for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+        how = spec(f)
+        if how is not None:
+            kind = field_type(cls, f)
+            held = () if typing.get_origin(kind) is dict else typing.get_args(kind)
+            out.append((f, how, kind, next((a for a in held if dataclasses.is_dataclass(a)),
+                                           kind)))
+    return tuple(out)
 
 
 def _plain(v: Any) -> Any:

@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm, quat_to_dcm
+from gcalign.schema import ATT_FRAME, stored
 from gcalign.sim.schedule import Schedule
 
 Array = NDArray[np.float64]  #: a float64 array (shapes in the docstrings)
@@ -61,11 +62,14 @@ class Truth:
     """Sampled truth (SI): times (N+1,), attitude (N+1, 3), ENU velocity (N+1, 3),
     position ``[lat, lon, h]`` (N+1, 3) in rad, rad, m; segment index (N+1,) or None."""
 
-    t: np.ndarray
-    att: np.ndarray
-    v_n: np.ndarray
-    pos: np.ndarray
-    segment: np.ndarray | None = None
+    t: np.ndarray = field(metadata=stored("s", dims="N", rule="increasing"))
+    att: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME, dims="N 3"))
+    v_n: np.ndarray = field(metadata=stored("m/s", frame="ENU", dims="N 3", optional=True))
+    pos: np.ndarray = field(metadata=stored(
+        "rad, rad, m", frame="[latitude, longitude, height], WGS-84", dims="N 3", optional=True))
+    segment: np.ndarray | None = field(default=None, metadata=stored(
+        "1", description="index into segment_names", dims="N", whole=True, optional=True,
+        rule="index<G"))
 
 
 def _fixed(t: ArrayLike, att0: ArrayLike, site: ArrayLike, C: Array | None = None,

@@ -52,18 +52,22 @@ True
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.estimation import observability as ob
 from gcalign.nav.rotation import quat_to_dcm
+from gcalign.schema import stored
 from gcalign.transfer.filter import NAMES_15, TransferResult
 from gcalign.transfer.model import error_matrix, measurement_matrix
 
 SCALINGS = ("none", "p0")
 PWCS_STATES = NAMES_15  #: the states of the PWCS analysis (the flexure left out)
+#: the shape of a table over the filter's states (its ``shape`` attribute)
+COVARIANCE = "(windows, states) in the order of the 'covariance_states' attribute"
 _MEASURED = {"attitude+velocity": [0, 1, 2, 3, 4, 5], "velocity": [3, 4, 5],
              "attitude": [0, 1, 2]}
 
@@ -90,27 +94,42 @@ class TransferObservability:
     pieces : J, the number of PWCS pieces.
     """
 
-    matching: str
-    scaling: str
-    rtol: float
-    piece_s: float
-    window_s: float
-    names: tuple[str, ...]
-    pwcs: tuple[str, ...]
-    t0: np.ndarray
-    t1: np.ndarray
-    table: ob.SegmentTable
-    condition: np.ndarray
-    separation: np.ndarray
-    sigma0: np.ndarray
+    row: ClassVar[str] = "window"  #: what a row of the table is (its stored texts)
+    matching: str = field(metadata=stored(None, attr=True, name="measure"))
+    scaling: str = field(metadata=stored(None, attr=True))
+    rtol: float = field(metadata=stored("1", attr=True, name="rank_rtol"))
+    piece_s: float = field(metadata=stored("s", attr=True))
+    window_s: float = field(metadata=stored("s", attr=True))
+    names: tuple[str, ...] = field(metadata=stored(None, attr=True, name="covariance_states"))
+    pwcs: tuple[str, ...] = field(metadata=stored(None, attr=True, name="states"))
+    t0: np.ndarray = field(metadata=stored("s", description="window start, from the start of "
+                                               "the run"))
+    t1: np.ndarray = field(metadata=stored("s"))
+    table: ob.SegmentTable = field(metadata=stored("", inline=True))
+    condition: np.ndarray = field(metadata=stored(
+        "1", flag=True, description="null(O_j) in null(F_j) for every piece (seed eq. 12)"))
+    separation: np.ndarray = field(metadata=stored(
+        "1", description="of each state's TOM column from the span of the others (whole run)"))
+    sigma0: np.ndarray = field(metadata=stored("SI", description="P0 sigma, "
+                                                     "'covariance_states' order"))
     sigma_end: np.ndarray
-    cov_degree: np.ndarray
-    cov_degree_segment: np.ndarray
-    singular_values: np.ndarray
+    cov_degree: np.ndarray = field(metadata=stored(
+        "1", shape=COVARIANCE, description="sigma(0)/sigma(t_end), PSINS kfstat"))
+    cov_degree_segment: np.ndarray = field(metadata=stored(
+        "1", shape=COVARIANCE, description="sigma(t_start)/sigma(t_end)"))
+    singular_values: np.ndarray = field(metadata=stored("1", description="whole run's TOM"))
     unobservable: np.ndarray
-    weakest: np.ndarray
+    weakest: np.ndarray = field(metadata=stored(
+        "1", description="right singular vector of the smallest singular value, scaled "
+        "coordinates"))
     weakest_ratio: float
     pieces: int
+    #: the windows by their bounds (``0–10 s``), in the file as ``segment_name``
+    windows: tuple[str, ...] = field(init=False, metadata=stored(None, name="segment_name"))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "windows", tuple(
+            f"{a:.0f}–{b:.0f} s" for a, b in zip(self.t0, self.t1, strict=True)))
 
 
 @dataclass(frozen=True)

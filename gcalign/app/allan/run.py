@@ -215,8 +215,8 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     summary["compute_s"] = time.perf_counter() - t_start
 
     def write(f) -> None:
-        from gcalign.app.allan.store import write_allan
+        from gcalign.io.stored import write_fields
 
-        write_allan(f, res)
+        write_fields(f.create_group("allan"), res.stored())
 
     return Outcome(summary, write, None, data.seed, tuple(warnings), result=res)

@@ -613,6 +613,7 @@ def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
     the INS solution's against a reference (:func:`reference_series`)."""
     import h5py
 
+    from gcalign.estimation.calibration import Errors
     from gcalign.io.results import put, write_segments
     from gcalign.io.stored import write_fields
 
@@ -641,36 +642,18 @@ def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
         rg, r = g.require_group(f"runs/{i:02d}"), run.result
         rg.attrs.update(label=run.label, measure=r.settings.measure)
         write_fields(rg, r)
-        units = {"velocity": "m/s", "position": "m"}.get(r.settings.measure, "m/s, m/s, m, m")
         if r.updated is not None:
             put(rg, "update_t", r.update_t, "s", description="the epochs with a measurement")
-        put(rg, "innovation", r.innovation, units, names=",".join(r.measure_names),
-            description="z - H x-, z = INS - reference")
-        put(rg, "nis", r.nis, "1", description=f"chi-square, {r.standardized.shape[1]} dof")
-        if r.sigma_z is not None:
-            put(rg, "sigma_z", r.sigma_z, units, names=",".join(r.measure_names),
-                description="the measurement sigma of each update (R = diag sigma^2)")
         e = (run.epoch_errors or {}).get("smoothed_series")
         if r.smoothed is not None and e is not None:
-            _put_errors(rg["smoothed"].create_group("error"), "the smoothed solution - the "
-                        "truth or the reference", e["t"], e["attitude"], e["velocity"],
-                        e["position"])
+            write_fields(rg["smoothed"].create_group("error"), Errors(
+                "the smoothed solution - the truth or the reference", e["t"], e["attitude"],
+                e["velocity"], e["position"]))
         e = None if against is None else against[i]
         if e is not None:
-            _put_errors(rg.create_group("reference_error"), "INS solution - reference, at "
-                        "the epochs it covers", e["t"], e["att"], e["v_n"], e["pos"])
-
-
-def _put_errors(g: h5py.Group, description: str, t, att, v_n, pos) -> None:
-    """A solution's errors at its epochs: t (s), att (Euler differences), v_n, pos (ENU)."""
-    from gcalign.io.results import put
-
-    g.attrs["description"] = description
-    put(g, "t", t, "s")
-    put(g, "att", att, "rad", description="Euler differences, roll and yaw wrapped: pitch, "
-        "roll, yaw")
-    put(g, "v_n", v_n, "m/s", "ENU")
-    put(g, "pos", pos, "m", "ENU")
+            write_fields(rg.create_group("reference_error"), Errors(
+                "INS solution - reference, at the epochs it covers", e["t"], e["att"],
+                e["v_n"], e["pos"]))
 
 
 def sigma_warnings(sc: Scenario, case: Case) -> tuple[str, ...]:

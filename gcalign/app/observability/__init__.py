@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from gcalign.app.align import Align
 from gcalign.app.calibrate import COMMAND as CALIBRATE
 from gcalign.app.calibrate import (
     SIMULATION_DOUBLES,
@@ -63,14 +64,7 @@ class Observability(Command):
 
         return figures(f, name)
 
-    def read_own(self, sc: Any) -> Any:
-        """A transfer-alignment scenario's slave and master (:func:`gcalign.app.align.
-        transfer.load_inputs`)."""
-        if not transfer_mode(sc):
-            return None
-        from gcalign.app.align.transfer import load_inputs
-
-        return load_inputs(sc)
+    read_own = Align.read_own  # a transfer scenario's slave and master
 
     def check(self, inputs: Inputs) -> None:
         sc = inputs.scenario

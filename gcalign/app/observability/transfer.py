@@ -126,34 +126,17 @@ def summary(sc, obs, compute_s: float) -> dict:
     }
 
 
-DEGREE = "(windows, states) in the order of the 'states' attribute"
-COVARIANCE = "(windows, states) in the order of the 'covariance_states' attribute"
-
-
 def write(f: h5py.File, obs, result) -> None:
-    """``/observability`` (module docstring) and the filter's σ per epoch."""
+    """``/observability`` (module docstring) as the table's fields say
+    (:class:`~gcalign.transfer.observability.TransferObservability`), the states' display
+    units, and the filter's σ per epoch."""
+    from gcalign.io.stored import write_fields
+
     g = f.create_group("observability")
     g.attrs["mode"] = "transfer"
-    g.attrs["measure"] = obs.matching
-    g.attrs["scaling"], g.attrs["rank_rtol"] = obs.scaling, obs.rtol
-    g.attrs["piece_s"], g.attrs["window_s"] = obs.piece_s, obs.window_s
-    g.attrs["states"] = ",".join(obs.pwcs)
-    g.attrs["covariance_states"] = ",".join(obs.names)
     g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in obs.names)
     g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in obs.names])
-    names = [f"{a:.0f}–{b:.0f} s" for a, b in zip(obs.t0, obs.t1, strict=True)]
-    put_rows(g, obs.table, names, obs.t0, obs.t1, obs.condition, shape=DEGREE, row="window",
-             t0_description="window start, from the start of the run")
-    put(g, "separation", obs.separation, "1", description="of each state's TOM column from "
-        "the span of the others (whole run)")
-    put(g, "singular_values", obs.singular_values, "1", description="whole run's TOM")
-    put(g, "weakest", obs.weakest, "1", description="right singular vector of the smallest "
-        "singular value, scaled coordinates")
-    put(g, "cov_degree", obs.cov_degree, "1", shape=COVARIANCE,
-        description="sigma(0)/sigma(t_end), PSINS kfstat")
-    put(g, "cov_degree_segment", obs.cov_degree_segment, "1", shape=COVARIANCE,
-        description="sigma(t_start)/sigma(t_end)")
-    put(g, "sigma0", obs.sigma0, "SI", description="P0 sigma, 'covariance_states' order")
+    write_fields(g, obs)
     put(g, "t", result.t - result.t0, "s", description="master epochs, from the start")
     put(g, "sigma", result.sigma, "SI", description="the filter's sigma per epoch, "
         "'covariance_states' order")
@@ -265,19 +248,3 @@ def figures(f, name: str) -> dict:
         f"{name}: the filter's σ / σ0 ({how}); 1 = nothing learnt",
         [f"{label[gr]} σ/σ0" for gr in groups])
     return figs
-
-
-def put_rows(g: h5py.Group, tab, names, t0, t1, condition, *, shape: str, row: str,
-             t0_description: str | None = None) -> None:
-    """The rows of an observability table (a window each) and their ranks."""
-    g.create_dataset("segment_name", data=np.array(names, dtype=h5py.string_dtype()))
-    put(g, "t0", t0, "s", **({} if t0_description is None else
-                             {"description": t0_description}))
-    put(g, "t1", t1, "s")
-    put(g, "eta", tab.eta, "1", shape=shape, description=f"seed eq. 17 per {row}")
-    put(g, "eta_cum", tab.eta_cum, "1", shape=shape, description="from the start of the run")
-    put(g, "sigma_state", tab.sigma_state, "SOM units", shape=shape)
-    for name in ("rank", "tom_rank", "rank_cum", "tom_rank_cum", "null_residual"):
-        put(g, name, getattr(tab, name), "1")
-    put(g, "condition", condition.astype(np.int8), "1",
-        description="null(O_j) in null(F_j) for every piece (seed eq. 12)")
