@@ -159,7 +159,8 @@ def compare_files(pa: Path, pb: Path, srcs) -> list[str]:
                              "chunks", "maxshape", "fletcher32", "scaleoffset"):
                     if getattr(x, prop) != getattr(y, prop):
                         out.append(f"{n}: {prop} {getattr(x, prop)} != {getattr(y, prop)}")
-                if x.dtype == y.dtype and x.shape == y.shape and not _same(x[()], y[()]):
+                if x.dtype == y.dtype and x.shape == y.shape and not TIMINGS.search(
+                        n.rsplit("/", 1)[-1]) and not _same(x[()], y[()]):
                     out.append(f"{n}: values differ")
     return out
 

@@ -30,7 +30,7 @@ import numpy as np
 from gcalign.align.result import AlignmentAt, PassRows
 from gcalign.allan import TriadRecord
 from gcalign.errors import ScenarioError
-from gcalign.estimation.calibration import CalibrationResult, Errors
+from gcalign.estimation.calibration import CalibrationResult, Errors, Spans
 from gcalign.estimation.degrees import ObservabilityTable
 from gcalign.io import results
 from gcalign.modulate.analysis import SchemeAnalysis
@@ -146,8 +146,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
     "calibrate": (
         Block("calibrate", {}, names=(("S", ".", "states"), ("S", ".", "display_units")),
               numbers=(("S", ".", "display_scale"),)),
-        Block("calibrate/segments", {"name": text(("G",)), "t0": times("G"),
-                                     "t1": times("G")}),
+        Block("calibrate/segments", from_fields(Spans)),
         Block("calibrate/outages", {"start": times("O"), "end": times("O"),
                                     "length": num(("O",))}),
         Block("calibrate/runs/*", {

@@ -19,6 +19,21 @@ LLH = "[latitude, longitude, height]"  #: the frame of a position
 
 
 @dataclass(frozen=True)
+class Spans:
+    """The named stretches of a flight (its segments): name, t0, t1 (G,), s."""
+
+    name: tuple[str, ...] = field(metadata=stored(None, dims="G"))
+    t0: np.ndarray = field(metadata=stored("s", dims="G", rule="increasing"))
+    t1: np.ndarray = field(metadata=stored("s", dims="G", rule="increasing"))
+
+    @classmethod
+    def of(cls, spans: Any) -> Spans:
+        """From spans with a name, start and end each."""
+        return cls(tuple(s.name for s in spans), np.array([s.start for s in spans]),
+                   np.array([s.end for s in spans]))
+
+
+@dataclass(frozen=True)
 class Errors:
     """A solution's errors at its epochs t (D,): att (Euler differences), v_n, pos (ENU m),
     (D, 3); what : what they are the errors of."""

@@ -68,6 +68,7 @@ from gcalign.nav.rotation import (
     rotvec_to_quat,
     skew,
 )
+from gcalign.schema import ATT_FRAME, stored
 from gcalign.transfer.model import attitude_measurement, measurement_matrix
 from gcalign.units import ARCMIN, DEG, DPH, DPSH, G0, UG, UGPSHZ
 
@@ -170,6 +171,10 @@ class TransferSettings:
                 "attitude": np.arange(3)}[self.matching]
 
 
+#: the ``description`` of a series of states in the results file
+STATE_SERIES = "(epochs, states) in the order of the 'states' attribute, units 'state_units'"
+
+
 @dataclass(frozen=True)
 class TransferResult:
     """Per master epoch after its update (SI).
@@ -187,20 +192,25 @@ class TransferResult:
     rad/s the ω_in^n of those steps, dt (K,) s their length.
     """
 
-    t: np.ndarray
-    x: np.ndarray
-    sigma: np.ndarray
+    t: np.ndarray = field(metadata=stored("s"))
+    x: np.ndarray = field(metadata=stored("SI", name="estimate", description=STATE_SERIES))
+    sigma: np.ndarray = field(metadata=stored("SI", description=STATE_SERIES))
     P: np.ndarray
-    sigma0: np.ndarray
-    names: tuple[str, ...]
-    bias_fed: np.ndarray
+    sigma0: np.ndarray = field(metadata=stored("SI"))
+    names: tuple[str, ...] = field(metadata=stored(None, attr=True, name="states"))
+    bias_fed: np.ndarray = field(metadata=stored(
+        "rad/s, m/s^2", description="ε (3), ∇ (3) fed back into the compensation so far"))
     nis: np.ndarray
     m: int
     q_slave: np.ndarray
-    att_slave: np.ndarray
-    v_slave: np.ndarray
+    att_slave: np.ndarray = field(metadata=stored(
+        "rad", name="att", frame=ATT_FRAME,
+        description="slave attitude corrected by the φ estimate"))
+    v_slave: np.ndarray = field(metadata=stored("m/s", name="v_n", frame="ENU"))
     q_master: np.ndarray
-    attitude_error: np.ndarray
+    attitude_error: np.ndarray = field(metadata=stored(
+        "rad", frame="ENU", description="corrected slave against master ∘ (μ + θ estimates), "
+        "misalignment φ"))
     t0: float
     settings: TransferSettings
     C_nb: np.ndarray

@@ -156,32 +156,21 @@ def write(f, result, stored: dict) -> None:
     """``/align/transfer``: per-epoch estimates and σ (SI, columns in the order of the
     ``states`` attribute), NIS, the corrected slave attitude and velocity, its error against
     master ∘ μ̂, the bias totals fed back; the file's stored PSINS values as attributes."""
-    from gcalign.io.results import ATT_FRAME, put
+    from gcalign.io.results import put
+    from gcalign.io.stored import write_fields
 
     r = result
     g = f.require_group("align").create_group("transfer")
     g.attrs["mode"] = "transfer"
     g.attrs["matching"] = r.settings.matching
-    g.attrs["states"] = ",".join(r.names)
     g.attrs["state_units"] = ",".join(SI_UNIT[group_of(n)] for n in r.names)
     g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in r.names)
     g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in r.names])
     for k, v in stored.items():
         g.attrs[f"psins_{k}"] = v
         g.attrs[f"psins_{k}_units"] = {"eb0": "rad/s", "db0": "m/s^2", "mu0": "rad"}[k]
-    shape = "(epochs, states) in the order of the 'states' attribute, units 'state_units'"
-    put(g, "t", r.t, "s")
-    put(g, "estimate", r.x, "SI", description=shape)
-    put(g, "sigma", r.sigma, "SI", description=shape)
-    put(g, "sigma0", r.sigma0, "SI")
+    write_fields(g, r)
     put(g, "nis", r.nis, "1", dof=r.m)
-    put(g, "att", r.att_slave, "rad", frame=ATT_FRAME,
-        description="slave attitude corrected by the φ estimate")
-    put(g, "v_n", r.v_slave, "m/s", frame="ENU")
-    put(g, "attitude_error", r.attitude_error, "rad", frame="ENU",
-        description="corrected slave against master ∘ (μ + θ estimates), misalignment φ")
-    put(g, "bias_fed", r.bias_fed, "rad/s, m/s^2",
-        description="ε (3), ∇ (3) fed back into the compensation so far")
 
 
 def _covered(sc, t, master, ref_path) -> None:

@@ -611,9 +611,7 @@ def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
     (:class:`~gcalign.calibrate.CalibrationResult`), the innovations in the measurement's
     units, the errors of the smoothed solution and, with `against` (one per run, or None),
     the INS solution's against a reference (:func:`reference_series`)."""
-    import h5py
-
-    from gcalign.estimation.calibration import Errors
+    from gcalign.estimation.calibration import Errors, Spans
     from gcalign.io.results import put, write_segments
     from gcalign.io.stored import write_fields
 
@@ -626,11 +624,7 @@ def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
                    display_units=",".join(ie.DISPLAY_UNITS),
                    display_scale=ie.display_scale(float(d.start.pos[0]),
                                                   float(d.start.pos[2]), d.earth))
-    seg = g.create_group("segments")
-    seg.create_dataset("name", data=np.array([s.name for s in d.segments],
-                                             dtype=h5py.string_dtype()))
-    put(seg, "t0", [s.start for s in d.segments], "s")
-    put(seg, "t1", [s.end for s in d.segments], "s")
+    write_fields(g.create_group("segments"), Spans.of(d.segments))
     if case.aid is not None:
         og = g.create_group("outages")
         og.attrs.update(t0=case.t0, max_gap_s=case.aid.info["max_gap_s"], description=(

@@ -91,8 +91,8 @@ def summary(sc, obs, compute_s: float) -> dict:
     from gcalign.calibrate.data import Span
 
     tab, pw, names = obs.table, obs.pwcs, obs.names
-    spans = [Span(f"{a:.0f}–{b:.0f} s", float(a), float(b))
-             for a, b in zip(obs.t0, obs.t1, strict=True)]
+    spans = [Span(w, float(a), float(b)) for w, a, b in zip(obs.windows, obs.t0, obs.t1,
+                                                            strict=True)]
     segs, cum = table_rows(tab, spans, obs.condition, pw,
                            (names, obs.cov_degree_segment, obs.cov_degree))
     return {
