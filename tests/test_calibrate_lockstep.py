@@ -201,3 +201,23 @@ def test_a_chunk_of_calibrate_seeds_gives_the_metrics_of_each_run():
     assert [{k: v for k, v in r.items() if k != "wall_s"} for r in chunk] == strip
     assert [r["status"] for r in chunk] == ["ok", "ok", "failed", "ok"]
     assert len({r["wall_s"] for r in chunk}) == 1  # one lockstep, its wall time shared
+
+
+def test_a_single_run_hands_the_kernel_its_own_increments(flights, monkeypatch):
+    """One run (a recording can be hours long) goes to the kernel without a copy of its
+    increments; the lanes of a lockstep are packed."""
+    import gcalign.calibrate._kernel as kernel
+
+    seen = []
+    epochs = kernel.epochs
+
+    def spy(k0, k1, ends, dtheta, dv, *rest):
+        seen.append((dtheta, dv))
+        return epochs(k0, k1, ends, dtheta, dv, *rest)
+
+    monkeypatch.setattr(kernel, "epochs", spy)
+    calibrate(flights[0], Settings(), np.random.default_rng(1))
+    assert np.shares_memory(seen[0][0], flights[0].dtheta)
+    assert np.shares_memory(seen[0][1], flights[0].dv)
+    calibrate_runs([(d, Settings(), np.random.default_rng(1)) for d in flights[:2]])
+    assert seen[1][0].shape[0] == 2 and not np.shares_memory(seen[1][0], flights[0].dtheta)

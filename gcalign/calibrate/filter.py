@@ -563,13 +563,18 @@ def _kernel_epochs(plans: list[_Plan], on_rows: Rows | None = None
     L, K, m = len(plans), len(p0.stops), len(p0.names)
     ends = np.array([0] + [st.end for st in p0.stops], np.int64)
     N = int(ends[-1])
-    dtheta = np.empty((L, N, 3))
-    dv = np.empty((L, N, 3))
+    if L == 1:  # the run's own arrays (a long recording is not copied)
+        dtheta = np.ascontiguousarray(data.dtheta[:N], float)[None]
+        dv = np.ascontiguousarray(data.dv[:N], float)[None]
+    else:
+        dtheta, dv = np.empty((L, N, 3)), np.empty((L, N, 3))
+        for ln, pl in enumerate(plans):
+            dtheta[ln], dv[ln] = pl.data.dtheta[:N], pl.data.dv[:N]
     noise = np.empty((L, K, m))
     nav = np.empty((L, 10))
     P = np.empty((L, N_STATES, N_STATES))
     for ln, pl in enumerate(plans):
-        dtheta[ln], dv[ln], noise[ln] = pl.data.dtheta[:N], pl.data.dv[:N], pl.noise
+        noise[ln] = pl.noise
         st = pl.data.start
         nav[ln] = np.concatenate([np.asarray(st.q_nb, float), np.asarray(st.v_n, float),
                                   np.asarray(st.pos, float)])
