@@ -112,6 +112,8 @@ def test_conventional_has_one_pass_and_no_boundary(align_files):
     full, zoom = data_series(fig.axes[4])[0], data_series(fig.axes[5])[0]
     n = len(full.get_xdata())
     np.testing.assert_allclose(zoom.get_xdata(), full.get_xdata()[n // 2:])
+    # one pass: its data time, with no word of passes laid end to end or their boundaries
+    assert fig.axes[4].get_xlabel() == fig.axes[5].get_xlabel() == "time (s)"
 
 
 def test_alignment_of_recorded_data_has_no_truth_in_its_figures(tmp_path):
@@ -125,6 +127,7 @@ def test_alignment_of_recorded_data_has_no_truth_in_its_figures(tmp_path):
     fig = figs["align_attitude"]
     assert "no truth" in fig.get_suptitle() and "vs truth" not in fig.get_suptitle()
     assert [ln.get_label() for ln in data_series(fig.axes[2])] == ["pass 1 forward (stage 1)"]
+    assert fig.axes[-1].get_xlabel() == "time (s)"  # one pass: no passes laid end to end
     assert "truth at T2" not in res.stdout and "estimate at T2 (deg)" in res.stdout
     assert "recorded data: no truth" in res.stdout
 

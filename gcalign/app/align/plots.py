@@ -24,6 +24,12 @@ PASS_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "
                "tab:pink", "tab:olive", "tab:cyan")
 XLABEL = "equivalent time (s): passes laid end to end; dotted lines: pass boundaries"
 
+def _xlabel(passes: list[PassRows], zoom: bool = False) -> str:
+    """The time axis: equivalent time for passes laid end to end, the data time for one."""
+    if len(passes) == 1:
+        return "time (s)"
+    return "equivalent time (s)" if zoom else XLABEL
+
 
 def equivalent_time(passes: list[PassRows]) -> tuple[list[np.ndarray], list[float]]:
     """Each pass's time on the equivalent axis (passes end to end; the first pass keeps its
@@ -103,7 +109,7 @@ def align_error_figure(passes: list[PassRows], title: str = "alignment error") -
     axes[0].set_title("all passes", fontsize="medium")
     axes[1].set_title(f"{what} (zoom)", fontsize="medium")
     for ax in axes[-2:]:
-        ax.set_xlabel(XLABEL if ax is axes[-2] else "equivalent time (s)")
+        ax.set_xlabel(_xlabel(passes, zoom=ax is axes[-1]))
     legend_below(fig, axes[0], ncols=min(3, len(with_err)))
     suptitle(fig, title)
     return fig
@@ -131,7 +137,7 @@ def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = N
         ax.set_ylabel(f"{name} (deg)")
         ax.grid(True, alpha=0.3)
     legend_below(fig, axes[0], ncols=min(4, len(passes) + 1))
-    axes[-1].set_xlabel(XLABEL)
+    axes[-1].set_xlabel(_xlabel(passes))
     suptitle(fig, title)
     return fig
 
