@@ -61,11 +61,11 @@ def run(sweep: Path, workers: int, out: Path) -> tuple[float, dict]:
 
 def worker_cache_stats() -> list[dict]:
     """Numba cache hits/misses in fresh pool workers after their warm-up."""
-    from gcalign.app.batch import LocalBackend, kernel_cache_stats
+    from gcalign.app.batch import kernel_cache_stats, local_workers
 
-    backend = LocalBackend(2, "align")
+    backend = local_workers(2, "align")
     try:
-        return backend.run_on_workers(kernel_cache_stats)
+        return [backend.executor.submit(kernel_cache_stats).result() for _ in range(2)]
     finally:
         backend.close()
 

@@ -331,10 +331,10 @@ def test_numba_cache_is_loaded_not_compiled_in_fresh_processes():
                          check=True)
     stats = json.loads(out.stdout)
     assert stats["cache_hits"] >= 1 and stats["cache_misses"] == 0, stats
-    backend = B.LocalBackend(1, "align")
+    backend = B.local_workers(1, "align")
     parent = B.kernel_cache_stats()
     try:
-        for s in backend.run_on_workers(B.warm_up):
+        for s in [backend.executor.submit(B.warm_up).result()]:
             if backend.start_method == "fork":  # inherited: nothing new loaded or compiled
                 assert (s["cache_hits"], s["cache_misses"]) == (
                     parent["cache_hits"], parent["cache_misses"]), (s, parent)

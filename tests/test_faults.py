@@ -694,15 +694,15 @@ def test_a_terminated_pool_worker_dies_even_under_the_commands_sigterm_handler(t
     process with a single thread."""
     code = """if True:
         import os, signal, sys, time
-        from gcalign.app.batch.backends import LocalBackend
+        from gcalign.app.batch.backends import local_workers
         from gcalign.cli import _terminate
         signal.signal(signal.SIGTERM, _terminate)
         forks = [0]
         os.register_at_fork(after_in_parent=lambda: forks.__setitem__(0, forks[0] + 1),
                             after_in_child=lambda: forks[0] == 1 and time.sleep(0.5))
-        backend = LocalBackend(2, "simulate")
+        backend = local_workers(2, "simulate")
         assert backend.start_method == "fork", backend.start_method
-        procs = list(backend._pool._processes.values())
+        procs = list(backend.executor._processes.values())
         assert len(procs) == 2 and all(p.is_alive() for p in procs)
         backend.close(cancel=True)
         deadline = time.monotonic() + 10
@@ -717,6 +717,61 @@ def test_a_terminated_pool_worker_dies_even_under_the_commands_sigterm_handler(t
     codes = json.loads(res.stdout)
     assert codes[1] == -signal.SIGTERM and codes[0] in (-signal.SIGTERM, 0), codes
     assert res.stderr == ""  # no exception raised in a worker (it exits 0 then, logged)
+
+
+_DIES_AT_SEED_2 = """
+import json, os
+import gcalign.app.batch.backends as K
+from gcalign.app.batch import load_sweep, run_batch
+
+real = K.run_chunk
+
+
+def dies(tasks):
+    if any(t["seed"] == 2 for t in tasks):
+        os._exit(3)  # a worker that crashes (a segfault, the OOM killer) on this run
+    return real(tasks)
+
+
+K.run_chunk = dies
+res = run_batch(load_sweep("SW.yaml"), "b.h5", workers=2, chunk_size=3)
+print(json.dumps(res.summary))
+"""
+
+
+@pytest.mark.slow  # a batch with a real pool, in a child process
+def test_a_worker_that_dies_breaks_the_local_pool_and_the_batch_goes_on(tmp_path):
+    """A real pool whose worker dies on seed 2 of each variant (chunks of 3 runs): the pool
+    is broken, every chunk in flight lost; a new pool runs each lost run again, alone. The
+    crashers are recorded failed; every other run either finished with the uninterrupted
+    run's numbers or, lost a second time beside a crasher, is recorded failed too; each run
+    once."""
+    sweep(tmp_path, seeds=6)
+    res = subprocess.run([sys.executable, "-c", _DIES_AT_SEED_2], cwd=tmp_path, timeout=300,
+                         capture_output=True, text=True, env=_this_gcalign())
+    assert res.returncode == 0, res.stderr
+    s = json.loads(res.stdout)
+    crashed = {(f["variant"], f["seed"]) for f in s["failures"]}
+    assert {(0, 2), (1, 2)} <= crashed
+    assert all("worker process died" in f["error"] for f in s["failures"])
+    assert s["ok"] + s["failed"] == s["runs"] == 12 and s["ok"] >= 1
+    with h5py.File(tmp_path / "b.h5", "r") as f:
+        keys = list(zip(f["batch/runs/variant"][()].tolist(), f["batch/runs/seed"][()].tolist(),
+                        strict=True))
+        got = f["batch/runs/metrics/error_t3_deg"][()]
+        status = [x.decode() for x in f["batch/runs/status"][()]]
+    assert sorted(keys) == [(v, k) for v in (0, 1) for k in range(1, 7)]
+    ref_dir = tmp_path / "ref"
+    ref_dir.mkdir()
+    sweep(ref_dir, seeds=6)
+    assert cli(["batch", "SW.yaml", "-o", "ref.h5", "-w", "1"], ref_dir).returncode == 0
+    with h5py.File(ref_dir / "ref.h5", "r") as f:
+        ref = dict(zip(zip(f["batch/runs/variant"][()].tolist(),
+                           f["batch/runs/seed"][()].tolist(), strict=True),
+                       f["batch/runs/metrics/error_t3_deg"][()], strict=True))
+    for k, row, st in zip(keys, got, status, strict=True):
+        if st == "ok":
+            np.testing.assert_array_equal(row, ref[k])
 
 
 def test_results_files_have_ordinary_permissions(tmp_path):
@@ -787,13 +842,16 @@ def _limited(limit_mb: int):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("limit_mb", [600, 540, 450])
+@pytest.mark.parametrize("limit_mb", [600, 540, 520, 480, 450])
 def test_openblas_under_an_address_space_limit_is_never_its_own_message(tmp_path, limit_mb):
     """``ulimit -v`` and the real-time run (SciPy's OpenBLAS takes its buffer late, in
     expm): OpenBLAS printed "Memory allocation still failed after 10 retries, giving up"
     and called exit(1) at 600 and 540 MB (the temporary file stayed), and retried without
     end at 500 MB. With one OpenBLAS thread and the buffers taken when the libraries load,
-    the run succeeds or is exit 1, our one "out of memory" line; nothing is left."""
+    the run succeeds or is exit 1, our one "out of memory" line; nothing is left. 520 and
+    480 MB: NumPy's first LAPACK solve (``lfilter_zi``) took a buffer of its own after the
+    product that had warmed it (OpenBLAS's message at 520, no end at 480); a solve warms it
+    now."""
     res = subprocess.run(GCALIGN + ["realtime", "-o", "o.h5"], cwd=tmp_path,
                          capture_output=True, text=True, timeout=300,
                          preexec_fn=_limited(limit_mb))
@@ -902,10 +960,10 @@ def test_pool_workers_die_with_a_killed_batch_even_inside_a_long_kernel(tmp_path
     in a C call for 120 s (what a kernel does) when the batch process is killed."""
     code = _HOLD_THE_GIL + """
 import time
-from gcalign.app.batch.backends import LocalBackend
+from gcalign.app.batch.backends import local_workers
 
-backend = LocalBackend(2, "simulate")
-futures = [backend._pool.submit(hold) for _ in range(2)]
+backend = local_workers(2, "simulate")
+futures = [backend.executor.submit(hold) for _ in range(2)]
 time.sleep(120)
 """
     p = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, env=_this_gcalign())

@@ -10,10 +10,11 @@ imported):
 * one OpenBLAS thread (each further thread of each copy maps its own buffer and a stack,
   40 MB), unless ``OPENBLAS_NUM_THREADS``, ``GOTO_NUM_THREADS`` or ``OMP_NUM_THREADS`` is
   set;
-* each copy's buffer taken when the library is loaded (a 2 × 2 product: NumPy's when
-  NumPy is imported, SciPy's when ``scipy.linalg`` is), after checking that the room is
-  there; later calls reuse it, so a later shortage is a MemoryError of NumPy, which the
-  command line reports as its one ``out of memory`` line (:mod:`gcalign.cli`).
+* each copy's buffer taken when the library is loaded (a 2 × 2 LAPACK solve, whose buffer
+  later products reuse: NumPy's when NumPy is imported, SciPy's when ``scipy.linalg`` is),
+  after checking that the room is there; later calls reuse it, so a later shortage is a
+  MemoryError of NumPy, which the command line reports as its one ``out of memory`` line
+  (:mod:`gcalign.cli`).
 
 :mod:`gcalign.cli` imports this module first, and importing it prepares the process.
 """
@@ -55,13 +56,15 @@ def warm(library: str) -> None:
                           f"{BUFFER_BYTES >> 20} MB")
     import numpy as np
 
-    a = np.ones((2, 2))
+    # A LAPACK solve, not a product: a product's buffer is not the one LAPACK takes, and a
+    # first solve late in a run (realtime's lfilter_zi at 520 MB) still ended the process.
+    a = np.eye(2)
     if library == "numpy":
-        a @ a
+        np.linalg.solve(a, a)
     else:
-        from scipy.linalg import blas
+        from scipy.linalg import lapack
 
-        blas.dgemm(1.0, a, a)
+        lapack.dgesv(a, a)
 
 
 class _WarmScipy(importlib.abc.MetaPathFinder):

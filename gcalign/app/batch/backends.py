@@ -1,9 +1,6 @@
-"""Where the chunks of runs execute: a local process pool, or an existing Dask cluster.
-
-Both backends offer the same small interface to the engine (``submit``, ``wait``,
-``result``, ``restart``, ``run_on_workers``, ``close``) and turn the death of a worker
-into :class:`WorkerLost`. The functions they send to workers live in
-:mod:`gcalign.app.batch.runs`.
+"""Where the chunks of runs execute: one ``concurrent.futures`` executor, a local process
+pool or an existing Dask cluster's (:class:`Workers`). The functions sent to workers live
+in :mod:`gcalign.app.batch.runs`.
 """
 
 from __future__ import annotations
@@ -13,6 +10,8 @@ import re
 import signal
 import threading
 import time
+from concurrent.futures import FIRST_COMPLETED, BrokenExecutor, ProcessPoolExecutor, wait
+from typing import Any
 
 from gcalign.app.batch.runs import run_chunk, warm_up
 from gcalign.errors import GcalignError, ScenarioError
@@ -56,7 +55,7 @@ def _init_worker(command: str) -> None:  # pragma: no cover - runs in workers
     # command removes its temporary files): a worker that the pool terminates must die,
     # not send the exception back through a queue nobody reads any more (a hang at exit).
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    # Forked with SIGTERM blocked (LocalBackend._new_pool): one sent before this point was
+    # Forked with SIGTERM blocked (local_workers): one sent before this point was
     # held, and is delivered now, with the default action.
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
     parent = os.getppid()
@@ -69,43 +68,83 @@ class WorkerLost(Exception):
     """The process running a chunk died (killed, crashed, out of memory)."""
 
 
-class LocalBackend:
-    """``concurrent.futures.ProcessPoolExecutor`` of `workers` processes, each warming the
-    JIT cache once (initializer).
+class Workers:
+    """Where a batch's chunks run: one ``concurrent.futures.Executor`` — a local process pool
+    (:func:`local_workers`) or Dask's ``Client.get_executor()`` (:func:`dask_workers`) —
+    behind the one code path of the engine. A chunk whose worker died is :class:`WorkerLost`
+    (the engine retries its runs alone); a local pool that a dying worker broke is replaced
+    at the next submit; `check` says whether the executor can still run anything (a Dask
+    client that lost its scheduler cannot: one line, the finished runs kept)."""
+
+    def __init__(self, executor, workers: int, description: str, *, renew=None,
+                 check=None, stop=None, start_method: str | None = None):
+        self.executor = executor
+        self.workers = workers
+        self.description = description
+        self.start_method = start_method
+        self._renew = renew  # a new executor in place of a broken one
+        self._check = check or (lambda: None)
+        self._stop = stop  # (executor, cancel) -> None: shut it down
+
+    def submit(self, chunk):
+        self._check()
+        try:
+            return self.executor.submit(run_chunk, chunk)
+        except BrokenExecutor:  # a local worker died and broke its pool: start a new one
+            if self._renew is None:
+                raise
+            self._stop(self.executor, True)
+            self.executor = self._renew()
+            return self.executor.submit(run_chunk, chunk)
+
+    def wait(self, futures, timeout: float):
+        done = wait(futures, timeout=timeout, return_when=FIRST_COMPLETED)[0]
+        if not done:
+            self._check()
+        return done
+
+    def result(self, fut) -> list[dict]:
+        try:
+            return fut.result()
+        except Exception as err:  # BrokenProcessPool, KilledWorker, CancelledError, ...
+            self._check()
+            raise WorkerLost(f"{type(err).__name__}: {err}" if str(err) else
+                             f"a worker process died ({type(err).__name__})") from None
+
+    def close(self, cancel: bool = False) -> None:
+        self._stop(self.executor, cancel)
+
+
+def local_workers(workers: int, command: str) -> Workers:
+    """A ``ProcessPoolExecutor`` of `workers` processes, each warming the JIT cache once
+    (initializer).
 
     Start method: ``fork`` when this process has no other thread (the workers then start
     with every module already imported: no interpreter start, no re-import), else the fork
     server (forking a multi-threaded process can deadlock the child). The processes are
     started here, before the caller starts a progress-bar thread.
     """
+    import multiprocessing as mp
 
-    def __init__(self, workers: int, command: str):
-        self.workers = workers
-        self.command = command
-        self.description = f"local pool, {workers} worker(s)"
-        # Warm the kernels here, once: forked workers inherit them and start in milliseconds
-        # instead of each loading the JIT cache again (about 0.6 s apiece).
-        warm_up(command)
-        self._pool = self._new_pool()
+    # Warm the kernels here, once: forked workers inherit them and start in milliseconds
+    # instead of each loading the JIT cache again (about 0.6 s apiece).
+    warm_up(command)
+    methods = mp.get_all_start_methods()
+    ctx: Any
+    if "fork" in methods and threading.active_count() == 1:
+        ctx = mp.get_context("fork")
+    elif "forkserver" in methods:
+        ctx = mp.get_context("forkserver")
+        # The fork server imports the engine (numpy, numba, pipelines) once; every
+        # worker forked from it starts with those modules loaded.
+        ctx.set_forkserver_preload(["gcalign.app.batch", "gcalign.app.align.run"])
+    else:
+        ctx = mp.get_context("spawn")
 
-    def _new_pool(self):
-        import multiprocessing as mp
-        from concurrent.futures import ProcessPoolExecutor
-
-        methods = mp.get_all_start_methods()
-        if "fork" in methods and threading.active_count() == 1:
-            ctx = mp.get_context("fork")
-        elif "forkserver" in methods:
-            ctx = mp.get_context("forkserver")
-            # The fork server imports the engine (numpy, numba, pipelines) once; every
-            # worker forked from it starts with those modules loaded.
-            ctx.set_forkserver_preload(["gcalign.app.batch", "gcalign.app.align.run"])
-        else:
-            ctx = mp.get_context("spawn")
-        self.start_method = ctx.get_start_method()
-        pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx,
-                                   initializer=_init_worker, initargs=(self.command,))
-        if self.start_method == "fork":
+    def new_pool() -> ProcessPoolExecutor:
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                   initializer=_init_worker, initargs=(command,))
+        if ctx.get_start_method() == "fork":
             # Forks every worker now (all at once for fork), with SIGTERM blocked: until its
             # initializer runs, a worker has the command's handler, under which a terminate
             # raised inside it and left it alive. The parent receives a held one on unblock.
@@ -117,38 +156,18 @@ class LocalBackend:
             first.result()
         return pool
 
-    def submit(self, chunk):
-        return self._pool.submit(run_chunk, chunk)
+    def stop(pool: ProcessPoolExecutor, cancel: bool) -> None:
+        if not cancel:
+            pool.shutdown(wait=True)
+            return
+        procs = list((getattr(pool, "_processes", None) or {}).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        for p in procs:  # do not wait for chunks in flight after Ctrl-C
+            if p.is_alive():
+                p.terminate()
 
-    def wait(self, futures, timeout: float):
-        from concurrent.futures import FIRST_COMPLETED, wait
-
-        return wait(futures, timeout=timeout, return_when=FIRST_COMPLETED)[0]
-
-    def result(self, fut) -> list[dict]:
-        from concurrent.futures.process import BrokenProcessPool
-
-        try:
-            return fut.result()
-        except BrokenProcessPool as err:
-            raise WorkerLost(str(err) or "a worker process died") from None
-
-    def restart(self) -> None:
-        self.close(cancel=True)
-        self._pool = self._new_pool()
-
-    def run_on_workers(self, fn) -> list:
-        return [f.result() for f in [self._pool.submit(fn) for _ in range(self.workers)]]
-
-    def close(self, cancel: bool = False) -> None:
-        if cancel:
-            procs = list((getattr(self._pool, "_processes", None) or {}).values())
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            for p in procs:  # do not wait for chunks in flight after Ctrl-C
-                if p.is_alive():
-                    p.terminate()
-        else:
-            self._pool.shutdown(wait=True)
+    return Workers(new_pool(), workers, f"local pool, {workers} worker(s)", renew=new_pool,
+                   stop=stop, start_method=ctx.get_start_method())
 
 
 def _probe(address: str, timeout: float) -> None:
@@ -279,61 +298,34 @@ def _close(client) -> None:
         pass
 
 
-class DaskBackend:
-    """Runs chunks on an existing Dask distributed cluster (``client.submit``)."""
+def dask_workers(address: str, command: str, timeout: float = SCHEDULER_TIMEOUT_S) -> Workers:
+    """The workers of an existing Dask distributed cluster, through ``client.get_executor``."""
+    client = dask_client(address, timeout)
+    nthreads = client.nthreads()
+    try:  # load the JIT cache on every worker, in parallel; checks gcalign is there
+        client.run(warm_up, command)
+    except Exception as err:
+        _close(client)
+        raise GcalignError(f"the Dask workers of {address} cannot run gcalign "
+                           f"({type(err).__name__}: {err}); install gcalign where the "
+                           "workers run") from None
 
-    def __init__(self, address: str, command: str, timeout: float = SCHEDULER_TIMEOUT_S):
-        self.client = dask_client(address, timeout)
-        self.address = address
-        nthreads = self.client.nthreads()
-        self.workers = max(1, sum(nthreads.values()))
-        self.description = f"Dask scheduler {address}, {len(nthreads)} worker(s)"
-        self.command = command
-        try:  # load the JIT cache on every worker, in parallel; checks gcalign is there
-            self.client.run(warm_up, command)
-        except Exception as err:
-            self.close()
-            raise GcalignError(f"the Dask workers of {address} cannot run gcalign "
-                               f"({type(err).__name__}: {err}); install gcalign where the "
-                               "workers run") from None
-
-    def _check_connected(self) -> None:
-        if self.client.status not in ("running", "connecting"):
-            raise GcalignError(f"lost the Dask scheduler at {self.address} (client "
-                               f"{self.client.status}); the finished runs are kept: rerun "
+    def check() -> None:
+        if client.status not in ("running", "connecting"):
+            raise GcalignError(f"lost the Dask scheduler at {address} (client "
+                               f"{client.status}); the finished runs are kept: rerun "
                                "with --resume")
 
-    def submit(self, chunk):
-        self._check_connected()
-        return self.client.submit(run_chunk, chunk, pure=False)
+    def stop(executor, cancel: bool) -> None:
+        _close(client)  # its futures released: the scheduler drops what is in flight
 
-    def wait(self, futures, timeout: float):
-        # distributed.wait needs a default client; polling the futures does not.
-        deadline = time.monotonic() + timeout
-        while True:
-            done = {f for f in futures if f.done()}
-            if done or time.monotonic() >= deadline:
-                return done
-            time.sleep(0.02)
-
-    def result(self, fut) -> list[dict]:
-        try:
-            return fut.result()
-        except Exception as err:  # KilledWorker, CancelledError, CommClosedError, ...
-            self._check_connected()
-            raise WorkerLost(f"{type(err).__name__}: {err}") from None
-
-    def restart(self) -> None:
-        pass  # the scheduler replaces lost workers itself
-
-    def run_on_workers(self, fn) -> list:
-        return list(self.client.run(fn).values())
-
-    def close(self, cancel: bool = False) -> None:
-        _close(self.client)
+    return Workers(client.get_executor(pure=False), max(1, sum(nthreads.values())),
+                   f"Dask scheduler {address}, {len(nthreads)} worker(s)", check=check,
+                   stop=stop)
 
 
-def make_backend(command: str, workers: int | None = None, scheduler: str | None = None):
+def make_backend(command: str, workers: int | None = None,
+                 scheduler: str | None = None) -> Workers:
     if scheduler is not None:
-        return DaskBackend(check_address(scheduler), command)
-    return LocalBackend(workers or os.cpu_count() or 1, command)
+        return dask_workers(check_address(scheduler), command)
+    return local_workers(workers or os.cpu_count() or 1, command)

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from gcalign.app.batch.aggregate import batch_summary
-from gcalign.app.batch.backends import LocalBackend, WorkerLost, make_backend
+from gcalign.app.batch.backends import WorkerLost, make_backend
 from gcalign.app.batch.store import (
     Journal,
     OutputLock,
@@ -250,12 +250,6 @@ def _drive(backend, sweep, todo, records, journal, progress, total, chunk_size, 
                 records[(r["variant"], r["seed"])] = r
                 failed += r["status"] != "ok"
         if broken is not None:
-            if isinstance(backend, LocalBackend):
-                # A broken pool fails every chunk in flight: take them all, start a new pool.
-                for chunk in in_flight.values():
-                    lost.extend(chunk)
-                in_flight.clear()
-                backend.restart()
             dead = []
             for t in lost:
                 k = (t["variant"], t["seed"])
