@@ -184,3 +184,9 @@ def test_the_real_file_by_matching(tmp_path):
         0.1 * wa["muy"], rel=0.05)  # φ along north scaled by σμ/σφ = 1°/10°
     assert av["unobservable"] == [] and all(av["sigma_final"][n] / ARCMIN < 2.0 for n in MU)
     assert all("mean NIS" in " ".join(x["warnings"]) for x in s.values())  # the demo's R
+    # its σ tables span the 21 filter states, the PWCS tables 15: the file reads back
+    h5 = tmp_path / "attitude+velocity.h5"
+    for args in (["show", h5], ["plot", h5, "-o", tmp_path / "figs"]):
+        res = runner.invoke(app, list(map(str, args)))
+        assert res.exit_code == 0, res.output
+    assert len(list((tmp_path / "figs").glob("*.png"))) == 3

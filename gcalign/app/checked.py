@@ -80,9 +80,10 @@ class Block:
     """The datasets of each group matching `where` (``*`` for one level of any name) by
     path within it (``error/phi``; ``*`` matches any name; a trailing ``?``: optional), and
     the sizes given by text attributes of comma-separated names, ``("S", "calibrate",
-    "states")`` (``.``: the group itself), by numeric attributes of one value per name
-    (`numbers`, same form), or by a count attribute of the group (`counts`: ``("H",
-    "order", 1)``, H = order + 1; absent from a file: no say)."""
+    "states")`` (``.``: the group itself; ``"a|b"``: a where the group has it, else b), by
+    numeric attributes of one value per name (`numbers`, same form), or by a count attribute
+    of the group (`counts`: ``("H", "order", 1)``, H = order + 1; absent from a file: no
+    say)."""
 
     where: str
     items: dict[str, Data]
@@ -164,7 +165,8 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
     "observability": (
         Block("observability", {**from_fields(ObservabilityTable), "t0": times("Q"),
                                  "t1": times("Q")},
-            names=(("S", ".", "states"),)),
+            # a transfer run's σ tables span its filter's states, the others the PWCS ones
+            names=(("S", ".", "states"), ("C", ".", "covariance_states|states"))),
         TRUTH),
     "realtime": (
         Block("realtime/cases/*", {
@@ -278,11 +280,13 @@ def _size(dim: Dim, sizes: dict[str, tuple[int, str]]) -> int | None:
 
 def _attribute_votes(path: Path, f: h5py.File, g: h5py.Group, block: Block,
                      votes: _Votes) -> None:
-    for dim, where, attr in (*block.names, *block.numbers):
+    for dim, where, attrs in (*block.names, *block.numbers):
         owner = g if where == "." else f.get(where)
+        attr = next((a for a in attrs.split("|") if owner is not None and a in owner.attrs),
+                    attrs.split("|")[-1])  # "a|b": a where the file has it, else b
         label = f"{owner.name if owner is not None else '/' + where} attribute {attr!r}"
         v = owner.attrs.get(attr) if owner is not None else None
-        if (dim, where, attr) in block.names:
+        if (dim, where, attrs) in block.names:
             v = v.decode("utf-8", "replace") if isinstance(v, bytes) else v
             if not isinstance(v, str):
                 raise ScenarioError(f"{path}: {label} must list names separated by commas, "

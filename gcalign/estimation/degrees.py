@@ -50,10 +50,10 @@ class ObservabilityTable:
     rank_cum: np.ndarray = field(metadata=stored("1", dims="Q", whole=True, optional=True))
     tom_rank_cum: np.ndarray = field(metadata=stored("1", dims="Q", whole=True, optional=True))
     cov_degree: np.ndarray | None = field(metadata=stored(
-        "1", shape=DEGREE, description="sigma(0)/sigma(t_end), PSINS kfstat", dims="Q S",
+        "1", shape=DEGREE, description="sigma(0)/sigma(t_end), PSINS kfstat", dims="Q C",
         optional=True))
     cov_degree_segment: np.ndarray | None = field(metadata=stored(
-        "1", shape=DEGREE, description="sigma(t_start)/sigma(t_end)", dims="Q S",
+        "1", shape=DEGREE, description="sigma(t_start)/sigma(t_end)", dims="Q C",
         optional=True))
     margin: np.ndarray = field(default_factory=lambda: np.zeros(0))
     margin_cum: np.ndarray = field(default_factory=lambda: np.zeros(0))
