@@ -69,6 +69,8 @@ def figures_for(path: Path) -> dict[str, Figure]:
             commands = kinds()
             figs: dict[str, Figure] = (commands[kind].figures(f, name) if kind in commands
                                        else {})
+        except ScenarioError:
+            raise  # a figure's own check, naming its datasets
         except (ValueError, TypeError, IndexError, KeyError) as err:
             # the checks hold each dataset; these are datasets that do not fit together
             # (a series shorter than its time, a vector of the wrong width)

@@ -64,9 +64,16 @@ def read_runs(f) -> tuple[list[ShownRun], dict]:
         nav, sm, e = r.get("navigation"), r.get("smoothed/error"), r.get("reference_error")
         navigation = None if nav is None or "error" not in nav else _errors(nav["error"]) | {
             "t0": float(nav["t"][0] - nav["t_run"][0]) if len(nav["t"]) else 0.0}
+        run = read_fields(r, CalibrationResult, innovation=None, nis=r["nis"][()],
+                          settings=None)
+        if run.updated is not None and int(run.updated.sum()) != len(run.nis):
+            from gcalign.errors import ScenarioError
+
+            raise ScenarioError(f"{f.filename}: dataset {r.name}/updated marks "
+                                f"{int(run.updated.sum())} epochs with a fix, {r.name}/nis "
+                                f"has {len(run.nis)}: one per fix")
         runs.append(ShownRun(
-            read_fields(r, CalibrationResult, innovation=None, nis=r["nis"][()], settings=None),
-            _s(r.attrs.get("label", "")), _s(r.attrs["measure"]), navigation,
+            run, _s(r.attrs.get("label", "")), _s(r.attrs["measure"]), navigation,
             None if sm is None else _errors(sm), None if e is None else _errors(e)))
     seg = g["segments"]
     attrs["segments"] = [(_s(n), float(a), float(b)) for n, a, b in
