@@ -16,6 +16,7 @@ Run: ``python benchmarks/bench_address_space.py [--low 400] [--high 700] [--step
 from __future__ import annotations
 
 import argparse
+import os
 import resource
 import statistics
 import subprocess
@@ -33,6 +34,9 @@ EAGER = ("import time, gcalign.cli.address_space as A; m0 = A.mapped_bytes(); "
          "t = time.process_time(); import numpy as np; from scipy.linalg import blas; "
          "a = np.ones((2, 2)); blas.dgemm(1.0, a, a); "
          "print(A.mapped_bytes() - m0, time.process_time() - t)")
+
+
+SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 
 
 def limited(mb: int):
@@ -57,10 +61,13 @@ def outcome(mb: int, hook: str, timeout: float) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--low", type=int, default=400)
+    # smoke: one limit where both run through (the hangs below 600 MB would take minutes)
+    ap.add_argument("--low", type=int, default=700 if SMOKE else 400)
     ap.add_argument("--high", type=int, default=700)
     ap.add_argument("--step", type=int, default=10)
     ap.add_argument("--timeout", type=float, default=60.0)
+    ap.add_argument("--repeat", type=int, default=1 if SMOKE else 5,
+                    help="turns of the start-up price")
     args = ap.parse_args()
     print("limit MB   with the hook   without")
     counts: dict[str, dict[str, int]] = {"with": {}, "without": {}}
@@ -74,10 +81,10 @@ def main() -> None:
         print(f"{hook} the hook: " + ", ".join(f"{k} {v}" for k, v in sorted(c.items())))
     cost = [subprocess.run([sys.executable, "-c", EAGER], capture_output=True, text=True,
                            check=True, preexec_fn=limited(2000)).stdout.split()
-            for _ in range(5)]
+            for _ in range(args.repeat)]
     mapped = statistics.median(float(c[0]) for c in cost) / 2**20
     cpu = statistics.median(float(c[1]) for c in cost)
-    print(f"SciPy's buffer at start-up instead (under a 2000 MB limit, median of 5): "
+    print(f"SciPy's buffer at start-up instead (under a 2000 MB limit, median of {args.repeat}): "
           f"{mapped:.0f} MB of address space and {cpu * 1e3:.0f} ms of CPU for every command")
 
 

@@ -26,6 +26,8 @@ import time
 from importlib import resources
 from pathlib import Path
 
+SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
+
 HERE = Path(__file__).resolve().parents[1]
 CLUSTER = ("import sys\n"
            "from distributed import LocalCluster\n"
@@ -64,9 +66,9 @@ def batch(tree: Path, sweep: Path, out: Path, where: list[str]) -> tuple[float, 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--before", type=Path)
-    ap.add_argument("--sizes", default="200,400")
-    ap.add_argument("--big", type=int, default=1000)
-    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--sizes", default="4" if SMOKE else "200,400")
+    ap.add_argument("--big", type=int, default=8 if SMOKE else 1000)
+    ap.add_argument("--repeat", type=int, default=1 if SMOKE else 5)
     args = ap.parse_args()
     trees = {"after": HERE}
     if args.before:

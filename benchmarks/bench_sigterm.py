@@ -20,6 +20,7 @@ Run: ``python benchmarks/bench_sigterm.py [--repeat 5]``
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import statistics
 import subprocess
@@ -28,6 +29,8 @@ import tempfile
 import time
 from importlib import resources
 from pathlib import Path
+
+SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 
 RUN = ("import sys\n"
        "import gcalign.cli.base as base\n"
@@ -89,9 +92,10 @@ def one(name: str, handler: str, delay: float) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--repeat", type=int, default=1 if SMOKE else 5)
     ap.add_argument("--delay", type=float, default=4.0)
-    ap.add_argument("--cases", default="simulate,align,batch")
+    # smoke: the batch only (a flag-only handler ends simulate and align about a minute late)
+    ap.add_argument("--cases", default="batch" if SMOKE else "simulate,align,batch")
     args = ap.parse_args()
     for name in args.cases.split(","):
         seen: dict[str, list[dict]] = {"raising": [], "flag-only": []}
