@@ -15,6 +15,7 @@ against 100 Hz, then run the 72 h cases at 10 Hz (a run without rotation at 1 Hz
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import h5py
@@ -43,12 +44,17 @@ def run(*args, **kw) -> dict:
     return run_modulate(scenario(*args, **kw))[0]
 
 
+_MEMORY_FILES = itertools.count()
+
+
 def run_series(*args, rate_out=None, **kw):
     """The summary and an in-memory results file with the series."""
     sc = scenario(*args, **kw)
     if rate_out is not None:
         sc.output.rate_hz = rate_out
-    f = h5py.File(f"mem-{id(sc)}.h5", "w", driver="core", backing_store=False)
+    # a name of its own: an id() comes back once its object is freed, while an earlier
+    # in-memory file of that name may still be open (h5py: "unable to truncate")
+    f = h5py.File(f"mem-{next(_MEMORY_FILES)}.h5", "w", driver="core", backing_store=False)
     return run_modulate(sc, sink=f)[0], f
 
 
