@@ -41,6 +41,8 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+from _child import Child  # noqa: E402
+
 SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 CHUNK = 16  #: runs a worker takes at a time (gcalign.app.batch.engine.CHUNK_MAX)
 HERE = Path(__file__).resolve()
@@ -100,26 +102,6 @@ def serve(seeds: int) -> None:
         print(json.dumps({"run": runs.run, "chunk": runs.chunk}[what](int(k))), flush=True)
 
 
-class Child:
-    def __init__(self, tree: Path, seeds: int):
-        env = dict(os.environ, PYTHONPATH=str(tree))
-        self.p = subprocess.Popen([sys.executable, str(HERE), "--serve", "--seeds", str(seeds)],
-                                  stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-                                  env=env, cwd=tree)
-        assert self.p.stdout is not None and self.p.stdout.readline().strip() == "ready"
-
-    def ask(self, what: str, k: int) -> dict:
-        assert self.p.stdin is not None and self.p.stdout is not None
-        self.p.stdin.write(f"{what} {k}\n")
-        self.p.stdin.flush()
-        return json.loads(self.p.stdout.readline())
-
-    def close(self) -> None:
-        assert self.p.stdin is not None
-        self.p.stdin.close()
-        self.p.wait()
-
-
 def batch(tree: Path, seeds: int, out: Path) -> dict:
     """``gcalign batch`` of the sweep on the checkout `tree`, 2 workers: wall, CPU (s)."""
     sweep = out.with_suffix(".yaml")
@@ -150,7 +132,7 @@ def main() -> None:
     if args.before is not None:
         trees = {"before": args.before.resolve(), **trees}
     load0 = os.getloadavg()[0]
-    sides = {name: Child(tree, args.seeds) for name, tree in trees.items()}
+    sides = {name: Child(HERE, tree, args.seeds) for name, tree in trees.items()}
     res: dict[str, list[dict]] = {k: [] for k in sides}
     for k in range(1, args.seeds + 1):
         for name, child in sides.items():

@@ -25,11 +25,12 @@ import json
 import os
 import resource
 import statistics
-import subprocess
 import sys
 import tempfile
 from importlib import resources
 from pathlib import Path
+
+from _child import Child
 
 SMOKE = os.environ.get("GCALIGN_BENCH_SMOKE") == "1"  #: python -m benchmarks --smoke: tiny sizes
 TARGET_RUN_MS = 25.0
@@ -129,26 +130,6 @@ def serve(seeds: int) -> None:
         print(json.dumps(fn(int(k))), flush=True)
 
 
-class Child:
-    def __init__(self, tree: Path, seeds: int):
-        env = dict(os.environ, PYTHONPATH=str(tree))
-        self.p = subprocess.Popen([sys.executable, str(HERE), "--serve", "--seeds", str(seeds)],
-                                  stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-                                  env=env, cwd=tree)
-        assert self.p.stdout is not None and self.p.stdout.readline().strip() == "ready"
-
-    def ask(self, what: str, k: int) -> dict:
-        assert self.p.stdin is not None and self.p.stdout is not None
-        self.p.stdin.write(f"{what} {k}\n")
-        self.p.stdin.flush()
-        return json.loads(self.p.stdout.readline())
-
-    def close(self) -> None:
-        assert self.p.stdin is not None
-        self.p.stdin.close()
-        self.p.wait()
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=3 if SMOKE else 80)
@@ -158,9 +139,9 @@ def main() -> None:
     if args.serve:
         serve(args.seeds)
         return
-    sides = {"after": Child(HERE.parents[1], args.seeds)}
+    sides = {"after": Child(HERE, HERE.parents[1], args.seeds)}
     if args.before is not None:
-        sides = {"before": Child(args.before.resolve(), args.seeds), **sides}
+        sides = {"before": Child(HERE, args.before.resolve(), args.seeds), **sides}
     # the runs one after another, as a worker runs them (nothing else allocating between),
     # then the floors; each seed on both sides in turn
     res: dict[str, list[dict]] = {k: [] for k in sides}
