@@ -8,7 +8,8 @@ renamed after what it shows. tests/test_plots.py checks the axes and series of e
 on small runs; this script is for the documentation (README, docs/batch.md, docs/results*).
 The realtime figures are also made by docs/results_realtime.py, the calibrate and
 observability ones by docs/make_results_calibrate.py, and the T_z sweep figure
-``seed000_tz.png`` by docs/seed000_results.py (from the full sweep; here a small one,
+``seed000_tz.png`` and the box plot per mode ``batch_error_t3_deg.png`` by
+docs/seed000_results.py (from the full sweeps; here a small one,
 ``batch_error_t3_yaw_vs_t_z.png``).
 """
 
@@ -62,17 +63,6 @@ def _small_batch(tmp: Path) -> Path:
     return out
 
 
-def _mode_batch(tmp: Path) -> Path:
-    sweep = tmp / "modes.yaml"
-    sweep.write_text(yaml.safe_dump({
-        "name": "modes", "base": str(ROOT / "configs" / "seed000_moving_full_cycle.yaml"),
-        "grid": {"align.mode": ["conventional", "full-cycle", "half-cycle"]},
-        "seeds": 10, "metrics": ["error_t3_deg"]}))
-    out = tmp / "modes.h5"
-    _cli("batch", sweep, "--workers", 1, "-o", out)
-    return out
-
-
 def main() -> list[Path]:
     OUT.mkdir(parents=True, exist_ok=True)
     made: list[Path] = []
@@ -109,7 +99,6 @@ def main() -> list[Path]:
                                         "observability_cumulative": "observability_cumulative",
                                         "covariance_degree": "observability_covariance_degree"},
                       tmp)
-        made += _plot(_mode_batch(tmp), {"batch_error_t3_deg": "batch_error_t3_deg"}, tmp)
         made += _plot(_small_batch(tmp), {
             "batch_error_t3_deg_2_vs_t_z_s": "batch_error_t3_yaw_vs_t_z"}, tmp)
     return made
