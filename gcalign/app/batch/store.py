@@ -19,7 +19,7 @@ import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
 import numpy as np
 
@@ -235,31 +235,26 @@ def read_journal(path: Path, metrics: Iterable[str] | None = None,
                  log=None) -> list[dict]:
     """Run records of a journal. Lines that are not valid records (torn by a SIGKILL,
     garbage, edited, NaN or missing metrics) are skipped, and `log` is told how many."""
-    out = []
-    skipped = 0
     metrics = list(metrics) if metrics is not None else None
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
-            for line in f:
-                if not line.strip():
-                    continue
-                try:
-                    obj = json.loads(line)
-                except ValueError:
-                    skipped += 1
-                    continue
-                if isinstance(obj, dict) and obj.get("type") == "header":
-                    continue
-                if valid_record(obj, metrics):
-                    out.append(obj)
-                else:
-                    skipped += 1
+            lines = [line for line in f if line.strip()]
     except OSError as err:
         raise ScenarioError(f"{path}: cannot read the journal ({err.strerror or err})") from None
-    if skipped and log is not None:
-        log(f"{path}: skipped {skipped} line(s) that are not valid run records (torn, damaged "
-            "or edited); those runs run again")
+    records = [r for r in map(_loads, lines) if not (isinstance(r, dict)
+                                                    and r.get("type") == "header")]
+    out = [r for r in records if valid_record(r, metrics)]
+    if len(out) < len(records) and log is not None:
+        log(f"{path}: skipped {len(records) - len(out)} line(s) that are not valid run records "
+            "(torn, damaged or edited); those runs run again")
     return out
+
+
+def _loads(line: str) -> Any:
+    try:
+        return json.loads(line)
+    except ValueError:  # (not a record: skipped)
+        return None
 
 
 def read_runs_h5(path: Path) -> list[dict]:
