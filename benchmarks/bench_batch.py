@@ -61,7 +61,8 @@ def run(sweep: Path, workers: int, out: Path) -> tuple[float, dict]:
 
 def worker_cache_stats() -> list[dict]:
     """Numba cache hits/misses in fresh pool workers after their warm-up."""
-    from gcalign.app.batch import kernel_cache_stats, local_workers
+    from gcalign.app.batch.backends import local_workers
+    from gcalign.app.batch.runs import kernel_cache_stats
 
     backend = local_workers(2, "align")
     try:
@@ -117,8 +118,8 @@ def main() -> None:
         tmp = Path(tmp)
         sweep = sweep_file(tmp, args.seeds)
         # Populate the on-disk JIT cache first (a no-op when it is already there).
-        subprocess.run([sys.executable, "-c", "from gcalign.app.batch import warm_up; warm_up()"],
-                       check=True)
+        subprocess.run([sys.executable, "-c",
+                        "from gcalign.app.batch.runs import warm_up; warm_up()"], check=True)
         t1, s1 = run(sweep, 1, tmp / "w1.h5")
         t2, s2 = run(sweep, 2, tmp / "w2.h5")
         r1, r2 = per_run_s(tmp / "w1.h5"), per_run_s(tmp / "w2.h5")

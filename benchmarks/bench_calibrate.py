@@ -134,7 +134,8 @@ def main() -> None:
     if "--epoch-only" in sys.argv[1:]:
         print_epochs()
         return
-    from gcalign.app.batch import run_batch, sweep_from_mapping
+    from gcalign.app.batch.engine import run_batch
+    from gcalign.app.batch.sweep import sweep_from_mapping
     from gcalign.app.calibrate.run import simulated_case
     from gcalign.app.data import noise_free
     from gcalign.app.observability.run import flight_truth

@@ -65,19 +65,21 @@ class Runs:
 
     def __init__(self, seeds: int):
         import gcalign
-        from gcalign.app import batch as B
+        from gcalign.app.batch import runs as B
+        from gcalign.app.batch.engine import _tasks
+        from gcalign.app.batch.sweep import load_sweep
 
         self.B = B
         tree = Path(gcalign.__file__).resolve().parents[1]  # the checkout this process runs
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / "mc.yaml"
             path.write_text(sweep_text(seeds + 1, tree), encoding="utf-8")
-            sweep = B.load_sweep(path)
-        self.tasks = B._tasks(sweep, sweep.run_keys())
-        B.runs.warm_up("calibrate")  # what a worker's initializer does
+            sweep = load_sweep(path)
+        self.tasks = _tasks(sweep, sweep.run_keys())
+        B.warm_up("calibrate")  # what a worker's initializer does
         rec = B.run_task(self.tasks[0])  # warm-up: JIT cache, imports, the simulation
         assert rec["status"] == "ok", rec
-        B.runs.run_chunk(self.tasks[:2])  # and the chunk's kernels, if another
+        B.run_chunk(self.tasks[:2])  # and the chunk's kernels, if another
 
     def run(self, k: int) -> dict:
         c0 = usage()
@@ -87,7 +89,7 @@ class Runs:
 
     def chunk(self, k: int) -> dict:
         c0 = usage()
-        recs = self.B.runs.run_chunk(self.tasks[k:k + CHUNK])
+        recs = self.B.run_chunk(self.tasks[k:k + CHUNK])
         assert all(r["status"] == "ok" for r in recs), recs
         return {"per_run": (usage() - c0) * 1e3 / len(recs),
                 "metrics": [r["metrics"] for r in recs]}

@@ -48,7 +48,9 @@ class Runs:
     """The sweep's tasks in this process, and a run of one seed with its floor."""
 
     def __init__(self, seeds: int):
-        from gcalign.app import batch as B
+        from gcalign.app.batch import runs as B
+        from gcalign.app.batch.engine import _tasks
+        from gcalign.app.batch.sweep import load_sweep
 
         self.B = B
         base = resources.files("gcalign.scenarios").joinpath("seed000_moving_full_cycle.yaml")
@@ -56,12 +58,12 @@ class Runs:
             path = Path(tmp) / "mc.yaml"
             path.write_text(f"name: mc\nbase: {Path(str(base)).resolve()}\nseeds: {seeds + 1}\n"
                             "metrics: [error_t3_deg, error_t2_deg]\n", encoding="utf-8")
-            sweep = B.load_sweep(path)
-        self.tasks = B._tasks(sweep, sweep.run_keys())
-        B.runs.warm_up("align")  # what a worker's initializer does
+            sweep = load_sweep(path)
+        self.tasks = _tasks(sweep, sweep.run_keys())
+        B.warm_up("align")  # what a worker's initializer does
         rec = B.run_task(self.tasks[0])  # warm-up: JIT cache, imports, the simulation
         assert rec["status"] == "ok", rec
-        B.runs.run_chunk(self.tasks[:2])  # and the chunk's kernels, if another
+        B.run_chunk(self.tasks[:2])  # and the chunk's kernels, if another
 
     def passes_of(self, task: dict):
         """The floor of a run: its passes on its block (the block prepared beforehand)."""
@@ -74,9 +76,9 @@ class Runs:
         from gcalign.app.data import scenario_data, stream_of
         from gcalign.nav.rotation import euler_to_quat
 
-        sc = self.B.runs._scenario(task)
+        sc = self.B._scenario(task)
         cfg = sc.align or AlignConfig()
-        stream = stream_of(scenario_data(sc, task["seed"], self.B.runs.noise_free_key(sc)))
+        stream = stream_of(scenario_data(sc, task["seed"], self.B.noise_free_key(sc)))
         settings = settings_of(cfg, sc.motion.kind if sc.motion else None)
         tl = timeline(settings, stream.ts, stream.samples)
         w = collect(stream, tl, cfg.aiding)
@@ -104,7 +106,7 @@ class Runs:
     def chunk(self, k: int) -> dict:
         """Seeds k .. k+CHUNK-1 as one worker chunk: CPU ms per run, their metrics."""
         u0, s0, _ = usage()
-        recs = self.B.runs.run_chunk(self.tasks[k:k + CHUNK])
+        recs = self.B.run_chunk(self.tasks[k:k + CHUNK])
         u1, s1, _ = usage()
         assert all(r["status"] == "ok" for r in recs), recs
         return {"per_run": (u1 - u0 + s1 - s0) * 1e3 / len(recs),

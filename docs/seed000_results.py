@@ -61,7 +61,8 @@ class Batch:
 
 def run(name: str, workers: int, runs_dir: Path, resume: bool) -> Batch:
     """Run configs/sweeps/NAME.yaml with a local pool into RUNS_DIR/<sweep>-batch.h5."""
-    from gcalign.app.batch import load_sweep, run_batch
+    from gcalign.app.batch.engine import run_batch
+    from gcalign.app.batch.sweep import load_sweep
 
     sweep = load_sweep(SWEEPS / f"{name}.yaml")
     out = runs_dir / f"{sweep.name}-batch.h5"

@@ -1044,7 +1044,7 @@ def materialize(case: Case, folder) -> list[str]:
         (folder / name).write_bytes(body)
     for name, body in case.files:
         if b"@VKEY" in body:  # a journal of the sweep: the real variant keys
-            from gcalign.app.batch import load_sweep
+            from gcalign.app.batch.sweep import load_sweep
 
             sw = load_sweep(folder / "SW.yaml")
             for v in sw.variants:

@@ -22,7 +22,12 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from gcalign.app import batch as B
+from gcalign.app.batch.backends import WorkerLost, local_workers
+from gcalign.app.batch.engine import _tasks, run_batch
+from gcalign.app.batch.overrides import apply_override
+from gcalign.app.batch.runs import kernel_cache_stats, run_chunk, run_summary, warm_up
+from gcalign.app.batch.store import Journal, journal_path
+from gcalign.app.batch.sweep import load_sweep, sweep_from_mapping
 from gcalign.cli import app
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import parse_scenario
@@ -84,7 +89,7 @@ def reference(tmp_path_factory):
 
 
 def test_grid_is_a_cartesian_product_in_grid_order(tmp_path):
-    sw = B.load_sweep(write_sweep(tmp_path))
+    sw = load_sweep(write_sweep(tmp_path))
     assert len(sw.variants) == 6 and sw.seed_values == range(1, 5)
     assert sw.variants[1].overrides == {"align.mode": "conventional", "align.stages.0.t_z_s": 60}
     assert sw.run_keys()[:5] == [(0, 1), (0, 2), (0, 3), (0, 4), (1, 1)]
@@ -97,7 +102,7 @@ def test_grid_is_a_cartesian_product_in_grid_order(tmp_path):
 
 def test_seed_start_and_command_from_northfind_section(tmp_path):
     base = str(Path(resources.files("gcalign")).parent / "configs/seed001_simulation.yaml")
-    sw = B.sweep_from_mapping({"base": base, "seeds": 3, "seed_start": 10,
+    sw = sweep_from_mapping({"base": base, "seeds": 3, "seed_start": 10,
                                "grid": {"northfind.tilt_deg": [0, 5]}}, "s.yaml", tmp_path)
     assert sw.command == "northfind" and list(sw.seed_values) == [10, 11, 12]
 
@@ -105,21 +110,21 @@ def test_seed_start_and_command_from_northfind_section(tmp_path):
 def test_apply_override_checks_the_schema_not_only_the_mapping():
     base = parse_scenario(copy.deepcopy(SMALL))
     d = copy.deepcopy(SMALL)
-    B.apply_override(d, "align.coarse.error_deg.2", 5.0, base)
+    apply_override(d, "align.coarse.error_deg.2", 5.0, base)
     assert d["align"]["coarse"]["error_deg"] == [1, 1, 5.0]
     with pytest.raises(ScenarioError, match=r"align.mdoe: unknown key; align has: .*mode"):
-        B.apply_override(copy.deepcopy(SMALL), "align.mdoe", "x", base)
+        apply_override(copy.deepcopy(SMALL), "align.mdoe", "x", base)
     with pytest.raises(ScenarioError, match=r"no item 5; align.stages has 1 item\(s\): index 0"):
-        B.apply_override(copy.deepcopy(SMALL), "align.stages.5.t_z_s", 100, base)
+        apply_override(copy.deepcopy(SMALL), "align.stages.5.t_z_s", 100, base)
     with pytest.raises(ScenarioError, match="single value"):
-        B.apply_override(copy.deepcopy(SMALL), "align.t2_s.x", 1, base)
+        apply_override(copy.deepcopy(SMALL), "align.t2_s.x", 1, base)
     # An optional section the base leaves out is still checked against its model.
     no_align = {k: v for k, v in copy.deepcopy(SMALL).items() if k != "align"}
     base2 = parse_scenario(copy.deepcopy(no_align))
     with pytest.raises(ScenarioError, match="align.foo: unknown key"):
-        B.apply_override(copy.deepcopy(no_align), "align.foo", 1, base2)
+        apply_override(copy.deepcopy(no_align), "align.foo", 1, base2)
     d2 = copy.deepcopy(no_align)
-    B.apply_override(d2, "align.mode", "conventional", base2)
+    apply_override(d2, "align.mode", "conventional", base2)
     assert d2["align"] == {"mode": "conventional"}
 
 
@@ -138,7 +143,7 @@ def test_bad_grid_exits_2_before_any_run(tmp_path, grid, message):
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], res.stderr
     assert "Traceback" not in res.output
-    assert not out.exists() and not B.journal_path(out).exists()
+    assert not out.exists() and not journal_path(out).exists()
     checked = runner.invoke(app, ["validate", str(tmp_path / "sweep.yaml")])
     assert checked.exit_code == 2 and checked.stderr == res.stderr  # validate says the same
 
@@ -202,7 +207,7 @@ def test_cases_are_crossed_with_the_grid_and_applied_first(tmp_path):
     overrides and in the canonical order; a grid value is applied after the case's."""
     cases = {"noisy": {}, "quiet": {"imu.gyro": {"bias_dph": [0.01, 0.01, 0.01]},
                                     "imu.accel.vrw_ugrhz": 0, "align.stages.0.t_z_s": 30}}
-    sw = B.load_sweep(write_sweep(tmp_path, cases=cases))
+    sw = load_sweep(write_sweep(tmp_path, cases=cases))
     assert list(sw.grid) == ["case", "align.mode", "align.stages.0.t_z_s"]
     assert sw.grid["case"] == ["noisy", "quiet"] and sw.cases == cases
     assert len(sw.variants) == 12
@@ -260,7 +265,7 @@ def test_batch_equals_single_runs(reference):
     """The batch's numbers are those of the single-run pipeline (`gcalign align --seed`),
     also with the noise-free simulation shared between seeds."""
     summary, sweep, out = reference
-    sw = B.load_sweep(sweep)
+    sw = load_sweep(sweep)
     v = sw.variants[3]
     sc = parse_scenario(copy.deepcopy(v.scenario))
     from gcalign.app.align.run import alignment_summary, run_alignment
@@ -271,7 +276,7 @@ def test_batch_equals_single_runs(reference):
         data = scenario_data(sc, seed)
         s = alignment_summary(run_alignment(sc, data), data, sc.name)
         values.append(s["error_t3_deg"])
-        cached = B.run_summary("align", sc, seed, cache_key="test")
+        cached = run_summary("align", sc, seed, cache_key="test")
         assert cached["error_t3_deg"] == s["error_t3_deg"]  # bit for bit
     st = summary["variants"][3]["stats"]["error_t3_deg"]
     arr = np.array(values)
@@ -286,12 +291,12 @@ def test_noise_free_key_shared_only_where_the_simulation_is_the_same(tmp_path):
     a different motion, site or IMU rate does not."""
     from gcalign.app.batch.runs import noise_free_key
 
-    sw = B.load_sweep(write_sweep(tmp_path, cases={"a": {}, "b": {"imu.gyro.arw_dprh": 0}}))
+    sw = load_sweep(write_sweep(tmp_path, cases={"a": {}, "b": {"imu.gyro.arw_dprh": 0}}))
     keys = {noise_free_key(parse_scenario(copy.deepcopy(v.scenario))) for v in sw.variants}
     assert len(keys) == 1 and None not in keys
     for key, value in (("motion.duration_s", 70), ("site.lat_deg", 30.0), ("imu.rate_hz", 50)):
         d = copy.deepcopy(SMALL)
-        B.apply_override(d, key, value, parse_scenario(copy.deepcopy(SMALL)))
+        apply_override(d, key, value, parse_scenario(copy.deepcopy(SMALL)))
         assert noise_free_key(parse_scenario(d)) not in keys, key
 
 
@@ -303,8 +308,8 @@ def test_same_aggregate_with_one_and_two_workers(reference, tmp_path):
     s = json.loads(res.stdout)
     assert s["variants"] == ref["variants"]
     assert s["runs"] == s["ok"] == 24 and s["failed"] == 0 and s["complete"]
-    assert runs_of(out) == runs_of(ref_out) == B.load_sweep(sweep).run_keys()
-    assert not B.journal_path(out).exists()  # complete: the file holds everything
+    assert runs_of(out) == runs_of(ref_out) == load_sweep(sweep).run_keys()
+    assert not journal_path(out).exists()  # complete: the file holds everything
     with h5py.File(out, "r") as f:
         assert f.attrs["kind"] == "batch"
         assert json.loads(f.attrs["summary_json"])["variants"] == ref["variants"]
@@ -325,16 +330,16 @@ def test_same_aggregate_with_one_and_two_workers(reference, tmp_path):
 def test_numba_cache_is_loaded_not_compiled_in_fresh_processes():
     """A fresh process (a single CLI run) loads the align kernels from the on-disk cache;
     pool workers forked after the parent's warm-up inherit them: no cache load, no compile."""
-    B.warm_up()  # populates the on-disk cache if this checkout has none yet
-    code = "import json; from gcalign.app.batch import warm_up; print(json.dumps(warm_up()))"
+    warm_up()  # populates the on-disk cache if this checkout has none yet
+    code = "import json; from gcalign.app.batch.runs import warm_up; print(json.dumps(warm_up()))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     stats = json.loads(out.stdout)
     assert stats["cache_hits"] >= 1 and stats["cache_misses"] == 0, stats
-    backend = B.local_workers(1, "align")
-    parent = B.kernel_cache_stats()
+    backend = local_workers(1, "align")
+    parent = kernel_cache_stats()
     try:
-        for s in [backend.executor.submit(B.warm_up).result()]:
+        for s in [backend.executor.submit(warm_up).result()]:
             if backend.start_method == "fork":  # inherited: nothing new loaded or compiled
                 assert (s["cache_hits"], s["cache_misses"]) == (
                     parent["cache_hits"], parent["cache_misses"]), (s, parent)
@@ -377,9 +382,9 @@ class _FlakyBackend:
         self.submitted.append([(t["variant"], t["seed"]) for t in chunk])
         fut = Future()
         if any((t["variant"], t["seed"]) == (0, 2) for t in chunk):
-            fut.set_exception(B.WorkerLost("killed"))
+            fut.set_exception(WorkerLost("killed"))
         else:
-            fut.set_result(B.run_chunk(chunk))
+            fut.set_result(run_chunk(chunk))
         return fut
 
     def wait(self, futures, timeout):
@@ -393,10 +398,10 @@ class _FlakyBackend:
 
 
 def test_a_dying_worker_costs_only_its_own_run(tmp_path):
-    sw = B.load_sweep(write_sweep(tmp_path, grid={"align.mode": ["full-cycle"]}, seeds=6,
+    sw = load_sweep(write_sweep(tmp_path, grid={"align.mode": ["full-cycle"]}, seeds=6,
                                   metrics=["error_t3_deg"]))
     fake = _FlakyBackend()
-    res = B.run_batch(sw, tmp_path / "k.h5", backend=fake, chunk_size=3)
+    res = run_batch(sw, tmp_path / "k.h5", backend=fake, chunk_size=3)
     s = res.summary
     assert (s["ok"], s["failed"]) == (5, 1)
     assert "worker process died" in s["failures"][0]["error"] and s["failures"][0]["seed"] == 2
@@ -409,19 +414,19 @@ def test_a_dying_worker_costs_only_its_own_run(tmp_path):
 
 
 def test_resume_skips_a_torn_journal_line(tmp_path):
-    sw = B.load_sweep(write_sweep(tmp_path, grid={"align.mode": ["full-cycle"]}, seeds=5,
+    sw = load_sweep(write_sweep(tmp_path, grid={"align.mode": ["full-cycle"]}, seeds=5,
                                   metrics=["error_t3_deg"]))
     out = tmp_path / "t.h5"
-    tasks = B._tasks(sw, sw.run_keys()[:3])
-    journal = B.Journal(B.journal_path(out), {"type": "header"})
-    journal.append(B.run_chunk(tasks))
+    tasks = _tasks(sw, sw.run_keys()[:3])
+    journal = Journal(journal_path(out), {"type": "header"})
+    journal.append(run_chunk(tasks))
     journal.close()
-    with open(B.journal_path(out), "a") as f:
+    with open(journal_path(out), "a") as f:
         f.write('{"type": "run", "variant": 0, "se')  # killed mid-write
-    res = B.run_batch(sw, out, workers=1, resume=True)
+    res = run_batch(sw, out, workers=1, resume=True)
     assert res.reused == 3 and res.summary["ok"] == 5
     assert runs_of(out) == sw.run_keys()
-    fresh = B.run_batch(sw, tmp_path / "u.h5", workers=1)
+    fresh = run_batch(sw, tmp_path / "u.h5", workers=1)
     assert fresh.summary["variants"] == res.summary["variants"]
 
 
@@ -435,8 +440,8 @@ def test_resume_from_the_file_with_more_seeds_reuses_what_is_there(reference, tm
     assert res.exit_code == 0, res.output
     assert "24 of 30 run(s) already finished" in res.stderr
     s = json.loads(res.stdout)
-    assert s["runs"] == s["ok"] == 30 and runs_of(out) == B.load_sweep(bigger).run_keys()
-    fresh = B.run_batch(B.load_sweep(bigger), tmp_path / "fresh.h5", workers=2)
+    assert s["runs"] == s["ok"] == 30 and runs_of(out) == load_sweep(bigger).run_keys()
+    fresh = run_batch(load_sweep(bigger), tmp_path / "fresh.h5", workers=2)
     assert fresh.summary["variants"] == s["variants"]
 
 
@@ -450,12 +455,12 @@ def _free_port() -> int:
 def test_unreachable_scheduler_fails_fast_and_keeps_the_journal(tmp_path):
     sw_path = write_sweep(tmp_path, grid={"align.mode": ["full-cycle"]}, seeds=3,
                           metrics=["error_t3_deg"])
-    sw = B.load_sweep(sw_path)
+    sw = load_sweep(sw_path)
     out = tmp_path / "d.h5"
-    journal = B.Journal(B.journal_path(out), {"type": "header"})
-    journal.append(B.run_chunk(B._tasks(sw, sw.run_keys()[:1])))
+    journal = Journal(journal_path(out), {"type": "header"})
+    journal.append(run_chunk(_tasks(sw, sw.run_keys()[:1])))
     journal.close()
-    before = B.journal_path(out).read_bytes()
+    before = journal_path(out).read_bytes()
     t0 = time.monotonic()
     res = batch_cli(sw_path, "--scheduler", f"tcp://127.0.0.1:{_free_port()}", "-o", out,
                     "--resume")
@@ -463,7 +468,7 @@ def test_unreachable_scheduler_fails_fast_and_keeps_the_journal(tmp_path):
     assert time.monotonic() - t0 < 120  # no hang (the time bound: benchmarks/bench_batch.py)
     assert "cannot reach the Dask scheduler at tcp://127.0.0.1:" in res.stderr
     assert len(res.stderr.strip().splitlines()) <= 2 and "Traceback" not in res.output
-    assert B.journal_path(out).read_bytes() == before and not out.exists()
+    assert journal_path(out).read_bytes() == before and not out.exists()
 
 
 @pytest.mark.slow
@@ -478,7 +483,7 @@ def test_dask_cluster_gives_the_local_numbers(reference, tmp_path):
     s = json.loads(res.stdout)
     assert s["executor"].startswith("Dask scheduler tcp://127.0.0.1:")
     assert s["variants"] == ref["variants"]
-    assert runs_of(out) == B.load_sweep(sweep).run_keys()
+    assert runs_of(out) == load_sweep(sweep).run_keys()
 
 
 def test_northfind_sweep(tmp_path):

@@ -722,7 +722,8 @@ def test_a_terminated_pool_worker_dies_even_under_the_commands_sigterm_handler(t
 _DIES_AT_SEED_2 = """
 import json, os
 import gcalign.app.batch.backends as K
-from gcalign.app.batch import load_sweep, run_batch
+from gcalign.app.batch.engine import run_batch
+from gcalign.app.batch.sweep import load_sweep
 
 real = K.run_chunk
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gcalign.app.batch import load_sweep
+from gcalign.app.batch.sweep import load_sweep
 from gcalign.app.data import scenario_data
 from gcalign.io.scenario import load_scenario, parse_scenario
 

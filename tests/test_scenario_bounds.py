@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from gcalign.app.batch import load_sweep
+from gcalign.app.batch.sweep import load_sweep
 from gcalign.cli import app
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario import parse_scenario

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import typer
 
-from gcalign.app import batch as engine  # its parts load when used
+from gcalign.app.batch import COMMAND
 from gcalign.cli.base import app, consoles, emit_json, user_errors
 from gcalign.cli.options import Json, Sets
 from gcalign.errors import ScenarioError
@@ -56,7 +56,7 @@ def load_batch(files: list[Path], command: str | None, seeds: int | None,
     """One sweep file, or a plain list of scenario files (each file a variant). On a sweep
     file, --seeds and --seed-start replace the file's (said in `notes`); --set changes the
     base scenario of a sweep, or every file of a list."""
-    from gcalign.app.batch.sweep import sweep_from_files
+    from gcalign.app.batch.sweep import sweep_from_files, sweep_from_mapping
     from gcalign.io.scenario.loader import parse_override, read_yaml
 
     pairs = [parse_override(item) for item in sets or []]
@@ -77,8 +77,8 @@ def load_batch(files: list[Path], command: str | None, seeds: int | None,
                                      f"({data.get(key, 1)})")
                     data[key] = value
                     text += f"\n# command line: {option} {value}\n"
-            return engine.sweep_from_mapping(data, str(files[0]), files[0].parent, text,
-                                             default_name=files[0].stem, sets=pairs)
+            return sweep_from_mapping(data, str(files[0]), files[0].parent, text,
+                                      default_name=files[0].stem, sets=pairs)
     return sweep_from_files(files, command, 1 if seeds is None else seeds,
                             1 if seed_start is None else seed_start, metrics or None, pairs)
 
@@ -163,6 +163,7 @@ def batch(
             "--workers: applies to the local process pool; with --scheduler "
             "the cluster's workers run the batch (give one or the other)"
         )
+    from gcalign.app.batch.engine import run_batch
     from gcalign.cli.common import output_name
 
     notes: list[str] = []
@@ -189,7 +190,7 @@ def batch(
     if bar is not None:
         bar.start()
     try:
-        result = engine.run_batch(
+        result = run_batch(
             sw,
             out,
             workers=workers,
@@ -203,7 +204,7 @@ def batch(
             bar.stop()
     summary = result.summary
     sys.stderr.write(f"wrote {out}\n")
-    consoles(as_json).print(engine.COMMAND.table(summary))
+    consoles(as_json).print(COMMAND.table(summary))
     if as_json:
         emit_json({**summary, "warnings": list(sw.warnings)})
     if summary["failed"]:  # the file records them: a result, but not a success

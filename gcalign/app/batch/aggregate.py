@@ -6,21 +6,14 @@ the same numbers whatever the number of workers or the order in which runs finis
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 
 from gcalign.app.batch.sweep import Sweep
+from gcalign.schema import plain
 
 STATS = ("mean", "std", "rms", "median", "p05", "p95")
-
-
-def _finite(x):
-    """JSON-safe numbers: NaN -> None."""
-    if isinstance(x, list):
-        return [_finite(v) for v in x]
-    return None if x is None or not math.isfinite(x) else float(x)
 
 
 def components(command: str, metric: str, k: int | None) -> list[str] | None:
@@ -73,11 +66,6 @@ def stats_of(values: np.ndarray) -> dict:
     }
 
 
-def _as_py(a):
-    a = np.asarray(a, dtype=float)
-    return _finite(a.tolist()) if a.ndim else _finite(float(a))
-
-
 def aggregate(sweep: Sweep, records: dict[tuple[int, int], dict]) -> list[dict]:
     """Per-variant statistics of every metric, per vector component, from the records of
     finished runs (keyed by (variant, seed)); canonical order, so reproducible."""
@@ -102,7 +90,7 @@ def aggregate(sweep: Sweep, records: dict[tuple[int, int], dict]) -> list[dict]:
                 arr = np.zeros((0, k) if k else (0,))
             st = stats_of(arr)
             stats[m] = {"n": len(vals), "components": components(sweep.command, m, k),
-                        "units": metric_units(m), **{s: _as_py(st[s]) for s in STATS}}
+                        "units": metric_units(m), **{s: plain(st[s]) for s in STATS}}
         out.append(entry)
     return out
 

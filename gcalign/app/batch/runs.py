@@ -113,20 +113,32 @@ def run_task(task: dict) -> dict:
     Never raises for a failing run: the record says ``status: failed`` and the error.
     """
     t0 = time.perf_counter()
+    outcome: dict | Exception
+    try:
+        sc = _scenario(task)
+        outcome = run_summary(task["command"], sc, task["seed"], noise_free_key(sc),
+                              task["vkey"])
+    except Exception as err:  # a failing run is recorded, the others go on
+        outcome = err
+    rec = _record(task, outcome)
+    rec["wall_s"] = time.perf_counter() - t0
+    return rec
+
+
+def _record(task: dict, outcome: dict | Exception) -> dict:
+    """The record of a task's run from its summary, or from the error that ended it."""
     rec = {"variant": task["variant"], "vkey": task["vkey"], "seed": task["seed"],
            "status": "ok", "metrics": {}, "error": ""}
     try:
-        sc = _scenario(task)
-        summary = run_summary(task["command"], sc, task["seed"], noise_free_key(sc),
-                              task["vkey"])
-        rec["metrics"] = {m: metric_value(summary, m) for m in task["metrics"]}
+        if isinstance(outcome, Exception):
+            raise outcome
+        rec["metrics"] = {m: metric_value(outcome, m) for m in task["metrics"]}
     except MetricError as err:
-        rec.update(status="bad-metric", error=str(err), metrics={})
-    except Exception as err:  # a failing run is recorded, the others go on
+        rec.update(status="bad-metric", error=str(err))
+    except Exception as err:  # noqa: BLE001 - a failing run is recorded, the others go on
         msg = str(err).strip().replace("\n", "; ")
-        rec.update(status="failed", metrics={},
+        rec.update(status="failed",
                    error=msg if isinstance(err, GcalignError) else f"{type(err).__name__}: {msg}")
-    rec["wall_s"] = time.perf_counter() - t0
     return rec
 
 
@@ -197,8 +209,6 @@ def run_seeds(tasks: list[dict]) -> list[dict] | None:
     if not room.lockstep_ok(sc):
         return None
     keep_freed_memory()
-    recs = [{"variant": t["variant"], "vkey": t["vkey"], "seed": t["seed"], "status": "ok",
-             "metrics": {}, "error": ""} for t in tasks]
     results: list[Any] = [None] * len(tasks)
     todo = []
     for i, t in enumerate(tasks):  # in checked_execute's order: the seed, the preflight
@@ -216,17 +226,7 @@ def run_seeds(tasks: list[dict]) -> list[dict] | None:
         for i, res in zip(todo, room.summaries_of_seeds(sc, [tasks[i]["seed"] for i in todo],
                                                         noise_free_key(sc)), strict=True):
             results[i] = res
-    for rec, t, res in zip(recs, tasks, results, strict=True):
-        try:
-            if isinstance(res, Exception):
-                raise res
-            rec["metrics"] = {m: metric_value(res, m) for m in t["metrics"]}
-        except MetricError as err:
-            rec.update(status="bad-metric", error=str(err), metrics={})
-        except Exception as err:  # noqa: BLE001 - a failing run is recorded, as run_task does
-            msg = str(err).strip().replace("\n", "; ")
-            rec.update(status="failed", metrics={}, error=msg if isinstance(
-                err, GcalignError) else f"{type(err).__name__}: {msg}")
+    recs = [_record(t, res) for t, res in zip(tasks, results, strict=True)]
     wall = (time.perf_counter() - t0) / len(tasks)
     for rec in recs:
         rec["wall_s"] = wall

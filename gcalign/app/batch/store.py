@@ -19,7 +19,7 @@ import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
 import numpy as np
 
@@ -149,11 +149,11 @@ class OutputLock:
     def __enter__(self) -> OutputLock:
         import fcntl
 
+        from gcalign.io.results import write_error
+
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as err:
-            from gcalign.io.results import write_error
-
             raise write_error(self.output, err) from None
         if self.path.resolve() in _HELD_LOCKS.values():
             raise GcalignError(f"{self.output}: another batch (pid {os.getpid()}, this "
@@ -163,16 +163,12 @@ class OutputLock:
             try:
                 fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
             except OSError as err:
-                from gcalign.io.results import write_error
-
                 raise write_error(self.output, err) from None
             try:
                 fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError as err:
                 if err.errno not in (errno.EACCES, errno.EAGAIN):
                     os.close(fd)
-                    from gcalign.io.results import write_error
-
                     raise write_error(self.output, err) from None
                 holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
                 os.close(fd)
@@ -189,8 +185,6 @@ class OutputLock:
                 except OSError as err:  # a full disk: no lock file left either
                     self.path.unlink(missing_ok=True)
                     os.close(fd)
-                    from gcalign.io.results import write_error
-
                     raise write_error(self.output, err) from None
                 self.fd = fd
                 _HELD_LOCKS[fd] = self.path.resolve()
@@ -241,68 +235,56 @@ def read_journal(path: Path, metrics: Iterable[str] | None = None,
                  log=None) -> list[dict]:
     """Run records of a journal. Lines that are not valid records (torn by a SIGKILL,
     garbage, edited, NaN or missing metrics) are skipped, and `log` is told how many."""
-    out = []
-    skipped = 0
     metrics = list(metrics) if metrics is not None else None
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
-            for line in f:
-                if not line.strip():
-                    continue
-                try:
-                    obj = json.loads(line)
-                except ValueError:
-                    skipped += 1
-                    continue
-                if isinstance(obj, dict) and obj.get("type") == "header":
-                    continue
-                if valid_record(obj, metrics):
-                    out.append(obj)
-                else:
-                    skipped += 1
+            lines = [line for line in f if line.strip()]
     except OSError as err:
         raise ScenarioError(f"{path}: cannot read the journal ({err.strerror or err})") from None
-    if skipped and log is not None:
-        log(f"{path}: skipped {skipped} line(s) that are not valid run records (torn, damaged "
-            "or edited); those runs run again")
+    records = [r for r in map(_loads, lines) if not (isinstance(r, dict)
+                                                    and r.get("type") == "header")]
+    out = [r for r in records if valid_record(r, metrics)]
+    if len(out) < len(records) and log is not None:
+        log(f"{path}: skipped {len(records) - len(out)} line(s) that are not valid run records "
+            "(torn, damaged or edited); those runs run again")
     return out
+
+
+def _loads(line: str) -> Any:
+    try:
+        return json.loads(line)
+    except ValueError:  # (not a record: skipped)
+        return None
 
 
 def read_runs_h5(path: Path) -> list[dict]:
     """Run records from a batch results file (``/batch/runs``)."""
-    try:
-        return _runs_h5(path)
-    except (KeyError, TypeError, ValueError, IndexError, OSError) as err:
-        raise ScenarioError(f"{path}: /batch/runs is damaged ({type(err).__name__}: "
-                            f"{str(err)[:60]})") from None
-
-
-def _runs_h5(path: Path) -> list[dict]:
+    from gcalign.app.plots import _s
     from gcalign.io import results
 
-    with results.open_results(path) as f:
-        if "batch/runs" not in f:
-            raise ScenarioError(f"{path}: not a batch results file (no /batch/runs)")
-        g = f["batch/runs"]
-        metrics = {m: g["metrics"][m][()] for m in g["metrics"]}
-        lengths = g["metrics"].attrs
-        recs = []
-        for i in range(g["seed"].shape[0]):
-            status = _s(g["status"][i])
-            vals = {}
-            if status == "ok":
-                for m, arr in metrics.items():
-                    x = arr[i]
-                    n = int(lengths.get(m + ".length", -1))
-                    vals[m] = float(x) if n < 0 else [float(v) for v in x[:n]]
-            recs.append({"variant": int(g["variant"][i]), "vkey": _s(g["vkey"][i]),
-                         "seed": int(g["seed"][i]), "status": status, "metrics": vals,
-                         "error": _s(g["error"][i]), "wall_s": float(g["wall_s"][i])})
+    try:
+        with results.open_results(path) as f:
+            if "batch/runs" not in f:
+                raise ScenarioError(f"{path}: not a batch results file (no /batch/runs)")
+            g = f["batch/runs"]
+            metrics = {m: g["metrics"][m][()] for m in g["metrics"]}
+            lengths = g["metrics"].attrs
+            recs = []
+            for i in range(g["seed"].shape[0]):
+                status = _s(g["status"][i])
+                vals = {}
+                if status == "ok":
+                    for m, arr in metrics.items():
+                        n = int(lengths.get(m + ".length", -1))
+                        vals[m] = float(arr[i]) if n < 0 else [float(v) for v in arr[i][:n]]
+                recs.append({"variant": int(g["variant"][i]), "vkey": _s(g["vkey"][i]),
+                             "seed": int(g["seed"][i]), "status": status, "metrics": vals,
+                             "error": _s(g["error"][i]), "wall_s": float(g["wall_s"][i])})
+    except (KeyError, TypeError, ValueError, IndexError, OSError) as err:
+        # (the refusals of open_results and of a file without /batch/runs too)
+        raise ScenarioError(f"{path}: /batch/runs is damaged ({type(err).__name__}: "
+                            f"{str(err)[:60]})") from None
     return recs
-
-
-def _s(x) -> str:
-    return x.decode() if isinstance(x, bytes) else str(x)
 
 
 def write_batch_h5(output: Path, sweep: Sweep, records: dict, summary: dict) -> None:
@@ -331,14 +313,12 @@ def write_batch_h5(output: Path, sweep: Sweep, records: dict, summary: dict) -> 
         r = b.create_group("runs")
         r.attrs["description"] = ("one row per finished run, sorted by (variant, seed); "
                                   "metric values NaN where the run failed")
-        str_dt = h5py.string_dtype()
         results.put(r, "variant", np.array([k[0] for k in keys], dtype=np.int32), "1")
         results.put(r, "seed", np.array([k[1] for k in keys], dtype=np.int64), "1")
         for name, what in (("status", "ok | failed"), ("error", "error message ('' if ok)"),
                            ("vkey", "hash of the variant's command, metrics and scenario")):
-            ds = r.create_dataset(name, data=np.array([x[name] for x in recs], dtype=object),
-                                  dtype=str_dt)
-            ds.attrs["units"], ds.attrs["description"] = "none", what
+            results.put(r, name, np.array([x[name] for x in recs], dtype=object), "none",
+                        create={"dtype": h5py.string_dtype()}, description=what)
         results.put(r, "wall_s", np.array([x.get("wall_s", np.nan) for x in recs]), "s")
         mg = r.create_group("metrics")
         for m in sweep.metrics:
@@ -417,12 +397,3 @@ def previous_records(sweep: Sweep, output: Path, log=None) -> tuple[dict, str]:
         kept[(vi, r["seed"])] = r
     return kept, where
 
-
-def read_batch(path: Path) -> tuple[dict, list[dict]]:
-    """Summary and run records of a batch results file."""
-    from gcalign.io import results
-
-    kind, summary, _ = results.read_summary(path)
-    if kind != "batch":
-        raise ScenarioError(f"{path}: a {kind!r} results file, not a batch")
-    return summary, read_runs_h5(path)
