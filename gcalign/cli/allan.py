@@ -65,7 +65,7 @@ def allan(
     data, _ = data_file(source, ("earth",))
     text = None if data is None else yaml.safe_dump(data)
     overrides = {"start_s": start, "duration_s": duration}
-    loaded = load_with_overrides(source, "", "allan", overrides, data=data, text=text,
+    loaded = load_with_overrides("allan", source, overrides, data=data, text=text,
                                  sets=set_, recorded=given)
     if as_json and scenario_out == "-":
         raise ScenarioError("--scenario: '-' prints the scenario on stdout, where --json "

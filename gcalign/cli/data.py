@@ -50,7 +50,7 @@ def simulate(
     set_: opt.Sets = None,
 ):
     """Simulate truth and IMU data; write /truth and /imu."""
-    run_and_show("simulate", load_with_overrides(scenario, "", "", {}, sets=set_), seed, output,
+    run_and_show("simulate", load_with_overrides("simulate", scenario, sets=set_), seed, output,
                  as_json)
 
 
@@ -104,7 +104,7 @@ def navigate(
                             "--imu-file FILE")
     data, stored = data_file(source, ("earth", "navigation", "output"))
     text = None if data is None else stored or yaml.safe_dump(data)
-    loaded = load_with_overrides(source, "", "navigation", overrides, data=data, text=text,
+    loaded = load_with_overrides("navigate", source, overrides, data=data, text=text,
                                  sets=set_, recorded=given_options)
     run_and_show("navigate", loaded, seed, output, as_json, init=init)
 
@@ -161,7 +161,7 @@ def validate(
     data = read_yaml(scenario)
     if isinstance(data, dict) and "base" in data:
         return _validate_sweep(scenario, set_, as_json)
-    sc = load_with_overrides(scenario, "", "", {}, sets=set_, recorded=given).scenario
+    sc = load_with_overrides(None, scenario, sets=set_, recorded=given).scenario
     inputs = preflight(sc)  # the checks every command runs first, for every section
     rows = resolved_rows(sc, None if inputs.recording is None else inputs.recording.imu)
     sections = [c.section for c in COMMANDS.values() if c.section]

@@ -6,14 +6,10 @@ from pathlib import Path
 
 import typer
 
-from gcalign.app.registry import COMMANDS
 from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
-
-BUILTIN = COMMANDS["northfind"].builtin or ""
-
 
 
 def parse_sweep(text: str | None) -> dict | None:
@@ -82,6 +78,6 @@ def northfind(
         "sweep": parse_sweep(sweep),
         "repeats": repeats,
     }
-    loaded = load_with_overrides(scenario, BUILTIN, "northfind", overrides, _one_azimuth_source,
+    loaded = load_with_overrides("northfind", scenario, overrides, _one_azimuth_source,
                                  sets=set_)
     run_and_show("northfind", loaded, seed, output, as_json)

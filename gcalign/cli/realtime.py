@@ -7,13 +7,9 @@ from pathlib import Path
 
 import typer
 
-from gcalign.app.registry import COMMANDS
 from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
-
-BUILTIN = COMMANDS["realtime"].builtin or ""
-
 
 
 @app.command()
@@ -35,5 +31,5 @@ def realtime(
 ):
     """Attitude at sync pulses: filter delay T + Δt, and prediction to the pulse time."""
     overrides = {"predictors": list(predictor) if predictor else None}
-    loaded = load_with_overrides(scenario, BUILTIN, "realtime", overrides, sets=set_)
+    loaded = load_with_overrides("realtime", scenario, overrides, sets=set_)
     run_and_show("realtime", loaded, seed, output, as_json)
