@@ -6,15 +6,16 @@ from pathlib import Path
 
 import typer
 
+from gcalign.choices import MATCHINGS, MEASUREMENTS, TRUTH_SOURCES, listed
 from gcalign.cli import options as opt
 from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show
 from gcalign.errors import ScenarioError
 
 SCENARIO_HELP = "Scenario YAML; without it, the built-in seed 002 designed 590 s take-off."
-MEASURE_HELP = "DGNSS measurement: velocity | position | both."
-MATCHING_HELP = ("Transfer alignment (align.mode: transfer): attitude+velocity | velocity | "
-                 "attitude (sets align.transfer.matching).")
+MEASURE_HELP = f"DGNSS measurement: {listed(MEASUREMENTS)}."
+MATCHING_HELP = (f"Transfer alignment (align.mode: transfer): {listed(MATCHINGS)} (sets "
+                 "align.transfer.matching).")
 
 
 @app.command()
@@ -28,7 +29,7 @@ def calibrate(
     smoother: bool | None = typer.Option(
         None, "--smoother/--no-smoother", help="Also run the RTS smoother (post-flight)."),
     truth: str | None = typer.Option(
-        None, "--truth", help="Injected errors: scenario | draw (from P0 with the seed)."),
+        None, "--truth", help=f"Injected errors: {listed(TRUTH_SOURCES)} (from P0 with the seed)."),
     seed: opt.Seed = None,
     output: opt.Output = None,
     as_json: opt.Json = False,

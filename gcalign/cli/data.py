@@ -8,6 +8,7 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
+from gcalign.choices import VERTICAL_CHOICES, listed
 from gcalign.cli import options as opt
 from gcalign.cli.base import app, consoles, emit_json, user_errors
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show, warn
@@ -66,7 +67,7 @@ def navigate(
         None, "--init", help="Start from: truth | header | an alignment results file (its "
         "attitude at T3, at T3's data time). Default: truth, or the header of recorded data."),
     vertical: str | None = typer.Option(
-        None, "--vertical", help="Vertical channel: auto | free | hold | damped."),
+        None, "--vertical", help=f"Vertical channel: {listed(VERTICAL_CHOICES)}."),
     start: float | None = typer.Option(None, "--start", help="Data time to start at (s)."),
     duration: float | None = typer.Option(None, "--duration", help="How long to navigate (s)."),
     output: opt.Output = None,

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import typer
 
+from gcalign.choices import AZIMUTH_METHODS_ALL, listed
 from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
@@ -47,10 +48,7 @@ def northfind(
         "0…355°, 10° tilt).",
     ),
     method: list[str] | None = typer.Option(
-        None,
-        "--method",
-        help="coordinate | vector | naive | none | vector_literal (repeat the option for several).",
-    ),
+        None, "--method", help=f"{listed(AZIMUTH_METHODS_ALL)} (repeat the option for several)."),
     positions: int | None = typer.Option(None, "--positions", help="Table positions per turn."),
     dwell: float | None = typer.Option(None, "--dwell", help="Dwell per position (s)."),
     tilt: float | None = typer.Option(None, "--tilt", help="Table tilt (deg)."),

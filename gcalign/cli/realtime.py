@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 
+from gcalign.choices import PREDICTORS, listed
 from gcalign.cli.base import app, user_errors
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
@@ -21,9 +22,8 @@ def realtime(
         "setting and a 13th case with asynchronous pulses.",
     ),
     predictor: list[str] | None = typer.Option(
-        None, "--predictor",
-        help="none | taylor | kalman-ls (repeat the option for several; default all three).",
-    ),
+        None, "--predictor", help=f"{listed(PREDICTORS)} (repeat the option for several; "
+        "default all three)."),
     seed: Seed = None,
     output: Output = None,
     as_json: Json = False,
