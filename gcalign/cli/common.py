@@ -26,6 +26,7 @@ import os
 import re
 import shutil
 import sys
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -325,8 +326,6 @@ class ProgressBar:
     it at once (also into a pipe or a log, where it stays), ``never`` turns it off."""
 
     def __init__(self, title: str, delay_s: float = 1.0):
-        import threading
-
         mode = os.environ.get("GCALIGN_PROGRESS", "auto").lower()
         self.enabled = mode == "always" or (mode == "auto" and sys.stderr.isatty())
         self.force = mode == "always"
@@ -363,8 +362,6 @@ class ProgressBar:
             self.bar.console.print(text, highlight=False)
 
     def __call__(self, done: float, total: float, what: str = "") -> None:
-        import threading
-
         if not self.enabled or total <= 0:
             return
         with self.lock:

@@ -17,12 +17,8 @@ def plot(
     file: Path = typer.Argument(..., help="A gcalign results file (.h5), or recorded IMU "
                                 "data (PSINS .imu, CSV; .gz/.xz): its IMU output."),
     out_dir: str | None = typer.Option(  # a str: a Path would turn '' into '.'
-        None,
-        "-o",
-        "--output",
-        help="Folder for the PNG files (default: FILE without its "
-        "suffixes + '_plots/', next to the file).",
-    ),
+        None, "-o", "--output", help="Folder for the PNG files (default: FILE without its "
+        "suffixes + '_plots/', next to the file)."),
     as_json: Json = False,
 ):
     """Write PNG figures: every figure the command that wrote FILE draws (alignment error

@@ -17,10 +17,8 @@ from gcalign.cli.options import Json, Output, Seed, Sets
 @user_errors
 def realtime(
     scenario: Path | None = typer.Argument(
-        None,
-        help="Scenario YAML; without it, the seed's Table 1 (12 cases) in its semi-physical "
-        "setting and a 13th case with asynchronous pulses.",
-    ),
+        None, help="Scenario YAML; without it, the seed's Table 1 (12 cases) in its "
+        "semi-physical setting and a 13th case with asynchronous pulses."),
     predictor: list[str] | None = typer.Option(
         None, "--predictor", help=f"{listed(PREDICTORS)} (repeat the option for several; "
         "default all three)."),
