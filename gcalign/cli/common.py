@@ -146,9 +146,7 @@ def _apply_recorded(data: dict, inv: Recorded, applied: list) -> None:
                              "format": reference_format_of(inv.reference)}
         applied.append(("reference", inv.reference))
     if inv.site:
-        site = dict(data.get("site") or {}) if isinstance(data.get("site"), dict) else {}
-        site.update(inv.site)
-        data["site"] = site
+        data["site"] = {**(data["site"] if isinstance(data.get("site"), dict) else {}), **inv.site}
         applied.extend((f"site.{k}", v) for k, v in inv.site.items())
 
 

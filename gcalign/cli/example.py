@@ -17,11 +17,6 @@ from gcalign.cli.common import builtin_text
 from gcalign.errors import ScenarioError
 
 
-def builtins() -> dict[str, str]:
-    """Command -> its built-in scenario file (package data), from the registry."""
-    return {name: c.builtin for name, c in COMMANDS.items() if c.builtin}
-
-
 def first_comment(text: str) -> str:
     """The first sentence of a scenario file's leading comment: what it is."""
     lines = []
@@ -41,7 +36,7 @@ def example(
     as_json: bool = typer.Option(False, "--json", help="The list as one JSON object."),
 ):
     """Print a built-in scenario (YAML) to start your own from, or list them."""
-    known = builtins()
+    known = {cmd: c.builtin for cmd, c in COMMANDS.items() if c.builtin}  # -> package data
     if name is None:
         from gcalign.app.report import kv_table
 
