@@ -24,14 +24,13 @@ def data_file(source: Path | None, keep: tuple[str, ...]) -> tuple[dict | None, 
     results file keeps the name of the scenario that made it and its sections `keep`."""
     import yaml
 
-    from gcalign.io import results
     from gcalign.io.imu_files import data_suffix
-    from gcalign.io.results import HDF5_SUFFIXES
+    from gcalign.io.results import HDF5_SUFFIXES, read_scenario_yaml
 
     suffix = "" if source is None else data_suffix(source)
     if source is None or suffix not in DATA_SUFFIXES | HDF5_SUFFIXES:
         return None, ""
-    text = results.read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
+    text = read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
     stored = yaml.safe_load(text) if text else None
     name = stored.get("name") if isinstance(stored, dict) else None
     name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.name.split(".")[0]) or "data"
@@ -119,7 +118,6 @@ def show(
     """Print the summary of a results file again, from the file alone."""
     from gcalign.app.checked import read_checked
     from gcalign.app.readback import summary_table
-    from gcalign.errors import ScenarioError
 
     kind, summary, attrs = read_checked(file)
     console = consoles(as_json)
