@@ -9,7 +9,7 @@ import typer
 
 from gcalign.choices import ALIGN_MODES_ALL, COMPENSATIONS, listed
 from gcalign.cli import options as opt
-from gcalign.cli.base import app, user_errors
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show
 from gcalign.errors import ScenarioError
 
@@ -47,7 +47,6 @@ def passes_into_stages(section: dict, given: dict) -> None:
 
 
 @app.command()
-@user_errors
 def align(
     scenario: Path | None = typer.Argument(
         None, help="Scenario YAML; without it, the built-in seed 000 §5.3 moving-base case "

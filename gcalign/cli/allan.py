@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from gcalign.cli import options as opt
-from gcalign.cli.base import app, user_errors
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
@@ -19,7 +19,6 @@ SCENARIO_HELP = ("Write a static scenario with the fitted noise as its imu secti
 
 
 @app.command()
-@user_errors
 def allan(
     source: Path | None = typer.Argument(
         None, help="A recording (PSINS .imu, CSV/text, PSINS MAT, KF-GINS; .gz/.xz "

@@ -8,7 +8,7 @@ import typer
 
 from gcalign.choices import MATCHINGS, MEASUREMENTS, TRUTH_SOURCES, listed
 from gcalign.cli import options as opt
-from gcalign.cli.base import app, user_errors
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show
 from gcalign.errors import ScenarioError
 
@@ -19,7 +19,6 @@ MATCHING_HELP = (f"Transfer alignment (align.mode: transfer): {listed(MATCHINGS)
 
 
 @app.command()
-@user_errors
 def calibrate(
     scenario: Path | None = typer.Argument(None, help=SCENARIO_HELP),
     measure: str | None = typer.Option(None, "--measure", help=MEASURE_HELP),
@@ -51,7 +50,6 @@ def calibrate(
 
 
 @app.command()
-@user_errors
 def observability(
     scenario: Path | None = typer.Argument(None, help=SCENARIO_HELP),
     measure: str | None = typer.Option(None, "--measure", help=MEASURE_HELP),

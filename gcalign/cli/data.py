@@ -10,7 +10,7 @@ import typer
 from gcalign.app.registry import COMMANDS
 from gcalign.choices import VERTICAL_CHOICES, listed
 from gcalign.cli import options as opt
-from gcalign.cli.base import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show, warn
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
@@ -41,7 +41,6 @@ def data_file(source: Path | None, keep: tuple[str, ...]) -> tuple[dict | None, 
 
 
 @app.command()
-@user_errors
 def simulate(
     scenario: Path = typer.Argument(..., help="Scenario YAML."),
     output: opt.Output = None,
@@ -55,7 +54,6 @@ def simulate(
 
 
 @app.command()
-@user_errors
 def navigate(
     source: Path | None = typer.Argument(
         None, help="Scenario YAML, a results file with /imu, or a PSINS .imu / CSV data file "
@@ -110,7 +108,6 @@ def navigate(
 
 
 @app.command()
-@user_errors
 def show(
     file: Path = typer.Argument(..., help="A gcalign results file."),
     as_json: opt.Json = False,
@@ -135,7 +132,6 @@ def show(
 
 
 @app.command()
-@user_errors
 def validate(
     scenario: Path = typer.Argument(..., help="Scenario YAML, or a sweep YAML."),
     as_json: opt.Json = False,

@@ -12,7 +12,7 @@ import sys
 import typer
 
 from gcalign.app.registry import COMMANDS
-from gcalign.cli.base import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json
 from gcalign.cli.common import builtin_text
 from gcalign.errors import ScenarioError
 
@@ -29,7 +29,6 @@ def first_comment(text: str) -> str:
 
 
 @app.command()
-@user_errors
 def example(
     name: str | None = typer.Argument(
         None, help="A command with a built-in scenario; without it, the list."),

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
-from gcalign.cli.base import app, user_errors
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, read_source, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 
@@ -38,7 +38,6 @@ def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
 
 
 @app.command()
-@user_errors
 def modulate(
     scenario: Path | None = typer.Argument(
         None, help="Scenario YAML; without it, the built-in seed 004 case (static, 72 h, "

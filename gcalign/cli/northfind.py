@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from gcalign.choices import AZIMUTH_METHODS_ALL, listed
-from gcalign.cli.base import app, user_errors
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
@@ -40,7 +40,6 @@ def _one_azimuth_source(section: dict, given: dict) -> None:
 
 
 @app.command()
-@user_errors
 def northfind(
     scenario: Path | None = typer.Argument(
         None, help="Scenario YAML; without it, the built-in seed 001 §3.1 simulation (sweep "

@@ -7,12 +7,11 @@ from pathlib import Path
 
 import typer
 
-from gcalign.cli.base import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json
 from gcalign.cli.options import Json
 
 
 @app.command()
-@user_errors
 def plot(
     file: Path = typer.Argument(..., help="A gcalign results file (.h5), or recorded IMU "
                                 "data (PSINS .imu, CSV; .gz/.xz): its IMU output."),

@@ -8,13 +8,12 @@ from pathlib import Path
 import typer
 
 from gcalign.choices import PREDICTORS, listed
-from gcalign.cli.base import app, user_errors
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 
 
 @app.command()
-@user_errors
 def realtime(
     scenario: Path | None = typer.Argument(
         None, help="Scenario YAML; without it, the seed's Table 1 (12 cases) in its "
