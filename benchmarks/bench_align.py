@@ -21,7 +21,6 @@ from gcalign.align.cycles import loop_gains
 from gcalign.align.stages import Stage
 from gcalign.app.align.run import run_alignment
 from gcalign.app.data import scenario_data
-from gcalign.cli.align import BUILTIN
 from gcalign.cli.common import load_with_overrides
 from gcalign.nav.earth import WGS84
 
@@ -59,7 +58,7 @@ def main() -> None:
     rate = n / t / 1e6
     rows.append(("gyrocompass steps (M/s, one core)", f"{rate:.1f}", "≥ 5", f"{rate / 5:.2f}×"))
 
-    sc = load_with_overrides(None, BUILTIN, "align", {}).scenario
+    sc = load_with_overrides("align", None).scenario
     data = scenario_data(sc)
     run_alignment(sc, data)  # warm
     repeat = 1 if SMOKE else 7

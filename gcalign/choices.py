@@ -19,6 +19,23 @@ COMPENSATIONS = ("none", "one-off", "continued")
 RECORDING_FORMATS = ("psins", "psins-mat", "i2nav", "csv")
 #: formats ``gcalign export`` writes (:data:`gcalign.app.export.FORMATS`)
 EXPORT_FORMATS = ("csv", "mat", "i2nav-nav", "psins-avp")
+#: vertical channel of strapdown navigation (:mod:`gcalign.nav.strapdown`)
+VERTICAL_MODES = ("free", "hold", "damped")
+#: ``navigation.vertical``: those, or "auto" (chosen from the base's motion)
+VERTICAL_CHOICES = ("auto", *VERTICAL_MODES)
+#: DGNSS measurements of in-flight calibration (:mod:`gcalign.estimation.ins_error`)
+MEASUREMENTS = ("velocity", "position", "both")
+#: a calibration run's injected errors: the scenario's, or drawn from P0 with the seed
+TRUTH_SOURCES = ("scenario", "draw")
+#: north-finding's azimuth methods, in the order of the result arrays
+#: (:mod:`gcalign.northfind.estimate`)
+AZIMUTH_METHODS = ("coordinate", "vector", "naive", "none")
+#: ``northfind.methods``: those and the seed's vector form as printed
+AZIMUTH_METHODS_ALL = (*AZIMUTH_METHODS, "vector_literal")
+#: attitude predictors to the pulse time (:mod:`gcalign.realtime.settings`, spec 003 §3)
+PREDICTORS = ("none", "taylor", "kalman-ls")
+#: what transfer alignment matches (:mod:`gcalign.transfer.filter`)
+MATCHINGS = ("attitude+velocity", "velocity", "attitude")
 
 
 def listed(names: tuple[str, ...]) -> str:

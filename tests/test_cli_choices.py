@@ -13,8 +13,18 @@ from gcalign.align.compensate import METHODS
 from gcalign.align.cycles import MODES
 from gcalign.app.export import FORMATS as EXPORTS
 from gcalign.cli import app
+from gcalign.estimation.ins_error import MEASUREMENTS
 from gcalign.io.recorded.imu import FORMAT_NAMES
 from gcalign.io.scenario.align import AlignConfig
+from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
+from gcalign.io.scenario.navigation import NavigationConfig
+from gcalign.io.scenario.northfind import MethodName
+from gcalign.io.scenario.realtime import PredictorName
+from gcalign.io.scenario.transfer import TransferConfig
+from gcalign.nav.strapdown import VERTICAL_MODES
+from gcalign.northfind.estimate import METHODS as AZIMUTH_METHODS
+from gcalign.realtime.settings import PREDICTORS
+from gcalign.transfer.filter import MATCHINGS
 
 CLICK = typer.main.get_command(app)
 
@@ -35,6 +45,13 @@ def choices(command: str, option: str) -> tuple[str, ...]:
     ("navigate", "--format", FORMAT_NAMES),
     ("validate", "--format", FORMAT_NAMES),
     ("export", "--format", tuple(EXPORTS)),
+    ("navigate", "--vertical", ("auto", *VERTICAL_MODES)),
+    ("calibrate", "--measure", MEASUREMENTS),
+    ("observability", "--measure", MEASUREMENTS),
+    ("calibrate", "--truth", ("scenario", "draw")),
+    ("observability", "--matching", MATCHINGS),
+    ("northfind", "--method", (*AZIMUTH_METHODS, "vector_literal")),
+    ("realtime", "--predictor", PREDICTORS),
 ])
 def test_each_help_choice_list_is_the_codes_tuple(command, option, code):
     assert choices(command, option) == tuple(code)
@@ -45,3 +62,13 @@ def test_the_scenario_models_take_the_same_choices():
     fields = AlignConfig.model_fields
     assert fields["mode"].annotation.__args__ == (*MODES, "transfer")  # type: ignore[union-attr]
     assert fields["compensation"].annotation.__args__ == METHODS  # type: ignore[union-attr]
+    literals = [(NavigationConfig, "vertical", ("auto", *VERTICAL_MODES)),
+                (CalibrateConfig, "measure", MEASUREMENTS),
+                (ObservabilityConfig, "measure", MEASUREMENTS),
+                (CalibrateConfig, "truth", choices("calibrate", "--truth")),
+                (TransferConfig, "matching", MATCHINGS)]
+    for model, name, code in literals:
+        annotation = model.model_fields[name].annotation
+        assert annotation.__args__ == code, (model, name)  # type: ignore[union-attr]
+    assert MethodName.__args__ == (*AZIMUTH_METHODS, "vector_literal")  # type: ignore[attr-defined]
+    assert PredictorName.__args__ == PREDICTORS  # type: ignore[attr-defined]

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 from gcalign import limits
 from gcalign.app.command import DOUBLE, Command, Cost, Extent, Inputs, Outcome, loading
 from gcalign.app.registry import COMMANDS, command
-from gcalign.errors import GcalignError, ScenarioError
+from gcalign.errors import GcalignError, ScenarioError, clip
 from gcalign.io.paths import not_a_file
 from gcalign.io.scenario import Scenario
 
@@ -279,9 +279,8 @@ def check_seed(seed: int | None, what: str = "--seed") -> int | None:
     if seed is None:
         return None
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= limits.SEED_MAX:
-        text = str(seed)
-        text = text if len(text) <= 30 else text[:27] + "..."
-        raise ScenarioError(f"{what}: must be a whole number within [0, 2^63), got {text}")
+        raise ScenarioError(f"{what}: must be a whole number within [0, 2^63), got "
+                            f"{clip(str(seed), 30)}")
     return seed
 
 

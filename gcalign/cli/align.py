@@ -7,15 +7,11 @@ from pathlib import Path
 
 import typer
 
-from gcalign.app.registry import COMMANDS
 from gcalign.choices import ALIGN_MODES_ALL, COMPENSATIONS, listed
 from gcalign.cli import options as opt
-from gcalign.cli.base import app, user_errors
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show
 from gcalign.errors import ScenarioError
-
-BUILTIN = COMMANDS["align"].builtin or ""
-
 
 
 def _t3(value: str | None):
@@ -51,7 +47,6 @@ def passes_into_stages(section: dict, given: dict) -> None:
 
 
 @app.command()
-@user_errors
 def align(
     scenario: Path | None = typer.Argument(
         None, help="Scenario YAML; without it, the built-in seed 000 §5.3 moving-base case "
@@ -83,14 +78,8 @@ def align(
 ):
     """Gyrocompass fine alignment with forward/reverse passes and T2 -> T3 compensation."""
     given = recorded(imu_file, imu_format, imu_axes, reference, lat, lon, height)
-    overrides = {
-        "mode": mode,
-        "compensation": compensation,
-        "passes": passes,
-        "t1_s": t1,
-        "t2_s": t2,
-        "t3_s": _t3(t3),
-    }
-    loaded = load_with_overrides(scenario, BUILTIN, "align", overrides, passes_into_stages,
-                                 sets=set_, recorded=given)
+    overrides = {"mode": mode, "compensation": compensation, "passes": passes, "t1_s": t1,
+                 "t2_s": t2, "t3_s": _t3(t3)}
+    loaded = load_with_overrides("align", scenario, overrides, passes_into_stages, sets=set_,
+                                 recorded=given)
     run_and_show("align", loaded, seed, output, as_json)

@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from gcalign.cli import options as opt
-from gcalign.cli.base import app, user_errors
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
@@ -19,7 +19,6 @@ SCENARIO_HELP = ("Write a static scenario with the fitted noise as its imu secti
 
 
 @app.command()
-@user_errors
 def allan(
     source: Path | None = typer.Argument(
         None, help="A recording (PSINS .imu, CSV/text, PSINS MAT, KF-GINS; .gz/.xz "
@@ -65,7 +64,7 @@ def allan(
     data, _ = data_file(source, ("earth",))
     text = None if data is None else yaml.safe_dump(data)
     overrides = {"start_s": start, "duration_s": duration}
-    loaded = load_with_overrides(source, "", "allan", overrides, data=data, text=text,
+    loaded = load_with_overrides("allan", source, overrides, data=data, text=text,
                                  sets=set_, recorded=given)
     if as_json and scenario_out == "-":
         raise ScenarioError("--scenario: '-' prints the scenario on stdout, where --json "

@@ -67,7 +67,8 @@ def _fail(message: str, code: int):
 
 class OneLineErrors(TyperGroup):
     """Click's usage errors (a bad option value, an unknown option, a missing argument) as
-    one line and exit 2, like every other bad input, instead of a usage box."""
+    one line and exit 2, like every other bad input, instead of a usage box; what a command
+    raises as :func:`user_errors` says."""
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True,
              **extra):
@@ -86,6 +87,10 @@ class OneLineErrors(TyperGroup):
         if not standalone_mode:
             return rv
         sys.exit(rv if isinstance(rv, int) else 0)
+
+    def invoke(self, ctx):
+        """Every command's own errors as one line and an exit code (:func:`user_errors`)."""
+        return user_errors(super().invoke)(ctx)
 
 
 app = typer.Typer(

@@ -13,7 +13,7 @@ from pathlib import Path
 import typer
 
 from gcalign.app.batch import COMMAND
-from gcalign.cli.base import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json
 from gcalign.cli.options import Json, Sets
 from gcalign.errors import ScenarioError
 
@@ -109,7 +109,6 @@ def bar_label(sw) -> str:
 
 
 @app.command()
-@user_errors
 def batch(
     files: list[Path] = typer.Argument(
         ..., help="A sweep YAML (base scenario, grid of overrides, seeds, metrics: "

@@ -6,28 +6,19 @@ from pathlib import Path
 
 import typer
 
-from gcalign.app.registry import COMMANDS
+from gcalign.choices import MATCHINGS, MEASUREMENTS, TRUTH_SOURCES, listed
 from gcalign.cli import options as opt
-from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import Loaded, Recorded, load_with_overrides, recorded, run_and_show
+from gcalign.cli.base import app
+from gcalign.cli.common import load_with_overrides, recorded, run_and_show
 from gcalign.errors import ScenarioError
 
-BUILTIN = COMMANDS["calibrate"].builtin or ""
 SCENARIO_HELP = "Scenario YAML; without it, the built-in seed 002 designed 590 s take-off."
-MEASURE_HELP = "DGNSS measurement: velocity | position | both."
-MATCHING_HELP = ("Transfer alignment (align.mode: transfer): attitude+velocity | velocity | "
-                 "attitude (sets align.transfer.matching).")
-
-
-def load_checked(path: Path | None, section: str, overrides: dict, sets: list[str] | None,
-                 given: Recorded | None = None) -> Loaded:
-    """The scenario with the options written into `section` (the command's check runs in
-    its preflight)."""
-    return load_with_overrides(path, BUILTIN, section, overrides, sets=sets, recorded=given)
+MEASURE_HELP = f"DGNSS measurement: {listed(MEASUREMENTS)}."
+MATCHING_HELP = (f"Transfer alignment (align.mode: transfer): {listed(MATCHINGS)} (sets "
+                 "align.transfer.matching).")
 
 
 @app.command()
-@user_errors
 def calibrate(
     scenario: Path | None = typer.Argument(None, help=SCENARIO_HELP),
     measure: str | None = typer.Option(None, "--measure", help=MEASURE_HELP),
@@ -37,7 +28,7 @@ def calibrate(
     smoother: bool | None = typer.Option(
         None, "--smoother/--no-smoother", help="Also run the RTS smoother (post-flight)."),
     truth: str | None = typer.Option(
-        None, "--truth", help="Injected errors: scenario | draw (from P0 with the seed)."),
+        None, "--truth", help=f"Injected errors: {listed(TRUTH_SOURCES)} (from P0 with the seed)."),
     seed: opt.Seed = None,
     output: opt.Output = None,
     as_json: opt.Json = False,
@@ -54,12 +45,11 @@ def calibrate(
     on recorded data); per state the injected truth, estimate, error and final σ."""
     given = recorded(imu_file, imu_format, imu_axes, reference, lat, lon, height)
     overrides = {"measure": measure, "smoother": smoother, "truth": truth}
-    loaded = load_checked(scenario, "calibrate", overrides, set_, given)
+    loaded = load_with_overrides("calibrate", scenario, overrides, sets=set_, recorded=given)
     run_and_show("calibrate", loaded, seed, output, as_json, compare=compare)
 
 
 @app.command()
-@user_errors
 def observability(
     scenario: Path | None = typer.Argument(None, help=SCENARIO_HELP),
     measure: str | None = typer.Option(None, "--measure", help=MEASURE_HELP),
@@ -77,10 +67,10 @@ def observability(
     overrides = {"measure": measure, "scaling": scaling}
     sets = list(set_ or [])
     if matching is not None:
-        sc = load_checked(scenario, "observability", overrides, set_).scenario
+        sc = load_with_overrides("observability", scenario, overrides, sets=set_).scenario
         if sc.align is None or sc.align.mode != "transfer":
             raise ScenarioError(f"--matching: {matching!r} applies to a transfer-alignment "
                                 "scenario (align.mode: transfer); a flight takes --measure")
         sets.append(f"align.transfer.matching={matching}")
-    run_and_show("observability", load_checked(scenario, "observability", overrides, sets),
-                 None, output, as_json)
+    loaded = load_with_overrides("observability", scenario, overrides, sets=sets)
+    run_and_show("observability", loaded, None, output, as_json)

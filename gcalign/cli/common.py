@@ -26,6 +26,7 @@ import os
 import re
 import shutil
 import sys
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -76,15 +77,12 @@ def recorded(imu_file: Path | None = None, imu_format: str | None = None,
 @dataclass(frozen=True)
 class Loaded:
     """A scenario as a command line loaded it (:func:`load_with_overrides`): the validated
-    scenario, the text stored in its results file, its source name, the options that were
-    applied (key, value; in order: the results file's default name records them) and the
-    recorded-data options given."""
+    scenario, the text stored in its results file and the options that were applied (key,
+    value; in order: the results file's default name records them)."""
 
     scenario: Scenario
     text: str
-    source: str
     applied: list[tuple[str, object]] = field(default_factory=list)
-    recorded: Recorded = field(default_factory=Recorded)
 
 
 def install(app: typer.Typer) -> None:
@@ -148,38 +146,50 @@ def _apply_recorded(data: dict, inv: Recorded, applied: list) -> None:
                              "format": reference_format_of(inv.reference)}
         applied.append(("reference", inv.reference))
     if inv.site:
-        site = dict(data.get("site") or {}) if isinstance(data.get("site"), dict) else {}
-        site.update(inv.site)
-        data["site"] = site
+        data["site"] = {**(data["site"] if isinstance(data.get("site"), dict) else {}), **inv.site}
         applied.extend((f"site.{k}", v) for k, v in inv.site.items())
 
 
+def read_source(path: Path | None, builtin: str) -> tuple[dict, str, str]:
+    """The scenario mapping of the file `path` (without it, of the built-in scenario
+    `builtin`), its text and its source name."""
+    with loading():  # yaml and the scenario models (pydantic builds each as it loads)
+        import yaml
+
+        from gcalign.io.scenario.loader import read_yaml
+
+    if path is None:
+        text = builtin_text(builtin)
+        return yaml.safe_load(text), text, f"<built-in {builtin}>"
+    return read_yaml(path), Path(path).read_text(encoding="utf-8"), str(path)
+
+
 def load_with_overrides(
+    command: str | None,
     path: Path | None,
-    builtin: str,
-    section: str,
-    overrides: dict,
+    overrides: dict | None = None,
     adjust: Callable[[dict, dict], None] | None = None,
     data: dict | None = None,
     text: str | None = None,
     sets: Sequence[str] | None = None,
     recorded: Recorded | None = None,
 ) -> Loaded:
-    """Scenario (the file, the built-in one, or a given mapping `data` with its `text`),
-    its text and its source name, with the options that were given written into `section`
-    before validation, so that a bad option is reported like a bad key in the file; then
-    the ``--set KEY=VALUE`` items `sets` and the recorded-data options `recorded`
-    (``--imu-file``, site: :func:`recorded`).
+    """The scenario of `command` (the file, the registry's built-in one, or a given mapping
+    `data` with its `text`), its text and its source name, with the options that were given
+    written into the command's section before validation, so that a bad option is reported
+    like a bad key in the file; then the ``--set KEY=VALUE`` items `sets` and the
+    recorded-data options `recorded` (``--imu-file``, site: :func:`recorded`).
     `adjust(section, given)` may drop keys of the section that a given option replaces, and
     may take options out of `given` that it wrote elsewhere in the section. The text stored
     in results files records the overrides.
     """
+    cmd = COMMANDS.get(command or "")
+    builtin, section = (cmd.builtin or "", cmd.section or "") if cmd else ("", "")
     inv = recorded or Recorded()
     with loading():  # yaml and the scenario models (pydantic builds each as it loads)
         import yaml
 
         from gcalign.io.scenario import parse_scenario
-        from gcalign.io.scenario.loader import read_yaml
 
     if data is not None:
         source = str(path) if path is not None else f"<built-in {builtin}>"
@@ -187,17 +197,11 @@ def load_with_overrides(
     elif path is None and inv.imu_file is not None:
         from gcalign.io.scenario.recording import recorded_scenario  # a recording alone
 
-        imu_file = inv.imu_file
-        data = recorded_scenario(section, imu_file)
-        text, source = yaml.safe_dump(data, sort_keys=False), f"--imu-file {imu_file}"
-    elif path is None:
-        text, source = builtin_text(builtin), f"<built-in {builtin}>"
-        data = yaml.safe_load(text)
+        data = recorded_scenario(section, inv.imu_file)
+        text, source = yaml.safe_dump(data, sort_keys=False), f"--imu-file {inv.imu_file}"
     else:
-        data, source = read_yaml(path), str(path)
-        text = Path(path).read_text(encoding="utf-8")
-    assert text is not None
-    given = {k: v for k, v in overrides.items() if v is not None}
+        data, text, source = read_source(path, builtin)
+    given = {k: v for k, v in (overrides or {}).items() if v is not None}
     named = dict(given)  # what the file name and the stored text record
     done: list = []
     if isinstance(data, dict):
@@ -219,7 +223,7 @@ def load_with_overrides(
         text += "\n# command-line overrides:\n" + yaml.safe_dump(
             {k: (str(v) if isinstance(v, Path) else v) for k, v in applied},
             sort_keys=False)
-    return Loaded(sc, text, source, applied, inv)
+    return Loaded(sc, text, applied)
 
 
 # --------------------------------------------------------------------------- output names
@@ -320,8 +324,6 @@ class ProgressBar:
     it at once (also into a pipe or a log, where it stays), ``never`` turns it off."""
 
     def __init__(self, title: str, delay_s: float = 1.0):
-        import threading
-
         mode = os.environ.get("GCALIGN_PROGRESS", "auto").lower()
         self.enabled = mode == "always" or (mode == "auto" and sys.stderr.isatty())
         self.force = mode == "always"
@@ -358,8 +360,6 @@ class ProgressBar:
             self.bar.console.print(text, highlight=False)
 
     def __call__(self, done: float, total: float, what: str = "") -> None:
-        import threading
-
         if not self.enabled or total <= 0:
             return
         with self.lock:

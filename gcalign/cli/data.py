@@ -8,8 +8,9 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
+from gcalign.choices import VERTICAL_CHOICES, listed
 from gcalign.cli import options as opt
-from gcalign.cli.base import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json
 from gcalign.cli.common import load_with_overrides, recorded, run_and_show, warn
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
@@ -23,14 +24,13 @@ def data_file(source: Path | None, keep: tuple[str, ...]) -> tuple[dict | None, 
     results file keeps the name of the scenario that made it and its sections `keep`."""
     import yaml
 
-    from gcalign.io import results
     from gcalign.io.imu_files import data_suffix
-    from gcalign.io.results import HDF5_SUFFIXES
+    from gcalign.io.results import HDF5_SUFFIXES, read_scenario_yaml
 
     suffix = "" if source is None else data_suffix(source)
     if source is None or suffix not in DATA_SUFFIXES | HDF5_SUFFIXES:
         return None, ""
-    text = results.read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
+    text = read_scenario_yaml(source) if suffix in HDF5_SUFFIXES else ""
     stored = yaml.safe_load(text) if text else None
     name = stored.get("name") if isinstance(stored, dict) else None
     name = name or re.sub(r"[^A-Za-z0-9_.+-]", "_", source.name.split(".")[0]) or "data"
@@ -41,7 +41,6 @@ def data_file(source: Path | None, keep: tuple[str, ...]) -> tuple[dict | None, 
 
 
 @app.command()
-@user_errors
 def simulate(
     scenario: Path = typer.Argument(..., help="Scenario YAML."),
     output: opt.Output = None,
@@ -50,12 +49,11 @@ def simulate(
     set_: opt.Sets = None,
 ):
     """Simulate truth and IMU data; write /truth and /imu."""
-    run_and_show("simulate", load_with_overrides(scenario, "", "", {}, sets=set_), seed, output,
+    run_and_show("simulate", load_with_overrides("simulate", scenario, sets=set_), seed, output,
                  as_json)
 
 
 @app.command()
-@user_errors
 def navigate(
     source: Path | None = typer.Argument(
         None, help="Scenario YAML, a results file with /imu, or a PSINS .imu / CSV data file "
@@ -66,7 +64,7 @@ def navigate(
         None, "--init", help="Start from: truth | header | an alignment results file (its "
         "attitude at T3, at T3's data time). Default: truth, or the header of recorded data."),
     vertical: str | None = typer.Option(
-        None, "--vertical", help="Vertical channel: auto | free | hold | damped."),
+        None, "--vertical", help=f"Vertical channel: {listed(VERTICAL_CHOICES)}."),
     start: float | None = typer.Option(None, "--start", help="Data time to start at (s)."),
     duration: float | None = typer.Option(None, "--duration", help="How long to navigate (s)."),
     output: opt.Output = None,
@@ -104,13 +102,12 @@ def navigate(
                             "--imu-file FILE")
     data, stored = data_file(source, ("earth", "navigation", "output"))
     text = None if data is None else stored or yaml.safe_dump(data)
-    loaded = load_with_overrides(source, "", "navigation", overrides, data=data, text=text,
+    loaded = load_with_overrides("navigate", source, overrides, data=data, text=text,
                                  sets=set_, recorded=given_options)
     run_and_show("navigate", loaded, seed, output, as_json, init=init)
 
 
 @app.command()
-@user_errors
 def show(
     file: Path = typer.Argument(..., help="A gcalign results file."),
     as_json: opt.Json = False,
@@ -118,7 +115,6 @@ def show(
     """Print the summary of a results file again, from the file alone."""
     from gcalign.app.checked import read_checked
     from gcalign.app.readback import summary_table
-    from gcalign.errors import ScenarioError
 
     kind, summary, attrs = read_checked(file)
     console = consoles(as_json)
@@ -136,7 +132,6 @@ def show(
 
 
 @app.command()
-@user_errors
 def validate(
     scenario: Path = typer.Argument(..., help="Scenario YAML, or a sweep YAML."),
     as_json: opt.Json = False,
@@ -161,7 +156,7 @@ def validate(
     data = read_yaml(scenario)
     if isinstance(data, dict) and "base" in data:
         return _validate_sweep(scenario, set_, as_json)
-    sc = load_with_overrides(scenario, "", "", {}, sets=set_, recorded=given).scenario
+    sc = load_with_overrides(None, scenario, sets=set_, recorded=given).scenario
     inputs = preflight(sc)  # the checks every command runs first, for every section
     rows = resolved_rows(sc, None if inputs.recording is None else inputs.recording.imu)
     sections = [c.section for c in COMMANDS.values() if c.section]

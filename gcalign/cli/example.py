@@ -12,14 +12,9 @@ import sys
 import typer
 
 from gcalign.app.registry import COMMANDS
-from gcalign.cli.base import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json
 from gcalign.cli.common import builtin_text
 from gcalign.errors import ScenarioError
-
-
-def builtins() -> dict[str, str]:
-    """Command -> its built-in scenario file (package data), from the registry."""
-    return {name: c.builtin for name, c in COMMANDS.items() if c.builtin}
 
 
 def first_comment(text: str) -> str:
@@ -34,14 +29,13 @@ def first_comment(text: str) -> str:
 
 
 @app.command()
-@user_errors
 def example(
     name: str | None = typer.Argument(
         None, help="A command with a built-in scenario; without it, the list."),
     as_json: bool = typer.Option(False, "--json", help="The list as one JSON object."),
 ):
     """Print a built-in scenario (YAML) to start your own from, or list them."""
-    known = builtins()
+    known = {cmd: c.builtin for cmd, c in COMMANDS.items() if c.builtin}  # -> package data
     if name is None:
         from gcalign.app.report import kv_table
 

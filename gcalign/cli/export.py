@@ -8,12 +8,11 @@ from pathlib import Path
 import typer
 
 from gcalign.choices import EXPORT_FORMATS, listed
-from gcalign.cli.base import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json
 from gcalign.cli.options import Json
 
 
 @app.command()
-@user_errors
 def export(
     file: Path = typer.Argument(..., help="A gcalign results file (.h5)."),
     fmt: str = typer.Option(..., "--format", metavar="FORMAT",

@@ -7,12 +7,9 @@ from pathlib import Path
 import typer
 
 from gcalign.app.registry import COMMANDS
-from gcalign.cli.base import app, user_errors
-from gcalign.cli.common import builtin_text, load_with_overrides, run_and_show
+from gcalign.cli.base import app
+from gcalign.cli.common import load_with_overrides, read_source, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
-
-BUILTIN = COMMANDS["modulate"].builtin or ""
-
 
 
 def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
@@ -23,13 +20,7 @@ def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
     --compare, is the one scheme run."""
     import yaml
 
-    from gcalign.io.scenario.loader import read_yaml
-
-    if path is None:
-        text = builtin_text(BUILTIN)
-        data = yaml.safe_load(text)
-    else:
-        data, text = read_yaml(path), Path(path).read_text(encoding="utf-8")
+    data, text, _ = read_source(path, COMMANDS["modulate"].builtin or "")
     given = {k: v for k, v in (("scheme", scheme), ("dwell_s", dwell)) if v is not None}
     if given and isinstance(data, dict):
         mech = data.get("mechanism")
@@ -43,12 +34,10 @@ def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
         data["mechanism"] = mech
         text += "\n# command-line overrides of mechanism:\n" + yaml.safe_dump(
             {"mechanism": given}, sort_keys=False)
-    return load_with_overrides(path, BUILTIN, "modulate", overrides, data=data, text=text,
-                               sets=sets)
+    return load_with_overrides("modulate", path, overrides, data=data, text=text, sets=sets)
 
 
 @app.command()
-@user_errors
 def modulate(
     scenario: Path | None = typer.Argument(
         None, help="Scenario YAML; without it, the built-in seed 004 case (static, 72 h, "

@@ -6,14 +6,11 @@ from pathlib import Path
 
 import typer
 
-from gcalign.app.registry import COMMANDS
-from gcalign.cli.base import app, user_errors
+from gcalign.choices import AZIMUTH_METHODS_ALL, listed
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 from gcalign.errors import ScenarioError
-
-BUILTIN = COMMANDS["northfind"].builtin or ""
-
 
 
 def parse_sweep(text: str | None) -> dict | None:
@@ -43,45 +40,30 @@ def _one_azimuth_source(section: dict, given: dict) -> None:
 
 
 @app.command()
-@user_errors
 def northfind(
     scenario: Path | None = typer.Argument(
-        None,
-        help="Scenario YAML; without it, the built-in seed 001 §3.1 simulation (sweep "
-        "0…355°, 10° tilt).",
-    ),
+        None, help="Scenario YAML; without it, the built-in seed 001 §3.1 simulation (sweep "
+        "0…355°, 10° tilt)."),
     method: list[str] | None = typer.Option(
-        None,
-        "--method",
-        help="coordinate | vector | naive | none | vector_literal (repeat the option for several).",
-    ),
+        None, "--method", help=f"{listed(AZIMUTH_METHODS_ALL)} (repeat the option for several)."),
     positions: int | None = typer.Option(None, "--positions", help="Table positions per turn."),
     dwell: float | None = typer.Option(None, "--dwell", help="Dwell per position (s)."),
     tilt: float | None = typer.Option(None, "--tilt", help="Table tilt (deg)."),
     azimuth: float | None = typer.Option(
-        None, "--azimuth", help="One true azimuth (deg); replaces a sweep."
-    ),
+        None, "--azimuth", help="One true azimuth (deg); replaces a sweep."),
     sweep: str | None = typer.Option(
-        None, "--sweep", help="START:STOP:STEP (deg); replaces azimuth_deg."
-    ),
+        None, "--sweep", help="START:STOP:STEP (deg); replaces azimuth_deg."),
     repeats: int | None = typer.Option(
-        None, "--repeats", help="Independent determinations per azimuth."
-    ),
+        None, "--repeats", help="Independent determinations per azimuth."),
     seed: Seed = None,
     output: Output = None,
     as_json: Json = False,
     set_: Sets = None,
 ):
     """Multi-position north-finding on a tilted table: coordinate, vector, naive and none."""
-    overrides = {
-        "methods": list(method) if method else None,
-        "positions": positions,
-        "dwell_s": dwell,
-        "tilt_deg": tilt,
-        "azimuth_deg": azimuth,
-        "sweep": parse_sweep(sweep),
-        "repeats": repeats,
-    }
-    loaded = load_with_overrides(scenario, BUILTIN, "northfind", overrides, _one_azimuth_source,
+    overrides = {"methods": list(method) if method else None, "positions": positions,
+                 "dwell_s": dwell, "tilt_deg": tilt, "azimuth_deg": azimuth,
+                 "sweep": parse_sweep(sweep), "repeats": repeats}
+    loaded = load_with_overrides("northfind", scenario, overrides, _one_azimuth_source,
                                  sets=set_)
     run_and_show("northfind", loaded, seed, output, as_json)

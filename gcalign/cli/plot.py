@@ -7,22 +7,17 @@ from pathlib import Path
 
 import typer
 
-from gcalign.cli.base import app, consoles, emit_json, user_errors
+from gcalign.cli.base import app, consoles, emit_json
 from gcalign.cli.options import Json
 
 
 @app.command()
-@user_errors
 def plot(
     file: Path = typer.Argument(..., help="A gcalign results file (.h5), or recorded IMU "
                                 "data (PSINS .imu, CSV; .gz/.xz): its IMU output."),
     out_dir: str | None = typer.Option(  # a str: a Path would turn '' into '.'
-        None,
-        "-o",
-        "--output",
-        help="Folder for the PNG files (default: FILE without its "
-        "suffixes + '_plots/', next to the file).",
-    ),
+        None, "-o", "--output", help="Folder for the PNG files (default: FILE without its "
+        "suffixes + '_plots/', next to the file)."),
     as_json: Json = False,
 ):
     """Write PNG figures: every figure the command that wrote FILE draws (alignment error

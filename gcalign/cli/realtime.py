@@ -7,27 +7,20 @@ from pathlib import Path
 
 import typer
 
-from gcalign.app.registry import COMMANDS
-from gcalign.cli.base import app, user_errors
+from gcalign.choices import PREDICTORS, listed
+from gcalign.cli.base import app
 from gcalign.cli.common import load_with_overrides, run_and_show
 from gcalign.cli.options import Json, Output, Seed, Sets
 
-BUILTIN = COMMANDS["realtime"].builtin or ""
-
-
 
 @app.command()
-@user_errors
 def realtime(
     scenario: Path | None = typer.Argument(
-        None,
-        help="Scenario YAML; without it, the seed's Table 1 (12 cases) in its semi-physical "
-        "setting and a 13th case with asynchronous pulses.",
-    ),
+        None, help="Scenario YAML; without it, the seed's Table 1 (12 cases) in its "
+        "semi-physical setting and a 13th case with asynchronous pulses."),
     predictor: list[str] | None = typer.Option(
-        None, "--predictor",
-        help="none | taylor | kalman-ls (repeat the option for several; default all three).",
-    ),
+        None, "--predictor", help=f"{listed(PREDICTORS)} (repeat the option for several; "
+        "default all three)."),
     seed: Seed = None,
     output: Output = None,
     as_json: Json = False,
@@ -35,5 +28,5 @@ def realtime(
 ):
     """Attitude at sync pulses: filter delay T + Δt, and prediction to the pulse time."""
     overrides = {"predictors": list(predictor) if predictor else None}
-    loaded = load_with_overrides(scenario, BUILTIN, "realtime", overrides, sets=set_)
+    loaded = load_with_overrides("realtime", scenario, overrides, sets=set_)
     run_and_show("realtime", loaded, seed, output, as_json)

@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from gcalign.choices import MEASUREMENTS
 from gcalign.errors import ScenarioError
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.units import ARCMIN, ARCSEC, DPH, DPSH, PPM, UG, UGPSHZ
@@ -72,7 +73,6 @@ DISPLAY_UNITS: tuple[str, ...] = (
 )  # fmt: skip
 """Units of the seed's P0 list (position in metres north, east, up); see :func:`display_scale`."""
 
-MEASUREMENTS = ("velocity", "position", "both")
 MEASUREMENT_NAMES = {
     "velocity": ("dvE", "dvN"),
     "position": ("dpN", "dpE"),

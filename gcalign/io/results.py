@@ -26,7 +26,7 @@ import h5py
 import numpy as np
 
 from gcalign._version import __version__
-from gcalign.errors import GcalignError, ScenarioError, check_terminated
+from gcalign.errors import GcalignError, ScenarioError, check_terminated, clip
 from gcalign.io.paths import not_a_file
 from gcalign.limits import SEED_MAX
 from gcalign.schema import ATT_FRAME as ATT_FRAME  # the frame texts, for the writers
@@ -726,8 +726,7 @@ def open_results(path: Path) -> h5py.File:
 
 
 def _short(value, n: int = 60) -> str:
-    text = repr(value)
-    return text if len(text) <= n else text[:n - 3] + "..."
+    return clip(repr(value), n)
 
 
 def text_attr(obj, name: str, path: Path) -> str:

@@ -25,11 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from gcalign.choices import VERTICAL_MODES
 from gcalign.nav import _kernels as K
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import euler_to_quat, quat_to_euler
-
-VERTICAL_MODES = ("free", "hold", "damped")
 
 
 @dataclass(frozen=True)

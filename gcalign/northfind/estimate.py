@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gcalign.choices import AZIMUTH_METHODS, AZIMUTH_METHODS_ALL
 from gcalign.nav import earth
 from gcalign.nav.rotation import euler_to_dcm, wrap_pi
 from gcalign.northfind.geometry import Values, _uz, _wrap_2pi
@@ -29,8 +30,8 @@ __all__ = [
 ]
 
 #: Azimuth methods, in the order of the result arrays.
-METHODS: tuple[str, ...] = ("coordinate", "vector", "naive", "none")
-_ALL_METHODS = METHODS + ("vector_literal",)
+METHODS: tuple[str, ...] = AZIMUTH_METHODS
+_ALL_METHODS = AZIMUTH_METHODS_ALL
 
 
 def _design(theta: Values) -> np.ndarray:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+from gcalign.choices import PREDICTORS
 from gcalign.units import ARCSEC, DEG
 
 __all__ = [
@@ -33,7 +34,6 @@ __all__ = [
     "seed_semi_physical",
 ]
 
-PREDICTORS = ("none", "taylor", "kalman-ls")  #: predictor names (spec 003 §3)
 CHAINS = ("navigation", "alignment")  #: filter chains (seed §2)
 PULSE_MODES = ("solution", "async")  #: pulses on the solution instants, or asynchronous
 

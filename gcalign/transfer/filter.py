@@ -54,6 +54,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from gcalign.choices import MATCHINGS
 from gcalign.errors import ScenarioError
 from gcalign.estimation.kalman import update, van_loan
 from gcalign.nav.earth import WGS84, EarthModel
@@ -72,7 +73,6 @@ from gcalign.schema import ATT_FRAME, stored
 from gcalign.transfer.model import attitude_measurement, measurement_matrix
 from gcalign.units import ARCMIN, DEG, DPH, DPSH, G0, UG, UGPSHZ
 
-MATCHINGS = ("attitude+velocity", "velocity", "attitude")
 GRAVITY_MODELS = ("normal", "constant")
 
 NAMES_15 = ("phiE", "phiN", "phiU", "dvE", "dvN", "dvU", "ebx", "eby", "ebz",

@@ -14,7 +14,7 @@ from concurrent.futures import FIRST_COMPLETED, BrokenExecutor, ProcessPoolExecu
 from typing import Any
 
 from gcalign.app.batch.runs import run_chunk, warm_up
-from gcalign.errors import GcalignError, ScenarioError
+from gcalign.errors import GcalignError, ScenarioError, clip
 
 SCHEDULER_TIMEOUT_S = 4.0  # each step of connecting to a Dask scheduler (≤ 15 s in all)
 WORKERS_TIMEOUT_S = 4.0  # waiting for a scheduler's first worker
@@ -205,7 +205,7 @@ def check_address(address: str) -> str:
     import ipaddress
 
     text = str(address).strip()
-    shown = text if len(text) <= 60 else text[:57] + "..."
+    shown = clip(text, 60)
 
     def bad(why: str) -> ScenarioError:
         return ScenarioError(f"--scheduler: {shown!r} {why}; give tcp://HOST:PORT (e.g. "

@@ -27,7 +27,7 @@ from typing import Any
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from gcalign.app.batch.overrides import apply_override
-from gcalign.errors import ScenarioError
+from gcalign.errors import ScenarioError, clip
 from gcalign.io.scenario.base import Model
 from gcalign.io.scenario.messages import _cut
 from gcalign.io.scenario.recording import absolute_paths
@@ -96,8 +96,7 @@ class Sweep:
 
 
 def _short(v) -> str:
-    text = json.dumps(v) if not isinstance(v, str) else v
-    return text if len(text) <= 40 else text[:37] + "..."
+    return clip(json.dumps(v) if not isinstance(v, str) else v, 40)
 
 
 def _hash(*parts) -> str:
