@@ -57,17 +57,14 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BeforeValidator, Field, model_validator
+from pydantic import Field, model_validator
 
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, NonNegVec3, Pos3, Vec3, three
+from gcalign.io.scenario.base import Model, NonNeg3, PerAxis, Pos3, Vec3, vector
 from gcalign.io.scenario.sensors import AccelGaussMarkov, GyroGaussMarkov, ScaleGaussMarkov
 from gcalign.nav.earth import EarthModel
-
-Pos3Zero = Annotated[NonNegVec3, BeforeValidator(three)]
-Any3 = Annotated[Vec3, BeforeValidator(three)]
 
 
 def _enu_m_to_si(enu, lat: float, h: float, earth: EarthModel) -> np.ndarray:
@@ -80,21 +77,14 @@ def _enu_m_to_si(enu, lat: float, h: float, earth: EarthModel) -> np.ndarray:
 class P0Sigma(Model):
     """The listed initial σ before ``p0_scale`` (default: the seed's §5.2 list)."""
 
-    attitude_arcsec: Annotated[Pos3, B.P0_ATTITUDE_ARCSEC] = Field(
-        default_factory=lambda: [20.0, 20.0, 1800.0],
-        description="φ [E, N, U]; the seed's 20″, 20″, 30′")
-    velocity_enu_mps: Annotated[Pos3, B.P0_VELOCITY_MPS] = Field(
-        default_factory=lambda: [0.2, 0.2, 0.2])
-    position_enu_m: Annotated[Pos3, B.P0_POSITION_M] = Field(
-        default_factory=lambda: [1.0, 1.0, 1.0])
-    gyro_bias_dph: Annotated[Pos3, B.P0_GYRO_BIAS_DPH] = Field(
-        default_factory=lambda: [0.01, 0.01, 0.01])
-    accel_bias_ug: Annotated[Pos3, B.P0_ACCEL_BIAS_UG] = Field(
-        default_factory=lambda: [50.0, 50.0, 50.0])
-    gyro_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = Field(
-        default_factory=lambda: [100.0, 100.0, 100.0])
-    accel_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = Field(
-        default_factory=lambda: [100.0, 100.0, 100.0])
+    attitude_arcsec: Annotated[Pos3, B.P0_ATTITUDE_ARCSEC] = vector(
+        (20.0, 20.0, 1800.0), description="φ [E, N, U]; the seed's 20″, 20″, 30′")
+    velocity_enu_mps: Annotated[Pos3, B.P0_VELOCITY_MPS] = vector(0.2)
+    position_enu_m: Annotated[Pos3, B.P0_POSITION_M] = vector(1.0)
+    gyro_bias_dph: Annotated[Pos3, B.P0_GYRO_BIAS_DPH] = vector(0.01)
+    accel_bias_ug: Annotated[Pos3, B.P0_ACCEL_BIAS_UG] = vector(50.0)
+    gyro_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = vector(100.0)
+    accel_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = vector(100.0)
 
     def to_si(self, lat: float, h: float, earth: EarthModel) -> np.ndarray:
         """(21,) SI σ in the state order."""
@@ -112,16 +102,16 @@ class ProcessNoise(Model):
     random constant (the seed)."""
 
     arw_dprh: Annotated[float, B.ARW_DPRH] = Field(
-        0.001, ge=0, description=f"gyro angle random walk, {B.ARW_DPRH.range()}")
+        0.001, ge=0, description="gyro angle random walk")
     vrw_ugrhz: Annotated[float, B.VRW_UGRHZ] = Field(
-        10.0, ge=0, description=f"accelerometer velocity random walk, {B.VRW_UGRHZ.range()}")
+        10.0, ge=0, description="accelerometer velocity random walk")
     gyro_bias_gm: GyroGaussMarkov | None = Field(
         None, description="gyro biases as first-order Gauss–Markov processes")
-    gyro_bias_rw_dphrh: Annotated[Pos3Zero, B.GYRO_BIAS_RW_DPHRH] | None = Field(
+    gyro_bias_rw_dphrh: Annotated[NonNeg3, B.GYRO_BIAS_RW_DPHRH] | None = Field(
         None, description="gyro biases as random walks (rate random walk, °/h/√h)")
     accel_bias_gm: AccelGaussMarkov | None = Field(
         None, description="accelerometer biases as first-order Gauss–Markov processes")
-    accel_bias_rw_ughrh: Annotated[Pos3Zero, B.ACCEL_BIAS_RW_UGRH] | None = Field(
+    accel_bias_rw_ughrh: Annotated[NonNeg3, B.ACCEL_BIAS_RW_UGRH] | None = Field(
         None, description="accelerometer biases as random walks (µg/√h)")
     gyro_scale_gm: ScaleGaussMarkov | None = Field(
         None, description="gyro scale factors as first-order Gauss–Markov processes")
@@ -175,10 +165,9 @@ class ProcessNoise(Model):
 class InitialError(Model):
     """The INS's initial errors in a simulation with ``truth: scenario`` (spec 002 §2 [X])."""
 
-    attitude_arcsec: Any3 = Field(default_factory=lambda: [20.0, -20.0, 1800.0],
-                                  description="misalignment φ [E, N, U]")
-    velocity_enu_mps: Any3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    position_enu_m: Any3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    attitude_arcsec: PerAxis = vector((20.0, -20.0, 1800.0), description="misalignment φ [E, N, U]")
+    velocity_enu_mps: PerAxis = vector()
+    position_enu_m: PerAxis = vector()
 
     def to_si(self, lat: float, h: float, earth: EarthModel) -> np.ndarray:
         """(9,) SI: [φ, δv, δL, δλ, δh]."""
@@ -208,8 +197,7 @@ class _AidingFile(Model):
     format: str
     columns: list[str] | None = None
     variable: str | None = None
-    lever_arm_m: LeverArm = Field(default_factory=lambda: [0.0, 0.0, 0.0],
-                                  description=_LEVER_HELP)
+    lever_arm_m: LeverArm = vector(description=_LEVER_HELP)
     interval_s: float | None = Field(None, gt=0, description=_INTERVAL_HELP)
 
 
@@ -245,12 +233,11 @@ def _divides(rate: float, sub: float) -> int | None:
 
 class CalibrateConfig(Model):
     measure: Literal["velocity", "position", "both"] = "velocity"
-    sigma_v_mps: Annotated[float, B.SIGMA_V_MPS] = Field(
-        0.2, description=f"DGNSS velocity σ; R = σ²; {B.SIGMA_V_MPS.range()}")
+    sigma_v_mps: Annotated[float, B.SIGMA_V_MPS] = Field(0.2,
+                                                        description="DGNSS velocity σ; R = σ²")
     sigma_p_m: Annotated[float, B.SIGMA_P_M] = Field(
-        1.0, description=f"DGNSS position σ (north, east); R = σ²; {B.SIGMA_P_M.range()}")
-    p0_scale: Annotated[float, B.P0_SCALE] = Field(
-        10.0, description=f"P0 = (p0_scale · listed σ)²; {B.P0_SCALE.range()}")
+        1.0, description="DGNSS position σ (north, east); R = σ²")
+    p0_scale: Annotated[float, B.P0_SCALE] = Field(10.0, description="P0 = (p0_scale · listed σ)²")
     p0: P0Sigma = Field(default_factory=P0Sigma)
     q: ProcessNoise = Field(default_factory=ProcessNoise)
     navigation_rate_hz: float | None = Field(None, gt=0, description="default: the IMU rate")
