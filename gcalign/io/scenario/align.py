@@ -25,7 +25,7 @@ from gcalign.align.stages import Stage
 from gcalign.io.recorded.aiding import VELOCITY_FORMATS
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario import transfer as transfer_section
-from gcalign.io.scenario.base import Model, Vec3
+from gcalign.io.scenario.base import Model, Vec3, vector
 
 #: Passes in all when the last stage does not say: 3 forward + 2 reverse in the cycle
 #: modes (seed 000 §5.3), one forward pass in conventional mode.
@@ -41,15 +41,10 @@ def _removed(data, key: str, instead: str):
 
 class Coarse(Model):
     method: Literal["given", "analytic", "inertial"] = "given"
-    error_deg: Vec3 = Field(
-        default_factory=lambda: [1.0, 1.0, 10.0],
-        description="method given: added to the true attitude at T1",
-    )
-    offset_deg: Vec3 = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0],
-        description="methods analytic and inertial: added to their result (studies of the "
-        "initial error on recorded data)",
-    )
+    error_deg: Vec3 = vector((1.0, 1.0, 10.0),
+                             description="method given: added to the true attitude at T1")
+    offset_deg: Vec3 = vector(description="methods analytic and inertial: added to their "
+                              "result (studies of the initial error on recorded data)")
 
     @model_validator(mode="before")
     @classmethod
@@ -80,7 +75,7 @@ class Aiding(Model):
 
     source: Literal["none", "odometer", "nav", "file"] = "none"
     noise_mps: Annotated[float, B.NOISE_MPS] = Field(
-        0.0, ge=0, description=f"white noise std of each reference sample, {B.NOISE_MPS.range()}")
+        0.0, ge=0, description="white noise std of each reference sample")
     path: Path | None = Field(None, description="source file: the aiding file")
     format: Literal[VELOCITY_FORMATS] | None = Field(  # type: ignore[valid-type]
         None, description=f"source file: one of {', '.join(VELOCITY_FORMATS)}")

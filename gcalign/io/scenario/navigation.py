@@ -86,7 +86,7 @@ class MechanismConfig(Model):
     turn_s: float | None = Field(None, gt=0, description="scheme: whole turn, s, instead of "
                                  "const_s (const = turn - accel - decel)")
     rate_dps: Annotated[float | None, B.RATE_DPS] = Field(
-        None, gt=0, description=f"continuous: rate, °/s (default 6), {B.RATE_DPS.range()}")
+        None, gt=0, description="continuous: rate, °/s (default 6)")
     axis: Literal["x", "y", "z", "-x", "-y", "-z"] | None = Field(
         None, description="continuous: the sensor axis it turns about (default z)")
     lever_arm_cm: Vec3 | None = Field(

@@ -74,7 +74,7 @@ from gcalign import limits
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, Vec3
+from gcalign.io.scenario.base import Model, Vec3, vector
 from gcalign.io.scenario.schedule import RowModel
 from gcalign.realtime.settings import (
     FilterSettings,
@@ -107,8 +107,7 @@ FIR_WINDOWS = ("hamming", "hann", "blackman", "boxcar", "triang", "parzen", "boh
 
 class FilterConfig(Model):
     fs_hz: Annotated[float, B.SENSOR_RATE_HZ] = Field(
-        5000.0, gt=0, description=f"sensor sampling and filter rate f1, "
-                                  f"{B.SENSOR_RATE_HZ.range()}")
+        5000.0, gt=0, description="sensor sampling and filter rate f1")
     chain: Literal["navigation", "alignment"] = "navigation"
     nav_order: int = Field(40, description="FIR order (taps − 1) of the navigation chain")
     nav_cutoff_hz: float = 200.0
@@ -138,8 +137,7 @@ class FilterConfig(Model):
 
 class SensorConfig(Model):
     quantum_arcsec: float = Field(0.1, ge=0, description="angle per count (0: none)")
-    arw_dprh: Annotated[float, B.ARW_DPRH] = Field(
-        0.0005, ge=0, description=f"angle random walk, {B.ARW_DPRH.range()}")
+    arw_dprh: Annotated[float, B.ARW_DPRH] = Field(0.0005, ge=0, description="angle random walk")
     dither_arcsec: float = Field(100.0, ge=0, description="dither peak in the sensed angle")
     dither_hz: float = Field(400.0, gt=0)
 
@@ -153,13 +151,10 @@ class SensorConfig(Model):
 class TrackerConfig(Model):
     qc_rad2ps5: float = Field(1.0, gt=0, description="white-jerk intensity Qc, rad²/s⁵")
     r_std_arcsec: Annotated[float, B.ATTITUDE_SIGMA_ARCSEC] = Field(
-        0.03, description=f"σ of the attitude observation, R = σ²; "
-                          f"{B.ATTITUDE_SIGMA_ARCSEC.range()}")
-    p0_theta_arcsec: Annotated[float, B.P0_ANGLE_ARCSEC] = Field(
-        0.03, description=B.P0_ANGLE_ARCSEC.range())
-    p0_omega_dps: Annotated[float, B.P0_RATE_DPS] = Field(20.0, description=B.P0_RATE_DPS.range())
-    p0_alpha_dps2: Annotated[float, B.P0_ANGULAR_ACCEL_DPS2] = Field(
-        20.0, description=B.P0_ANGULAR_ACCEL_DPS2.range())
+        0.03, description="σ of the attitude observation, R = σ²")
+    p0_theta_arcsec: Annotated[float, B.P0_ANGLE_ARCSEC] = 0.03
+    p0_omega_dps: Annotated[float, B.P0_RATE_DPS] = 20.0
+    p0_alpha_dps2: Annotated[float, B.P0_ANGULAR_ACCEL_DPS2] = 20.0
 
     def to_settings(self) -> TrackerSettings:
         return TrackerSettings(qc=self.qc_rad2ps5, r=(self.r_std_arcsec * u.ARCSEC) ** 2,
@@ -172,8 +167,7 @@ class PulsesConfig(Model):
     rate_hz: float = Field(1000.0, gt=0)
     offset_us: float | None = Field(0.0, ge=0, description="null: random first edge (async)")
     jitter_us: float = Field(0.0, ge=0)
-    drift_ppm: Annotated[float, B.CLOCK_DRIFT_PPM] = Field(
-        0.0, description=B.CLOCK_DRIFT_PPM.range())
+    drift_ppm: Annotated[float, B.CLOCK_DRIFT_PPM] = 0.0
     resolution_us: float = Field(0.0, ge=0, description="Δt counter resolution (0: exact)")
 
     @model_validator(mode="after")
@@ -216,8 +210,7 @@ class PulsesConfig(Model):
 
 class CaseConfig(Model):
     name: str = Field(min_length=1)
-    attitude_deg: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0],
-                               description="[pitch, roll, yaw] at rest before t = 0")
+    attitude_deg: Vec3 = vector(description="[pitch, roll, yaw] at rest before t = 0")
     steps: list[RowModel] = Field(min_length=1)
     duration_s: float | None = Field(None, gt=0, description="default: the rows' total")
     pulses: PulsesConfig | None = None

@@ -62,11 +62,9 @@ class RowModel(Model):
     accel_s: float | None = Field(None, gt=0)
     const_s: float | None = Field(None, ge=0)
     decel_s: float | None = Field(None, gt=0)
-    rate_dps: Annotated[float | None, B.RATE_DPS] = Field(None, description=B.RATE_DPS.range())
-    accel_dps2: Annotated[float | None, B.ANGULAR_ACCEL_DPS2] = Field(
-        None, description=B.ANGULAR_ACCEL_DPS2.range())
-    jerk_dps3: Annotated[float | None, B.ANGULAR_JERK_DPS3] = Field(
-        None, gt=0, description=B.ANGULAR_JERK_DPS3.range())
+    rate_dps: Annotated[float | None, B.RATE_DPS] = None
+    accel_dps2: Annotated[float | None, B.ANGULAR_ACCEL_DPS2] = None
+    jerk_dps3: Annotated[float | None, B.ANGULAR_JERK_DPS3] = Field(None, gt=0)
     amplitude_deg: float | None = None
     frequency_hz: float | None = Field(None, gt=0)
     phase_deg: float = 0.0
