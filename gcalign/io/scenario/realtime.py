@@ -75,7 +75,7 @@ from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, Vec3, vector
-from gcalign.io.scenario.schedule import RowModel
+from gcalign.io.scenario.schedule import RowModel, steps_of
 from gcalign.realtime.settings import (
     FilterSettings,
     PulseSettings,
@@ -84,7 +84,6 @@ from gcalign.realtime.settings import (
     TrackerSettings,
     seed_semi_physical,
 )
-from gcalign.sim.schedule import Step
 
 if TYPE_CHECKING:  # the cases module builds seed 003's table at import: where it is used
     from gcalign.realtime.cases import Case
@@ -229,14 +228,8 @@ def case_of(name: str, rows: list[RowModel], attitude_deg, duration_s: float | N
     """A core :class:`Case` from validated rows (ValueError names the row)."""
     from gcalign.realtime.cases import Case
 
-    steps: list[Step] = []
-    for i, r in enumerate(rows):
-        try:
-            steps.append(r.to_step())
-        except ValueError as err:
-            raise ValueError(f"steps.{i}: {err}") from None
     a = np.radians(np.asarray(attitude_deg, dtype=float))
-    return Case(name=name, steps=tuple(steps), att0=(float(a[0]), float(a[1]), float(a[2])),
+    return Case(name=name, steps=steps_of(rows), att0=(float(a[0]), float(a[1]), float(a[2])),
                 duration_s=duration_s, pulses=pulses, seed_before=seed_before,
                 seed_after=seed_after)
 
