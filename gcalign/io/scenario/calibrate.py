@@ -225,10 +225,16 @@ class AidingFiles(Model):
     position: PositionFile | None = None
 
 
-def _divides(rate: float, sub: float) -> int | None:
-    """The whole number `rate / sub`, or None."""
+def _divided(key: str, what: str, rate: float, sub: float, ks: range, whole: bool = True) -> int:
+    """The whole number `rate` / `sub`; else ScenarioError naming ``calibrate.key``, with
+    the rates `rate` / k for k in `ks` (with `whole`, those that are whole numbers) as
+    examples."""
     k = rate / sub
-    return int(round(k)) if round(k) >= 1 and abs(k - round(k)) <= 1e-9 * k else None
+    if round(k) >= 1 and abs(k - round(k)) <= 1e-9 * k:
+        return int(round(k))
+    ok = [f"{rate / j:g}" for j in ks if not whole or (rate / j).is_integer()][:6]
+    raise ScenarioError(f"calibrate.{key}: must be the {what} rate {rate:g} Hz divided by a "
+                        f"whole number (e.g. {', '.join(ok)} Hz), got {sub:g}")
 
 
 class CalibrateConfig(Model):
@@ -269,26 +275,14 @@ class CalibrateConfig(Model):
 
     def subsamples(self, imu_rate: float) -> int:
         """IMU increments per navigation step; ScenarioError naming the field."""
-        nav = self.navigation_rate_hz or imu_rate
-        n = _divides(imu_rate, nav)
-        if n is None:
-            allowed = ", ".join(f"{imu_rate / k:g}" for k in range(1, 6))
-            raise ScenarioError(
-                f"calibrate.navigation_rate_hz: must be the IMU rate {imu_rate:g} Hz divided by "
-                f"a whole number (e.g. {allowed} Hz), got {nav:g}")
-        return n
+        return _divided("navigation_rate_hz", "IMU", imu_rate,
+                        self.navigation_rate_hz or imu_rate, range(1, 6), whole=False)
 
     def steps_per_update(self, imu_rate: float) -> int:
         """Navigation steps per filter step; ScenarioError naming the field."""
         nav = imu_rate / self.subsamples(imu_rate)
-        S = _divides(nav, self.filter_rate_hz)
-        if S is None:
-            ok = [nav / k for k in range(1, int(nav) + 1) if (nav / k).is_integer()]
-            raise ScenarioError(
-                f"calibrate.filter_rate_hz: must be the navigation rate {nav:g} Hz divided by a "
-                f"whole number (e.g. {', '.join(f'{r:g}' for r in ok[:6])} Hz), got "
-                f"{self.filter_rate_hz:g}")
-        return S
+        return _divided("filter_rate_hz", "navigation", nav, self.filter_rate_hz,
+                        range(1, int(nav) + 1))
 
     # ------------------------------------------------------------------ checks
 
@@ -302,11 +296,9 @@ class CalibrateConfig(Model):
 
     def check(self, sc) -> None:
         """Checks that need the rest of the scenario; ScenarioError naming the field."""
-        if self.files is None:
-            for key in ("max_gap_s",):
-                if getattr(self, key) is not None:
-                    raise ScenarioError(f"calibrate.{key}: finds the outages of aiding files "
-                                        f"(aiding: file); this run has none (remove it)")
+        if self.files is None and self.max_gap_s is not None:
+            raise ScenarioError("calibrate.max_gap_s: finds the outages of aiding files "
+                                "(aiding: file); this run has none (remove it)")
         if (self.aiding == "file") != (self.files is not None):
             raise ScenarioError("calibrate.files: goes with aiding 'file' (and it needs them); "
                                 f"got aiding {self.aiding!r}"
@@ -409,14 +401,8 @@ class CalibrateConfig(Model):
         """Navigation steps per stored row of the solution; ScenarioError naming the field."""
         if self.output_rate_hz is None:
             return 1
-        k = _divides(nav_rate, self.output_rate_hz)
-        if k is None:
-            ok = [nav_rate / j for j in range(1, 11) if (nav_rate / j).is_integer()]
-            raise ScenarioError(
-                f"calibrate.output_rate_hz: must be the navigation rate {nav_rate:g} Hz divided "
-                f"by a whole number (e.g. {', '.join(f'{r:g}' for r in ok[:6])} Hz), got "
-                f"{self.output_rate_hz:g}")
-        return k
+        return _divided("output_rate_hz", "navigation", nav_rate, self.output_rate_hz,
+                        range(1, 11))
 
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
         rows = [

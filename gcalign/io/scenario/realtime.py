@@ -234,6 +234,18 @@ def case_of(name: str, rows: list[RowModel], attitude_deg, duration_s: float | N
                 seed_after=seed_after)
 
 
+def _check_case(case: Case, settings: Settings, where: str, filter_where: str = "") -> None:
+    """The core's checks of a case (its keys named under `where`) and of the filter for it
+    (named after `filter_where`); ValueError."""
+    from gcalign.realtime.cases import check_case, check_filter
+
+    for check, prefix in ((check_case, f"{where}."), (check_filter, filter_where)):
+        try:
+            check(case, settings)
+        except ValueError as err:
+            raise ValueError(f"{prefix}{err}") from None
+
+
 class RealtimeConfig(Model):
     """Real-time attitude at sync pulses (seed 003); see the module docstring."""
 
@@ -267,15 +279,9 @@ class RealtimeConfig(Model):
         for i, c in enumerate(self.cases or ()):
             if c.pulses is not None:
                 c.pulses.check_offset(f"cases.{i}.pulses", self.solution_hz)
-        from gcalign.realtime.cases import check_case, check_filter
-
         settings = self.to_settings()  # the core's checks, one line naming the setting
         for i, c in enumerate(self.cases or ()):
-            try:
-                check_case(c.to_case(), settings)
-            except ValueError as err:
-                raise ValueError(f"cases.{i}.{err}") from None
-            check_filter(c.to_case(), settings)
+            _check_case(c.to_case(), settings, f"cases.{i}")
         return self
 
     def unused(self, sc=None) -> list[str]:
@@ -345,17 +351,11 @@ class RealtimeConfig(Model):
             if mo.repeat:
                 raise ScenarioError("motion.repeat: a realtime case runs its rows once; "
                                     "allowed: false, got true")
-            from gcalign.realtime.cases import check_case, check_filter
-
             case = case_of(sc.name, mo.steps, mo.attitude_deg, mo.duration_s)
             try:
-                check_case(case, self.to_settings())
+                _check_case(case, self.to_settings(), "motion", "realtime.")
             except ValueError as err:
-                raise ScenarioError(f"motion.{err}") from None
-            try:
-                check_filter(case, self.to_settings())
-            except ValueError as err:
-                raise ScenarioError(f"realtime.{err}") from None
+                raise ScenarioError(str(err)) from None
         imu = sc.imu
         if "rate_hz" in imu.model_fields_set and imu.rate_hz != self.filter.fs_hz:
             raise ScenarioError(f"imu.rate_hz: the realtime gyros are sampled at "
