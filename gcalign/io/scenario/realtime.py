@@ -362,8 +362,9 @@ class RealtimeConfig(Model):
                                 f"realtime.filter.fs_hz = {self.filter.fs_hz:g} Hz; omit "
                                 f"imu.rate_hz or set it equal, got {imu.rate_hz:g}")
         for name, sensor in (("gyro", imu.gyro), ("accel", imu.accel)):
-            for key, value in sensor.model_dump().items():
-                if value is not None and np.any(np.asarray(value, dtype=float) != 0):
+            for key, value in sensor.model_dump().items():  # a process (a mapping) is set
+                if isinstance(value, dict) or (value is not None
+                                               and np.any(np.asarray(value, dtype=float) != 0)):
                     raise ScenarioError(
                         f"imu.{name}.{key}: not used by realtime (its gyro model is "
                         f"realtime.sensor: quantum, ARW, dither); allowed: 0, got {value}")
