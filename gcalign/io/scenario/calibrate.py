@@ -63,7 +63,12 @@ from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, NonNeg3, PerAxis, Pos3, Vec3, vector
-from gcalign.io.scenario.sensors import AccelGaussMarkov, GyroGaussMarkov, ScaleGaussMarkov
+from gcalign.io.scenario.sensors import (
+    AccelGaussMarkov,
+    GyroGaussMarkov,
+    ScaleGaussMarkov,
+    gauss_markov_si,
+)
 from gcalign.nav.earth import EarthModel
 
 
@@ -120,10 +125,8 @@ class ProcessNoise(Model):
 
     @model_validator(mode="after")
     def _one_process_per_state(self):
-        for what in ("gyro", "accel"):
-            if getattr(self, f"{what}_bias_gm") is not None and \
-                    getattr(self, f"{what}_bias_rw_{'dphrh' if what == 'gyro' else 'ughrh'}") \
-                    is not None:
+        for what, rw in (("gyro", self.gyro_bias_rw_dphrh), ("accel", self.accel_bias_rw_ughrh)):
+            if getattr(self, f"{what}_bias_gm") is not None and rw is not None:
                 raise ValueError(f"{what}_bias_gm: a bias is one process; give "
                                  f"{what}_bias_gm or the random walk, not both")
         return self
@@ -133,32 +136,20 @@ class ProcessNoise(Model):
         states, or None when every one is a random constant."""
         from gcalign.estimation.ins_error import SensorProcesses
 
-        groups = [(self.gyro_bias_gm, "std_dph", u.DPH, self.gyro_bias_rw_dphrh,
-                   u.DPH / math.sqrt(u.HOUR)),
-                  (self.accel_bias_gm, "std_ug", u.UG, self.accel_bias_rw_ughrh,
-                   u.UG / math.sqrt(u.HOUR)),
-                  (self.gyro_scale_gm, "std_ppm", u.PPM, None, 0.0),
-                  (self.accel_scale_gm, "std_ppm", u.PPM, None, 0.0)]
-        if all(gm is None and rw is None for gm, _, _, rw, _ in groups):
+        groups = [(self.gyro_bias_gm, u.DPH, self.gyro_bias_rw_dphrh, u.DPH / math.sqrt(u.HOUR)),
+                  (self.accel_bias_gm, u.UG, self.accel_bias_rw_ughrh, u.UG / math.sqrt(u.HOUR)),
+                  (self.gyro_scale_gm, u.PPM, None, 0.0), (self.accel_scale_gm, u.PPM, None, 0.0)]
+        if all(gm is None and rw is None for gm, _, rw, _ in groups):
             return None
         kinds: list[str] = []
         std, tau, dens = [], [], []
-        for gm, key, unit, rw, rw_unit in groups:
-            if gm is not None:
-                kinds += ["gauss-markov"] * 3
-                std += [float(x) * unit for x in getattr(gm, key)]
-                tau += [float(x) for x in gm.tau_s]
-                dens += [0.0] * 3
-            elif rw is not None:
-                kinds += ["random-walk"] * 3
-                std += [0.0] * 3
-                tau += [math.inf] * 3
-                dens += [float(x) * rw_unit for x in rw]
-            else:
-                kinds += ["constant"] * 3
-                std += [0.0] * 3
-                tau += [math.inf] * 3
-                dens += [0.0] * 3
+        for gm, unit, rw, rw_unit in groups:  # one process per state (the validator)
+            kinds += ["gauss-markov" if gm is not None else "constant" if rw is None
+                      else "random-walk"] * 3
+            gm_std, gm_tau = gauss_markov_si(gm, unit)  # zeros and inf without a process
+            std += gm_std.tolist()
+            tau += gm_tau.tolist()
+            dens += [0.0] * 3 if rw is None else [float(x) * rw_unit for x in rw]
         return SensorProcesses.of(kinds, std, tau, dens)
 
 
@@ -424,9 +415,8 @@ class CalibrateConfig(Model):
             ("calibrate.components", self.components_for(sc), "horizontal: the seed's eqs. "
              "5-7; 3d: with the vertical velocity and height"),
         ]
-        procs = [k for k in ("gyro_bias_gm", "gyro_bias_rw_dphrh", "accel_bias_gm",
-                             "accel_bias_rw_ughrh", "gyro_scale_gm", "accel_scale_gm")
-                 if getattr(self.q, k) is not None]
+        procs = [k for k in ProcessNoise.model_fields if k not in ("arw_dprh", "vrw_ugrhz")
+                 and getattr(self.q, k) is not None]
         rows.append(("calibrate.q processes", ", ".join(procs) or "none",
                      "the other sensor states are random constants"))
         if self.files is not None:
