@@ -343,6 +343,8 @@ def test_bad_realtime_section_exits_2(tmp_path, change, field, more):
         ({"site": None}, "site", ("missing",)),
         ({"imu": {"seed": 1, "gyro": {"bias_dph": [0.01, 0, 0]}}}, "imu.gyro.bias_dph",
          ("realtime.sensor",)),
+        ({"imu": {"seed": 1, "gyro": {"bias_gm": {"std_dph": 0.01, "tau_s": 100}}}},
+         "imu.gyro.bias_gm", ("realtime.sensor", "'tau_s': [100.0, 100.0, 100.0]")),
         ({"imu": {"rate_hz": 100}}, "imu.rate_hz", ("5000 Hz", "got 100")),
         ({"motion": {"kind": "static", "duration_s": 3}}, "realtime.cases", ("not both",)),
     ],

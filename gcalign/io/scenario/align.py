@@ -25,7 +25,7 @@ from gcalign.align.stages import Stage
 from gcalign.io.recorded.aiding import VELOCITY_FORMATS
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario import transfer as transfer_section
-from gcalign.io.scenario.base import Model, Vec3
+from gcalign.io.scenario.base import Model, Vec3, vector
 
 #: Passes in all when the last stage does not say: 3 forward + 2 reverse in the cycle
 #: modes (seed 000 §5.3), one forward pass in conventional mode.
@@ -41,15 +41,10 @@ def _removed(data, key: str, instead: str):
 
 class Coarse(Model):
     method: Literal["given", "analytic", "inertial"] = "given"
-    error_deg: Vec3 = Field(
-        default_factory=lambda: [1.0, 1.0, 10.0],
-        description="method given: added to the true attitude at T1",
-    )
-    offset_deg: Vec3 = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0],
-        description="methods analytic and inertial: added to their result (studies of the "
-        "initial error on recorded data)",
-    )
+    error_deg: Vec3 = vector((1.0, 1.0, 10.0),
+                             description="method given: added to the true attitude at T1")
+    offset_deg: Vec3 = vector(description="methods analytic and inertial: added to their "
+                              "result (studies of the initial error on recorded data)")
 
     @model_validator(mode="before")
     @classmethod
@@ -80,7 +75,7 @@ class Aiding(Model):
 
     source: Literal["none", "odometer", "nav", "file"] = "none"
     noise_mps: Annotated[float, B.NOISE_MPS] = Field(
-        0.0, ge=0, description=f"white noise std of each reference sample, {B.NOISE_MPS.range()}")
+        0.0, ge=0, description="white noise std of each reference sample")
     path: Path | None = Field(None, description="source file: the aiding file")
     format: Literal[VELOCITY_FORMATS] | None = Field(  # type: ignore[valid-type]
         None, description=f"source file: one of {', '.join(VELOCITY_FORMATS)}")
@@ -131,17 +126,14 @@ class StageModel(Model):
 class AlignConfig(Model):
     coarse: Coarse = Field(default_factory=Coarse)
     mode: Literal["conventional", "full-cycle", "half-cycle", "transfer"] = "full-cycle"
-    start_s: float = Field(
-        0.0, ge=0, description="offset from the first sample taken as t = 0 (data windows)"
-    )
+    start_s: float = Field(0.0, ge=0, description="offset from the first sample taken as t = 0 "
+                           "(data windows)")
     t1_s: float = Field(10.0, ge=0, description="end of the coarse window [0, T1]")
     t2_s: float = Field(300.0, gt=0)
     t3_s: float | Literal["measured"] = 330.0
-    realtime: bool = Field(
-        True,
-        description="conventional mode: run the loop through T3 in real time; false stops "
-        "it at T2 and carries the attitude to T3 by the compensation (seed §5.2)",
-    )
+    realtime: bool = Field(True, description="conventional mode: run the loop through T3 in "
+                           "real time; false stops it at T2 and carries the attitude to T3 by "
+                           "the compensation (seed §5.2)")
     compensation: Literal["none", "one-off", "continued"] = "continued"
     azimuth_poles: Literal["double-oscillator", "oscillator-overdamped"] | None = None
     aiding: Aiding = Field(default_factory=Aiding)
@@ -162,14 +154,11 @@ class AlignConfig(Model):
         if self.t2_s <= self.t1_s:
             raise ValueError(f"t2_s: must be greater than t1_s ({self.t1_s} s), got {self.t2_s}")
         if self.t3_s != "measured" and self.t3_s < self.t2_s:
-            raise ValueError(
-                f"t3_s: must be at least t2_s ({self.t2_s} s) or 'measured', got {self.t3_s}"
-            )
+            raise ValueError(f"t3_s: must be at least t2_s ({self.t2_s} s) or 'measured', got "
+                             f"{self.t3_s}")
         if self.coarse.method != "given" and self.t1_s <= 0:
-            raise ValueError(
-                f"t1_s: coarse method {self.coarse.method!r} needs data before T1, "
-                f"got t1_s = {self.t1_s}"
-            )
+            raise ValueError(f"t1_s: coarse method {self.coarse.method!r} needs data before T1, "
+                             f"got t1_s = {self.t1_s}")
         if any(s.passes is None for s in self.stages[:-1]):
             raise ValueError("stages: only the last stage may omit 'passes' (it takes the rest)")
         if self.mode != "conventional":
@@ -182,16 +171,13 @@ class AlignConfig(Model):
                     "stage's passes")
             passes = self.pass_count
             if passes < 3 or passes % 2 == 0:
-                raise ValueError(
-                    f"stages: mode {self.mode!r} needs an odd number of passes ≥ 3 in all "
-                    f"(forward, reverse, …, forward), the stages give {passes} "
-                    f"({' + '.join(str(s.passes) for s in self.stage_list())})"
-                )
+                counts = " + ".join(str(s.passes) for s in self.stage_list())
+                raise ValueError(f"stages: mode {self.mode!r} needs an odd number of passes ≥ 3 "
+                                 f"in all (forward, reverse, …, forward), the stages give "
+                                 f"{passes} ({counts})")
         if self.level_phase_s >= self.t2_s - self.t1_s:
-            raise ValueError(
-                f"level_s: the level phase ({self.level_phase_s} s) must be shorter "
-                f"than the fine block t2_s - t1_s ({self.t2_s - self.t1_s} s)"
-            )
+            raise ValueError(f"level_s: the level phase ({self.level_phase_s} s) must be shorter "
+                             f"than the fine block t2_s - t1_s ({self.t2_s - self.t1_s} s)")
         return self
 
     @property
@@ -267,25 +253,14 @@ class AlignConfig(Model):
                       str(np.radians(c.offset_deg).round(6).tolist()) + " rad")
         rows = [
             ("align.mode", self.mode, f"{self.pass_count} pass(es)"),
-            (
-                "align.realtime",
-                str(self.realtime),
-                "loop runs to T3 on live data"
-                if realtime
-                else (
-                    "stops at T2, then compensation"
-                    if self.mode == "conventional"
-                    else "(unused by the cycle modes)"
-                ),
-            ),
+            ("align.realtime", str(self.realtime), "loop runs to T3 on live data" if realtime
+             else "stops at T2, then compensation" if self.mode == "conventional"
+             else "(unused by the cycle modes)"),
             ("align.start_s", f"{self.start_s} s", "offset of t = 0 from the first sample"),
             ("align.coarse", *coarse),
             ("align.t1_s / t2_s / t3_s", f"{self.t1_s} / {self.t2_s} / {self.t3_s} s", ""),
-            (
-                "align.compensation",
-                self.compensation,
-                "(unused: real-time conventional)" if realtime else "",
-            ),
+            ("align.compensation", self.compensation,
+             "(unused: real-time conventional)" if realtime else ""),
             ("align.azimuth_poles", self.poles_for(kind), ""),
             ("align.aiding", f"file {self.aiding.path} ({self.aiding.format})"
              if self.aiding.source == "file" else
@@ -295,11 +270,6 @@ class AlignConfig(Model):
         stages = self.stage_list()
         for i, s in enumerate(self.stages):
             n = stages[i].passes if i < len(stages) else 0
-            rows.append(
-                (
-                    f"align.stages.{i}",
-                    f"T_xy {s.t_xy_s} s, T_z {s.t_z_s} s, ξ {s.xi}",
-                    f"stage {i + 1}: {n} pass(es)",
-                )
-            )
+            rows.append((f"align.stages.{i}", f"T_xy {s.t_xy_s} s, T_z {s.t_z_s} s, ξ {s.xi}",
+                         f"stage {i + 1}: {n} pass(es)"))
         return rows

@@ -3,9 +3,11 @@ the data (simulated, or a recording) and over which window."""
 
 from __future__ import annotations
 
-from pydantic import Field, field_validator
+from typing import Annotated
 
-from gcalign.io.scenario.base import Model
+from pydantic import AfterValidator, Field
+
+from gcalign.io.scenario.base import Model, span
 
 
 class AllanConfig(Model):
@@ -16,13 +18,6 @@ class AllanConfig(Model):
     start_s: float = Field(0.0, ge=0, description="data time at which the window starts")
     duration_s: float | None = Field(None, gt=0, description="default: to the end of the "
                                      "data")
-    fit_tau_s: list[float] | None = Field(
+    fit_tau_s: Annotated[list[float] | None, AfterValidator(span)] = Field(
         None, description="[lo, hi] s: fit the noise terms on these τ only (the curve is "
         "drawn whole): where the sensor, not a swaying base, shapes σ(τ)")
-
-    @field_validator("fit_tau_s")
-    @classmethod
-    def _span(cls, v):
-        if v is not None and (len(v) != 2 or not 0 < v[0] < v[1]):
-            raise ValueError(f"must be [lo, hi] in s with 0 < lo < hi, got {v}")
-        return v

@@ -24,14 +24,32 @@ NonNegVec3 = Annotated[list[Annotated[float, Field(ge=0)]], Field(min_length=3, 
 PosVec3 = Annotated[list[Annotated[float, Field(gt=0)]], Field(min_length=3, max_length=3)]
 
 
-def three(x: Any) -> Any:
+def is_number(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def broadcast(x: Any) -> Any:
     """One number stands for all three axes."""
-    if isinstance(x, (int, float)) and not isinstance(x, bool):
-        return [x, x, x]
-    return x
+    return [x, x, x] if is_number(x) else x
 
 
-Pos3 = Annotated[PosVec3, BeforeValidator(three)]  #: positive, one number or three
+#: A bias, a scale-factor error, an angle: one number for all three axes, or one per axis.
+PerAxis = Annotated[Vec3, BeforeValidator(broadcast)]
+Pos3 = Annotated[PosVec3, BeforeValidator(broadcast)]  #: positive, one number or three
+NonNeg3 = Annotated[NonNegVec3, BeforeValidator(broadcast)]  #: ≥ 0, one number or three
+
+
+def span(v: list[float] | None) -> list[float] | None:
+    """A τ span ``[lo, hi]`` in s (None: none)."""
+    if v is not None and (len(v) != 2 or not 0 < v[0] < v[1]):
+        raise ValueError(f"must be [lo, hi] in s with 0 < lo < hi, got {v}")
+    return v
+
+
+def vector(value: float | tuple[float, float, float] = 0.0, **field: Any) -> Any:
+    """A field of three numbers whose default is `value` (one number: on all three axes)."""
+    values = list(value) if isinstance(value, tuple) else [value] * 3
+    return Field(default_factory=lambda: list(values), **field)
 
 
 def _takes_bool(annotation: Any) -> bool:

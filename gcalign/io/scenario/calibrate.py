@@ -57,17 +57,19 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BeforeValidator, Field, model_validator
+from pydantic import Field, model_validator
 
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, NonNegVec3, Pos3, Vec3, three
-from gcalign.io.scenario.sensors import AccelGaussMarkov, GyroGaussMarkov, ScaleGaussMarkov
+from gcalign.io.scenario.base import Model, NonNeg3, PerAxis, Pos3, Vec3, vector
+from gcalign.io.scenario.sensors import (
+    AccelGaussMarkov,
+    GyroGaussMarkov,
+    ScaleGaussMarkov,
+    gauss_markov_si,
+)
 from gcalign.nav.earth import EarthModel
-
-Pos3Zero = Annotated[NonNegVec3, BeforeValidator(three)]
-Any3 = Annotated[Vec3, BeforeValidator(three)]
 
 
 def _enu_m_to_si(enu, lat: float, h: float, earth: EarthModel) -> np.ndarray:
@@ -80,21 +82,14 @@ def _enu_m_to_si(enu, lat: float, h: float, earth: EarthModel) -> np.ndarray:
 class P0Sigma(Model):
     """The listed initial σ before ``p0_scale`` (default: the seed's §5.2 list)."""
 
-    attitude_arcsec: Annotated[Pos3, B.P0_ATTITUDE_ARCSEC] = Field(
-        default_factory=lambda: [20.0, 20.0, 1800.0],
-        description="φ [E, N, U]; the seed's 20″, 20″, 30′")
-    velocity_enu_mps: Annotated[Pos3, B.P0_VELOCITY_MPS] = Field(
-        default_factory=lambda: [0.2, 0.2, 0.2])
-    position_enu_m: Annotated[Pos3, B.P0_POSITION_M] = Field(
-        default_factory=lambda: [1.0, 1.0, 1.0])
-    gyro_bias_dph: Annotated[Pos3, B.P0_GYRO_BIAS_DPH] = Field(
-        default_factory=lambda: [0.01, 0.01, 0.01])
-    accel_bias_ug: Annotated[Pos3, B.P0_ACCEL_BIAS_UG] = Field(
-        default_factory=lambda: [50.0, 50.0, 50.0])
-    gyro_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = Field(
-        default_factory=lambda: [100.0, 100.0, 100.0])
-    accel_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = Field(
-        default_factory=lambda: [100.0, 100.0, 100.0])
+    attitude_arcsec: Annotated[Pos3, B.P0_ATTITUDE_ARCSEC] = vector(
+        (20.0, 20.0, 1800.0), description="φ [E, N, U]; the seed's 20″, 20″, 30′")
+    velocity_enu_mps: Annotated[Pos3, B.P0_VELOCITY_MPS] = vector(0.2)
+    position_enu_m: Annotated[Pos3, B.P0_POSITION_M] = vector(1.0)
+    gyro_bias_dph: Annotated[Pos3, B.P0_GYRO_BIAS_DPH] = vector(0.01)
+    accel_bias_ug: Annotated[Pos3, B.P0_ACCEL_BIAS_UG] = vector(50.0)
+    gyro_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = vector(100.0)
+    accel_scale_ppm: Annotated[Pos3, B.P0_SCALE_PPM] = vector(100.0)
 
     def to_si(self, lat: float, h: float, earth: EarthModel) -> np.ndarray:
         """(21,) SI σ in the state order."""
@@ -112,16 +107,16 @@ class ProcessNoise(Model):
     random constant (the seed)."""
 
     arw_dprh: Annotated[float, B.ARW_DPRH] = Field(
-        0.001, ge=0, description=f"gyro angle random walk, {B.ARW_DPRH.range()}")
+        0.001, ge=0, description="gyro angle random walk")
     vrw_ugrhz: Annotated[float, B.VRW_UGRHZ] = Field(
-        10.0, ge=0, description=f"accelerometer velocity random walk, {B.VRW_UGRHZ.range()}")
+        10.0, ge=0, description="accelerometer velocity random walk")
     gyro_bias_gm: GyroGaussMarkov | None = Field(
         None, description="gyro biases as first-order Gauss–Markov processes")
-    gyro_bias_rw_dphrh: Annotated[Pos3Zero, B.GYRO_BIAS_RW_DPHRH] | None = Field(
+    gyro_bias_rw_dphrh: Annotated[NonNeg3, B.GYRO_BIAS_RW_DPHRH] | None = Field(
         None, description="gyro biases as random walks (rate random walk, °/h/√h)")
     accel_bias_gm: AccelGaussMarkov | None = Field(
         None, description="accelerometer biases as first-order Gauss–Markov processes")
-    accel_bias_rw_ughrh: Annotated[Pos3Zero, B.ACCEL_BIAS_RW_UGRH] | None = Field(
+    accel_bias_rw_ughrh: Annotated[NonNeg3, B.ACCEL_BIAS_RW_UGRH] | None = Field(
         None, description="accelerometer biases as random walks (µg/√h)")
     gyro_scale_gm: ScaleGaussMarkov | None = Field(
         None, description="gyro scale factors as first-order Gauss–Markov processes")
@@ -130,10 +125,8 @@ class ProcessNoise(Model):
 
     @model_validator(mode="after")
     def _one_process_per_state(self):
-        for what in ("gyro", "accel"):
-            if getattr(self, f"{what}_bias_gm") is not None and \
-                    getattr(self, f"{what}_bias_rw_{'dphrh' if what == 'gyro' else 'ughrh'}") \
-                    is not None:
+        for what, rw in (("gyro", self.gyro_bias_rw_dphrh), ("accel", self.accel_bias_rw_ughrh)):
+            if getattr(self, f"{what}_bias_gm") is not None and rw is not None:
                 raise ValueError(f"{what}_bias_gm: a bias is one process; give "
                                  f"{what}_bias_gm or the random walk, not both")
         return self
@@ -143,42 +136,29 @@ class ProcessNoise(Model):
         states, or None when every one is a random constant."""
         from gcalign.estimation.ins_error import SensorProcesses
 
-        groups = [(self.gyro_bias_gm, "std_dph", u.DPH, self.gyro_bias_rw_dphrh,
-                   u.DPH / math.sqrt(u.HOUR)),
-                  (self.accel_bias_gm, "std_ug", u.UG, self.accel_bias_rw_ughrh,
-                   u.UG / math.sqrt(u.HOUR)),
-                  (self.gyro_scale_gm, "std_ppm", u.PPM, None, 0.0),
-                  (self.accel_scale_gm, "std_ppm", u.PPM, None, 0.0)]
-        if all(gm is None and rw is None for gm, _, _, rw, _ in groups):
+        groups = [(self.gyro_bias_gm, u.DPH, self.gyro_bias_rw_dphrh, u.DPH / math.sqrt(u.HOUR)),
+                  (self.accel_bias_gm, u.UG, self.accel_bias_rw_ughrh, u.UG / math.sqrt(u.HOUR)),
+                  (self.gyro_scale_gm, u.PPM, None, 0.0), (self.accel_scale_gm, u.PPM, None, 0.0)]
+        if all(gm is None and rw is None for gm, _, rw, _ in groups):
             return None
         kinds: list[str] = []
         std, tau, dens = [], [], []
-        for gm, key, unit, rw, rw_unit in groups:
-            if gm is not None:
-                kinds += ["gauss-markov"] * 3
-                std += [float(x) * unit for x in getattr(gm, key)]
-                tau += [float(x) for x in gm.tau_s]
-                dens += [0.0] * 3
-            elif rw is not None:
-                kinds += ["random-walk"] * 3
-                std += [0.0] * 3
-                tau += [math.inf] * 3
-                dens += [float(x) * rw_unit for x in rw]
-            else:
-                kinds += ["constant"] * 3
-                std += [0.0] * 3
-                tau += [math.inf] * 3
-                dens += [0.0] * 3
+        for gm, unit, rw, rw_unit in groups:  # one process per state (the validator)
+            kinds += ["gauss-markov" if gm is not None else "constant" if rw is None
+                      else "random-walk"] * 3
+            gm_std, gm_tau = gauss_markov_si(gm, unit)  # zeros and inf without a process
+            std += gm_std.tolist()
+            tau += gm_tau.tolist()
+            dens += [0.0] * 3 if rw is None else [float(x) * rw_unit for x in rw]
         return SensorProcesses.of(kinds, std, tau, dens)
 
 
 class InitialError(Model):
     """The INS's initial errors in a simulation with ``truth: scenario`` (spec 002 §2 [X])."""
 
-    attitude_arcsec: Any3 = Field(default_factory=lambda: [20.0, -20.0, 1800.0],
-                                  description="misalignment φ [E, N, U]")
-    velocity_enu_mps: Any3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    position_enu_m: Any3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    attitude_arcsec: PerAxis = vector((20.0, -20.0, 1800.0), description="misalignment φ [E, N, U]")
+    velocity_enu_mps: PerAxis = vector()
+    position_enu_m: PerAxis = vector()
 
     def to_si(self, lat: float, h: float, earth: EarthModel) -> np.ndarray:
         """(9,) SI: [φ, δv, δL, δλ, δh]."""
@@ -208,8 +188,7 @@ class _AidingFile(Model):
     format: str
     columns: list[str] | None = None
     variable: str | None = None
-    lever_arm_m: LeverArm = Field(default_factory=lambda: [0.0, 0.0, 0.0],
-                                  description=_LEVER_HELP)
+    lever_arm_m: LeverArm = vector(description=_LEVER_HELP)
     interval_s: float | None = Field(None, gt=0, description=_INTERVAL_HELP)
 
 
@@ -237,20 +216,25 @@ class AidingFiles(Model):
     position: PositionFile | None = None
 
 
-def _divides(rate: float, sub: float) -> int | None:
-    """The whole number `rate / sub`, or None."""
+def _divided(key: str, what: str, rate: float, sub: float, ks: range, whole: bool = True) -> int:
+    """The whole number `rate` / `sub`; else ScenarioError naming ``calibrate.key``, with
+    the rates `rate` / k for k in `ks` (with `whole`, those that are whole numbers) as
+    examples."""
     k = rate / sub
-    return int(round(k)) if round(k) >= 1 and abs(k - round(k)) <= 1e-9 * k else None
+    if round(k) >= 1 and abs(k - round(k)) <= 1e-9 * k:
+        return int(round(k))
+    ok = [f"{rate / j:g}" for j in ks if not whole or (rate / j).is_integer()][:6]
+    raise ScenarioError(f"calibrate.{key}: must be the {what} rate {rate:g} Hz divided by a "
+                        f"whole number (e.g. {', '.join(ok)} Hz), got {sub:g}")
 
 
 class CalibrateConfig(Model):
     measure: Literal["velocity", "position", "both"] = "velocity"
-    sigma_v_mps: Annotated[float, B.SIGMA_V_MPS] = Field(
-        0.2, description=f"DGNSS velocity σ; R = σ²; {B.SIGMA_V_MPS.range()}")
+    sigma_v_mps: Annotated[float, B.SIGMA_V_MPS] = Field(0.2,
+                                                        description="DGNSS velocity σ; R = σ²")
     sigma_p_m: Annotated[float, B.SIGMA_P_M] = Field(
-        1.0, description=f"DGNSS position σ (north, east); R = σ²; {B.SIGMA_P_M.range()}")
-    p0_scale: Annotated[float, B.P0_SCALE] = Field(
-        10.0, description=f"P0 = (p0_scale · listed σ)²; {B.P0_SCALE.range()}")
+        1.0, description="DGNSS position σ (north, east); R = σ²")
+    p0_scale: Annotated[float, B.P0_SCALE] = Field(10.0, description="P0 = (p0_scale · listed σ)²")
     p0: P0Sigma = Field(default_factory=P0Sigma)
     q: ProcessNoise = Field(default_factory=ProcessNoise)
     navigation_rate_hz: float | None = Field(None, gt=0, description="default: the IMU rate")
@@ -282,26 +266,14 @@ class CalibrateConfig(Model):
 
     def subsamples(self, imu_rate: float) -> int:
         """IMU increments per navigation step; ScenarioError naming the field."""
-        nav = self.navigation_rate_hz or imu_rate
-        n = _divides(imu_rate, nav)
-        if n is None:
-            allowed = ", ".join(f"{imu_rate / k:g}" for k in range(1, 6))
-            raise ScenarioError(
-                f"calibrate.navigation_rate_hz: must be the IMU rate {imu_rate:g} Hz divided by "
-                f"a whole number (e.g. {allowed} Hz), got {nav:g}")
-        return n
+        return _divided("navigation_rate_hz", "IMU", imu_rate,
+                        self.navigation_rate_hz or imu_rate, range(1, 6), whole=False)
 
     def steps_per_update(self, imu_rate: float) -> int:
         """Navigation steps per filter step; ScenarioError naming the field."""
         nav = imu_rate / self.subsamples(imu_rate)
-        S = _divides(nav, self.filter_rate_hz)
-        if S is None:
-            ok = [nav / k for k in range(1, int(nav) + 1) if (nav / k).is_integer()]
-            raise ScenarioError(
-                f"calibrate.filter_rate_hz: must be the navigation rate {nav:g} Hz divided by a "
-                f"whole number (e.g. {', '.join(f'{r:g}' for r in ok[:6])} Hz), got "
-                f"{self.filter_rate_hz:g}")
-        return S
+        return _divided("filter_rate_hz", "navigation", nav, self.filter_rate_hz,
+                        range(1, int(nav) + 1))
 
     # ------------------------------------------------------------------ checks
 
@@ -315,11 +287,9 @@ class CalibrateConfig(Model):
 
     def check(self, sc) -> None:
         """Checks that need the rest of the scenario; ScenarioError naming the field."""
-        if self.files is None:
-            for key in ("max_gap_s",):
-                if getattr(self, key) is not None:
-                    raise ScenarioError(f"calibrate.{key}: finds the outages of aiding files "
-                                        f"(aiding: file); this run has none (remove it)")
+        if self.files is None and self.max_gap_s is not None:
+            raise ScenarioError("calibrate.max_gap_s: finds the outages of aiding files "
+                                "(aiding: file); this run has none (remove it)")
         if (self.aiding == "file") != (self.files is not None):
             raise ScenarioError("calibrate.files: goes with aiding 'file' (and it needs them); "
                                 f"got aiding {self.aiding!r}"
@@ -422,14 +392,8 @@ class CalibrateConfig(Model):
         """Navigation steps per stored row of the solution; ScenarioError naming the field."""
         if self.output_rate_hz is None:
             return 1
-        k = _divides(nav_rate, self.output_rate_hz)
-        if k is None:
-            ok = [nav_rate / j for j in range(1, 11) if (nav_rate / j).is_integer()]
-            raise ScenarioError(
-                f"calibrate.output_rate_hz: must be the navigation rate {nav_rate:g} Hz divided "
-                f"by a whole number (e.g. {', '.join(f'{r:g}' for r in ok[:6])} Hz), got "
-                f"{self.output_rate_hz:g}")
-        return k
+        return _divided("output_rate_hz", "navigation", nav_rate, self.output_rate_hz,
+                        range(1, 11))
 
     def resolved_rows(self, sc) -> list[tuple[str, str, str]]:
         rows = [
@@ -451,9 +415,8 @@ class CalibrateConfig(Model):
             ("calibrate.components", self.components_for(sc), "horizontal: the seed's eqs. "
              "5-7; 3d: with the vertical velocity and height"),
         ]
-        procs = [k for k in ("gyro_bias_gm", "gyro_bias_rw_dphrh", "accel_bias_gm",
-                             "accel_bias_rw_ughrh", "gyro_scale_gm", "accel_scale_gm")
-                 if getattr(self.q, k) is not None]
+        procs = [k for k in ProcessNoise.model_fields if k not in ("arw_dprh", "vrw_ugrhz")
+                 and getattr(self.q, k) is not None]
         rows.append(("calibrate.q processes", ", ".join(procs) or "none",
                      "the other sensor states are random constants"))
         if self.files is not None:

@@ -19,7 +19,7 @@ from gcalign import units as u
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.align import AlignConfig
 from gcalign.io.scenario.allan import AllanConfig
-from gcalign.io.scenario.base import Model
+from gcalign.io.scenario.base import Model, PerAxis, span, vector
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 from gcalign.io.scenario.modulate import ModulateConfig
 from gcalign.io.scenario.motion import MotionModel
@@ -31,7 +31,6 @@ from gcalign.io.scenario.sensors import (
     AccelGaussMarkov,
     GyroGaussMarkov,
     Noise,
-    PerAxis,
     ScaleGaussMarkov,
     gauss_markov_si,
     per_axis,
@@ -55,6 +54,9 @@ def _check_misalignment(m):
     return m
 
 
+Misalignment = Annotated[list[list[float]] | None, AfterValidator(_check_misalignment)]
+
+
 class Site(Model):
     lat_deg: float = Field(description="geodetic latitude, deg, within (-90, 90)")
     lon_deg: float = Field(ge=-180, le=360, description="longitude, deg")
@@ -73,52 +75,36 @@ class Site(Model):
         return np.array([self.lat_deg * u.DEG, self.lon_deg * u.DEG, self.height_m])
 
 
-def _tau_range(v):
-    if v is None:
-        return v
-    if len(v) != 2 or not 0 < v[0] < v[1]:
-        raise ValueError(f"must be [lo, hi] in s with 0 < lo < hi, got {v}")
-    return v
-
-
 def _span(v: list[float] | None) -> tuple[float, float] | None:
     return None if v is None else (float(v[0]), float(v[1]))
 
 
-TauRange = Annotated[list[Annotated[float, B.CORRELATION_TIME_S]] | None,
-                     AfterValidator(_tau_range)]
+TauRange = Annotated[list[Annotated[float, B.CORRELATION_TIME_S]] | None, AfterValidator(span)]
 INSTABILITY_TAU = ("τ range (s) over which the bias instability's Allan deviation is flat "
                    "(its Gauss–Markov sum, gcalign.sim.errors), from 10 samples on; default 1 s "
                    "(or 10 samples) to the run's duration")
+_ASYM = "asymmetric scale factor: + for positive input, − negative"
+_SCALE_GM = "a scale-factor error that wanders (added to scale_ppm)"
+_RANDOM_WALK = "random walk, the bias's std after t hours is this · √t"
+_INSTABILITY = ("the flat part of the Allan deviation / 0.664 (flicker noise, simulated as a "
+                "sum of Gauss–Markov processes)")
 
 
 class Gyro(Model):
-    bias_dph: Annotated[PerAxis, B.GYRO_BIAS_DPH] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0], description=B.GYRO_BIAS_DPH.range())
-    arw_dprh: Annotated[Noise, B.ARW_DPRH] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0], description=B.ARW_DPRH.range())
-    scale_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0], description=B.SCALE_PPM.range())
-    misalignment_arcsec: list[list[float]] | None = None
+    bias_dph: Annotated[PerAxis, B.GYRO_BIAS_DPH] = vector()
+    arw_dprh: Annotated[Noise, B.ARW_DPRH] = vector()
+    scale_ppm: Annotated[PerAxis, B.SCALE_PPM] = vector()
+    misalignment_arcsec: Misalignment = None
     quantum_arcsec: float = Field(0.0, ge=0)
-    asym_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0],
-        description="asymmetric scale factor: + for positive input, − negative")
+    asym_ppm: Annotated[PerAxis, B.SCALE_PPM] = vector(description=_ASYM)
     bias_gm: GyroGaussMarkov | None = Field(
         None, description="a bias that wanders: first-order Gauss–Markov (added to bias_dph)")
-    bias_rw_dphrh: Annotated[Noise, B.GYRO_BIAS_RW_DPHRH] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0],
-        description=f"rate random walk, the bias's std after t hours is this · √t; "
-                    f"{B.GYRO_BIAS_RW_DPHRH.range()}")
-    scale_gm: ScaleGaussMarkov | None = Field(
-        None, description="a scale-factor error that wanders (added to scale_ppm)")
-    bias_instability_dph: Annotated[Noise, B.GYRO_BIAS_DPH] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0],
-        description="bias instability B, °/h: the flat part of the Allan deviation / 0.664 "
-                    "(flicker noise, simulated as a sum of Gauss–Markov processes)")
+    bias_rw_dphrh: Annotated[Noise, B.GYRO_BIAS_RW_DPHRH] = vector(
+        description=f"rate {_RANDOM_WALK}")
+    scale_gm: ScaleGaussMarkov | None = Field(None, description=_SCALE_GM)
+    bias_instability_dph: Annotated[Noise, B.GYRO_BIAS_DPH] = vector(
+        description=f"bias instability B, °/h: {_INSTABILITY}")
     bias_instability_tau_s: TauRange = Field(None, description=INSTABILITY_TAU)
-
-    _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
     def to_si(self) -> SensorErrors:
         return _sensor_si(self, u.DPH, u.DPSH, self.bias_dph, self.arw_dprh,
@@ -127,32 +113,20 @@ class Gyro(Model):
 
 
 class Accel(Model):
-    bias_ug: Annotated[PerAxis, B.ACCEL_BIAS_UG] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0], description=B.ACCEL_BIAS_UG.range())
-    vrw_ugrhz: Annotated[Noise, B.VRW_UGRHZ] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0], description=B.VRW_UGRHZ.range())
-    scale_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0], description=B.SCALE_PPM.range())
-    misalignment_arcsec: list[list[float]] | None = None
+    bias_ug: Annotated[PerAxis, B.ACCEL_BIAS_UG] = vector()
+    vrw_ugrhz: Annotated[Noise, B.VRW_UGRHZ] = vector()
+    scale_ppm: Annotated[PerAxis, B.SCALE_PPM] = vector()
+    misalignment_arcsec: Misalignment = None
     quantum_ugs: float = Field(0.0, ge=0, description="velocity quantum, µg·s (PSINS header unit)")
-    asym_ppm: Annotated[PerAxis, B.SCALE_PPM] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0],
-        description="asymmetric scale factor: + for positive input, − negative")
+    asym_ppm: Annotated[PerAxis, B.SCALE_PPM] = vector(description=_ASYM)
     bias_gm: AccelGaussMarkov | None = Field(
         None, description="a bias that wanders: first-order Gauss–Markov (added to bias_ug)")
-    bias_rw_ughrh: Annotated[Noise, B.ACCEL_BIAS_RW_UGRH] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0],
-        description=f"acceleration random walk, the bias's std after t hours is this · √t; "
-                    f"{B.ACCEL_BIAS_RW_UGRH.range()}")
-    scale_gm: ScaleGaussMarkov | None = Field(
-        None, description="a scale-factor error that wanders (added to scale_ppm)")
-    bias_instability_ug: Annotated[Noise, B.ACCEL_BIAS_UG] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0],
-        description="bias instability B, µg: the flat part of the Allan deviation / 0.664 "
-                    "(flicker noise, simulated as a sum of Gauss–Markov processes)")
+    bias_rw_ughrh: Annotated[Noise, B.ACCEL_BIAS_RW_UGRH] = vector(
+        description=f"acceleration {_RANDOM_WALK}")
+    scale_gm: ScaleGaussMarkov | None = Field(None, description=_SCALE_GM)
+    bias_instability_ug: Annotated[Noise, B.ACCEL_BIAS_UG] = vector(
+        description=f"bias instability B, µg: {_INSTABILITY}")
     bias_instability_tau_s: TauRange = Field(None, description=INSTABILITY_TAU)
-
-    _check = field_validator("misalignment_arcsec")(_check_misalignment)
 
     def to_si(self) -> SensorErrors:
         return _sensor_si(self, u.UG, u.UGPSHZ, self.bias_ug, self.vrw_ugrhz,

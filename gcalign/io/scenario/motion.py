@@ -14,7 +14,7 @@ from pydantic import Field, field_validator, model_validator
 
 from gcalign import units as u
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, NonNegVec3, PosVec3, Vec3
+from gcalign.io.scenario.base import Model, NonNegVec3, PosVec3, Vec3, vector
 from gcalign.io.scenario.schedule import RowModel, schedule_of
 from gcalign.sim import motions as M
 
@@ -22,8 +22,7 @@ MOTION_KINDS = ("static", "swing", "moving", "turntable", "flight")
 
 
 class _Base(Model):
-    attitude_deg: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0],
-                               description="[pitch, roll, yaw]: initial (or mean, swing)")
+    attitude_deg: Vec3 = vector(description="[pitch, roll, yaw]: initial (or mean, swing)")
     duration_s: float = Field(gt=0, le=1e6)
 
     @field_validator("attitude_deg")
@@ -50,9 +49,9 @@ class StaticModel(_Base):
 
 
 class SwingParams(Model):
-    amplitude_deg: NonNegVec3 = Field(default_factory=lambda: [2.0, 3.0, 4.0])
-    period_s: PosVec3 = Field(default_factory=lambda: [10.0, 10.0, 20.0])
-    phase_deg: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    amplitude_deg: NonNegVec3 = vector((2.0, 3.0, 4.0))
+    period_s: PosVec3 = vector((10.0, 10.0, 20.0))
+    phase_deg: Vec3 = vector()
 
 
 class SwingModel(_Base):
@@ -69,9 +68,8 @@ class SwingModel(_Base):
 
 class SegmentModel(Model):
     duration_s: float = Field(gt=0)
-    accel_mps2: Annotated[float, B.ACCEL_MPS2] = Field(0.0, description=B.ACCEL_MPS2.range())
-    rate_dps: Annotated[Vec3, B.RATE_DPS] = Field(default_factory=lambda: [0.0, 0.0, 0.0],
-                                                       description=B.RATE_DPS.range())
+    accel_mps2: Annotated[float, B.ACCEL_MPS2] = 0.0
+    rate_dps: Annotated[Vec3, B.RATE_DPS] = vector()
     name: str = ""
 
 
@@ -106,11 +104,9 @@ class TurntableModel(_Base):
 class FlightSegmentModel(Model):
     kind: Literal["hold", "accelerate", "pitch", "roll", "yaw", "turn", "coordinated_turn"]
     duration_s: float | None = Field(None, gt=0)
-    accel_mps2: Annotated[float | None, B.ACCEL_MPS2] = Field(None,
-                                                          description=B.ACCEL_MPS2.range())
+    accel_mps2: Annotated[float | None, B.ACCEL_MPS2] = None
     speed_mps: float | None = Field(None, ge=0)
-    rate_dps: Annotated[float | None, B.RATE_DPS] = Field(None, gt=0,
-                                                      description=B.RATE_DPS.range())
+    rate_dps: Annotated[float | None, B.RATE_DPS] = Field(None, gt=0)
     angle_deg: float | None = None
     name: str = ""
 

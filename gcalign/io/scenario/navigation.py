@@ -10,13 +10,11 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Annotated, Literal
 
-import numpy as np
 from pydantic import Field, model_validator
 
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, Vec3
-from gcalign.io.scenario.schedule import RowModel, schedule_of
-from gcalign.nav.rotation import euler_to_quat
+from gcalign.io.scenario.schedule import RowModel, quat_of, schedule_of
 from gcalign.sim.mechanism import Mechanism
 from gcalign.sim.schedule import Schedule
 
@@ -86,7 +84,7 @@ class MechanismConfig(Model):
     turn_s: float | None = Field(None, gt=0, description="scheme: whole turn, s, instead of "
                                  "const_s (const = turn - accel - decel)")
     rate_dps: Annotated[float | None, B.RATE_DPS] = Field(
-        None, gt=0, description=f"continuous: rate, °/s (default 6), {B.RATE_DPS.range()}")
+        None, gt=0, description="continuous: rate, °/s (default 6)")
     axis: Literal["x", "y", "z", "-x", "-y", "-z"] | None = Field(
         None, description="continuous: the sensor axis it turns about (default z)")
     lever_arm_cm: Vec3 | None = Field(
@@ -103,7 +101,7 @@ class MechanismConfig(Model):
             if timing:
                 raise ValueError(f"{timing[0]}: applies to a built-in scheme; a steps table "
                                  "gives its own timing in each row")
-            period = schedule_of(self.steps, self.repeat, self.start_deg).period
+            period = schedule_of(self.steps, self.repeat).period
             where = "steps"
         else:
             if self.name is not None:
@@ -159,10 +157,7 @@ class MechanismConfig(Model):
         start = self.start_deg
         if start is None and self.resolved_reference == "navigation":
             start = body_att0_deg
-        if start is None:
-            return (1.0, 0.0, 0.0, 0.0)
-        q = euler_to_quat(np.radians(start))
-        return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+        return quat_of(start)
 
     @property
     def resolved_reference(self) -> str:
@@ -190,7 +185,7 @@ class MechanismConfig(Model):
         if name is not None:
             return self.scheme_of(name, q0).schedule
         assert self.steps is not None
-        return replace(schedule_of(self.steps, self.repeat), q0=q0)
+        return schedule_of(self.steps, self.repeat, q0)
 
     def to_mechanism(self, body_att0_deg=None) -> Mechanism:
         """The mechanism (see :meth:`schedule`)."""

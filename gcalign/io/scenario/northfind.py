@@ -58,6 +58,7 @@ from gcalign import limits
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario.base import Model
+from gcalign.io.scenario.sensors import per_axis
 
 if TYPE_CHECKING:  # the capability loads when a north-finding is set up, not at start-up
     from gcalign.northfind import NorthfindSetup
@@ -74,34 +75,32 @@ def _fmt(x: float) -> str:
 
 def axis(value, i: int) -> float:
     """Component `i` of an IMU per-axis value (a scalar default stands for all three axes)."""
-    return float(np.broadcast_to(np.asarray(value, dtype=float), (3,))[i])
+    return float(per_axis(value)[i])
 
 
 class Sweep(Model):
     """True azimuths ``start_deg, start_deg + step_deg, …`` up to ``stop_deg`` (see module)."""
 
-    start_deg: float = Field(0.0, allow_inf_nan=False)
-    stop_deg: float = Field(360.0, allow_inf_nan=False)
-    step_deg: float = Field(allow_inf_nan=False, gt=0, le=360)
+    start_deg: float = 0.0
+    stop_deg: float = 360.0
+    step_deg: float = Field(gt=0, le=360)
 
     @model_validator(mode="after")
     def _not_empty(self):
         if self.stop_deg < self.start_deg:
-            raise ValueError(
-                f"stop_deg: empty sweep, stop_deg {_fmt(self.stop_deg)} is below start_deg "
-                f"{_fmt(self.start_deg)}; allowed: stop_deg >= start_deg"
-            )
-        count = int(np.floor((self.stop_deg - self.start_deg) / self.step_deg + _TOL)) + 1
-        if count > MAX_AZIMUTHS:
-            raise ValueError(
-                f"step_deg: the sweep would hold {count} azimuths, at most {MAX_AZIMUTHS} "
-                f"allowed; got step_deg {_fmt(self.step_deg)}"
-            )
+            raise ValueError(f"stop_deg: empty sweep, stop_deg {_fmt(self.stop_deg)} is below "
+                             f"start_deg {_fmt(self.start_deg)}; allowed: stop_deg >= start_deg")
+        if self._count() > MAX_AZIMUTHS:
+            raise ValueError(f"step_deg: the sweep would hold {self._count()} azimuths, at most "
+                             f"{MAX_AZIMUTHS} allowed; got step_deg {_fmt(self.step_deg)}")
         return self
+
+    def _count(self) -> int:
+        return int(np.floor((self.stop_deg - self.start_deg) / self.step_deg + _TOL)) + 1
 
     def azimuths_deg(self) -> np.ndarray:
         """The swept azimuths (deg), shape (M,), M >= 1."""
-        count = int(np.floor((self.stop_deg - self.start_deg) / self.step_deg + _TOL)) + 1
+        count = self._count()
         az = self.start_deg + self.step_deg * np.arange(count)
         full_turn = abs(self.stop_deg - self.start_deg - 360.0) < _TOL
         if full_turn and count > 1 and abs(az[-1] - self.stop_deg) < 1e-6:
@@ -116,39 +115,28 @@ class NorthfindConfig(Model):
     """Multi-position north-finding (seed 001); see the module docstring for the rules."""
 
     positions: int = Field(24, ge=3, le=100_000, description="table positions per turn")
-    dwell_s: float = Field(60.0, gt=0, le=1e6, allow_inf_nan=False, description="dwell, s")
-    azimuth_deg: float | None = Field(
-        None, allow_inf_nan=False, description="true azimuth of the reference axis, deg"
-    )
+    dwell_s: float = Field(60.0, gt=0, le=1e6, description="dwell, s")
+    azimuth_deg: float | None = Field(None, description="true azimuth of the reference axis, deg")
     sweep: Sweep | None = None
-    tilt_deg: float | None = Field(
-        None, allow_inf_nan=False, description="table normal from the vertical, deg; default 0"
-    )
-    tilt_direction_deg: float | None = Field(
-        None, allow_inf_nan=False, description="azimuth of descent, deg; default 0"
-    )
+    tilt_deg: float | None = Field(None, description="table normal from the vertical, deg; "
+                                   "default 0")
+    tilt_direction_deg: float | None = Field(None, description="azimuth of descent, deg; "
+                                             "default 0")
     tilt_reference: Literal["north", "table"] | None = Field(
-        None, description="north (fixed to the earth, default) or table (fixed to the table)"
-    )
-    pitch_deg: float | None = Field(
-        None, gt=-90, lt=90, allow_inf_nan=False, description="PSINS pitch of the table"
-    )
-    roll_deg: float | None = Field(
-        None, gt=-90, lt=90, allow_inf_nan=False, description="PSINS roll of the table"
-    )
+        None, description="north (fixed to the earth, default) or table (fixed to the table)")
+    pitch_deg: float | None = Field(None, gt=-90, lt=90, description="PSINS pitch of the table")
+    roll_deg: float | None = Field(None, gt=-90, lt=90, description="PSINS roll of the table")
     methods: list[MethodName] = Field(default_factory=lambda: list(DEFAULT_METHODS), min_length=1)
     repeats: int = Field(1, ge=1, le=1_000_000, description="independent determinations")
-    index_error_arcsec: float = Field(0.0, ge=0, allow_inf_nan=False)
+    index_error_arcsec: float = Field(0.0, ge=0)
     samples: bool = False
 
     @field_validator("tilt_deg")
     @classmethod
     def _tilt_range(cls, v):
         if v is not None and not 0.0 <= v < 90.0:
-            raise ValueError(
-                f"the angle between the table normal and the vertical must satisfy "
-                f"0 <= tilt_deg < 90, got {_fmt(v)}"
-            )
+            raise ValueError(f"the angle between the table normal and the vertical must "
+                             f"satisfy 0 <= tilt_deg < 90, got {_fmt(v)}")
         return v
 
     @field_validator("methods")
@@ -162,26 +150,19 @@ class NorthfindConfig(Model):
     @model_validator(mode="after")
     def _choices(self):
         if self.azimuth_deg is None and self.sweep is None:
-            raise ValueError(
-                "azimuth_deg: missing; give the true azimuth (azimuth_deg) or a sweep "
-                "({start_deg, stop_deg, step_deg})"
-            )
+            raise ValueError("azimuth_deg: missing; give the true azimuth (azimuth_deg) or a "
+                             "sweep ({start_deg, stop_deg, step_deg})")
         if self.azimuth_deg is not None and self.sweep is not None:
-            raise ValueError(
-                f"sweep: give either azimuth_deg or sweep, not both (got azimuth_deg "
-                f"{_fmt(self.azimuth_deg)} and sweep {self.sweep.label()})"
-            )
+            raise ValueError(f"sweep: give either azimuth_deg or sweep, not both (got "
+                             f"azimuth_deg {_fmt(self.azimuth_deg)} and sweep "
+                             f"{self.sweep.label()})")
         attitude = self.pitch_deg is not None or self.roll_deg is not None
         if attitude and (self.tilt_deg is not None or self.tilt_direction_deg is not None):
-            raise ValueError(
-                "pitch_deg: give the tilt either as tilt_deg/tilt_direction_deg or as "
-                "pitch_deg/roll_deg, not both"
-            )
+            raise ValueError("pitch_deg: give the tilt either as tilt_deg/tilt_direction_deg or "
+                             "as pitch_deg/roll_deg, not both")
         if attitude and self.tilt_reference == "north":
-            raise ValueError(
-                "tilt_reference: pitch_deg/roll_deg describe the table itself (tilt fixed to "
-                "the table); allowed: 'table' or omit it, got 'north'"
-            )
+            raise ValueError("tilt_reference: pitch_deg/roll_deg describe the table itself (tilt "
+                             "fixed to the table); allowed: 'table' or omit it, got 'north'")
         return self
 
     # ---------------------------------------------------------------- resolved values
@@ -215,17 +196,9 @@ class NorthfindConfig(Model):
         if sc.site is None:
             raise ScenarioError("site: missing; north-finding needs the site latitude "
                                 "(site: {lat_deg, lon_deg, height_m})")
-        lat = sc.site.lat_deg
-        if abs(lat) >= 90.0:
-            raise ScenarioError(
-                f"site.lat_deg: north is undefined at the poles (the horizontal earth rate "
-                f"vanishes); north-finding needs -90 < lat_deg < 90, got {_fmt(lat)}"
-            )
-        if sc.imu_file is not None:
-            raise ScenarioError(
-                f"imu_file: northfind simulates the turntable; recorded data is not supported, "
-                f"got {str(sc.imu_file)!r} (remove imu_file)"
-            )
+        if sc.imu_file is not None:  # (the site's latitude is within (-90, 90): Site)
+            raise ScenarioError(f"imu_file: northfind simulates the turntable; recorded data is "
+                                f"not supported, got {str(sc.imu_file)!r} (remove imu_file)")
         n = round(self.dwell_s * sc.imu.rate_hz)
         readings = self.azimuths_deg().size * self.repeats * self.positions
         limits.MAX_NORTHFIND_READINGS.check(
@@ -236,33 +209,22 @@ class NorthfindConfig(Model):
                 readings * n, "northfind.samples", "use samples: false (exact dwell means, "
                 "statistically identical)")
         if n < 1:
-            raise ScenarioError(
-                f"northfind.dwell_s: {_fmt(self.dwell_s)} s holds no sample at imu.rate_hz "
-                f"{_fmt(sc.imu.rate_hz)} Hz; allowed: dwell_s >= 1/rate_hz"
-            )
-        g, a = sc.imu.gyro, sc.imu.accel
-        vrw = [axis(a.vrw_ugrhz, i) for i in range(3)]
+            raise ScenarioError(f"northfind.dwell_s: {_fmt(self.dwell_s)} s holds no sample at "
+                                f"imu.rate_hz {_fmt(sc.imu.rate_hz)} Hz; allowed: dwell_s >= "
+                                "1/rate_hz")
+        vrw = per_axis(sc.imu.accel.vrw_ugrhz).tolist()
         if vrw[0] != vrw[1]:
-            raise ScenarioError(
-                f"imu.accel.vrw_ugrhz: the north-finder's x and y accelerometers share one noise "
-                f"density; x and y must be equal, got {vrw}"
-            )
-        unsupported = [
-            ("imu.gyro.misalignment_arcsec", g.misalignment_arcsec is not None
-             and np.any(np.asarray(g.misalignment_arcsec, float) != 0), g.misalignment_arcsec),
-            ("imu.gyro.quantum_arcsec", g.quantum_arcsec != 0, g.quantum_arcsec),
-            ("imu.accel.misalignment_arcsec", a.misalignment_arcsec is not None
-             and np.any(np.asarray(a.misalignment_arcsec, float) != 0), a.misalignment_arcsec),
-            ("imu.accel.scale_ppm", axis(a.scale_ppm, 0) != 0 or axis(a.scale_ppm, 1) != 0,
-             a.scale_ppm),
-            ("imu.accel.quantum_ugs", a.quantum_ugs != 0, a.quantum_ugs),
-        ]
-        for field, bad, value in unsupported:
-            if bad:
-                raise ScenarioError(
-                    f"{field}: not modelled by the north-finder (one in-plane gyro, two "
-                    f"accelerometers with bias and white noise); allowed: 0, got {value}"
-                )
+            raise ScenarioError(f"imu.accel.vrw_ugrhz: the north-finder's x and y accelerometers "
+                                f"share one noise density; x and y must be equal, got {vrw}")
+        for key in ("gyro.misalignment_arcsec", "gyro.quantum_arcsec",
+                    "accel.misalignment_arcsec", "accel.scale_ppm", "accel.quantum_ugs"):
+            sensor, name = key.split(".")
+            value = getattr(getattr(sc.imu, sensor), name)
+            used = per_axis(value)[:2] if name == "scale_ppm" else value  # x and y only
+            if used is not None and np.any(np.asarray(used, float) != 0):
+                raise ScenarioError(f"imu.{key}: not modelled by the north-finder (one in-plane "
+                                    "gyro, two accelerometers with bias and white noise); "
+                                    f"allowed: 0, got {value}")
 
     def to_setup(self, sc) -> NorthfindSetup:
         """The SI setup for :func:`gcalign.northfind.run_northfind` (runs :meth:`check`)."""

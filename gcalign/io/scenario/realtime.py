@@ -74,8 +74,8 @@ from gcalign import limits
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, Vec3
-from gcalign.io.scenario.schedule import RowModel
+from gcalign.io.scenario.base import Model, Vec3, vector
+from gcalign.io.scenario.schedule import RowModel, steps_of
 from gcalign.realtime.settings import (
     FilterSettings,
     PulseSettings,
@@ -84,7 +84,6 @@ from gcalign.realtime.settings import (
     TrackerSettings,
     seed_semi_physical,
 )
-from gcalign.sim.schedule import Step
 
 if TYPE_CHECKING:  # the cases module builds seed 003's table at import: where it is used
     from gcalign.realtime.cases import Case
@@ -107,8 +106,7 @@ FIR_WINDOWS = ("hamming", "hann", "blackman", "boxcar", "triang", "parzen", "boh
 
 class FilterConfig(Model):
     fs_hz: Annotated[float, B.SENSOR_RATE_HZ] = Field(
-        5000.0, gt=0, description=f"sensor sampling and filter rate f1, "
-                                  f"{B.SENSOR_RATE_HZ.range()}")
+        5000.0, gt=0, description="sensor sampling and filter rate f1")
     chain: Literal["navigation", "alignment"] = "navigation"
     nav_order: int = Field(40, description="FIR order (taps − 1) of the navigation chain")
     nav_cutoff_hz: float = 200.0
@@ -138,8 +136,7 @@ class FilterConfig(Model):
 
 class SensorConfig(Model):
     quantum_arcsec: float = Field(0.1, ge=0, description="angle per count (0: none)")
-    arw_dprh: Annotated[float, B.ARW_DPRH] = Field(
-        0.0005, ge=0, description=f"angle random walk, {B.ARW_DPRH.range()}")
+    arw_dprh: Annotated[float, B.ARW_DPRH] = Field(0.0005, ge=0, description="angle random walk")
     dither_arcsec: float = Field(100.0, ge=0, description="dither peak in the sensed angle")
     dither_hz: float = Field(400.0, gt=0)
 
@@ -153,13 +150,10 @@ class SensorConfig(Model):
 class TrackerConfig(Model):
     qc_rad2ps5: float = Field(1.0, gt=0, description="white-jerk intensity Qc, rad²/s⁵")
     r_std_arcsec: Annotated[float, B.ATTITUDE_SIGMA_ARCSEC] = Field(
-        0.03, description=f"σ of the attitude observation, R = σ²; "
-                          f"{B.ATTITUDE_SIGMA_ARCSEC.range()}")
-    p0_theta_arcsec: Annotated[float, B.P0_ANGLE_ARCSEC] = Field(
-        0.03, description=B.P0_ANGLE_ARCSEC.range())
-    p0_omega_dps: Annotated[float, B.P0_RATE_DPS] = Field(20.0, description=B.P0_RATE_DPS.range())
-    p0_alpha_dps2: Annotated[float, B.P0_ANGULAR_ACCEL_DPS2] = Field(
-        20.0, description=B.P0_ANGULAR_ACCEL_DPS2.range())
+        0.03, description="σ of the attitude observation, R = σ²")
+    p0_theta_arcsec: Annotated[float, B.P0_ANGLE_ARCSEC] = 0.03
+    p0_omega_dps: Annotated[float, B.P0_RATE_DPS] = 20.0
+    p0_alpha_dps2: Annotated[float, B.P0_ANGULAR_ACCEL_DPS2] = 20.0
 
     def to_settings(self) -> TrackerSettings:
         return TrackerSettings(qc=self.qc_rad2ps5, r=(self.r_std_arcsec * u.ARCSEC) ** 2,
@@ -172,8 +166,7 @@ class PulsesConfig(Model):
     rate_hz: float = Field(1000.0, gt=0)
     offset_us: float | None = Field(0.0, ge=0, description="null: random first edge (async)")
     jitter_us: float = Field(0.0, ge=0)
-    drift_ppm: Annotated[float, B.CLOCK_DRIFT_PPM] = Field(
-        0.0, description=B.CLOCK_DRIFT_PPM.range())
+    drift_ppm: Annotated[float, B.CLOCK_DRIFT_PPM] = 0.0
     resolution_us: float = Field(0.0, ge=0, description="Δt counter resolution (0: exact)")
 
     @model_validator(mode="after")
@@ -216,8 +209,7 @@ class PulsesConfig(Model):
 
 class CaseConfig(Model):
     name: str = Field(min_length=1)
-    attitude_deg: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0],
-                               description="[pitch, roll, yaw] at rest before t = 0")
+    attitude_deg: Vec3 = vector(description="[pitch, roll, yaw] at rest before t = 0")
     steps: list[RowModel] = Field(min_length=1)
     duration_s: float | None = Field(None, gt=0, description="default: the rows' total")
     pulses: PulsesConfig | None = None
@@ -236,16 +228,22 @@ def case_of(name: str, rows: list[RowModel], attitude_deg, duration_s: float | N
     """A core :class:`Case` from validated rows (ValueError names the row)."""
     from gcalign.realtime.cases import Case
 
-    steps: list[Step] = []
-    for i, r in enumerate(rows):
-        try:
-            steps.append(r.to_step())
-        except ValueError as err:
-            raise ValueError(f"steps.{i}: {err}") from None
     a = np.radians(np.asarray(attitude_deg, dtype=float))
-    return Case(name=name, steps=tuple(steps), att0=(float(a[0]), float(a[1]), float(a[2])),
+    return Case(name=name, steps=steps_of(rows), att0=(float(a[0]), float(a[1]), float(a[2])),
                 duration_s=duration_s, pulses=pulses, seed_before=seed_before,
                 seed_after=seed_after)
+
+
+def _check_case(case: Case, settings: Settings, where: str, filter_where: str = "") -> None:
+    """The core's checks of a case (its keys named under `where`) and of the filter for it
+    (named after `filter_where`); ValueError."""
+    from gcalign.realtime.cases import check_case, check_filter
+
+    for check, prefix in ((check_case, f"{where}."), (check_filter, filter_where)):
+        try:
+            check(case, settings)
+        except ValueError as err:
+            raise ValueError(f"{prefix}{err}") from None
 
 
 class RealtimeConfig(Model):
@@ -281,15 +279,9 @@ class RealtimeConfig(Model):
         for i, c in enumerate(self.cases or ()):
             if c.pulses is not None:
                 c.pulses.check_offset(f"cases.{i}.pulses", self.solution_hz)
-        from gcalign.realtime.cases import check_case, check_filter
-
         settings = self.to_settings()  # the core's checks, one line naming the setting
         for i, c in enumerate(self.cases or ()):
-            try:
-                check_case(c.to_case(), settings)
-            except ValueError as err:
-                raise ValueError(f"cases.{i}.{err}") from None
-            check_filter(c.to_case(), settings)
+            _check_case(c.to_case(), settings, f"cases.{i}")
         return self
 
     def unused(self, sc=None) -> list[str]:
@@ -359,25 +351,20 @@ class RealtimeConfig(Model):
             if mo.repeat:
                 raise ScenarioError("motion.repeat: a realtime case runs its rows once; "
                                     "allowed: false, got true")
-            from gcalign.realtime.cases import check_case, check_filter
-
             case = case_of(sc.name, mo.steps, mo.attitude_deg, mo.duration_s)
             try:
-                check_case(case, self.to_settings())
+                _check_case(case, self.to_settings(), "motion", "realtime.")
             except ValueError as err:
-                raise ScenarioError(f"motion.{err}") from None
-            try:
-                check_filter(case, self.to_settings())
-            except ValueError as err:
-                raise ScenarioError(f"realtime.{err}") from None
+                raise ScenarioError(str(err)) from None
         imu = sc.imu
         if "rate_hz" in imu.model_fields_set and imu.rate_hz != self.filter.fs_hz:
             raise ScenarioError(f"imu.rate_hz: the realtime gyros are sampled at "
                                 f"realtime.filter.fs_hz = {self.filter.fs_hz:g} Hz; omit "
                                 f"imu.rate_hz or set it equal, got {imu.rate_hz:g}")
         for name, sensor in (("gyro", imu.gyro), ("accel", imu.accel)):
-            for key, value in sensor.model_dump().items():
-                if value is not None and np.any(np.asarray(value, dtype=float) != 0):
+            for key, value in sensor.model_dump().items():  # a process (a mapping) is set
+                if isinstance(value, dict) or (value is not None
+                                               and np.any(np.asarray(value, dtype=float) != 0)):
                     raise ScenarioError(
                         f"imu.{name}.{key}: not used by realtime (its gyro model is "
                         f"realtime.sensor: quantum, ARW, dither); allowed: 0, got {value}")

@@ -31,7 +31,7 @@ from gcalign.io.recorded.axes import rotation_to_rfu
 from gcalign.io.recorded.imu import ACCEL_UNITS, FORMAT_NAMES, GYRO_UNITS, Layout
 from gcalign.io.recorded.reference import REFERENCE_FORMATS
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, Pos3, Vec3
+from gcalign.io.scenario.base import Model, Pos3, Vec3, vector
 
 
 class Units(Model):
@@ -145,8 +145,7 @@ class Initial(Model):
 
     att_deg: Vec3 = Field(description="[pitch, roll, yaw], deg (ENU, yaw CCW positive); "
                           "pitch within (-90, 90), roll and yaw within [-360, 360]")
-    v_enu_mps: Annotated[Vec3, B.VELOCITY_MPS] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0], description=B.VELOCITY_MPS.range())
+    v_enu_mps: Annotated[Vec3, B.VELOCITY_MPS] = vector()
     lat_deg: float | None = Field(None, gt=-90, lt=90, description="start latitude, deg")
     lon_deg: float | None = Field(None, ge=-180, le=360, description="start longitude, deg")
     height_m: float | None = Field(None, ge=-1000, le=1e5, description="start height, m")

@@ -38,29 +38,22 @@ def resolved_rows(sc: Scenario, imu=None) -> list[tuple[str, str, str]]:
         rows += reference_rows(sc, imu)
     else:
         imu, err = sc.imu, sc.imu.errors()
-        rows += [
-            ("imu.rate_hz", _v(imu.rate_hz) + " Hz", _v(imu.ts) + " s"),
-            ("imu.seed", str(imu.seed), ""),
-            ("imu.gyro.bias_dph", _v(imu.gyro.bias_dph) + " °/h", _v(err.gyro.bias) + " rad/s"),
-            ("imu.gyro.arw_dprh", _v(imu.gyro.arw_dprh) + " °/√h", _v(err.gyro.noise) + " rad/√s"),
-            ("imu.gyro.scale_ppm", _v(imu.gyro.scale_ppm) + " ppm", _v(err.gyro.scale)),
-            ("imu.accel.bias_ug", _v(imu.accel.bias_ug) + " µg", _v(err.accel.bias) + " m/s²"),
-            (
-                "imu.accel.vrw_ugrhz",
-                _v(imu.accel.vrw_ugrhz) + " µg/√Hz",
-                _v(err.accel.noise) + " m/s/√s",
-            ),
-            ("imu.accel.scale_ppm", _v(imu.accel.scale_ppm) + " ppm", _v(err.accel.scale)),
-        ]
+        rows += [("imu.rate_hz", _v(imu.rate_hz) + " Hz", _v(imu.ts) + " s"),
+                 ("imu.seed", str(imu.seed), "")]
+        for key, unit, si, si_unit in (
+                ("gyro.bias_dph", "°/h", err.gyro.bias, " rad/s"),
+                ("gyro.arw_dprh", "°/√h", err.gyro.noise, " rad/√s"),
+                ("gyro.scale_ppm", "ppm", err.gyro.scale, ""),
+                ("accel.bias_ug", "µg", err.accel.bias, " m/s²"),
+                ("accel.vrw_ugrhz", "µg/√Hz", err.accel.noise, " m/s/√s"),
+                ("accel.scale_ppm", "ppm", err.accel.scale, "")):
+            sensor, name = key.split(".")
+            rows.append((f"imu.{key}", f"{_v(getattr(getattr(imu, sensor), name))} {unit}",
+                         _v(si) + si_unit))
         for name, sensor, m in (("gyro", imu.gyro, err.gyro), ("accel", imu.accel, err.accel)):
             if sensor.misalignment_arcsec is not None:
-                rows.append(
-                    (
-                        f"imu.{name}.misalignment_arcsec",
-                        _v(sensor.misalignment_arcsec) + " ″",
-                        _v(m.misalignment) + " rad",
-                    )
-                )
+                rows.append((f"imu.{name}.misalignment_arcsec",
+                             _v(sensor.misalignment_arcsec) + " ″", _v(m.misalignment) + " rad"))
             if m.quantum:
                 unit = "rad" if name == "gyro" else "m/s"
                 rows.append((f"imu.{name}.quantum", "", _v(m.quantum) + f" {unit}"))

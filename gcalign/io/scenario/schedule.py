@@ -62,11 +62,9 @@ class RowModel(Model):
     accel_s: float | None = Field(None, gt=0)
     const_s: float | None = Field(None, ge=0)
     decel_s: float | None = Field(None, gt=0)
-    rate_dps: Annotated[float | None, B.RATE_DPS] = Field(None, description=B.RATE_DPS.range())
-    accel_dps2: Annotated[float | None, B.ANGULAR_ACCEL_DPS2] = Field(
-        None, description=B.ANGULAR_ACCEL_DPS2.range())
-    jerk_dps3: Annotated[float | None, B.ANGULAR_JERK_DPS3] = Field(
-        None, gt=0, description=B.ANGULAR_JERK_DPS3.range())
+    rate_dps: Annotated[float | None, B.RATE_DPS] = None
+    accel_dps2: Annotated[float | None, B.ANGULAR_ACCEL_DPS2] = None
+    jerk_dps3: Annotated[float | None, B.ANGULAR_JERK_DPS3] = Field(None, gt=0)
     amplitude_deg: float | None = None
     frequency_hz: float | None = Field(None, gt=0)
     phase_deg: float = 0.0
@@ -158,19 +156,29 @@ class RowModel(Model):
         return Step(axis_vector(self.axis), prof, self.dwell_s)
 
 
-def schedule_of(rows: list[RowModel], repeat: bool, start_deg=None) -> Schedule:
-    """The :class:`Schedule` of validated rows; `start_deg` ``[pitch, roll, yaw]`` the
-    starting orientation (PSINS Euler angles of C0). ValueError names a row that fails."""
-    from gcalign.nav.rotation import euler_to_quat
-
+def steps_of(rows: list[RowModel]) -> tuple[Step, ...]:
+    """The steps of validated rows; ValueError names a row that fails."""
     steps = []
     for i, r in enumerate(rows):
         try:
             steps.append(r.to_step())
         except ValueError as err:
             raise ValueError(f"steps.{i}: {err}") from None
-    q0 = (1.0, 0.0, 0.0, 0.0)
-    if start_deg is not None:
-        q = euler_to_quat(np.radians(start_deg))
-        q0 = (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
-    return Schedule(tuple(steps), repeat=repeat, q0=q0)
+    return tuple(steps)
+
+
+def quat_of(att_deg=None) -> tuple[float, float, float, float]:
+    """The quaternion of PSINS Euler angles ``[pitch, roll, yaw]`` in deg (None: the
+    identity)."""
+    from gcalign.nav.rotation import euler_to_quat
+
+    if att_deg is None:
+        return (1.0, 0.0, 0.0, 0.0)
+    q = euler_to_quat(np.radians(att_deg))
+    return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+
+
+def schedule_of(rows: list[RowModel], repeat: bool, q0=(1.0, 0.0, 0.0, 0.0)) -> Schedule:
+    """The :class:`Schedule` of validated rows starting at `q0`; ValueError names a row
+    that fails."""
+    return Schedule(steps_of(rows), repeat=repeat, q0=q0)

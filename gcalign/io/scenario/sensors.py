@@ -10,29 +10,19 @@ import numpy as np
 from pydantic import BeforeValidator, Field
 
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, NonNegVec3, Vec3
-
-
-def _is_number(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool)
+from gcalign.io.scenario.base import Model, NonNegVec3, PerAxis, is_number
 
 
 def _broadcast_scalar(x):
-    if _is_number(x):
+    if is_number(x):
         if x < 0:
             raise ValueError(f"must be ≥ 0 (one number, or one per axis), got {x}")
         return [x, x, x]
     return x
 
 
-def _broadcast(x):
-    return [x, x, x] if _is_number(x) else x
-
-
 # A noise density: one number for all three axes, or one per axis.
 Noise = Annotated[NonNegVec3, BeforeValidator(_broadcast_scalar)]
-# A bias or scale-factor error: one number for all three axes (the same sign), or one per axis.
-PerAxis = Annotated[Vec3, BeforeValidator(_broadcast)]
 Tau = Annotated[PerAxis, B.CORRELATION_TIME_S]
 
 

@@ -35,7 +35,7 @@ from typing import Annotated, Literal
 from pydantic import Field
 
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, PosVec3, Vec3
+from gcalign.io.scenario.base import Model, PosVec3, Vec3, vector
 from gcalign.units import ARCMIN, DEG, DPH, DPSH, UG, UGPSHZ
 
 
@@ -77,9 +77,9 @@ class Q(Model):
 
 
 class FlexureModel(Model):
-    beta_per_s: PosVec3 = Field(default_factory=lambda: [0.5, 0.4, 10.0])
-    sigma_arcmin: Vec3 = Field(default_factory=lambda: [0.6, -1.0, 0.7],
-                               description="PSINS markov2 σ (its sign is kept; σ² is used)")
+    beta_per_s: PosVec3 = vector((0.5, 0.4, 10.0))
+    sigma_arcmin: Vec3 = vector((0.6, -1.0, 0.7),
+                                description="PSINS markov2 σ (its sign is kept; σ² is used)")
 
 
 class TransferConfig(Model):
@@ -88,9 +88,8 @@ class TransferConfig(Model):
     matching: Literal["attitude+velocity", "velocity", "attitude"] = "attitude+velocity"
     flexure: bool = True
     feedback: Feedback = Field(default_factory=Feedback)
-    lever_arm_m: Annotated[Vec3, B.TRANSFER_LEVER_ARM_M] = Field(
-        default_factory=lambda: [0.0, 0.0, 0.0],
-        description=f"slave relative to master, body frame, m; {B.TRANSFER_LEVER_ARM_M.range()}")
+    lever_arm_m: Annotated[Vec3, B.TRANSFER_LEVER_ARM_M] = vector(
+        description="slave relative to master, body frame, m")
     gravity: Literal["normal", "constant"] = "normal"
     p0: P0 = Field(default_factory=P0)
     r: R = Field(default_factory=R)
