@@ -135,7 +135,7 @@ def _start_error(state: NavState, ref: Reference, t: float, earth) -> NavErrors:
 def _columns(rows: NavRows | NavErrors, under: str = "") -> dict[str, tuple[np.ndarray, Stored]]:
     """The stored series of `rows` by their names in the results file (the errors under
     ``error/``), each with how its field says it is stored."""
-    out = {}
+    out: dict[str, tuple[np.ndarray, Stored]] = {}
     for f in fields(rows):
         value, how = getattr(rows, f.name), spec(f)
         if isinstance(value, NavErrors):
