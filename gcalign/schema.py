@@ -140,7 +140,7 @@ SUMMARY_UNITS: dict[str, tuple[str, Any]] = {
     "": ("", None), "deg": ("deg", np.degrees),
     "deg360": ("deg", lambda a: np.mod(np.degrees(a), 360.0)),
     **{k: (k, lambda a, s=si: a / s) for k, si in (
-        ("s", 1.0), ("m", 1.0), ("arcsec", u.ARCSEC), ("dph", u.DPH), ("ug", u.UG))},
+        ("s", 1.0), ("m", 1.0), ("mps", 1.0), ("arcsec", u.ARCSEC), ("dph", u.DPH), ("ug", u.UG))},
 }
 
 

@@ -102,9 +102,12 @@ def _get(ds: h5py.Dataset, how: Stored) -> np.ndarray:
 
 def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
     """The dataclass `cls` from the group `g` as :func:`write_fields` wrote it; `given` fills
-    fields the file does not hold. A field stored as a flag comes back as bool, one stored
-    as names as a tuple of str."""
-    values: dict[str, Any] = {}
+    fields the file does not hold; a field it cannot hold (not stored, no default) is None.
+    A field stored as a flag comes back as bool, one stored as names as a tuple of str."""
+    values: dict[str, Any] = {
+        f.name: None for f in dataclasses.fields(cls)  # type: ignore[arg-type]
+        if spec(f) is None and f.init and f.default is dataclasses.MISSING
+        and f.default_factory is dataclasses.MISSING}
     for f, how, kind, inner in _stored_fields(cls):  # type: ignore[arg-type]
         if f.name in given or not f.init:
             continue
@@ -135,7 +138,7 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
         if f.name not in values and f.default is dataclasses.MISSING and \
                 f.default_factory is dataclasses.MISSING:
             values[f.name] = None  # not in the file (an optional series the run did not make)
-    return cls(**values, **given)
+    return cls(**(values | given))
 
 
 @functools.cache

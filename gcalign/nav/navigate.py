@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
@@ -36,6 +36,7 @@ from gcalign.nav import _kernels as K
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import euler_to_quat, quat_conj, quat_mult
 from gcalign.nav.strapdown import Navigator, NavState, Vertical
+from gcalign.schema import ATT_FRAME, PHI_FRAME, stored
 
 __all__ = ["NavErrors", "NavRows", "NavTruth", "Navigation", "navigate", "navigate_blocks",
            "position_error_enu"]
@@ -118,12 +119,18 @@ class Increments:
 @dataclass(frozen=True)
 class NavErrors:
     """Errors (or their largest magnitudes) per component: att (Euler differences est −
-    true, roll and yaw wrapped, rad), v_n (m/s ENU), pos (m ENU), phi (misalignment, rad)."""
+    true, roll and yaw wrapped, rad), v_n (m/s ENU), pos (m ENU), phi (misalignment, rad).
+    Stored under ``error/`` of the rows (the frame names what they are against) and
+    summarised in degrees, m/s and m."""
 
-    att: Array
-    v_n: Array
-    pos: Array
-    phi: Array
+    att: Array = field(metadata=stored(
+        "rad", frame="Euler differences est - {against}, roll and yaw wrapped",
+        summary="deg", label="attitude"))
+    v_n: Array = field(metadata=stored("m/s", frame="ENU", summary="mps", label="velocity"))
+    pos: Array = field(metadata=stored("m", frame="ENU (east, north, up)", summary="m",
+                                       label="position"))
+    phi: Array = field(metadata=stored("rad", frame=PHI_FRAME, summary="deg",
+                                       label="misalignment"))
 
     def stack(self) -> Array:
         """(4, 3): att, v_n, pos, phi."""
@@ -135,11 +142,11 @@ class NavRows:
     """Stored rows: record time t (n,), body attitude att, v_n, pos (n, 3), and the
     errors against the truth (None without truth) as in :class:`NavErrors`."""
 
-    t: Array
-    att: Array
-    v_n: Array
-    pos: Array
-    error: NavErrors | None = None
+    t: Array = field(metadata=stored("s"))
+    att: Array = field(metadata=stored("rad", frame=ATT_FRAME))
+    v_n: Array = field(metadata=stored("m/s", frame="ENU"))
+    pos: Array = field(metadata=stored("rad, rad, m", frame="[latitude, longitude, height]"))
+    error: NavErrors | None = field(default=None, metadata=stored(""))
 
 
 @dataclass(frozen=True)
@@ -154,17 +161,17 @@ class Navigation:
     compute_s : integration time; wall_s : the whole call, s.
     """
 
-    samples: int
-    start_s: float
-    duration_s: float
+    samples: int = field(metadata=stored("1", summary=""))
+    start_s: float = field(metadata=stored("s", summary="s", label="start"))
+    duration_s: float = field(metadata=stored("s", summary="s", label="duration"))
     stride: int
     vertical: Vertical
     final: NavState
-    displacement: Array
-    max_horizontal_displacement: float
-    max_error: NavErrors | None
-    final_error: NavErrors | None
-    max_horizontal_error: float | None
+    displacement: Array = field(metadata=stored("m", summary="m"))
+    max_horizontal_displacement: float = field(metadata=stored("m", summary="m"))
+    final_error: NavErrors | None = field(metadata=stored("", summary=""))
+    max_error: NavErrors | None = field(metadata=stored("", summary=""))
+    max_horizontal_error: float | None = field(metadata=stored("m", summary="m"))
     rows: NavRows | None
     compute_s: float
     wall_s: float

@@ -36,6 +36,20 @@ def group_of(name: str) -> str:
     return next(g for g in ("phi", "dv", "eb", "db", "mu", "th", "w") if name.startswith(g))
 
 
+def display(names) -> dict[str, dict]:
+    """Per state its SI unit, the unit the table and figures give it in and the factor from
+    SI: a summary's ``units``, ``display_units`` and ``display_scale``."""
+    return {"units": {n: SI_UNIT[group_of(n)] for n in names},
+            "display_units": {n: DISPLAY[group_of(n)][0] for n in names},
+            "display_scale": {n: DISPLAY[group_of(n)][1] for n in names}}
+
+
+def write_display(g, names) -> None:
+    """The states' display units and factors from SI as attributes of the group `g`."""
+    g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in names)
+    g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in names])
+
+
 def reference_path(sc) -> Path:
     """The master's file: the imu_file itself (``reference.path`` null), else the path,
     a relative one taken from the imu_file's folder."""
@@ -103,7 +117,7 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
     err = r.attitude_error_summary(10.0)
     states = {n: {"estimate": float(r.x[-1, i]), "sigma": float(r.sigma[-1, i]),
                   "sigma0": float(r.sigma0[i])} for i, n in enumerate(r.names)}
-    lo, hi = _chi2_band(r.m)
+    lo, hi = mean_nis_band(1, r.m)  # the band of one epoch
     mean_lo, mean_hi = mean_nis_band(len(r.nis), r.m)
     out = {
         "scenario": sc.name,
@@ -119,9 +133,7 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
         "duration_s": float(r.t[-1] - r.t0),
         "epochs": len(r.t),
         "states": states,
-        "units": {n: SI_UNIT[group_of(n)] for n in r.names},
-        "display_units": {n: DISPLAY[group_of(n)][0] for n in r.names},
-        "display_scale": {n: DISPLAY[group_of(n)][1] for n in r.names},
+        **display(r.names),
         "convergence_s": conv,
         "attitude_error_vs_reference_arcmin": None if r.settings.matching == "velocity"
         and np.isnan(r.q_master).any() else {
@@ -146,12 +158,6 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
     return out
 
 
-def _chi2_band(dof: int, level: float = 0.95) -> tuple[float, float]:
-    from scipy.stats import chi2
-
-    return float(chi2.ppf((1 - level) / 2, dof)), float(chi2.ppf((1 + level) / 2, dof))
-
-
 def write(f, result, stored: dict) -> None:
     """``/align/transfer``: per-epoch estimates and σ (SI, columns in the order of the
     ``states`` attribute), NIS, the corrected slave attitude and velocity, its error against
@@ -164,8 +170,7 @@ def write(f, result, stored: dict) -> None:
     g.attrs["mode"] = "transfer"
     g.attrs["matching"] = r.settings.matching
     g.attrs["state_units"] = ",".join(SI_UNIT[group_of(n)] for n in r.names)
-    g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in r.names)
-    g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in r.names])
+    write_display(g, r.names)
     for k, v in stored.items():
         g.attrs[f"psins_{k}"] = v
         g.attrs[f"psins_{k}_units"] = {"eb0": "rad/s", "db0": "m/s^2", "mu0": "rad"}[k]
@@ -315,13 +320,14 @@ def figures(f, name: str) -> dict:
     """kfplot-like panels: per state group, the estimate with ±σ against time and, for ε,
     ∇, μ, PSINS's stored value as a dashed line."""
     from gcalign.app.plots import finish, new_figure
+    from gcalign.io.stored import read_fields
+    from gcalign.transfer import TransferResult
 
     g = f["align/transfer"]
-    names = g.attrs["states"]
-    names = (names.decode() if isinstance(names, bytes) else str(names)).split(",")
+    r = read_fields(g, TransferResult)  # the filter's series, as its fields say
+    names, t, x, sig = r.names, r.t, r.x, r.sigma
     units = str(g.attrs["display_units"]).split(",")
     scale = np.asarray(g.attrs["display_scale"], dtype=float)
-    t, x, sig = g["t"][()], g["estimate"][()], g["sigma"][()]
     groups = [gr for gr in ("phi", "dv", "eb", "db", "mu", "th", "w")
               if any(group_of(n) == gr for n in names)]
     label = {"phi": "φ attitude error", "dv": "δv velocity error", "eb": "ε gyro bias",

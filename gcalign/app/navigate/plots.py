@@ -10,6 +10,7 @@ from matplotlib.figure import Figure
 
 from gcalign.app.plots import (
     ENU,
+    _s,
     angle_scale,
     finish,
     new_figure,
@@ -53,24 +54,22 @@ def navigate_state_figure(t, att, vel, displacement, title: str = "navigation") 
 
 
 def figures(f, name: str) -> dict:
-    """The figures of a navigate results file."""
+    """The figures of a navigate results file, its rows read back
+    (:class:`~gcalign.nav.navigate.NavRows`)."""
+    from gcalign.io.stored import read_fields
+    from gcalign.nav.navigate import NavRows, position_error_enu
+
     if "navigate" not in f:
         return {}
     g = f["navigate"]
-    t = g["t"][()]
-    vertical = g.attrs.get("vertical", "")
-    vertical = vertical.decode() if isinstance(vertical, bytes) else str(vertical)
+    rows = read_fields(g, NavRows)
+    vertical = _s(g.attrs.get("vertical", ""))
     head = f"{name}: vertical channel {vertical}" if vertical else name
-    if "error" in g:
-        e = g["error"]
-        phi = e["phi"][()] if "phi" in e else e["att"][()]
-        against = g.attrs.get("error_source", "truth")
-        against = against.decode() if isinstance(against, bytes) else str(against)
+    if (e := rows.error) is not None:
+        against = _s(g.attrs.get("error_source", "truth"))
         return {"navigate_error": navigate_error_figure(
-            t, phi, e["v_n"][()], e["pos"][()], title=f"{head} — error against {against}")}
-    from gcalign.nav.navigate import position_error_enu
-
-    pos = g["pos"][()]
-    disp = position_error_enu(pos, np.broadcast_to(pos[0], pos.shape))
-    return {"navigate": navigate_state_figure(t, g["att"][()], g["v_n"][()], disp,
+            rows.t, e.att if e.phi is None else e.phi, e.v_n, e.pos,
+            title=f"{head} — error against {against}")}
+    disp = position_error_enu(rows.pos, np.broadcast_to(rows.pos[0], rows.pos.shape))
+    return {"navigate": navigate_state_figure(rows.t, rows.att, rows.v_n, disp,
                                               title=f"{head} — no truth: drift from the start")}

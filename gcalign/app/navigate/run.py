@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -32,10 +32,11 @@ from gcalign.errors import InputError, ScenarioError
 from gcalign.io.recorded.reference import Reference, initial_state, reference_at, reference_gaps
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.navigation import NavigationConfig
-from gcalign.nav.navigate import Navigation, NavRows, NavTruth, navigate_blocks
+from gcalign.nav.navigate import NavErrors, Navigation, NavRows, NavTruth, navigate_blocks
 from gcalign.nav.navigate import position_error_enu as position_error_enu  # its old home
 from gcalign.nav.rotation import attitude_error, misalignment_q
 from gcalign.nav.strapdown import NavState, Vertical
+from gcalign.schema import Stored, placed, spec, summary_of
 
 
 @dataclass(frozen=True)
@@ -122,37 +123,40 @@ def against_reference(blocks: Iterator[DataBlock], ref: Reference, t_a: float, t
         yield replace(b, truth=NavTruth(att, v, pos))  # type: ignore[arg-type]
 
 
-def _start_error(state: NavState, ref: Reference, t: float, earth) -> dict[str, np.ndarray]:
+def _start_error(state: NavState, ref: Reference, t: float, earth) -> NavErrors:
     """The errors of the start row against the reference at data time `t`."""
     att, v, pos = (a[0] for a in reference_at(ref, [t], tol=1e-6))
     tr = NavState.from_euler(att, v, pos)
-    return {"error/att": attitude_error(state.att, att)[None],
-            "error/v_n": (np.asarray(state.v_n) - v)[None],
-            "error/pos": position_error_enu(np.asarray(state.pos)[None], pos[None], earth),
-            "error/phi": misalignment_q(state.q_nb, tr.q_nb)[None]}
+    return NavErrors(attitude_error(state.att, att)[None], (np.asarray(state.v_n) - v)[None],
+                     position_error_enu(np.asarray(state.pos)[None], pos[None], earth),
+                     misalignment_q(state.q_nb, tr.q_nb)[None])
 
 
-def _as_dict(rows: NavRows) -> dict[str, np.ndarray]:
-    """Stored rows by the names of the results file's series."""
-    data = {"t": rows.t, "att": rows.att, "v_n": rows.v_n, "pos": rows.pos}
-    if rows.error is not None:
-        e = rows.error
-        data |= {"error/att": e.att, "error/v_n": e.v_n, "error/pos": e.pos, "error/phi": e.phi}
-    return data
+def _columns(rows: NavRows | NavErrors, under: str = "") -> dict[str, tuple[np.ndarray, Stored]]:
+    """The stored series of `rows` by their names in the results file (the errors under
+    ``error/``), each with how its field says it is stored."""
+    out: dict[str, tuple[np.ndarray, Stored]] = {}
+    for f in fields(rows):
+        value, how = getattr(rows, f.name), spec(f)
+        if isinstance(value, NavErrors):
+            out |= _columns(value, f"{under}{f.name}/")
+        elif value is not None and how is not None:
+            out[under + f.name] = (value, how)
+    return out
 
 
 def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
                     duration_s: float | None = None, sink=None, on_rows=None,
                     progress=None, reference: Reference | None = None,
-                    ref_gaps: tuple = ()) -> dict:
+                    ref_gaps: tuple = ()) -> Navigation:
     """Navigate from `start` to the end of the data (or for `duration_s`) by
     :func:`gcalign.nav.navigate.navigate_blocks`, write every `stride`-th row to `sink` (an
-    h5py group) and hand it to `on_rows` (called with the dict of arrays appended to the
-    series, block by block), and return the plain-number pieces of the summary (SI,
-    radians) with the core's result under ``result``. `progress(done_s, total_s, what)`,
-    if given, hears of every block (seconds of data navigated). With `reference` (recorded
-    data) the errors are against it (see the module docstring)."""
-    from gcalign.io.results import ATT_FRAME, PHI_FRAME, Series
+    h5py group; the series as the fields of :class:`~gcalign.nav.navigate.NavRows` say) and
+    hand it to `on_rows` (called with the dict of arrays appended to the series, block by
+    block), and return the core's result. `progress(done_s, total_s, what)`, if given,
+    hears of every block (seconds of data navigated). With `reference` (recorded data) the
+    errors are against it (see the module docstring)."""
+    from gcalign.io.results import Series
 
     ts = stream.ts
     k_end = stream.samples if duration_s is None else min(
@@ -161,33 +165,25 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
     if reference is not None:
         t_a, t_b = reference_window(reference, stream, start.k, k_end)
         blocks = against_reference(blocks, reference, t_a, t_b, ref_gaps)
-    has_truth = stream.truth0 is not None or reference is not None
-    against = "reference" if reference is not None else "true"
     series = None
     if sink is not None:
-        spec = {"t": (None, "s", None), "att": (3, "rad", ATT_FRAME), "v_n": (3, "m/s", "ENU"),
-                "pos": (3, "rad, rad, m", "[latitude, longitude, height]")}
-        if has_truth:
-            spec |= {"error/att": (3, "rad", f"Euler differences est - {against}, roll and "
-                                              "yaw wrapped"),
-                     "error/v_n": (3, "m/s", "ENU"),
-                     "error/pos": (3, "m", "ENU (east, north, up)"),
-                     "error/phi": (3, "rad", PHI_FRAME)}
-        series = Series(sink, spec, stride=stride, rate_hz=1.0 / (stride * ts),
-                        vertical=vertical.mode)
+        t_start = start.k * ts + stream.t0
+        error = None if stream.truth0 is None and reference is None else (
+            NavErrors(*[np.zeros((1, 3))] * 4) if reference is None
+            else _start_error(start.state, reference, t_start, stream.earth))
+        row0 = _columns(NavRows(np.array([t_start]), start.state.att[None],
+                                start.state.v_n[None], start.state.pos[None], error))
+        against = "reference" if reference is not None else "true"
+        series = Series(sink, {name: (a.shape[1] if a.ndim > 1 else None, how.units or "",
+                                      how.frame and how.frame.replace("{against}", against))
+                               for name, (a, how) in row0.items()},
+                        stride=stride, rate_hz=1.0 / (stride * ts), vertical=vertical.mode)
         if reference is not None:
             sink.attrs["error_source"] = "reference"
-        t_start = start.k * ts + stream.t0
-        row0: dict = {"t": [t_start], "att": [start.state.att], "v_n": [start.state.v_n],
-                      "pos": [start.state.pos]}
-        if reference is not None:
-            row0 |= _start_error(start.state, reference, t_start, stream.earth)
-        elif has_truth:
-            row0 |= {f"error/{n}": np.zeros((1, 3)) for n in ("att", "v_n", "pos", "phi")}
-        series.append(**row0)
+        series.append(**{name: a for name, (a, _) in row0.items()})
 
     def rows_out(rows: NavRows) -> None:  # always given, so the rows are never all held
-        data = _as_dict(rows)
+        data = {name: a for name, (a, _) in _columns(rows).items()}
         if series is not None:
             series.append(**data)
         if on_rows is not None:
@@ -202,20 +198,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         raise ScenarioError(f"navigation: {err.message}") from None
     if series is not None:
         series.flush()
-    return {
-        "samples": nav.samples,
-        "duration_s": nav.duration_s,
-        "start_s": nav.start_s,
-        "final_state": (nav.final.att, nav.final.v_n, nav.final.pos),
-        "displacement": nav.displacement,
-        "max_horizontal_displacement": nav.max_horizontal_displacement,
-        "peak": None if nav.max_error is None else nav.max_error.stack(),
-        "final_error": None if nav.final_error is None else nav.final_error.stack(),
-        "max_horizontal_error": nav.max_horizontal_error,
-        "compute_s": nav.compute_s,
-        "wall_s": nav.wall_s,
-        "result": nav,
-    }
+    return nav
 
 
 def run_navigation(sc: Scenario, seed: int | None = None, init: str | Path | None = None,
@@ -259,9 +242,9 @@ def _run(sc: Scenario, seed: int | None, init: str | Path | None, sink, on_rows,
         start = Start(k, state, source)
     gaps = () if ref is None or sc.reference is None else reference_gaps(
         ref, sc.reference.max_gap_s)
-    part = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink, on_rows,
-                           progress, ref, gaps)
-    return _summary(sc, stream, start, vertical, stride, part), stream, part["result"]
+    nav = navigate_stream(stream, start, vertical, stride, cfg.duration_s, sink, on_rows,
+                          progress, ref, gaps)
+    return _summary(sc, stream, start, vertical, stride, nav), stream, nav
 
 
 def _recorded_start(sc: Scenario, stream: Stream, k: int, ref: Reference | None,
@@ -300,18 +283,15 @@ def _stride(sc: Scenario, stream: Stream) -> int:
 
 
 def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, stride: int,
-             part: dict) -> dict:
-    att, v, pos = part["final_state"]
-    out = {
-        "scenario": sc.name,
-        "source": stream.source,
-        "seed": stream.seed,
-        "earth": stream.earth.name,
-        "samples": part["samples"],
-        "start_s": part["start_s"],
-        "duration_s": part["duration_s"],
+             nav: Navigation) -> dict:
+    """Plain numbers (degrees, m): the JSON contract of ``gcalign navigate``; the run's
+    figures as the fields of :class:`~gcalign.nav.navigate.Navigation` say, the scenario's
+    settings and the final state placed around them."""
+    out = placed(summary_of(nav), {"samples": {
+        "scenario": sc.name, "source": stream.source, "seed": stream.seed,
+        "earth": stream.earth.name}, "displacement_m": {
         "init": start.source,
-        "error_source": None if part["peak"] is None else (
+        "error_source": None if nav.max_error is None else (
             "reference" if sc.reference is not None else "truth"),
         "reference": None if sc.reference is None else {
             "path": str(sc.reference.path), "format": sc.reference.format},
@@ -319,26 +299,14 @@ def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, str
         "vertical_tau_s": vertical.tau if vertical.mode == "damped" else None,
         "mechanism": stream.has_mechanism,
         "output_rate_hz": 1.0 / (stride * stream.ts),
-        "compute_s": part["compute_s"],
+        "compute_s": nav.compute_s,
         "final_state": {
-            "attitude_deg": np.degrees(att).tolist(),
-            "velocity_mps": v.tolist(),
-            "position_deg_m": [*np.degrees(pos[:2]).tolist(), float(pos[2])],
-        },
-        "displacement_m": part["displacement"].tolist(),
-        "max_horizontal_displacement_m": part["max_horizontal_displacement"],
-        "final_error": None,
-        "max_error": None,
-        "max_horizontal_error_m": None,
-    }
-    if part["peak"] is not None:
-        scale = np.array([[math.degrees(1.0)], [1.0], [1.0], [math.degrees(1.0)]])
-        names = ("attitude_deg", "velocity_mps", "position_m", "misalignment_deg")
-        if np.isfinite(part["final_error"]).all():  # else the run ends in a reference gap
-            out["final_error"] = dict(zip(names, (part["final_error"] * scale).tolist(),
-                                          strict=True))
-        out["max_error"] = dict(zip(names, (part["peak"] * scale).tolist(), strict=True))
-        out["max_horizontal_error_m"] = part["max_horizontal_error"]
+            "attitude_deg": np.degrees(nav.final.att).tolist(),
+            "velocity_mps": nav.final.v_n.tolist(),
+            "position_deg_m": [*np.degrees(nav.final.pos[:2]).tolist(),
+                               float(nav.final.pos[2])]}}})
+    if nav.final_error is not None and not np.isfinite(nav.final_error.stack()).all():
+        out["final_error"] = None  # the run ends in a reference gap
     return out
 
 

@@ -17,9 +17,8 @@ import time
 from typing import Any
 
 import h5py
-import numpy as np
 
-from gcalign.app.align.transfer import DECIMALS, DISPLAY, SI_UNIT, group_of
+from gcalign.app.align.transfer import DECIMALS, display, group_of, write_display
 from gcalign.app.command import DOUBLE, Cost, Outcome
 from gcalign.io.results import put
 
@@ -119,9 +118,7 @@ def summary(sc, obs, compute_s: float) -> dict:
         "sigma0": per_state(names, obs.sigma0),
         "sigma_final": per_state(names, obs.sigma_end[-1]),
         "covariance_degree_final": per_state(names, obs.cov_degree[-1]),
-        "units": {n: SI_UNIT[group_of(n)] for n in names},
-        "display_units": {n: DISPLAY[group_of(n)][0] for n in names},
-        "display_scale": {n: DISPLAY[group_of(n)][1] for n in names},
+        **display(names),
         "compute_s": compute_s,
     }
 
@@ -134,8 +131,7 @@ def write(f: h5py.File, obs, result) -> None:
 
     g = f.create_group("observability")
     g.attrs["mode"] = "transfer"
-    g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in obs.names)
-    g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in obs.names])
+    write_display(g, obs.names)
     write_fields(g, obs)
     put(g, "t", result.t - result.t0, "s", description="master epochs, from the start")
     put(g, "sigma", result.sigma, "SI", description="the filter's sigma per epoch, "
@@ -212,24 +208,25 @@ def figures(f, name: str) -> dict:
     """The cumulative degree η per window (heat map, windows × 15 states), the covariance
     degree σ0/σ likewise (all states), and σ/σ0 against time per state group."""
     from gcalign.app.observability.plots import heat_map
-    from gcalign.app.plots import _s, finish, new_figure
+    from gcalign.app.plots import finish, new_figure
+    from gcalign.io.stored import read_fields
+    from gcalign.transfer.observability import TransferObservability
 
     g = f["observability"]
-    states = _s(g.attrs["states"]).split(",")
-    cov_states = _s(g.attrs["covariance_states"]).split(",")
-    wins = [_s(n) for n in g["segment_name"][()]]
-    how = f"{_s(g.attrs['measure'])} matching, scaling {_s(g.attrs['scaling'])}"
+    obs = read_fields(g, TransferObservability)
+    cov_states = obs.names
+    how = f"{obs.matching} matching, scaling {obs.scaling}"
     figs = {
         "observability_cumulative": heat_map(
-            g["eta_cum"][()], [f"to {w}" for w in wins], states,
+            obs.table.eta_cum, [f"to {w}" for w in obs.windows], list(obs.pwcs),
             f"{name}: cumulative degree η from the start (transfer alignment, {how}; grey ·: "
             "0, unobservable)", "log10 η", "·"),
         "covariance_degree": heat_map(
-            g["cov_degree"][()], [f"after {w}" for w in wins], cov_states,
+            obs.cov_degree, [f"after {w}" for w in obs.windows], list(cov_states),
             f"{name}: covariance degree σ(0)/σ(t) at the end of each window ({how})",
             "log10 σ(0)/σ(t)", exponents=False),
     }
-    t, sig, sig0 = g["t"][()], g["sigma"][()], g["sigma0"][()]
+    t, sig, sig0 = g["t"][()], g["sigma"][()], obs.sigma0
     groups = [gr for gr in ("phi", "dv", "eb", "db", "mu", "th", "w")
               if any(group_of(n) == gr for n in cov_states)]
     label = {"phi": "φ", "dv": "δv", "eb": "ε", "db": "∇", "mu": "μ", "th": "θ", "w": "ω"}
