@@ -45,8 +45,6 @@ KEYS: dict[str, dict[str, tuple[str, float]]] = {
               "instability": ("bias_instability_ug", 1.0 / u.UG),
               "rate_rw": ("bias_rw_ughrh", 1.0 / UGRH)},
 }
-#: σ(τ) in the table and the figure: °/h and µg
-SIGMA_UNIT = {"gyro": ("deg/h", u.DPH), "accel": ("ug", u.UG)}
 #: τ at which the summary gives σ (the values one compares across tools)
 TAU_POINTS_S = (1.0, 10.0, 100.0)
 #: 1-s means of the specific force straying more than this (m/s²) from their median: the

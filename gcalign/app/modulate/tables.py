@@ -67,6 +67,13 @@ def _ratios(r: dict) -> list[str]:
     return ["—" if q[k] is None else f"{q[k]:.3g}" for k in ("last_hour", "max", "rms")]
 
 
+def _schemes(title: str, width: int) -> Table:
+    """A table of one row per scheme, its first column the scheme's name (`width` wide)."""
+    t = Table(title=title, title_justify="left", header_style="bold", box=box.SIMPLE_HEAD)
+    t.add_column("scheme", no_wrap=True, min_width=width)
+    return t
+
+
 def _terms_table(rows: list[list[str]]) -> Table:
     """The invariant terms per scheme; each column at least as wide as its numbers (the
     headers wrap instead)."""
@@ -91,27 +98,21 @@ def modulate_table(s: dict) -> Group:
     head = Text(f"gcalign modulate: {s['scenario']} — {s['hours']:g} h at {s['rate_hz']:g} Hz, "
                 f"{s['motion']} base at {lat:g}°, {lon:g}°, earth {s['earth']}, seed "
                 f"{s['seed']}", style="bold")
-    pos = Table(title="horizontal position error (m)", title_justify="left",
-                header_style="bold", box=box.SIMPLE_HEAD)
     width = max((len(n) for n in s["compare"]), default=6)  # names whole, never "four-posit…"
-    pos.add_column("scheme", no_wrap=True, min_width=width)
+    pos = _schemes("horizontal position error (m)", width)
     for h in hours:
         pos.add_column(f"{h:g} h", justify="right")
     pos.add_column("max", justify="right")
     # the linear model and the ratios to the unrotated run in a table of their own: with
     # them the 72 h table is 92 columns wide, and rich cut its numbers at 80 ("2,0…")
-    cmp = Table(title="against the linear model and the unrotated run", title_justify="left",
-                header_style="bold", box=box.SIMPLE_HEAD)
-    cmp.add_column("scheme", no_wrap=True, min_width=width)
+    cmp = _schemes("against the linear model and the unrotated run", width)
     cmp.add_column(f"lin. {hours[-1]:g} h" if hours else "linear", justify="right")
     ratios = any(s["schemes"][n].get("ratio_to_fixed") for n in s["compare"])
     if ratios:
         last = f"{hours[-1]:g} h" if hours else "end"
         for col in (f"fixed ÷ at {last}", "fixed ÷ max", "fixed ÷ RMS"):
             cmp.add_column(col, justify="right")
-    inv = Table(title="attitude error and invariants", title_justify="left",
-                header_style="bold", box=box.SIMPLE_HEAD)
-    inv.add_column("scheme", no_wrap=True, min_width=width)
+    inv = _schemes("attitude error and invariants", width)
     for col, just in (("ref", "left"), ("T (min)", "right"), ("diag C̄", "right"),
                       ("φ max (″)", "right"), ("Schuler", "center")):
         inv.add_column(col, justify=just)  # type: ignore[arg-type]
