@@ -123,16 +123,14 @@ def figures(f, name: str) -> dict[str, Figure]:
         # site) is not kept in the file: the case's attributes stand for it
         res = read_fields(c, CaseResult, case=None, settings=None, site=None, earth=None,
                           chain_delay=None, delay=None, t_update=None)
-        t, truth, latched, pred = res.pulses.t, res.truth, res.latched, res.predicted
+        t, truth, latched = res.pulses.t, res.truth, res.latched
         keep = t >= settle
-        ref = res.ins_ref if reference == "seed" else truth
-        after = {p: wrap_pi(a - ref)[:, comp] for p, a in pred.items() if p != "none"}
-        truth_after = None
-        if reference == "seed":
-            truth_after = {p: wrap_pi(a - truth)[:, comp] for p, a in pred.items()
-                           if p != "none"}
+        predictors = [p for p in res.predicted if p != "none"]
+        after = {p: res.error(p, reference)[:, comp] for p in predictors}
+        truth_after = ({p: res.error(p)[:, comp] for p in predictors} if reference == "seed"
+                       else None)
         figs[f"realtime_case{key}"] = case_figure(
-            t, keep, wrap_pi(latched - ref)[:, comp], after, truth_after,
+            t, keep, res.error("none", reference)[:, comp], after, truth_after,
             component=ANGLES[comp], reference=reference,
             title=f"{name}: {cname} — error before and after prediction")
         rate = float(c.attrs.get("rate", 0.0))
