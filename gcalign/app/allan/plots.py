@@ -7,35 +7,37 @@ from __future__ import annotations
 
 import numpy as np
 
+from gcalign import units as u
+from gcalign.allan import FLAT, AllanRecord, TriadRecord
 from gcalign.app.plots import new_figure
+from gcalign.io.stored import read_fields
 
 AXES = ("x", "y", "z")
 COLORS = ("tab:blue", "tab:orange", "tab:green")
 LETTER = {"quantization": "Q", "white": "N", "instability": "B", "rate_rw": "K"}
-FLAT = float(np.sqrt(2.0 * np.log(2.0) / np.pi))
 BASIS = {"quantization": lambda t: np.sqrt(3.0) / t, "white": lambda t: 1.0 / np.sqrt(t),
          "instability": lambda t: FLAT + 0.0 * t, "rate_rw": lambda t: np.sqrt(t / 3.0)}
-SCALE = {"gyro": (1.0 / (np.pi / 180 / 3600), "σ(τ) (°/h)", "gyros"),
-         "accel": (1.0 / (9.7803267715e-6), "σ(τ) (µg)", "accelerometers")}
+SCALE = {"gyro": (1.0 / u.DPH, "σ(τ) (°/h)", "gyros"),
+         "accel": (1.0 / u.UG, "σ(τ) (µg)", "accelerometers")}
 
 
 def figures(f, name: str) -> dict:
-    """``{stem: Figure}`` of a results file holding ``/allan``."""
+    """``{stem: Figure}`` of a results file holding ``/allan``, from its record read back
+    (:class:`gcalign.allan.AllanRecord`)."""
+    rec = read_fields(f["allan"], AllanRecord)
+    span = None if rec.fit_tau_s is None else tuple(rec.fit_tau_s)
     fig, axes = new_figure(1, 2, width=13.0, height=5.6, sharex=False)
-    span = f["allan"].attrs.get("fit_tau_s")
     for ax, triad in zip(axes, ("gyro", "accel"), strict=True):
-        _panel(ax, f[f"allan/{triad}"], triad, None if span is None else tuple(span))
+        _panel(ax, getattr(rec, triad), triad, span)
     fig.suptitle(f"{name}: Allan deviation and fitted noise terms (1σ bands dashed)",
                  fontsize="medium")
     return {f"{name}-allan": fig}
 
 
-def _panel(ax, g, triad: str, span: tuple | None) -> None:
+def _panel(ax, g: TriadRecord, triad: str, span: tuple | None) -> None:
     scale, ylabel, title = SCALE[triad]
-    tau = g["tau"][()]
-    adev = g["adev"][()] * scale
-    lo, hi = g["adev_lo"][()] * scale, g["adev_hi"][()] * scale
-    model = g["model"][()] * scale
+    tau = g.tau
+    adev, lo, hi, model = (x * scale for x in (g.adev, g.adev_lo, g.adev_hi, g.model))
     if span is not None:  # the terms were fitted on span only: their sum is drawn there
         model[(tau < span[0] * (1 - 1e-9)) | (tau > span[1] * (1 + 1e-9))] = np.nan
         for a, b in ((tau[0], span[0]), (span[1], tau[-1])):
@@ -50,8 +52,8 @@ def _panel(ax, g, triad: str, span: tuple | None) -> None:
         ax.loglog(tau, model[:, i], "-", color=color, lw=3.0, alpha=0.25,
                   label=f"{axis} fitted (sum)")
         for name, letter in LETTER.items():
-            tg = g[f"terms/{name}"]
-            value = float(tg["value"][i]) * scale
+            tg = g.terms[name]
+            value = float(tg.value[i]) * scale
             if not np.isfinite(value) or value <= 0:
                 continue
             line = value * BASIS[name](t_line)
@@ -59,7 +61,7 @@ def _panel(ax, g, triad: str, span: tuple | None) -> None:
             if not keep.any():
                 continue
             ax.loglog(t_line[keep], line[keep], ":", color=color, lw=0.9, label="_term")
-            a, b = tg["tau_range"][i]
+            a, b = tg.tau_range[i]
             seg = (t_line >= a) & (t_line <= b)
             ax.loglog(t_line[seg], line[seg], "-", color=color, lw=1.0, alpha=0.9,
                       label="_term range")

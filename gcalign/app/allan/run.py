@@ -45,8 +45,6 @@ KEYS: dict[str, dict[str, tuple[str, float]]] = {
               "instability": ("bias_instability_ug", 1.0 / u.UG),
               "rate_rw": ("bias_rw_ughrh", 1.0 / UGRH)},
 }
-#: σ(τ) in the table and the figure: °/h and µg
-SIGMA_UNIT = {"gyro": ("deg/h", u.DPH), "accel": ("ug", u.UG)}
 #: τ at which the summary gives σ (the values one compares across tools)
 TAU_POINTS_S = (1.0, 10.0, 100.0)
 #: 1-s means of the specific force straying more than this (m/s²) from their median: the
@@ -57,8 +55,7 @@ TAU_POINTS_S = (1.0, 10.0, 100.0)
 FORCE_SPREAD = 20e-3 * u.G0
 
 
-def _window(sc: Scenario, n: int, ts: float) -> tuple[int, int]:
-    cfg = sc.allan or AllanConfig()
+def _window(cfg: AllanConfig, n: int, ts: float) -> tuple[int, int]:
     k0 = int(round(cfg.start_s / ts))
     if k0 >= n:
         raise ScenarioError(f"allan.start_s: {cfg.start_s:g} s is past the end of the data "
@@ -92,13 +89,11 @@ def imu_section(summary: dict) -> dict:
     for triad in ("gyro", "accel"):
         sec: dict = {}
         for key, term in summary[triad].items():
-            v = [x if x is not None and math.isfinite(x) else None for x in term["value"]]
-            if all(x is None for x in v):
-                continue
-            if key.startswith("quantum"):
-                sec[key] = float(np.mean([x for x in v if x is not None]))
-            else:
-                sec[key] = [0.0 if x is None else float(x) for x in v]
+            v = term["value"]  # plain numbers, None where not resolved (_list)
+            resolved = [x for x in v if x is not None]
+            if resolved:
+                sec[key] = (float(np.mean(resolved)) if key.startswith("quantum")
+                            else [0.0 if x is None else x for x in v])
         out[triad] = sec
     return out
 
@@ -168,8 +163,8 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
         raise ScenarioError("mechanism: the IMU turns on a mechanism; an Allan deviation "
                             "needs the sensors still (remove the mechanism)")
     ts = imu.ts
-    k0, k1 = _window(sc, len(imu), ts)
     cfg = sc.allan or AllanConfig()
+    k0, k1 = _window(cfg, len(imu), ts)
     dtheta, dv = imu.dtheta[k0:k1], imu.dv[k0:k1]
     if progress is not None:
         progress(0.0, 1.0, "Allan deviation")

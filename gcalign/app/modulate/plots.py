@@ -10,16 +10,11 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
-from gcalign.app.navigate.plots import angle_scale
-from gcalign.app.plots import ENU, new_figure
+from gcalign.app.plots import AXES, ENU, _s, angle_scale, new_figure
+from gcalign.modulate.linear import REPORT_HOURS
 
-AXES = ("x", "y", "z")
 COLOURS = ("tab:red", "tab:blue", "tab:green", "tab:purple", "tab:orange", "tab:brown",
            "tab:pink", "tab:gray", "tab:olive", "tab:cyan")
-
-
-def _s(x) -> str:
-    return x.decode() if isinstance(x, bytes) else str(x)
 
 
 def _names(g) -> list[str]:
@@ -131,7 +126,7 @@ def figures(f, name: str) -> dict:
     root = f["modulate"]
     pos, att, cyc = {}, {}, {}
     hours = float(root.attrs.get("hours", 0.0))
-    rep = [h for h in (1, 4, 12, 24, 72) if h <= hours + 1e-9]
+    rep = [h for h in REPORT_HOURS if h <= hours + 1e-9]
     for s in _names(root):
         g = root[s]
         t = g["t"][()]

@@ -67,6 +67,15 @@ def _ratios(r: dict) -> list[str]:
     return ["—" if q[k] is None else f"{q[k]:.3g}" for k in ("last_hour", "max", "rms")]
 
 
+def _schemes(title: str, width: int, *columns: str) -> Table:
+    """A table of one row per scheme: its name (`width` wide), then `columns` of numbers."""
+    t = Table(title=title, title_justify="left", header_style="bold", box=box.SIMPLE_HEAD)
+    t.add_column("scheme", no_wrap=True, min_width=width)
+    for col in columns:
+        t.add_column(col, justify="right")
+    return t
+
+
 def _terms_table(rows: list[list[str]]) -> Table:
     """The invariant terms per scheme; each column at least as wide as its numbers (the
     headers wrap instead)."""
@@ -91,31 +100,21 @@ def modulate_table(s: dict) -> Group:
     head = Text(f"gcalign modulate: {s['scenario']} — {s['hours']:g} h at {s['rate_hz']:g} Hz, "
                 f"{s['motion']} base at {lat:g}°, {lon:g}°, earth {s['earth']}, seed "
                 f"{s['seed']}", style="bold")
-    pos = Table(title="horizontal position error (m)", title_justify="left",
-                header_style="bold", box=box.SIMPLE_HEAD)
     width = max((len(n) for n in s["compare"]), default=6)  # names whole, never "four-posit…"
-    pos.add_column("scheme", no_wrap=True, min_width=width)
-    for h in hours:
-        pos.add_column(f"{h:g} h", justify="right")
-    pos.add_column("max", justify="right")
+    pos = _schemes("horizontal position error (m)", width, *(f"{h:g} h" for h in hours), "max")
     # the linear model and the ratios to the unrotated run in a table of their own: with
     # them the 72 h table is 92 columns wide, and rich cut its numbers at 80 ("2,0…")
-    cmp = Table(title="against the linear model and the unrotated run", title_justify="left",
-                header_style="bold", box=box.SIMPLE_HEAD)
-    cmp.add_column("scheme", no_wrap=True, min_width=width)
-    cmp.add_column(f"lin. {hours[-1]:g} h" if hours else "linear", justify="right")
     ratios = any(s["schemes"][n].get("ratio_to_fixed") for n in s["compare"])
-    if ratios:
-        last = f"{hours[-1]:g} h" if hours else "end"
-        for col in (f"fixed ÷ at {last}", "fixed ÷ max", "fixed ÷ RMS"):
-            cmp.add_column(col, justify="right")
-    inv = Table(title="attitude error and invariants", title_justify="left",
-                header_style="bold", box=box.SIMPLE_HEAD)
-    inv.add_column("scheme", no_wrap=True, min_width=width)
+    last = f"{hours[-1]:g} h" if hours else "end"
+    cmp = _schemes("against the linear model and the unrotated run", width,
+                   f"lin. {hours[-1]:g} h" if hours else "linear",
+                   *((f"fixed ÷ at {last}", "fixed ÷ max", "fixed ÷ RMS") if ratios else ()))
+    inv = _schemes("attitude error and invariants", width)
     for col, just in (("ref", "left"), ("T (min)", "right"), ("diag C̄", "right"),
                       ("φ max (″)", "right"), ("Schuler", "center")):
         inv.add_column(col, justify=just)  # type: ignore[arg-type]
     term_rows: list[list[str]] = []
+    residuals: list[str] = []
     for name in s["compare"]:
         r = s["schemes"][name]
         lin = r.get("linear")
@@ -137,6 +136,11 @@ def modulate_table(s: dict) -> Group:
                 name, _triple(r.get("peak_integral_C_s"), "{:.0f}"),
                 _triple(r["gyro_bias_excursion_arcsec"], "{:.2g}"),
                 _net_peak_mean(r, "scale_factor"), _net_peak_mean(r, "misalignment")])
+            res = r["residual_gyro_bias_dph"]
+            if any(abs(x) > 1e-12 for x in res):
+                residuals.append(
+                    f"{name}: residual drift C̄ε = ({', '.join(f'{x:.3g}' for x in res)}) °/h, "
+                    f"C̄∇ = ({', '.join(f'{x:.3g}' for x in r['residual_accel_bias_ug'])}) µg")
     notes = [
         "navigation against truth at each hour (the last: the run's end); max: over every "
         "sample; lin.: the linear error model (static base) for the same errors; fixed ÷: the "
@@ -148,18 +152,9 @@ def modulate_table(s: dict) -> Group:
         "from the gyro bias, scale-factor δk and gyro misalignment M × rate terms (net over "
         "the cycle / peak in it / cycle mean: the standing attitude offset the navigation "
         "sees as an initial attitude error, which a net 0 does not cancel), E N U",
-        _errors_line(s["errors"]),
+        _errors_line(s["errors"]), *residuals,
+        f"output {s.get('output') or '—'}; {s['wall_s']:.1f} s",
     ]
-    for name in s["compare"]:
-        r = s["schemes"][name]
-        if not r["mechanism"]:
-            continue
-        res = r["residual_gyro_bias_dph"]
-        if any(abs(x) > 1e-12 for x in res):
-            notes.append(f"{name}: residual drift C̄ε = ({', '.join(f'{x:.3g}' for x in res)}) "
-                         f"°/h, C̄∇ = ({', '.join(f'{x:.3g}' for x in r['residual_accel_bias_ug'])}"
-                         f") µg")
-    notes.append(f"output {s.get('output') or '—'}; {s['wall_s']:.1f} s")
     tables: list[RenderableType] = [head, pos, cmp, inv]
     if term_rows:
         tables.append(_terms_table(term_rows))

@@ -22,7 +22,6 @@ import numpy as np
 from gcalign import northfind as nf
 from gcalign import units as u
 from gcalign.app.command import Outcome
-from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.northfind import NorthfindConfig, axis
 from gcalign.schema import placed, plain, summary_of
@@ -57,14 +56,11 @@ def run_northfind(sc: Scenario, seed: int | None = None) -> NorthfindRun:
     Raises
     ------
     ScenarioError
-        Missing section or a value the north-finder cannot use (names the field).
+        A value the north-finder cannot use (names the field); a missing section is the
+        preflight's refusal (:meth:`gcalign.app.command.Command.check`).
     """
     cfg = sc.northfind
-    if cfg is None:
-        raise ScenarioError(
-            "northfind: missing; the scenario needs a 'northfind' section "
-            "(positions, dwell_s, azimuth_deg or sweep, tilt_deg, …)"
-        )
+    assert cfg is not None
     setup = cfg.to_setup(sc)
     seed = sc.imu.seed if seed is None else int(seed)  # checked by the registry's run
     rng = np.random.default_rng(seed)

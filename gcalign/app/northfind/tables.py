@@ -16,14 +16,6 @@ def _rms(values) -> float | None:
     return (sum(x * x for x in v) / len(v)) ** 0.5 if v else None
 
 
-def _arcmin(values) -> list[str]:
-    return angles(values, "′")
-
-
-def _deg(values) -> list[str]:
-    return angles(values, "deg")
-
-
 def northfind_table(s: dict) -> Table:
     """North-finding per method: a single determination, the seed's Table 1 (repeats of one
     azimuth: estimates, mean, std, bias) or a sweep (max and RMS error per method)."""
@@ -51,9 +43,9 @@ def northfind_table(s: dict) -> Table:
             d = ms[name]
             table.add_row(
                 Text(name),
-                *_deg([d["estimates_deg"][0]]),
-                *_arcmin([d["errors_deg"][0], d["std_pred_deg"][0]]),
-                DASH if name == "none" else _deg([tilt[0]])[0],
+                *angles([d["estimates_deg"][0]], "deg"),
+                *angles([d["errors_deg"][0], d["std_pred_deg"][0]], "′"),
+                DASH if name == "none" else angles([tilt[0]], "deg")[0],
             )
         table.caption = (
             f"true azimuth {s['azimuth_true_deg'][0]:.4f}°; estimated tilt "
@@ -70,16 +62,17 @@ def northfind_table(s: dict) -> Table:
                 continue
             table.add_row(
                 Text(f"group {i + 1}"),
-                *_deg([ms[n]["estimates_deg"][i] for n in order]),
-                _deg([tilt[i]])[0],
+                *angles([ms[n]["estimates_deg"][i] for n in order], "deg"),
+                angles([tilt[i]], "deg")[0],
                 end_section=i == r - 1,
             )
-        table.add_row(Text("mean (deg)"), *_deg([ms[n]["mean_deg"][0] for n in order]), "")
+        table.add_row(Text("mean (deg)"),
+                      *angles([ms[n]["mean_deg"][0] for n in order], "deg"), "")
         for label, key in (("std (′)", "std_deg"), ("bias (′)", "bias_deg"),
                            ("pred. σ (′)", "std_pred_deg")):
-            table.add_row(Text(label), *_arcmin([ms[n][key][0] for n in order]), "")
+            table.add_row(Text(label), *angles([ms[n][key][0] for n in order], "′"), "")
         table.add_row(Text("max |error| (′)"),
-                      *_arcmin([ms[n]["max_abs_error_deg"] for n in order]), "")
+                      *angles([ms[n]["max_abs_error_deg"] for n in order], "′"), "")
         table.caption = (
             f"true azimuth {s['azimuth_true_deg'][0]:.4f}°; {r} independent "
             f"determinations; std: sample standard deviation (ddof 1); bias: mean − "
@@ -99,7 +92,7 @@ def northfind_table(s: dict) -> Table:
                       _rms(d["std_pred_deg"])]
             if r > 1:
                 values.append(_rms(d["std_deg"]))
-            table.add_row(Text(name), *_arcmin(values))
+            table.add_row(Text(name), *angles(values, "′"))
         sweep = s.get("sweep")
         az = (
             f"sweep {sweep['start_deg']:g}…{sweep['stop_deg']:g}° step {sweep['step_deg']:g}°"

@@ -13,18 +13,15 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.plots import ANGLES, _s, finish, legend_right, new_figure, suptitle
+from gcalign.app.plots import ANGLES, _s, finish, new_figure
 from gcalign.io.stored import read_fields
+from gcalign.nav.rotation import wrap_pi
 from gcalign.realtime.filters import ChainResponse
 from gcalign.realtime.result import CaseResult
 from gcalign.units import ARCSEC
 
 REFERENCE = {"seed": "against the INS's output T later (the seed's reference)",
              "truth": "against the truth"}
-
-
-def _wrap(a: np.ndarray) -> np.ndarray:
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def _limits(ax, values: list[np.ndarray]) -> None:
@@ -82,13 +79,8 @@ def filter_figure(freq: np.ndarray, magnitude: dict[str, np.ndarray], group_dela
     lo, hi = chain_delay * 1e3 - 0.2, chain_delay * 1e3 + 0.4
     axes[1].set_ylim(lo, hi)
     axes[1].set_xlim(0, 1000)
-    axes[1].set_xlabel("frequency (Hz)")
     axes[1].set_ylabel("group delay (ms)")
-    for ax in axes:
-        ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, "frequency (Hz)", title)
 
 
 def lag_figure(window: tuple | None,
@@ -111,12 +103,7 @@ def lag_figure(window: tuple | None,
     axes[1].axhline(chain_delay * 1e3, color="black", linestyle="--", linewidth=0.8,
                     label=f"_chain delay {chain_delay * 1e3:.4f} ms")
     axes[1].set_ylabel("INS lag behind the table (ms)")
-    axes[1].set_xlabel("pulse time (s)")
-    for ax in axes:
-        ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, "pulse time (s)", title)
 
 
 def figures(f, name: str) -> dict[str, Figure]:
@@ -136,21 +123,19 @@ def figures(f, name: str) -> dict[str, Figure]:
         # site) is not kept in the file: the case's attributes stand for it
         res = read_fields(c, CaseResult, case=None, settings=None, site=None, earth=None,
                           chain_delay=None, delay=None, t_update=None)
-        t, truth, latched, pred = res.pulses.t, res.truth, res.latched, res.predicted
+        t, truth, latched = res.pulses.t, res.truth, res.latched
         keep = t >= settle
-        ref = res.ins_ref if reference == "seed" else truth
-        after = {p: _wrap(a - ref)[:, comp] for p, a in pred.items() if p != "none"}
-        truth_after = None
-        if reference == "seed":
-            truth_after = {p: _wrap(a - truth)[:, comp] for p, a in pred.items()
-                           if p != "none"}
+        predictors = [p for p in res.predicted if p != "none"]
+        after = {p: res.error(p, reference)[:, comp] for p in predictors}
+        truth_after = ({p: res.error(p)[:, comp] for p in predictors} if reference == "seed"
+                       else None)
         figs[f"realtime_case{key}"] = case_figure(
-            t, keep, _wrap(latched - ref)[:, comp], after, truth_after,
+            t, keep, res.error("none", reference)[:, comp], after, truth_after,
             component=ANGLES[comp], reference=reference,
             title=f"{name}: {cname} — error before and after prediction")
         rate = float(c.attrs.get("rate", 0.0))
         if kind == "rate" and rate != 0.0:
-            lag = _wrap(truth - latched)[keep, comp] / rate
+            lag = wrap_pi(truth - latched)[keep, comp] / rate
             lags[cname] = (t[keep], lag)
             sync = _s(c.attrs.get("pulses", "")) == "solution"
             if sync and (window is None or abs(rate) > window[4]):

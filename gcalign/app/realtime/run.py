@@ -1,10 +1,10 @@
 """Real-time attitude output of a scenario (seed 003; spec 003): every case through the
 chain on the core, summarised per the JSON contract of ``gcalign realtime --json``.
 
-``run_realtime(sc, seed)`` turns the ``realtime`` section into core settings and cases and
-runs them (:func:`gcalign.realtime.table.table1`: each case on its own child generator);
-``realtime_summary(run, sc)`` is the plain dict that ``--json`` prints, the results file
-stores and ``gcalign show`` reprints.
+``execute(sc, seed)`` turns the ``realtime`` section into core settings and cases and
+runs them (:func:`gcalign.realtime.table.run_realtime`: each case on its own child
+generator); ``realtime_summary(result, sc, ...)`` is the plain dict that ``--json`` prints,
+the results file stores and ``gcalign show`` reprints.
 
 Summary (arc-seconds, milliseconds, degrees). Top level: ``filter_delay_ms`` (the T the
 predictors use), ``chain_delay_ms`` (the designed chain's own low-frequency group delay),
@@ -25,65 +25,25 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from gcalign import units as u
 from gcalign.app.command import Outcome
-from gcalign.errors import ScenarioError
 from gcalign.io.scenario import Scenario
-from gcalign.io.scenario.realtime import RealtimeConfig
 from gcalign.realtime.cases import Case
 from gcalign.realtime.chain import CaseResult
 from gcalign.realtime.table import CaseSummary, RealtimeResult
 from gcalign.realtime.table import run_realtime as core_run
+from gcalign.schema import plain
 
 if TYPE_CHECKING:
     import h5py
 
-__all__ = ["RealtimeRun", "execute", "realtime_summary", "run_realtime"]
+__all__ = ["execute", "realtime_summary"]
 
 COMPONENTS = ("pitch", "roll", "yaw")
-
-
-@dataclass(frozen=True)
-class RealtimeRun:
-    """A run: configuration, the core's result (SI), the seed and the compute time."""
-
-    cfg: RealtimeConfig
-    result: RealtimeResult
-    seed: int
-    compute_s: float
-
-
-def run_realtime(sc: Scenario, seed: int | None = None,
-                 progress: Callable[[int, int, str], None] | None = None) -> RealtimeRun:
-    """Run every case of the scenario's ``realtime`` section.
-
-    Raises
-    ------
-    ScenarioError
-        Missing section or a value the chain cannot use (names the field).
-    """
-    cfg = sc.realtime
-    if cfg is None:
-        raise ScenarioError("realtime: missing; the scenario needs a 'realtime' section "
-                            "(cases or a turntable motion, filter, sensor, tracker, pulses)")
-    cases = cfg.cases_of(sc)
-    settings = cfg.to_settings()
-    seed = sc.imu.seed if seed is None else int(seed)  # checked by the registry's run
-    assert sc.site is not None  # checked by cases_of
-    t0 = time.perf_counter()
-    result = core_run(settings, np.random.default_rng(seed), cases, site=sc.site.to_si(),
-                      earth=sc.earth_model, progress=progress)
-    return RealtimeRun(cfg=cfg, result=result, seed=seed, compute_s=time.perf_counter() - t0)
-
-
-def _as(x: float) -> float | None:
-    """rad → arc-seconds; nan → None (JSON null)."""
-    return None if not math.isfinite(x) else float(x) / u.ARCSEC
 
 
 def _user(x: float, unit: float = 1.0) -> float:
@@ -109,47 +69,42 @@ def _motion(case: Case) -> dict:
 
 
 def _errors(row: CaseSummary, metric: str, kind: str) -> dict:
-    out = {
-        "before_max_arcsec": _as(row.before_max[metric]),
-        "after_max_arcsec": {p: _as(st.max[metric]) for p, st in row.stats.items()},
-        "after_rms_arcsec": {p: _as(st.rms[metric]) for p, st in row.stats.items()},
-    }
-    if kind == "accel":
-        out["before_slope_arcsec_per_s"] = _as(row.before[metric])
-        out["before_theory_arcsec_per_s"] = _as(row.before_theory[metric])
-        out["corner_max_arcsec"] = {p: _as(st.corner_max[metric])
-                                    for p, st in row.stats.items()}
-    else:
-        out["before_theory_arcsec"] = _as(row.before_theory[metric])
-    return out
+    """The errors of one case on `metric` (arc-seconds; NaN as None)."""
+    def per(part: str) -> dict:  # per predictor
+        return {p: plain(getattr(st, part)[metric], "arcsec") for p, st in row.stats.items()}
+
+    out = {"before_max_arcsec": plain(row.before_max[metric], "arcsec"),
+           "after_max_arcsec": per("max"), "after_rms_arcsec": per("rms")}
+    theory = plain(row.before_theory[metric], "arcsec")
+    if kind != "accel":
+        return out | {"before_theory_arcsec": theory}
+    return out | {"before_slope_arcsec_per_s": plain(row.before[metric], "arcsec"),
+                  "before_theory_arcsec_per_s": theory, "corner_max_arcsec": per("corner_max")}
 
 
 def case_summary(res: CaseResult, row: CaseSummary, reference: str) -> dict:
     """One case of the summary (see the module docstring)."""
     case, p = res.case, res.pulses
     train = case.pulses or res.settings.pulses
-    entry = {"name": case.name, **_motion(case),
-             "pulses": "synchronous" if train.mode == "solution" else "asynchronous",
-             "pulse_rate_hz": train.rate_hz, "n_pulses": row.n_pulses,
-             "dt_us": {"min": float(np.min(p.dt_true)) * 1e6 if len(p) else None,
-                       "max": float(np.max(p.dt_true)) * 1e6 if len(p) else None},
-             **_errors(row, reference, case.kind),
-             "truth": _errors(row, "truth", case.kind),
-             "lag_ms": None if not math.isfinite(row.lag) else row.lag * 1e3,
-             "seed_before": case.seed_before, "seed_after": case.seed_after}
-    return entry
+    return {"name": case.name, **_motion(case),
+            "pulses": "synchronous" if train.mode == "solution" else "asynchronous",
+            "pulse_rate_hz": train.rate_hz, "n_pulses": row.n_pulses,
+            "dt_us": {"min": float(np.min(p.dt_true)) * 1e6 if len(p) else None,
+                      "max": float(np.max(p.dt_true)) * 1e6 if len(p) else None},
+            **_errors(row, reference, case.kind),
+            "truth": _errors(row, "truth", case.kind),
+            "lag_ms": None if not math.isfinite(row.lag) else row.lag * 1e3,
+            "seed_before": case.seed_before, "seed_after": case.seed_after}
 
 
-def realtime_summary(run: RealtimeRun, sc: Scenario) -> dict:
+def realtime_summary(r: RealtimeResult, sc: Scenario, seed: int, compute_s: float) -> dict:
     """Plain-number summary: the JSON contract of ``gcalign realtime --json``."""
-    s, chain, cfg = run.result.settings, run.result.chain, run.cfg
-    T = run.result.delay
-    site = sc.site
-    assert site is not None
+    s, chain, cfg, site, T = r.settings, r.chain, sc.realtime, sc.site, r.delay
+    assert cfg is not None and site is not None
     f, sen, tr = s.filter, s.sensor, s.tracker
     return {
         "scenario": sc.name,
-        "seed": run.seed,
+        "seed": seed,
         "semi_physical": cfg.semi_physical,
         "reference": cfg.reference,
         "filter_delay_ms": T * 1e3,
@@ -179,29 +134,40 @@ def realtime_summary(run: RealtimeRun, sc: Scenario) -> dict:
         },
         "settle_s": s.settle_s,
         "corner_ms": s.corner_s * 1e3,
-        "cases": [case_summary(r, row, cfg.reference)
-                  for r, row in zip(run.result.cases, run.result.rows, strict=True)],
-        "compute_s": run.compute_s,
+        "cases": [case_summary(res, row, cfg.reference)
+                  for res, row in zip(r.cases, r.rows, strict=True)],
+        "compute_s": compute_s,
     }
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             progress: Callable[[int, int, str], None] | None = None) -> Outcome:
-    """Run, summarise; the registry's entry point (`progress`: one report per case)."""
-    run = run_realtime(sc, seed, progress)
-    return Outcome(realtime_summary(run, sc), lambda f: write_realtime(f, run), None,
-                   run.seed, result=run.result)
+    """Every case of the scenario's ``realtime`` section through the chain on the core
+    (each case on its own child generator), summarised; the registry's entry point
+    (`progress`: one report per case; the preflight checked the section is there)."""
+    cfg = sc.realtime
+    assert cfg is not None
+    cases = cfg.cases_of(sc)  # refuses a value the chain cannot use, naming the field
+    settings = cfg.to_settings()
+    seed = sc.imu.seed if seed is None else int(seed)  # checked by the registry's run
+    assert sc.site is not None  # checked by cases_of
+    t0 = time.perf_counter()
+    r = core_run(settings, np.random.default_rng(seed), cases, site=sc.site.to_si(),
+                 earth=sc.earth_model, progress=progress)
+    summary = realtime_summary(r, sc, seed, time.perf_counter() - t0)
+    return Outcome(summary, lambda f: write_realtime(f, r, cfg.reference), None, seed,
+                   result=r)
 
 
-def write_realtime(f: h5py.File, run: RealtimeRun) -> None:
+def write_realtime(f: h5py.File, r: RealtimeResult, reference: str) -> None:
     """/realtime: the run's settings; ``filter``, the chain's response (its fields say how);
     ``cases/NN``, each case's motion and pulse train, and its per-pulse records (CaseResult's
     fields say how)."""
     from gcalign.io.stored import write_fields
 
-    s, r = run.result.settings, run.result
+    s = r.settings
     g = f.create_group("realtime")
-    g.attrs.update(reference=run.cfg.reference, delay=r.delay, chain_delay=r.chain_delay,
+    g.attrs.update(reference=reference, delay=r.delay, chain_delay=r.chain_delay,
                    solution_hz=s.solution_hz, fs_hz=s.filter.fs_hz,
                    predictors=",".join(s.predictors), settle_s=s.settle_s,
                    corner_s=s.corner_s,

@@ -39,6 +39,15 @@ def _tdelay(c: dict, T_ms: float) -> str:
     return f"{T_ms + lo * 1e-3:.1f}–{T_ms + hi * 1e-3:.1f}"
 
 
+def _cases(title: str, *columns: str) -> Table:
+    """A table of one row per case: its name, then `columns` of numbers."""
+    table = Table(title=title, title_justify="left", header_style="bold")
+    table.add_column("case", justify="left", no_wrap=True)
+    for name in columns:
+        table.add_column(name, justify="right")
+    return table
+
+
 def realtime_table(s: dict) -> Table:
     """Two tables, one above the other (each fits 80 columns): per case T + Δt and the
     error before prediction (the seed's, ours, the closed form); then the seed's "after"
@@ -49,18 +58,10 @@ def realtime_table(s: dict) -> Table:
     setting = ("the seed's semi-physical setting: T fixed at 4 ms (n = 4), pulses on the "
                "solution instants (Δt = 0)" if s["semi_physical"] else
                f"T = {T:.4f} ms")
-    before = Table(title="before prediction: the attitude latched at the pulse",
-                   title_justify="left", header_style="bold")
-    before.add_column("case", justify="left", no_wrap=True)
-    for name in ("T+Δt (ms)", "seed", "ours", "closed form"):
-        before.add_column(name, justify="right")
-    later = Table(title="after prediction to the pulse time: max (rms), ″",
-                  title_justify="left", header_style="bold")
-    later.add_column("case", justify="left", no_wrap=True)
-    later.add_column("seed", justify="right")
-    for p in after:
-        later.add_column(p, justify="right")
-    later.add_column(f"truth: max ({' / '.join(after)})", justify="right")
+    before = _cases("before prediction: the attitude latched at the pulse",
+                    "T+Δt (ms)", "seed", "ours", "closed form")
+    later = _cases("after prediction to the pulse time: max (rms), ″", "seed", *after,
+                   f"truth: max ({' / '.join(after)})")
 
     for c in s["cases"]:
         before.add_row(Text(c["name"]), _tdelay(c, T), c["seed_before"] or "—", _before(c),

@@ -95,6 +95,18 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
     for series in (truth, imu):
         if series is not None:
             series.flush()
+    end = None if last is None else last.truth
+    moved: dict = dict.fromkeys(("initial_attitude_deg", "final_attitude_deg",
+                                 "final_velocity_mps", "distance_m", "height_range_m",
+                                 "final_displacement_m"))  # none without a truth
+    if tr0 is not None and end is not None:
+        from gcalign.nav.navigate import position_error_enu
+
+        d = position_error_enu(end.pos[-1:], tr0.pos[:1], stream.earth)[0]
+        moved = {"initial_attitude_deg": np.degrees(tr0.att[0]).tolist(),
+                 "final_attitude_deg": np.degrees(end.att[-1]).tolist(),
+                 "final_velocity_mps": end.v_n[-1].tolist(), "distance_m": distance,
+                 "height_range_m": list(h_range), "final_displacement_m": d.tolist()}
     summary: dict = {
         "scenario": sc.name,
         "seed": stream.seed,
@@ -105,24 +117,6 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
         "output_rate_hz": 1.0 / (stride * ts),
         "mechanism": stream.has_mechanism,
         "compute_s": time.perf_counter() - t_start,
-        "initial_attitude_deg": None,
-        "final_attitude_deg": None,
-        "final_velocity_mps": None,
-        "distance_m": None,
-        "height_range_m": None,
-        "final_displacement_m": None,
+        **moved,
     }
-    end = None if last is None else last.truth
-    if tr0 is not None and end is not None:
-        from gcalign.app.navigate.run import position_error_enu
-
-        d = position_error_enu(end.pos[-1:], tr0.pos[:1], stream.earth)[0]
-        summary.update(
-            initial_attitude_deg=np.degrees(tr0.att[0]).tolist(),
-            final_attitude_deg=np.degrees(end.att[-1]).tolist(),
-            final_velocity_mps=end.v_n[-1].tolist(),
-            distance_m=distance,
-            height_range_m=list(h_range),
-            final_displacement_m=d.tolist(),
-        )
     return Outcome(summary, lambda f: None, None, stream.seed)
