@@ -234,18 +234,24 @@ def cost(sc, runs: int = 1) -> Cost:
                 memory_what="the inputs and every epoch's covariance")
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None,
-            progress=None, recording=None) -> Outcome:
-    """Read the slave and the master (`recording`: as the preflight read them,
-    :func:`load_inputs`), align, summarise (the align room's mode transfer)."""
+def run_filter(sc, recording=None) -> tuple:
+    """The filter over the slave and the master (`recording`: as the preflight read them,
+    :func:`load_inputs`): its result, the file's stored PSINS values, the master's path
+    and the filter's CPU time (s)."""
     from gcalign.transfer import transfer_align
 
-    cfg = sc.align.transfer
     dtheta, dv, t, master, stored, ref_path = recording or load_inputs(sc)
     _covered(sc, t, master, ref_path)
     start = time.process_time()
-    result = transfer_align(dtheta, dv, t, master, cfg.settings(sc.earth_model))
-    out = summary(sc, result, stored, ref_path, time.process_time() - start)
+    result = transfer_align(dtheta, dv, t, master, sc.align.transfer.settings(sc.earth_model))
+    return result, stored, ref_path, time.process_time() - start
+
+
+def execute(sc, seed: int | None = None, cache_key: str | None = None,
+            progress=None, recording=None) -> Outcome:
+    """Align (:func:`run_filter`), summarise (the align room's mode transfer)."""
+    result, stored, ref_path, compute_s = run_filter(sc, recording)
+    out = summary(sc, result, stored, ref_path, compute_s)
     # the filter's consistency (mean NIS, σ growth): calibrate's checks, on recorded data too
     warnings = (*sc.align.unused(sc), *result.health_warnings())
     out["warnings"] = list(warnings)

@@ -61,17 +61,14 @@ def cost(sc) -> Cost:
 def execute(sc, seed: int | None = None, cache_key: str | None = None,
             progress: Any = None, recording: Any = None) -> Outcome:
     """The filter's run and its table (no randomness: the seed only names the run)."""
-    from gcalign.app.align.transfer import _covered, load_inputs
-    from gcalign.transfer import transfer_align
+    from gcalign.app.align.transfer import run_filter
     from gcalign.transfer.observability import transfer_observability
 
-    cfg, tcfg = _config(sc), sc.align.transfer
+    cfg = _config(sc)
     if progress is not None:
-        progress(0, 2, f"transfer filter ({tcfg.matching})")
-    dtheta, dv, t, master, _, ref_path = recording or load_inputs(sc)
-    _covered(sc, t, master, ref_path)
-    start = time.perf_counter()
-    result = transfer_align(dtheta, dv, t, master, tcfg.settings(sc.earth_model))
+        progress(0, 2, f"transfer filter ({sc.align.transfer.matching})")
+    result, _, _, filter_s = run_filter(sc, recording)
+    start = time.process_time()
     if progress is not None:
         progress(1, 2, "PWCS + SVD table")
     obs = transfer_observability(result, cfg.piece_s, cfg.window_s, cfg.scaling,
@@ -79,7 +76,7 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None,
     if progress is not None:
         progress(2, 2, "PWCS + SVD table")
     warnings = tuple(result.health_warnings())
-    out = summary(sc, obs, time.perf_counter() - start)
+    out = summary(sc, obs, filter_s + time.process_time() - start)
     out["warnings"] = list(warnings)
     return Outcome(out, lambda f: write(f, obs, result), None, None, warnings, result=obs)
 
