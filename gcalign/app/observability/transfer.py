@@ -85,21 +85,16 @@ def summary(sc, obs, compute_s: float) -> dict:
     """Plain numbers: the JSON contract of ``gcalign observability`` on a transfer run."""
     from gcalign.app.observability.run import per_state, table_rows
     from gcalign.calibrate.data import Span
+    from gcalign.schema import placed, summary_of
 
     tab, pw, names = obs.table, obs.pwcs, obs.names
     spans = [Span(w, float(a), float(b)) for w, a, b in zip(obs.windows, obs.t0, obs.t1,
                                                             strict=True)]
     segs, cum = table_rows(tab, spans, obs.condition, pw,
                            (names, obs.cov_degree_segment, obs.cov_degree))
-    return {
-        "scenario": sc.name,
-        "mode": "transfer",
-        "measure": obs.matching,
-        "matching": obs.matching,
-        "scaling": obs.scaling,
-        "rank_rtol": obs.rtol,
-        "piece_s": obs.piece_s,
-        "window_s": obs.window_s,
+    return placed(summary_of(obs), {  # how the table was made, from its fields
+        "measure": {"scenario": sc.name, "mode": "transfer"},
+        "scaling": {"matching": obs.matching}}, {
         "pieces": obs.pieces,
         "states": list(pw),
         "covariance_states": list(names),
@@ -117,7 +112,7 @@ def summary(sc, obs, compute_s: float) -> dict:
         "covariance_degree_final": per_state(names, obs.cov_degree[-1]),
         **display(names),
         "compute_s": compute_s,
-    }
+    })
 
 
 def write(f: h5py.File, obs, result) -> None:
