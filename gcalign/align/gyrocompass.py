@@ -60,6 +60,7 @@ from gcalign.nav.rotation import (
     quat_to_dcm,
     quat_to_euler,
 )
+from gcalign.schema import stored
 
 __all__ = ["AlignSettings", "Alignment", "Spread", "Timeline", "TruthRows", "align",
            "timeline", "truth_samples"]
@@ -276,10 +277,10 @@ class Alignment:
     """
 
     settings: AlignSettings
-    t1: float
-    t2: float
-    t3: float
-    t3_source: str
+    t1: float = field(metadata=stored("s", summary="s"))
+    t2: float = field(metadata=stored("s", summary="s"))
+    t3: float = field(metadata=stored("s", summary="s"))
+    t3_source: str = field(metadata=stored(None, summary=""))
     coarse_att: Array
     passes: list[PassRecord]
     truth: TruthRows | None
@@ -287,10 +288,10 @@ class Alignment:
     att_t3: Array
     truth_t2: Array | None
     truth_t3: Array | None
-    compute_s: float
-    equivalent_s: float
+    equivalent_s: float = field(metadata=stored("s", summary="s", label="equivalent"))
+    compute_s: float = field(metadata=stored("s", summary="s", label="compute"))
     index_offset: int
-    warnings: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = field(default=(), metadata=stored(None, summary=""))
 
     @property
     def azimuth_poles(self) -> str:

@@ -31,10 +31,11 @@ class ObservabilityTable:
     """
 
     segments: tuple[str, ...] = field(metadata=stored(None, name="segment_name", dims="Q"))
-    measure: str = field(metadata=stored(None, attr=True))
-    scaling: str = field(metadata=stored(None, attr=True))
-    rtol: float = field(metadata=stored("1", attr=True, name="rank_rtol"))
-    piece_s: float = field(metadata=stored("s", attr=True))
+    measure: str = field(metadata=stored(None, attr=True, summary=""))
+    scaling: str = field(metadata=stored(None, attr=True, summary=""))
+    rtol: float = field(metadata=stored("1", attr=True, name="rank_rtol", summary="",
+                                        label="rank_rtol"))
+    piece_s: float = field(metadata=stored("s", attr=True, summary="s", label="piece"))
     eta: np.ndarray = field(metadata=stored(
         "1", shape=DEGREE, description="seed eq. 17 per segment", dims="Q S"))
     sigma_state: np.ndarray = field(metadata=stored("SOM units", shape=DEGREE, dims="Q S",

@@ -95,11 +95,13 @@ class TransferObservability:
     """
 
     row: ClassVar[str] = "window"  #: what a row of the table is (its stored texts)
-    matching: str = field(metadata=stored(None, attr=True, name="measure"))
-    scaling: str = field(metadata=stored(None, attr=True))
-    rtol: float = field(metadata=stored("1", attr=True, name="rank_rtol"))
-    piece_s: float = field(metadata=stored("s", attr=True))
-    window_s: float = field(metadata=stored("s", attr=True))
+    matching: str = field(metadata=stored(None, attr=True, name="measure", summary="",
+                                          label="measure"))
+    scaling: str = field(metadata=stored(None, attr=True, summary=""))
+    rtol: float = field(metadata=stored("1", attr=True, name="rank_rtol", summary="",
+                                        label="rank_rtol"))
+    piece_s: float = field(metadata=stored("s", attr=True, summary="s", label="piece"))
+    window_s: float = field(metadata=stored("s", attr=True, summary="s", label="window"))
     names: tuple[str, ...] = field(metadata=stored(None, attr=True, name="covariance_states"))
     pwcs: tuple[str, ...] = field(metadata=stored(None, attr=True, name="states"))
     t0: np.ndarray = field(metadata=stored("s", description="window start, from the start of "

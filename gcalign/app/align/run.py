@@ -472,7 +472,9 @@ def lockstep_ok(sc: Scenario) -> bool:
 
 
 def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> dict:
-    """Plain-number summary (degrees, seconds): the JSON contract of `gcalign align --json`."""
+    """Plain-number summary (degrees, seconds): the JSON contract of `gcalign align --json`;
+    the times and notes as the fields of :class:`Alignment` say, the settings, the attitude
+    at T1, T2, T3 and the passes placed around them."""
     if isinstance(stream, RunData):
         stream = stream_of(stream)
     s = run.settings
@@ -487,7 +489,7 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
         "window_s": [aligned_time(spread.t_from), aligned_time(spread.t_to)],
         "rows": spread.rows,
         **{f"{k}_deg": plain(getattr(spread, k), "deg") for k in ("mean", "std", "max")}}
-    return {
+    return placed(summary_of(run), {"t1_s": {
         "scenario": name,
         "seed": stream.seed,
         "source": stream.source,
@@ -497,23 +499,15 @@ def alignment_summary(run: Alignment, stream: Stream | RunData, name: str) -> di
         "compensation": "real time" if realtime else s.compensation,
         "azimuth_poles": run.azimuth_poles,
         "stages": [{"stage": i + 1, "t_xy_s": st.t_xy, "t_z_s": st.t_z, "xi": st.xi,
-                    "passes": st.passes} for i, st in enumerate(s.stages)],
-        "t1_s": run.t1,
-        "t2_s": run.t2,
-        "t3_s": run.t3,
-        "t3_source": run.t3_source,
+                    "passes": st.passes} for i, st in enumerate(s.stages)]}, "equivalent_s": {
         **summary_of(run.at_times()),  # the attitude at T1, T2, T3 and its errors, in deg
         "last_pass_error": last,
         "passes": [placed(summary_of(r), {"direction": {"pass": r.index + 1}}, {
             "stage": r.stage + 1, "t_end_s": aligned_time(float(r.t[-1])),
             "error_deg": plain(run.pass_end_error(r.index), "deg"),
             "attitude_deg": np.degrees(quat_to_euler(r.q_nb[-1])).tolist()})
-            for r in run.passes],
-        "equivalent_s": run.equivalent_s,
-        "data_used_s": run.t3 if realtime else run.t2,
-        "compute_s": run.compute_s,
-        "warnings": list(run.warnings),
-    }
+            for r in run.passes]},
+        "compute_s": {"data_used_s": run.t3 if realtime else run.t2}})
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,

@@ -114,7 +114,12 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
 
     r, s = result, result.settings
     conv = r.convergence_s()
-    err = r.attitude_error_summary(10.0)
+    last = r.t >= r.t[-1] - 10.0
+
+    def final_and_rms(e: np.ndarray) -> dict:  # in arcmin, the RMS over the last 10 s
+        return {"final": (e[-1] / ARCMIN).tolist(),
+                "rms_last_10s": (np.sqrt(np.mean(e[last] ** 2, axis=0)) / ARCMIN).tolist()}
+
     states = {n: {"estimate": float(r.x[-1, i]), "sigma": float(r.sigma[-1, i]),
                   "sigma0": float(r.sigma0[i])} for i, n in enumerate(r.names)}
     lo, hi = mean_nis_band(1, r.m)  # the band of one epoch
@@ -136,25 +141,19 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
         **display(r.names),
         "convergence_s": conv,
         "attitude_error_vs_reference_arcmin": None if r.settings.matching == "velocity"
-        and np.isnan(r.q_master).any() else {
-            "final": (err["final"] / ARCMIN).tolist(),
-            "rms_last_10s": (err["rms_last"] / ARCMIN).tolist()},
+        and np.isnan(r.q_master).any() else final_and_rms(r.attitude_error),
         "nis": {"mean": float(r.nis.mean()), "dof": r.m, "band_95": [lo, hi],
                 "band_95_of_mean": [mean_lo, mean_hi],
                 "consistent": bool(mean_lo <= r.nis.mean() <= mean_hi)},
         "slave_attitude_deg": np.degrees(r.att_slave[-1]).tolist(),
-        "psins_stored": {"eb0_dph": (stored["eb0"] / DPH).tolist() if "eb0" in stored else None,
-                         "db0_ug": (stored["db0"] / UG).tolist() if "db0" in stored else None,
-                         "mu0_arcmin": (stored["mu0"] / ARCMIN).tolist() if "mu0" in stored
-                         else None},
+        "psins_stored": {f"{k}_{unit}": (stored[k] / si).tolist() if k in stored else None
+                         for k, unit, si in (("eb0", "dph", DPH), ("db0", "ug", UG),
+                                             ("mu0", "arcmin", ARCMIN))},
         "compute_s": compute_s,
     }
     if "mu0" in stored and not np.isnan(r.q_master).any():
-        e = attitude_error_vs(r, stored["mu0"])
-        w = r.t >= r.t[-1] - 10.0
-        out["attitude_error_vs_psins_mu0_arcmin"] = {
-            "final": (e[-1] / ARCMIN).tolist(),
-            "rms_last_10s": (np.sqrt(np.mean(e[w] ** 2, axis=0)) / ARCMIN).tolist()}
+        out["attitude_error_vs_psins_mu0_arcmin"] = final_and_rms(
+            attitude_error_vs(r, stored["mu0"]))
     return out
 
 
@@ -234,18 +233,24 @@ def cost(sc, runs: int = 1) -> Cost:
                 memory_what="the inputs and every epoch's covariance")
 
 
-def execute(sc, seed: int | None = None, cache_key: str | None = None,
-            progress=None, recording=None) -> Outcome:
-    """Read the slave and the master (`recording`: as the preflight read them,
-    :func:`load_inputs`), align, summarise (the align room's mode transfer)."""
+def run_filter(sc, recording=None) -> tuple:
+    """The filter over the slave and the master (`recording`: as the preflight read them,
+    :func:`load_inputs`): its result, the file's stored PSINS values, the master's path
+    and the filter's CPU time (s)."""
     from gcalign.transfer import transfer_align
 
-    cfg = sc.align.transfer
     dtheta, dv, t, master, stored, ref_path = recording or load_inputs(sc)
     _covered(sc, t, master, ref_path)
     start = time.process_time()
-    result = transfer_align(dtheta, dv, t, master, cfg.settings(sc.earth_model))
-    out = summary(sc, result, stored, ref_path, time.process_time() - start)
+    result = transfer_align(dtheta, dv, t, master, sc.align.transfer.settings(sc.earth_model))
+    return result, stored, ref_path, time.process_time() - start
+
+
+def execute(sc, seed: int | None = None, cache_key: str | None = None,
+            progress=None, recording=None) -> Outcome:
+    """Align (:func:`run_filter`), summarise (the align room's mode transfer)."""
+    result, stored, ref_path, compute_s = run_filter(sc, recording)
+    out = summary(sc, result, stored, ref_path, compute_s)
     # the filter's consistency (mean NIS, σ growth): calibrate's checks, on recorded data too
     warnings = (*sc.align.unused(sc), *result.health_warnings())
     out["warnings"] = list(warnings)

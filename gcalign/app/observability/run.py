@@ -115,10 +115,7 @@ def summary(sc: Scenario, tab: ObservabilityTable, spans: tuple[Span, ...],
                            else (names, tab.cov_degree_segment, tab.cov_degree))
     return {
         "scenario": sc.name,
-        "measure": tab.measure,
-        "scaling": tab.scaling,
-        "rank_rtol": tab.rtol,
-        "piece_s": tab.piece_s,
+        **summary_of(tab),  # how the table was made
         "states": list(ie.STATE_NAMES),
         "segments": segs,
         "cumulative": cum,

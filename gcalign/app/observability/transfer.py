@@ -61,17 +61,14 @@ def cost(sc) -> Cost:
 def execute(sc, seed: int | None = None, cache_key: str | None = None,
             progress: Any = None, recording: Any = None) -> Outcome:
     """The filter's run and its table (no randomness: the seed only names the run)."""
-    from gcalign.app.align.transfer import _covered, load_inputs
-    from gcalign.transfer import transfer_align
+    from gcalign.app.align.transfer import run_filter
     from gcalign.transfer.observability import transfer_observability
 
-    cfg, tcfg = _config(sc), sc.align.transfer
+    cfg = _config(sc)
     if progress is not None:
-        progress(0, 2, f"transfer filter ({tcfg.matching})")
-    dtheta, dv, t, master, _, ref_path = recording or load_inputs(sc)
-    _covered(sc, t, master, ref_path)
-    start = time.perf_counter()
-    result = transfer_align(dtheta, dv, t, master, tcfg.settings(sc.earth_model))
+        progress(0, 2, f"transfer filter ({sc.align.transfer.matching})")
+    result, _, _, filter_s = run_filter(sc, recording)
+    start = time.process_time()
     if progress is not None:
         progress(1, 2, "PWCS + SVD table")
     obs = transfer_observability(result, cfg.piece_s, cfg.window_s, cfg.scaling,
@@ -79,7 +76,7 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None,
     if progress is not None:
         progress(2, 2, "PWCS + SVD table")
     warnings = tuple(result.health_warnings())
-    out = summary(sc, obs, time.perf_counter() - start)
+    out = summary(sc, obs, filter_s + time.process_time() - start)
     out["warnings"] = list(warnings)
     return Outcome(out, lambda f: write(f, obs, result), None, None, warnings, result=obs)
 
@@ -88,21 +85,16 @@ def summary(sc, obs, compute_s: float) -> dict:
     """Plain numbers: the JSON contract of ``gcalign observability`` on a transfer run."""
     from gcalign.app.observability.run import per_state, table_rows
     from gcalign.calibrate.data import Span
+    from gcalign.schema import placed, summary_of
 
     tab, pw, names = obs.table, obs.pwcs, obs.names
     spans = [Span(w, float(a), float(b)) for w, a, b in zip(obs.windows, obs.t0, obs.t1,
                                                             strict=True)]
     segs, cum = table_rows(tab, spans, obs.condition, pw,
                            (names, obs.cov_degree_segment, obs.cov_degree))
-    return {
-        "scenario": sc.name,
-        "mode": "transfer",
-        "measure": obs.matching,
-        "matching": obs.matching,
-        "scaling": obs.scaling,
-        "rank_rtol": obs.rtol,
-        "piece_s": obs.piece_s,
-        "window_s": obs.window_s,
+    return placed(summary_of(obs), {  # how the table was made, from its fields
+        "measure": {"scenario": sc.name, "mode": "transfer"},
+        "scaling": {"matching": obs.matching}}, {
         "pieces": obs.pieces,
         "states": list(pw),
         "covariance_states": list(names),
@@ -120,7 +112,7 @@ def summary(sc, obs, compute_s: float) -> dict:
         "covariance_degree_final": per_state(names, obs.cov_degree[-1]),
         **display(names),
         "compute_s": compute_s,
-    }
+    })
 
 
 def write(f: h5py.File, obs, result) -> None:
