@@ -75,9 +75,6 @@ class OneLineErrors(TyperGroup):
         try:
             rv = super().main(args=args, prog_name=prog_name, complete_var=complete_var,
                               standalone_mode=False, **extra)
-        except click_errors.NoArgsIsHelpError as err:
-            print(err.ctx.get_help() if err.ctx else "")
-            sys.exit(0)
         except click_errors.ClickException as err:
             where = f" (see '{err.ctx.command_path} --help')" if getattr(err, "ctx", None) \
                 else ""

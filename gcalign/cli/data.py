@@ -148,7 +148,7 @@ def validate(
     that cannot matter (as warnings). A sweep file (docs/batch.md): every variant checked
     as `gcalign batch` checks it, and what the batch would run."""
     from gcalign.app.preflight import preflight
-    from gcalign.app.report import kv_table, with_warnings
+    from gcalign.app.report import kv_table
     from gcalign.io.scenario.loader import read_yaml
     from gcalign.io.scenario.resolve import resolved_rows
 
@@ -161,16 +161,25 @@ def validate(
     rows = resolved_rows(sc, None if inputs.recording is None else inputs.recording.imu)
     sections = [c.section for c in COMMANDS.values() if c.section]
     warnings = list(dict.fromkeys(w for sec in sections for w in sc.unused(sec)))
-    warn(warnings, as_json)
     table = kv_table(f"{scenario}: valid", rows, ("field", "value", "SI"),
                      ("left", "right", "left"))
-    for column in table.columns:  # a long name or value folds onto the next line, whole
-        column.overflow = "fold"
     table.columns[0].no_wrap = True  # the keys whole, on one line
+    _answer(table, warnings, as_json,
+            {"values": {k: {"value": v, "si": s} for k, v, s in rows}})
+
+
+def _answer(table, warnings: list[str], as_json: bool, answer: dict) -> None:
+    """validate's answer: the warnings (:func:`~gcalign.cli.common.warn`), the table, where
+    a long name or value folds onto the next line, whole, and under --json
+    ``{"valid": true, **answer, "warnings": [...]}``."""
+    from gcalign.app.report import with_warnings
+
+    warn(warnings, as_json)
+    for column in table.columns:
+        column.overflow = "fold"
     consoles(as_json).print(table if as_json else with_warnings(table, warnings))
     if as_json:
-        emit_json({"valid": True, "values": {k: {"value": v, "si": s} for k, v, s in rows},
-                   "warnings": warnings})
+        emit_json({"valid": True, **answer, "warnings": warnings})
 
 
 def _validate_sweep(path: Path, sets: list[str] | None, as_json: bool) -> None:
@@ -180,13 +189,12 @@ def _validate_sweep(path: Path, sets: list[str] | None, as_json: bool) -> None:
     import os
 
     from gcalign.app.batch.engine import budget_check, worker_count
-    from gcalign.app.report import kv_table, with_warnings
+    from gcalign.app.report import kv_table
     from gcalign.cli.batch import load_batch
 
     sw = load_batch([path], None, None, None, None, sets)
     runs = len(sw.variants) * sw.seeds
     budget_check(sw, worker_count(None, None, runs))
-    warnings = list(sw.warnings)
     seeds = (f"seed {sw.seed_start}" if sw.seeds == 1 else
              f"seeds {sw.seed_start}–{sw.seed_start + sw.seeds - 1}")
     base = os.path.normpath(sw.base_source)
@@ -194,17 +202,9 @@ def _validate_sweep(path: Path, sets: list[str] | None, as_json: bool) -> None:
             "variants": len(sw.variants), "seeds": f"{sw.seeds} ({seeds})", "runs": runs,
             "metrics": ", ".join(sw.metrics)}
     info |= {f"grid: {k}": ", ".join(map(str, v)) for k, v in sw.grid.items()}
-    warn(warnings, as_json)
     table = kv_table(f"{path}: valid sweep", [(k, str(v)) for k, v in info.items()],
                      ("key", "value"), ("left", "left"))
-    for column in table.columns:
-        column.overflow = "fold"
-    consoles(as_json).print(table if as_json else with_warnings(table, warnings))
-    if as_json:
-        emit_json({"valid": True, "sweep": {"name": sw.name, "command": sw.command,
-                                            "base": base,
-                                            "variants": [v.label for v in sw.variants],
-                                            "seeds": list(sw.seed_values), "runs": runs,
-                                            "metrics": list(sw.metrics),
-                                            "grid": sw.grid},
-                   "warnings": warnings})
+    _answer(table, list(sw.warnings), as_json, {"sweep": {
+        "name": sw.name, "command": sw.command, "base": base,
+        "variants": [v.label for v in sw.variants], "seeds": list(sw.seed_values),
+        "runs": runs, "metrics": list(sw.metrics), "grid": sw.grid}})
