@@ -525,15 +525,16 @@ def aiding_files(cfg: CalibrateConfig) -> dict | None:
 def reference_series(sc: Scenario, case: Case, run: Run) -> Errors | None:
     """A recording's INS solution against the scenario's reference at every filter epoch
     the reference covers (:meth:`gcalign.app.calibrate.solution.Errors.of`: the reference
-    at the recording's time ``t + t0``, none inside its gaps); None without a reference,
-    with truth, or with no epoch inside it."""
+    at the recording's time ``t + t0``, to 1 µs beyond its ends as
+    :func:`~gcalign.io.recorded.reference.reference_at` takes it, none inside its gaps);
+    None without a reference, with truth, or with no epoch inside it."""
     from gcalign.app.calibrate.solution import epoch_errors
 
     errors, r = solution_errors(sc, case, run.data), run.result
     if errors.against != "reference":
         return None
     e = epoch_errors(errors, r.t, case.t0, r.index, r.att, r.v_n, r.pos, (),
-                     "INS solution - reference, at the epochs it covers")[1]
+                     "INS solution - reference, at the epochs it covers", tol=1e-6)[1]
     return e if len(e.t) else None
 
 

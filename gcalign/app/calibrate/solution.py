@@ -78,11 +78,12 @@ class Errors:
             "reference" if reference is not None else None)
 
     def of(self, rows: slice | np.ndarray | None, t_data: np.ndarray, att: np.ndarray,
-           v: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+           v: np.ndarray, pos: np.ndarray, tol: float = 1e-9
+           ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """``(valid (n,), errors)`` of solution rows at the data times `t_data`, the rows
         `rows` of the truth (unused against a reference): position ENU m, velocity ENU m/s,
         attitude Euler differences rad, each (n, 3), NaN where nothing is compared (beyond
-        the reference or in one of its gaps)."""
+        the reference by more than `tol` s, or in one of its gaps)."""
         n = len(t_data)
         out = {q: np.full((n, 3), np.nan) for q in QUANTITIES}
         if self.truth is not None:
@@ -94,7 +95,7 @@ class Errors:
         ref = self.reference
         if ref is None:
             return np.zeros(n, dtype=bool), out
-        ok = (t_data >= ref.t[0] - 1e-9) & (t_data <= ref.t[-1] + 1e-9)
+        ok = (t_data >= ref.t[0] - tol) & (t_data <= ref.t[-1] + tol)
         ok &= ~inside(t_data, self.ref_gaps)
         if ok.any():
             r_att, r_v, r_pos = reference_at(ref, t_data[ok], tol=1e-6)
@@ -190,14 +191,14 @@ def add_split(stats: dict[str, ErrorStats], ok: np.ndarray, out: np.ndarray,
 
 
 def epoch_errors(errors: Errors, t: np.ndarray, t0: float, index: np.ndarray | None,
-                 att: np.ndarray,
-                 v_n: np.ndarray, pos: np.ndarray, outages: tuple[Outage, ...], what: str = ""
+                 att: np.ndarray, v_n: np.ndarray, pos: np.ndarray,
+                 outages: tuple[Outage, ...], what: str = "", tol: float = 1e-9
                  ) -> tuple[dict[str, dict | None], Series]:
     """A solution at the filter epochs (the forward filter's or the smoother's) against
-    the truth or the reference: its statistics inside and outside the outages, and the
-    errors themselves at the epochs compared, as the results file keeps them (`what` they
-    are the errors of)."""
-    ok, err = errors.of(index, t + t0, att, v_n, pos)
+    the truth or the reference (:meth:`Errors.of`, `tol`): its statistics inside and
+    outside the outages, and the errors themselves at the epochs compared, as the results
+    file keeps them (`what` they are the errors of)."""
+    ok, err = errors.of(index, t + t0, att, v_n, pos, tol)
     stats = add_split({k: ErrorStats() for k in SPLIT}, ok, inside(t, outages), err)
     return ({k: s.summary() for k, s in stats.items()}, Series(
         what, t[ok], err["attitude"][ok], err["velocity"][ok], err["position"][ok]))
