@@ -140,8 +140,7 @@ def estimates_figure(runs: list[ShownRun], attrs, states: list[str], title: str)
         k = scale[i]
         lim = 0.0
         for r in runs:
-            t, minutes = r.result.t, False
-            tx, xlabel = _time_axis(t)
+            tx, xlabel = _time_axis(r.result.t)
             minutes = xlabel.endswith("(min)")
             est, sig = r.result.estimate[:, i] * k, r.result.sigma[:, i] * k
             style = STYLE[r.measure] if len(runs) > 1 else dict(color="tab:blue",
@@ -156,7 +155,7 @@ def estimates_figure(runs: list[ShownRun], attrs, states: list[str], title: str)
                     ax.plot(tx, est + sign * 3 * sig, linewidth=0.7, alpha=0.7,
                             label="_3s", **style)
             truth = None if r.result.truth is None else r.result.truth[:, i] * k
-            lim = max(lim, _ylim(est, sig, truth, t))
+            lim = max(lim, _ylim(est, sig, truth, r.result.t))
         if runs[0].result.truth is not None:
             ax.axhline(runs[0].result.truth[0, i] * k, color="black", linewidth=0.9,
                        linestyle=(0, (4, 2)), label="truth")

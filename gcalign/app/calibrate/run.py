@@ -48,7 +48,7 @@ from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.rotation import quat_to_euler
-from gcalign.schema import summary_of
+from gcalign.schema import plain, summary_of
 from gcalign.sim.motions import Truth
 
 if TYPE_CHECKING:
@@ -98,6 +98,11 @@ class Case:
     @property
     def navigation_rate(self) -> float:
         return self.imu_rate / self.subsamples
+
+    def display_scale(self) -> np.ndarray:
+        """(21,) the factors from SI to the display units at the start (``DISPLAY_UNITS``)."""
+        pos = self.data.start.pos
+        return ie.display_scale(float(pos[0]), float(pos[2]), self.data.earth)
 
     def dgnss_rng(self) -> np.random.Generator:
         """The stream of the DGNSS noise (the module doc): one per seed, 0 for recorded data."""
@@ -474,12 +479,9 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
         "site_deg_m": [*np.degrees(d.start.pos[:2]).tolist(), float(d.start.pos[2])],
         "earth": d.earth.name,
         "units": dict(zip(ie.STATE_NAMES, ie.STATE_UNITS, strict=True)),
-        "display_scale": dict(zip(ie.STATE_NAMES,
-                                  ie.display_scale(float(d.start.pos[0]), float(d.start.pos[2]),
-                                                   d.earth).tolist(), strict=True)),
+        "display_scale": dict(zip(ie.STATE_NAMES, case.display_scale().tolist(), strict=True)),
         "display_units": dict(zip(ie.STATE_NAMES, ie.DISPLAY_UNITS, strict=True)),
-        "coarse_attitude_deg": None if case.coarse_att is None or not case.coarse
-        else np.degrees(case.coarse_att).tolist(),
+        "coarse_attitude_deg": plain(case.coarse_att if case.coarse else None, "deg"),
         "aiding_files": aiding_files(config_of(sc)),
         "compare": compare,
         "components": s.components,
@@ -488,8 +490,7 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
     if case.source != "simulated":
         out["start"] = {"source": case.start_source, "t_s": float(d.t[0]),
                         "t_data_s": float(d.t[0] + case.t0),
-                        "attitude_deg": None if case.coarse_att is None
-                        else np.degrees(case.coarse_att).tolist()}
+                        "attitude_deg": plain(case.coarse_att, "deg")}
         out["time"] = {"t0_s": case.t0, "origin": "the recording's time base (t_data = t + "
                        "t0)" if case.aid is None else case.aid.info["time_origin"]}
     if case.aid is not None:
@@ -601,9 +602,7 @@ def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
     g.attrs.update(aiding=case.aiding, navigation_rate_hz=case.navigation_rate,
                    filter_rate_hz=case.settings.filter_rate, compare=compare,
                    states=",".join(ie.STATE_NAMES), state_units=",".join(ie.STATE_UNITS),
-                   display_units=",".join(ie.DISPLAY_UNITS),
-                   display_scale=ie.display_scale(float(d.start.pos[0]),
-                                                  float(d.start.pos[2]), d.earth))
+                   display_units=",".join(ie.DISPLAY_UNITS), display_scale=case.display_scale())
     write_fields(g.create_group("segments"), Spans.of(d.segments))
     if case.aid is not None:
         og = g.create_group("outages")
