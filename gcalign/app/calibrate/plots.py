@@ -23,7 +23,7 @@ from matplotlib.figure import Figure
 
 from gcalign.app.plots import _s, finish, legend_below, legend_right, new_figure, suptitle
 from gcalign.app.report import UNIT_TEXT
-from gcalign.estimation.calibration import CalibrationResult
+from gcalign.estimation.calibration import CalibrationResult, Errors, Spans
 from gcalign.units import ANGLE_UNITS, angle_unit
 
 STYLE = {"both": dict(color="tab:red", linestyle="--"),
@@ -37,23 +37,22 @@ class ShownRun:
     """A run of a calibrate file as its figures draw it: the filter's result read back by
     the generic reader (:class:`~gcalign.estimation.calibration.CalibrationResult`), and
     what the command keeps beside its fields: its label and measurement, and the errors
-    (t, att, v_n, pos) of the solution at every navigation sample (with ``t0``, the run's
-    start in the file's time), of the smoothed solution and against a reference."""
+    of the solution at every navigation sample (``navigation``; ``t0``: the run's start in
+    the file's time), of the smoothed solution and against a reference (each None where the
+    file has none)."""
 
     result: CalibrationResult
     label: str
     measure: str
-    navigation: dict | None
-    smoothed: dict | None
-    reference_error: dict | None
-
-
-def _errors(g) -> dict[str, np.ndarray]:
-    return {k: g[k][()] for k in ("t", "att", "v_n", "pos")}
+    navigation: Errors | None
+    smoothed: Errors | None
+    reference_error: Errors | None
+    t0: float
 
 
 def read_runs(f) -> tuple[list[ShownRun], dict]:
-    """The runs of a calibrate file (arrays SI) and the group's attributes."""
+    """The runs of a calibrate file (arrays SI) and the group's attributes, with its
+    ``segments`` (:class:`~gcalign.estimation.calibration.Spans`) and ``outages``."""
     from gcalign.io.stored import read_fields
 
     g = f["calibrate"]
@@ -61,9 +60,10 @@ def read_runs(f) -> tuple[list[ShownRun], dict]:
     runs = []
     for key in sorted(g["runs"]):
         r = g["runs"][key]
-        nav, sm, e = r.get("navigation"), r.get("smoothed/error"), r.get("reference_error")
-        navigation = None if nav is None or "error" not in nav else _errors(nav["error"]) | {
-            "t0": float(nav["t"][0] - nav["t_run"][0]) if len(nav["t"]) else 0.0}
+        nav = r.get("navigation")
+        on_rows, smoothed, against = (None if x is None else read_fields(x, Errors) for x in (
+            None if nav is None else nav.get("error"), r.get("smoothed/error"),
+            r.get("reference_error")))
         run = read_fields(r, CalibrationResult, innovation=None, nis=r["nis"][()],
                           settings=None)
         if run.updated is not None and int(run.updated.sum()) != len(run.nis):
@@ -72,12 +72,10 @@ def read_runs(f) -> tuple[list[ShownRun], dict]:
             raise ScenarioError(f"{f.filename}: dataset {r.name}/updated marks "
                                 f"{int(run.updated.sum())} epochs with a fix, {r.name}/nis "
                                 f"has {len(run.nis)}: one per fix")
-        runs.append(ShownRun(
-            run, _s(r.attrs.get("label", "")), _s(r.attrs["measure"]), navigation,
-            None if sm is None else _errors(sm), None if e is None else _errors(e)))
-    seg = g["segments"]
-    attrs["segments"] = [(_s(n), float(a), float(b)) for n, a, b in
-                         zip(seg["name"][()], seg["t0"][()], seg["t1"][()], strict=True)]
+        runs.append(ShownRun(run, _s(r.attrs.get("label", "")), _s(r.attrs["measure"]),
+                             on_rows, smoothed, against, float(nav["t"][0] - nav["t_run"][0])
+                             if nav is not None and len(nav["t"]) else 0.0))
+    attrs["segments"] = read_fields(g["segments"], Spans)
     o = g.get("outages")
     attrs["outages"] = [] if o is None else list(zip(o["start"][()].tolist(),
                                                      o["end"][()].tolist(), strict=True))
@@ -96,10 +94,10 @@ def _time_axis(t: np.ndarray) -> tuple[np.ndarray, str]:
     return (t / 60.0, "time (min)") if t[-1] - t[0] > 1200 else (t, "time (s)")
 
 
-def _segment_lines(ax, segments, minutes: bool) -> None:
-    k = 60.0 if minutes else 1.0
-    for _, a, _b in segments[1:]:
-        ax.axvline(a / k, color="0.85", linewidth=0.6, zorder=0, label="_segment")
+def _segment_lines(ax, segments: Spans, minutes: bool) -> None:
+    for a in segments.t0[1:]:
+        ax.axvline(a / 60.0 if minutes else a, color="0.85", linewidth=0.6, zorder=0,
+                   label="_segment")
 
 
 def _ylim(est, sig, truth, t) -> float:
@@ -142,8 +140,7 @@ def estimates_figure(runs: list[ShownRun], attrs, states: list[str], title: str)
         k = scale[i]
         lim = 0.0
         for r in runs:
-            t, minutes = r.result.t, False
-            tx, xlabel = _time_axis(t)
+            tx, xlabel = _time_axis(r.result.t)
             minutes = xlabel.endswith("(min)")
             est, sig = r.result.estimate[:, i] * k, r.result.sigma[:, i] * k
             style = STYLE[r.measure] if len(runs) > 1 else dict(color="tab:blue",
@@ -158,7 +155,7 @@ def estimates_figure(runs: list[ShownRun], attrs, states: list[str], title: str)
                     ax.plot(tx, est + sign * 3 * sig, linewidth=0.7, alpha=0.7,
                             label="_3s", **style)
             truth = None if r.result.truth is None else r.result.truth[:, i] * k
-            lim = max(lim, _ylim(est, sig, truth, t))
+            lim = max(lim, _ylim(est, sig, truth, r.result.t))
         if runs[0].result.truth is not None:
             ax.axhline(runs[0].result.truth[0, i] * k, color="black", linewidth=0.9,
                        linestyle=(0, (4, 2)), label="truth")
@@ -291,14 +288,14 @@ def attitude_figure(run: CalibrationResult, title: str) -> Figure:
     return finish(fig, axes, xlabel, title)
 
 
-def reference_figure(e: dict, title: str) -> Figure:
+def reference_figure(e: Errors, title: str) -> Figure:
     """Attitude (in the unit its size needs), velocity and position of the INS solution
     minus the reference, per component, against time."""
     fig, axes = new_figure(3, 1, width=10.0, height=8.0)
-    tx, xlabel = _time_axis(e["t"])
-    unit = angle_unit(float(np.max(np.abs(e["att"]))))
-    rows = ((e["att"] / ANGLE_UNITS[unit][0], ("pitch", "roll", "yaw")),
-            (e["v_n"], ("E", "N", "U")), (e["pos"], ("E", "N", "U")))
+    tx, xlabel = _time_axis(e.t)
+    unit = angle_unit(float(np.max(np.abs(e.att))))
+    rows = ((e.att / ANGLE_UNITS[unit][0], ("pitch", "roll", "yaw")),
+            (e.v_n, ("E", "N", "U")), (e.pos, ("E", "N", "U")))
     for ax, (values, names) in zip(axes, rows, strict=True):
         for j, n in enumerate(names):
             ax.plot(tx, values[:, j], linewidth=0.9, label=n)
@@ -314,23 +311,22 @@ def solution_figure(run: ShownRun, attrs, title: str) -> Figure:
     e = run.navigation
     assert e is not None  # drawn only where the file holds it
     scale = np.asarray(attrs["display_scale"])
-    t_run = e["t"] - e["t0"]
-    tx, xlabel = _time_axis(t_run)
+    tx, xlabel = _time_axis(e.t - run.t0)
     minutes = xlabel.endswith("(min)")
     te = _time_axis(run.result.t)[0] if not minutes else run.result.t / 60.0
-    unit = angle_unit(float(np.max(np.abs(e["att"]))))
+    unit = angle_unit(float(np.max(np.abs(e.att))))
     k_att = 1.0 / ANGLE_UNITS[unit][0]
     fig, axes = new_figure(3, 3, width=13.0, height=8.5, sharex=True)
     sig_pos = run.result.sigma[:, [7, 6, 8]] * scale[[7, 6, 8]]  # east, north, up in metres
     sig_v = run.result.sigma[:, 3:6]
     sig_att = run.result.sigma[:, 0:3] * k_att
-    rows = (("position", e["pos"], sig_pos, ("east", "north", "up"), "m"),
-            ("velocity", e["v_n"], sig_v, ("east", "north", "up"), "m/s"),
-            ("attitude", e["att"] * k_att, sig_att, ("pitch", "roll", "yaw"),
+    rows = (("position", e.pos, sig_pos, ("east", "north", "up"), "m"),
+            ("velocity", e.v_n, sig_v, ("east", "north", "up"), "m/s"),
+            ("attitude", e.att * k_att, sig_att, ("pitch", "roll", "yaw"),
              UNIT_WORD.get(unit, unit)))
     sm = run.smoothed
-    sm_rows = None if sm is None else (sm["pos"], sm["v_n"], sm["att"] * k_att)
-    ts = None if sm is None else (sm["t"] / 60.0 if minutes else sm["t"])
+    sm_rows = None if sm is None else (sm.pos, sm.v_n, sm.att * k_att)
+    ts = None if sm is None else (sm.t / 60.0 if minutes else sm.t)
     for r, (what, err, sig, labels, u) in enumerate(rows):
         for c in range(3):
             ax = axes[3 * r + c]
@@ -454,7 +450,7 @@ def figures(f, name: str) -> dict[str, Figure]:
     figs["innovations"] = innovations_figure(
         first.result, f"{name}: standardized innovations, NIS"
         + (" and NEES" if first.result.nees is not None else "") + f" ({how})", attrs["outages"])
-    if first.navigation is not None and len(first.navigation["t"]):
+    if first.navigation is not None and len(first.navigation.t):
         against = "truth" if first.result.truth is not None else "reference"
         figs["solution_errors"] = solution_figure(
             first, attrs, f"{name}: solution − {against} at every navigation sample "

@@ -42,12 +42,13 @@ from gcalign.calibrate import (
 from gcalign.calibrate.filter import warm_up
 from gcalign.errors import ScenarioError
 from gcalign.estimation import ins_error as ie
+from gcalign.estimation.calibration import Errors
 from gcalign.io.recorded.reference import Reference
 from gcalign.io.scenario import Scenario
 from gcalign.io.scenario.calibrate import CalibrateConfig
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.rotation import quat_to_euler
-from gcalign.schema import summary_of
+from gcalign.schema import plain, summary_of
 from gcalign.sim.motions import Truth
 
 if TYPE_CHECKING:
@@ -97,6 +98,15 @@ class Case:
     @property
     def navigation_rate(self) -> float:
         return self.imu_rate / self.subsamples
+
+    def display_scale(self) -> np.ndarray:
+        """(21,) the factors from SI to the display units at the start (``DISPLAY_UNITS``)."""
+        pos = self.data.start.pos
+        return ie.display_scale(float(pos[0]), float(pos[2]), self.data.earth)
+
+    def dgnss_rng(self) -> np.random.Generator:
+        """The stream of the DGNSS noise (the module doc): one per seed, 0 for recorded data."""
+        return np.random.default_rng([0 if self.seed is None else self.seed, 3])
 
     def truth(self) -> Truth | None:
         """The truth at the navigation rate (for /truth), with the segment of each sample."""
@@ -276,7 +286,6 @@ def run_filter(case: Case, measure: str | None = None, data: FlightData | None =
 
     s = case.settings if measure is None else replace(case.settings, measure=measure)
     data = case.data if data is None else data
-    rng = np.random.default_rng([0 if case.seed is None else case.seed, 3])
     sink = None
     if group is not None or errors is not None:
         from gcalign.app.calibrate.solution import Errors
@@ -287,7 +296,7 @@ def run_filter(case: Case, measure: str | None = None, data: FlightData | None =
                             outages, case.navigation_rate, origin)
     warm_up()
     t0 = time.perf_counter()
-    result = calibrate(data, s, rng, on_rows=sink)
+    result = calibrate(data, s, case.dgnss_rng(), on_rows=sink)
     compute = time.perf_counter() - t0
     stats = None if sink is None else sink.close()
     at_epochs = None
@@ -319,9 +328,7 @@ def summaries_of_seeds(sc: Scenario, seeds: list[int],
         out.append(ScenarioError("not run"))
     warm_up()
     t0 = time.perf_counter()
-    results = calibrate_runs([(c.data, c.settings,
-                               np.random.default_rng([0 if c.seed is None else c.seed, 3]))
-                              for c in cases])
+    results = calibrate_runs([(c.data, c.settings, c.dgnss_rng()) for c in cases])
     compute = (time.perf_counter() - t0) / max(len(cases), 1)
     for i, case, res in zip(where, cases, results, strict=True):
         try:
@@ -354,7 +361,8 @@ def _epoch_errors(case: Case, r: CalibrationResult, errors) -> dict:
     if r.smoothed is not None:
         sm = r.smoothed
         out["smoothed"], out["smoothed_series"] = epoch_errors(
-            errors, r.t, case.t0, r.index, sm.att, sm.v_n, sm.pos, outages)
+            errors, r.t, case.t0, r.index, sm.att, sm.v_n, sm.pos, outages,
+            "the smoothed solution - the truth or the reference")
     return out
 
 
@@ -393,22 +401,14 @@ def _chi2_band(dof: int, level: float = 0.95) -> list[float]:
 def run_summary(run: Run) -> dict:
     """The per-state part of the summary (SI): the JSON contract of ``gcalign calibrate``."""
     r, data = run.result, run.data
-    names = ie.STATE_NAMES
-    x0 = data.x_true
-    truth_end = None if r.truth is None else r.truth[-1]
-    states = {}
-    for i, name in enumerate(names):
-        est, sig = float(r.estimate[-1, i]), float(r.sigma[-1, i])
-        tru = None if truth_end is None else float(truth_end[i])
-        states[name] = {
-            "injected": None if x0 is None else float(x0[i]),
-            "truth": tru,
-            "estimate": est,
-            "error": None if tru is None else est - tru,
-            "sigma": sig,
-            "sigma0": float(r.sigma[0, i]),
-        }
-    m = r.standardized.shape[1]
+    x0, end = data.x_true, None if r.truth is None else r.truth[-1]
+    states = {name: {"injected": None if x0 is None else float(x0[i]),
+                     "truth": None if end is None else float(end[i]),
+                     "estimate": float(r.estimate[-1, i]),
+                     "error": None if end is None else float(r.estimate[-1, i]) - float(end[i]),
+                     "sigma": float(r.sigma[-1, i]), "sigma0": float(r.sigma[0, i])}
+              for i, name in enumerate(ie.STATE_NAMES)}
+    m = r.dof
     out = {
         "label": run.label,
         "measure": r.settings.measure,
@@ -448,12 +448,12 @@ def run_summary(run: Run) -> dict:
             name: {"estimate": float(sm.estimate[0, i]), "sigma": float(sm.sigma[0, i]),
                    "filtered_sigma": float(r.sigma[0, i]),
                    "truth": None if r.truth is None else float(r.truth[0, i])}
-            for i, name in enumerate(names[:9])}
+            for i, name in enumerate(ie.STATE_NAMES[:9])}
     return out
 
 
 def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
-            against: list[dict[str, np.ndarray] | None] | None = None) -> dict:
+            against: list[Errors | None] | None = None) -> dict:
     """The command's summary: the run's settings and data, then one run (or the six of
     ``--compare`` under ``runs``); `against`, one per run, their errors against a
     reference (:func:`reference_series`)."""
@@ -479,12 +479,9 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
         "site_deg_m": [*np.degrees(d.start.pos[:2]).tolist(), float(d.start.pos[2])],
         "earth": d.earth.name,
         "units": dict(zip(ie.STATE_NAMES, ie.STATE_UNITS, strict=True)),
-        "display_scale": dict(zip(ie.STATE_NAMES,
-                                  ie.display_scale(float(d.start.pos[0]), float(d.start.pos[2]),
-                                                   d.earth).tolist(), strict=True)),
+        "display_scale": dict(zip(ie.STATE_NAMES, case.display_scale().tolist(), strict=True)),
         "display_units": dict(zip(ie.STATE_NAMES, ie.DISPLAY_UNITS, strict=True)),
-        "coarse_attitude_deg": None if case.coarse_att is None or not case.coarse
-        else np.degrees(case.coarse_att).tolist(),
+        "coarse_attitude_deg": plain(case.coarse_att if case.coarse else None, "deg"),
         "aiding_files": aiding_files(config_of(sc)),
         "compare": compare,
         "components": s.components,
@@ -493,8 +490,7 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
     if case.source != "simulated":
         out["start"] = {"source": case.start_source, "t_s": float(d.t[0]),
                         "t_data_s": float(d.t[0] + case.t0),
-                        "attitude_deg": None if case.coarse_att is None
-                        else np.degrees(case.coarse_att).tolist()}
+                        "attitude_deg": plain(case.coarse_att, "deg")}
         out["time"] = {"t0_s": case.t0, "origin": "the recording's time base (t_data = t + "
                        "t0)" if case.aid is None else case.aid.info["time_origin"]}
     if case.aid is not None:
@@ -511,13 +507,10 @@ def summary(sc: Scenario, case: Case, runs: list[Run], compare: bool,
 def processes_summary(cfg: CalibrateConfig) -> dict | None:
     """The filter's sensor processes as the scenario gives them (user units), or None when
     every sensor state is a random constant."""
-    keys = [k for k in ("gyro_bias_gm", "gyro_bias_rw_dphrh", "accel_bias_gm",
-                        "accel_bias_rw_ughrh", "gyro_scale_gm", "accel_scale_gm")
-            if getattr(cfg.q, k) is not None]
-    if not keys:
-        return None
-    return {k: getattr(cfg.q, k).model_dump() if hasattr(getattr(cfg.q, k), "model_dump")
-            else list(getattr(cfg.q, k)) for k in keys}
+    out = {k: v.model_dump() if hasattr(v, "model_dump") else list(v) for k in (
+        "gyro_bias_gm", "gyro_bias_rw_dphrh", "accel_bias_gm", "accel_bias_rw_ughrh",
+        "gyro_scale_gm", "accel_scale_gm") if (v := getattr(cfg.q, k)) is not None}
+    return out or None
 
 
 def aiding_files(cfg: CalibrateConfig) -> dict | None:
@@ -530,43 +523,31 @@ def aiding_files(cfg: CalibrateConfig) -> dict | None:
             if f is not None}
 
 
-def reference_series(sc: Scenario, run: Run, t0: float = 0.0,
-                     reference: Reference | None = None) -> dict[str, np.ndarray] | None:
+def reference_series(sc: Scenario, case: Case, run: Run) -> Errors | None:
     """A recording's INS solution against the scenario's reference at every filter epoch
-    the reference covers (SI): ``t`` (the run's epochs, s from sample 0), ``att`` (Euler
-    differences est − reference, roll and yaw wrapped; the reference's attitude by slerp),
-    ``v_n`` (ENU), ``pos`` (m ENU), the reference taken at the recording's time ``t + t0``
-    (:attr:`Case.t0`), none inside the reference's gaps; None without a reference, with
-    truth, or with no epoch inside it."""
-    r = run.result
-    if sc.reference is None or r.truth is not None:
+    the reference covers (:meth:`gcalign.app.calibrate.solution.Errors.of`: the reference
+    at the recording's time ``t + t0``, to 1 µs beyond its ends as
+    :func:`~gcalign.io.recorded.reference.reference_at` takes it, none inside its gaps);
+    None without a reference, with truth, or with no epoch inside it."""
+    from gcalign.app.calibrate.solution import epoch_errors
+
+    errors, r = solution_errors(sc, case, run.data), run.result
+    if errors.against != "reference":
         return None
-    from gcalign.calibrate.fixes import inside as in_gaps
-    from gcalign.io.recorded.reference import reference_at, reference_gaps
-    from gcalign.nav.navigate import position_error_enu
-    from gcalign.nav.rotation import attitude_error
-
-    ref = reference if reference is not None else sc.reference.read()
-    t_data = r.t + t0
-    inside = (t_data >= ref.t[0] - 1e-6) & (t_data <= ref.t[-1] + 1e-6)
-    inside &= ~in_gaps(t_data, reference_gaps(ref, sc.reference.max_gap_s))  # not in its gaps
-    if not inside.any():
-        return None
-    t = r.t[inside]
-    att, v_n, pos = reference_at(ref, t_data[inside], tol=1e-6)
-    return {"t": t, "att": attitude_error(r.att[inside], att), "v_n": r.v_n[inside] - v_n,
-            "pos": position_error_enu(r.pos[inside], pos, run.data.earth)}
+    e = epoch_errors(errors, r.t, case.t0, r.index, r.att, r.v_n, r.pos, (),
+                     "INS solution - reference, at the epochs it covers", tol=1e-6)[1]
+    return e if len(e.t) else None
 
 
-def reference_errors(e: dict[str, np.ndarray] | None) -> dict:
+def reference_errors(e: Errors | None) -> dict:
     """The summary's errors against a reference (:func:`reference_series`) at the last
     epoch it covers, in the fields navigate gives against truth: ``final_error`` and
     ``error_source: "reference"``."""
     if e is None:
         return {}
     return {"error_source": "reference", "final_error": {
-        "t_s": float(e["t"][-1]), "attitude_deg": np.degrees(e["att"][-1]).tolist(),
-        "velocity_mps": e["v_n"][-1].tolist(), "position_m": e["pos"][-1].tolist()}}
+        "t_s": float(e.t[-1]), "attitude_deg": np.degrees(e.att[-1]).tolist(),
+        "velocity_mps": e.v_n[-1].tolist(), "position_m": e.pos[-1].tolist()}}
 
 
 def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
@@ -593,7 +574,7 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
             else [run_filter(case, group=group_of(0), errors=errors_of(case.data))])
     if progress is not None and not compare:
         progress(1, 1, "filter run")
-    against = [reference_series(sc, r, case.t0, case.reference) for r in runs]
+    against = [reference_series(sc, case, r) for r in runs]
     out = summary(sc, case, runs, compare, against)
     from gcalign.app.at_rest import zero_velocity_warnings  # a moving recording under ZUPT
 
@@ -605,13 +586,13 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
 
 
 def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
-                      against: list[dict[str, np.ndarray] | None] | None = None) -> None:
+                      against: list[Errors | None] | None = None) -> None:
     """``/calibrate``: the run's settings, the flight's segments and outages, and per run
     (``runs/NN``) the filter's result as its fields say
     (:class:`~gcalign.calibrate.CalibrationResult`), the innovations in the measurement's
     units, the errors of the smoothed solution and, with `against` (one per run, or None),
     the INS solution's against a reference (:func:`reference_series`)."""
-    from gcalign.estimation.calibration import Errors, Spans
+    from gcalign.estimation.calibration import Spans
     from gcalign.io.results import put, write_segments
     from gcalign.io.stored import write_fields
 
@@ -621,9 +602,7 @@ def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
     g.attrs.update(aiding=case.aiding, navigation_rate_hz=case.navigation_rate,
                    filter_rate_hz=case.settings.filter_rate, compare=compare,
                    states=",".join(ie.STATE_NAMES), state_units=",".join(ie.STATE_UNITS),
-                   display_units=",".join(ie.DISPLAY_UNITS),
-                   display_scale=ie.display_scale(float(d.start.pos[0]),
-                                                  float(d.start.pos[2]), d.earth))
+                   display_units=",".join(ie.DISPLAY_UNITS), display_scale=case.display_scale())
     write_fields(g.create_group("segments"), Spans.of(d.segments))
     if case.aid is not None:
         og = g.create_group("outages")
@@ -640,14 +619,9 @@ def write_calibration(f: h5py.File, case: Case, runs: list[Run], compare: bool,
             put(rg, "update_t", r.update_t, "s", description="the epochs with a measurement")
         e = (run.epoch_errors or {}).get("smoothed_series")
         if r.smoothed is not None and e is not None:
-            write_fields(rg["smoothed"].create_group("error"), Errors(
-                "the smoothed solution - the truth or the reference", e["t"], e["attitude"],
-                e["velocity"], e["position"]))
-        e = None if against is None else against[i]
-        if e is not None:
-            write_fields(rg.create_group("reference_error"), Errors(
-                "INS solution - reference, at the epochs it covers", e["t"], e["att"],
-                e["v_n"], e["pos"]))
+            write_fields(rg["smoothed"].create_group("error"), e)
+        if against is not None and against[i] is not None:
+            write_fields(rg.create_group("reference_error"), against[i])
 
 
 def sigma_warnings(sc: Scenario, case: Case) -> tuple[str, ...]:

@@ -13,14 +13,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gcalign.calibrate.fixes import Outage, inside
+from gcalign.estimation.calibration import Errors as Series
 from gcalign.io.recorded.reference import Reference, reference_at
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.navigate import position_error_enu
 from gcalign.nav.rotation import attitude_error, quat_to_euler
 
 QUANTITIES = ("position", "velocity", "attitude")
+SPLIT = ("outside_outages", "in_outages")  #: the rows outside and inside the outages
 BLOCK_ROWS = 4096  #: rows held before they are compared and stored
-UNITS = {"position": "m", "velocity": "m/s", "attitude": "deg"}
+#: the unit each quantity's summary keys end in (``position_rms_m``, ``velocity_max_mps``)
+UNITS = {"position": "m", "velocity": "mps", "attitude": "deg"}
 
 
 @dataclass
@@ -57,9 +60,8 @@ class ErrorStats:
         out: dict = {"samples": self.n}
         for q in QUANTITIES:
             k = np.degrees(1.0) if q == "attitude" else 1.0
-            out[f"{q}_rms_{UNITS[q].replace('/', 'p')}"] = (
-                np.sqrt(self.sq[q] / self.n) * k).tolist()
-            out[f"{q}_max_{UNITS[q].replace('/', 'p')}"] = (self.peak[q] * k).tolist()
+            out[f"{q}_rms_{UNITS[q]}"] = (np.sqrt(self.sq[q] / self.n) * k).tolist()
+            out[f"{q}_max_{UNITS[q]}"] = (self.peak[q] * k).tolist()
         out["horizontal_rms_m"] = float(np.sqrt(self.h_sq / self.n))
         out["horizontal_max_m"] = self.h_peak
         return out
@@ -75,24 +77,25 @@ class Errors:
         self.against = "truth" if truth is not None else (
             "reference" if reference is not None else None)
 
-    def of(self, k: int, t_data: np.ndarray, att: np.ndarray, v: np.ndarray,
-           pos: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-        """``(valid (n,), errors)`` of rows k … k+n−1 (their data times `t_data`):
-        position ENU m, velocity ENU m/s, attitude Euler differences rad, each (n, 3), NaN
-        where nothing is compared (beyond the reference or in one of its gaps)."""
+    def of(self, rows: slice | np.ndarray | None, t_data: np.ndarray, att: np.ndarray,
+           v: np.ndarray, pos: np.ndarray, tol: float = 1e-9
+           ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """``(valid (n,), errors)`` of solution rows at the data times `t_data`, the rows
+        `rows` of the truth (unused against a reference): position ENU m, velocity ENU m/s,
+        attitude Euler differences rad, each (n, 3), NaN where nothing is compared (beyond
+        the reference by more than `tol` s, or in one of its gaps)."""
         n = len(t_data)
         out = {q: np.full((n, 3), np.nan) for q in QUANTITIES}
         if self.truth is not None:
             tr = self.truth
-            sl = slice(k, k + n)
-            out["position"] = position_error_enu(pos, tr.pos[sl], self.earth)
-            out["velocity"] = v - tr.v_n[sl]
-            out["attitude"] = attitude_error(att, tr.att[sl])
+            out["position"] = position_error_enu(pos, tr.pos[rows], self.earth)
+            out["velocity"] = v - tr.v_n[rows]
+            out["attitude"] = attitude_error(att, tr.att[rows])
             return np.ones(n, dtype=bool), out
         ref = self.reference
         if ref is None:
             return np.zeros(n, dtype=bool), out
-        ok = (t_data >= ref.t[0] - 1e-9) & (t_data <= ref.t[-1] + 1e-9)
+        ok = (t_data >= ref.t[0] - tol) & (t_data <= ref.t[-1] + tol)
         ok &= ~inside(t_data, self.ref_gaps)
         if ok.any():
             r_att, r_v, r_pos = reference_at(ref, t_data[ok], tol=1e-6)
@@ -119,7 +122,7 @@ class SolutionSink:
         self.k = 0  # rows processed
         self._held: list[tuple[np.ndarray, ...]] = []
         self._held_rows = 0
-        self.inside, self.outside = ErrorStats(), ErrorStats()
+        self.stats = {k: ErrorStats() for k in SPLIT}
         self.series = None
         if group is not None:
             spec = {"t": (None, "s", None), "t_run": (None, "s", None),
@@ -155,10 +158,8 @@ class SolutionSink:
         att = quat_to_euler(q_nb)
         t_data = t + self.t0
         if self.errors.against is not None:
-            ok, err = self.errors.of(self.k, t_data, att, v_n, pos)
-            out = inside(t, self.outages)
-            self.inside.add({q: e[ok & out] for q, e in err.items()})
-            self.outside.add({q: e[ok & ~out] for q, e in err.items()})
+            ok, err = self.errors.of(slice(self.k, self.k + n), t_data, att, v_n, pos)
+            add_split(self.stats, ok, inside(t, self.outages), err)
         if self.series is not None:
             keep = (self.k + np.arange(n)) % self.stride == 0
             rows = {"t": t_data[keep], "t_run": t[keep], "att": att[keep], "v_n": v_n[keep],
@@ -177,26 +178,27 @@ class SolutionSink:
             self.series.flush()
         if self.errors.against is None:
             return None
-        return {"against": self.errors.against, "outside_outages": self.outside.summary(),
-                "in_outages": self.inside.summary()}
+        return {"against": self.errors.against, **{k: s.summary() for k, s in self.stats.items()}}
 
 
-def epoch_errors(errors: Errors, t: np.ndarray, t0: float, index: np.ndarray, att: np.ndarray,
-                 v_n: np.ndarray, pos: np.ndarray, outages: tuple[Outage, ...]
-                 ) -> tuple[dict[str, dict | None], dict[str, np.ndarray]]:
+def add_split(stats: dict[str, ErrorStats], ok: np.ndarray, out: np.ndarray,
+              err: dict[str, np.ndarray]) -> dict[str, ErrorStats]:
+    """`stats` (:data:`SPLIT`) with the errors `err` of the rows `ok` added, outside or
+    inside the outages as `out` says."""
+    for key, where in zip(SPLIT, (ok & ~out, ok & out), strict=True):
+        stats[key].add({q: e[where] for q, e in err.items()})
+    return stats
+
+
+def epoch_errors(errors: Errors, t: np.ndarray, t0: float, index: np.ndarray | None,
+                 att: np.ndarray, v_n: np.ndarray, pos: np.ndarray,
+                 outages: tuple[Outage, ...], what: str = "", tol: float = 1e-9
+                 ) -> tuple[dict[str, dict | None], Series]:
     """A solution at the filter epochs (the forward filter's or the smoother's) against
-    the truth or the reference: its statistics inside and outside the outages, and the
-    errors themselves (``t`` and position, velocity, attitude at the epochs compared)."""
-    if errors.truth is not None:
-        tr = errors.truth
-        err = {"position": position_error_enu(pos, tr.pos[index], errors.earth),
-               "velocity": v_n - tr.v_n[index], "attitude": attitude_error(att, tr.att[index])}
-        ok = np.ones(len(t), dtype=bool)
-    else:
-        ok, err = errors.of(0, t + t0, att, v_n, pos)
-    out = inside(t, outages)
-    stats = {"outside_outages": ErrorStats(), "in_outages": ErrorStats()}
-    stats["in_outages"].add({q: e[ok & out] for q, e in err.items()})
-    stats["outside_outages"].add({q: e[ok & ~out] for q, e in err.items()})
-    return ({k: s.summary() for k, s in stats.items()},
-            {"t": t[ok], **{q: e[ok] for q, e in err.items()}})
+    the truth or the reference (:meth:`Errors.of`, `tol`): its statistics inside and
+    outside the outages, and the errors themselves at the epochs compared, as the results
+    file keeps them (`what` they are the errors of)."""
+    ok, err = errors.of(index, t + t0, att, v_n, pos, tol)
+    stats = add_split({k: ErrorStats() for k in SPLIT}, ok, inside(t, outages), err)
+    return ({k: s.summary() for k, s in stats.items()}, Series(
+        what, t[ok], err["attitude"][ok], err["velocity"][ok], err["position"][ok]))

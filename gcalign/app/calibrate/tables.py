@@ -61,12 +61,10 @@ def run_table(s: dict) -> Table:
     for h in heads:
         table.add_column(h, justify="left" if h in ("state", "unit") else "right")
     for name in names:
-        st, k = s["states"][name], scale[name]
+        st, k, u = s["states"][name], scale[name], units[name]
         err = st["error"]
-        u = units[name]
-        table.add_row(Text(name), UNIT_TEXT.get(u, u),
-                      _g(_scaled(st["injected"], k), u), _g(st["estimate"] * k, u),
-                      _g(_scaled(err, k), u), _g(st["sigma"] * k, u), _g(st["sigma0"] * k, u),
+        table.add_row(Text(name), UNIT_TEXT.get(u, u), *(_g(_scaled(st[c], k), u) for c in (
+            "injected", "estimate", "error", "sigma", "sigma0")),
                       "—" if err is None else f"{err / st['sigma']:+.2f}".replace("-0.00",
                                                                                  "+0.00"),
                       end_section=name in GROUP_ENDS)
@@ -196,8 +194,7 @@ def compare_table(s: dict) -> Table:
         for r in runs:
             t.add_column(_tag(r), justify="right", min_width=8, no_wrap=True)
         for name in shown:
-            k = scale[name]
-            u = units[name]
+            k, u = scale[name], units[name]
             cells = [_g(_scaled(r["states"][name][what], k), u) for r in runs]
             t.add_row(Text(name), UNIT_TEXT.get(u, u),
                       _g(_scaled(runs[0]["states"][name]["injected"], k), u), *cells,
