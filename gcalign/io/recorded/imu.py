@@ -190,10 +190,8 @@ def guess_format(path) -> str:
 
 
 def _text_lines(name: str, data: bytes) -> list[str]:
-    """Lines with ``#`` and ``%`` comments cut off (line numbers kept)."""
-    if data.startswith(_HDF5_MAGIC):
-        raise ImuFileError(f"{name}: is an HDF5 file, not text (a gcalign results file is "
-                           "read without format; a MAT v7.3 file: format psins-mat)")
+    """Lines with ``#`` and ``%`` comments cut off (line numbers kept); ImuFileError for
+    what is not text (:func:`~gcalign.io.imu_files.text_of`)."""
     return [_uncommented(line) for line in text_of(name, data).splitlines()]
 
 

@@ -90,7 +90,6 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
         origin = "seconds, the avp array's last column"
     elif format == "i2nav-nav":
         rows, (_, where) = _table_of(name, data, 11, _NAV_LABELS)
-        _finite(name, rows, _NAV_LABELS, where)
         t = rows[:, 1]
         att = np.column_stack([rows[:, 9], rows[:, 8], -rows[:, 10]]) * DEG  # yaw = -heading
         v = np.column_stack([rows[:, 6], rows[:, 5], -rows[:, 7]])
@@ -100,7 +99,6 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     else:
         cols = _columns(columns, _CSV_COLUMNS)
         rows, (_, where) = _table_of(name, data, len(cols), cols)
-        _finite(name, rows, cols, where)
         c = {k: rows[:, cols.index(k)] for k in _CSV_COLUMNS}
         t = c["t"]
         att = np.column_stack([c["pitch"], c["roll"], c["yaw"]]) * DEG

@@ -3,10 +3,23 @@ fields, the declared columns; each failure one line naming the file, the row and
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.io.imu_files import ImuFileError
+from gcalign.io.recorded.imu import _table_of
+
+
+def _read_columns(name: str, data: bytes, cols: tuple[str, ...], keep: tuple[str, ...]
+                  ) -> tuple[dict[str, np.ndarray], Callable[[int], str]]:
+    """The columns `keep` of the text table `data` whose columns are `cols` (every field
+    finite, the time ``t`` strictly increasing), and where(k), the file line of row k."""
+    rows, (_, where) = _table_of(name, data, len(cols), cols)
+    c = {k: rows[:, cols.index(k)] for k in keep}
+    _check_rows(name, c["t"], where)
+    return c, where
 
 
 def _check_rows(name: str, t: np.ndarray, where) -> None:
