@@ -57,9 +57,7 @@ def check_output(path, what: str = "--output") -> Path:
                             f"{p / 'result.h5'})")
     if p.exists() and not p.is_file() and not p.is_symlink():
         raise ScenarioError(f"{what}: {p} exists and is not a regular file")
-    parent = p.parent
-    while not parent.exists() and parent != parent.parent:
-        parent = parent.parent
+    parent = _existing(p.parent)
     if parent.exists() and not parent.is_dir():
         raise ScenarioError(f"{what}: {parent} is not a directory, so {p} cannot be written")
     return p
@@ -74,15 +72,20 @@ def check_output_dir(path, what: str = "--output") -> Path:
     if p.exists() and not p.is_dir():
         raise ScenarioError(f"{what}: {p} exists and is not a folder; give a folder for the "
                             "figures")
-    parent = p
-    while not parent.exists() and parent != parent.parent:
-        parent = parent.parent
+    parent = _existing(p)
     if not parent.is_dir():
         raise ScenarioError(f"{what}: {parent} is not a folder, so {p} cannot be made")
     try:
         p.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise write_error(p, err) from None
+    return p
+
+
+def _existing(p: Path) -> Path:
+    """`p`, or the nearest folder above it that exists (the root at the latest)."""
+    while not p.exists() and p != p.parent:
+        p = p.parent
     return p
 
 

@@ -31,9 +31,9 @@ import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.gaps import default_max_gap
-from gcalign.io.imu_files import ImuFileError, read_bytes, text_of
+from gcalign.io.imu_files import ImuFileError, _finite, _increasing, read_bytes, text_of
 from gcalign.io.recorded.axes import _DIRECTIONS
-from gcalign.io.recorded.rows import _check_rows, _columns, _finite, _read_columns
+from gcalign.io.recorded.rows import _columns, _read_columns
 from gcalign.units import DEG
 
 __all__ = ["PositionFixes", "Velocities", "read_gnss", "read_velocity", "read_odometer",
@@ -161,7 +161,7 @@ def _rtklib(name: str, data: bytes):
                                f"{', '.join(need)}, got {' '.join(parts)[:80]!r}") from None
     where = lambda k: f":{body[k][0]}"  # noqa: E731
     _finite(name, values, need, where)
-    _check_rows(name, t, where)
+    _increasing(name, t, where, got="")
     lat, lon, h = values[:, 0], values[:, 1], values[:, 2]
     s_enu = values[:, [4, 3, 5]]
     _ranges(name, lat, lon, s_enu, where)

@@ -55,7 +55,7 @@ from gcalign.io.imu_files import (
     _is_number,
     _parse_block,
     check_increments,
-    data_suffix,
+    guess_format,
     read_bytes,
     read_psins_imu,
     text_of,
@@ -168,25 +168,6 @@ class _Raw:
 
 
 # --------------------------------------------------------------------------- formats
-
-
-def guess_format(path) -> str:
-    """The format a file's name (or signature) implies: ``.imu`` psins, ``.mat`` psins-mat,
-    otherwise csv (a ``%`` first line: psins)."""
-    suffix = data_suffix(path)
-    if suffix == ".imu":
-        return "psins"
-    if suffix == ".mat":
-        return "psins-mat"
-    if suffix in (".csv", ".txt"):
-        return "csv"
-    try:
-        _, head = read_bytes(path, head=4096)
-    except ImuFileError:
-        return "csv"
-    first = next((ln.strip() for ln in head[:4096].decode("utf-8", "replace").splitlines()
-                  if ln.strip()), "")
-    return "psins" if first.startswith("%") else "csv"
 
 
 def _text_lines(name: str, data: bytes) -> list[str]:

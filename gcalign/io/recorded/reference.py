@@ -30,10 +30,10 @@ import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.gaps import Outage, default_max_gap, find_outages
-from gcalign.io.imu_files import ImuFileError, read_bytes
+from gcalign.io.imu_files import ImuFileError, _finite, _increasing, read_bytes
 from gcalign.io.recorded import mat
 from gcalign.io.recorded.imu import _table_of
-from gcalign.io.recorded.rows import _check_rows, _columns, _finite
+from gcalign.io.recorded.rows import _columns
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
 from gcalign.units import DEG
 
@@ -105,7 +105,7 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
         v = np.column_stack([c["ve"], c["vn"], c["vu"]])
         pos = np.column_stack([c["lat"] * DEG, c["lon"] * DEG, c["h"]])
         origin = "the file's time column"
-    _check_rows(name, t, where)
+    _increasing(name, t, where, got="")
     if len(t) < 2:
         raise ImuFileError(f"{name}: {len(t)} epoch(s); a reference needs at least 2")
     if att is not None:

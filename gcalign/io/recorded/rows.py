@@ -1,5 +1,5 @@
-"""Row checks shared by the aiding and reference readers: strictly increasing times, finite
-fields, the declared columns; each failure one line naming the file, the row and the field."""
+"""What the aiding and reference readers share: their columns read with strictly increasing
+times, the declared columns; each failure one line naming the file, the row and the field."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from collections.abc import Callable
 import numpy as np
 
 from gcalign.errors import ScenarioError
-from gcalign.io.imu_files import ImuFileError
+from gcalign.io.imu_files import _increasing
 from gcalign.io.recorded.imu import _table_of
 
 
@@ -18,24 +18,8 @@ def _read_columns(name: str, data: bytes, cols: tuple[str, ...], keep: tuple[str
     finite, the time ``t`` strictly increasing), and where(k), the file line of row k."""
     rows, (_, where) = _table_of(name, data, len(cols), cols)
     c = {k: rows[:, cols.index(k)] for k in keep}
-    _check_rows(name, c["t"], where)
+    _increasing(name, c["t"], where, got="")
     return c, where
-
-
-def _check_rows(name: str, t: np.ndarray, where) -> None:
-    dt = np.diff(t)
-    if (dt <= 0).any():
-        k = int(np.argmax(dt <= 0)) + 1
-        raise ImuFileError(f"{name}{where(k)}: time must increase strictly, got "
-                           f"{float(t[k])!r} after {float(t[k - 1])!r}")
-
-
-def _finite(name: str, a: np.ndarray, labels, where) -> None:
-    bad = ~np.isfinite(a)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        raise ImuFileError(f"{name}{where(int(row))}: field {col + 1} ({labels[col]}) must be "
-                           f"finite, got {float(a[row, col])!r}")
 
 
 def _columns(columns, default, allowed_extra=("-",)) -> tuple[str, ...]:
