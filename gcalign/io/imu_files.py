@@ -162,19 +162,14 @@ def read_bytes(path, head: int | None = None, text: bool = False) -> tuple[str, 
             return name, bytes(out)
     except (ScenarioError, MemoryError):  # ours (the limits), or out of memory
         raise
-    except (EOFError, ValueError) as exc:
+    except Exception as exc:  # noqa: BLE001 - what a damaged compressed stream raises varies
+        # (EOFError, lzma.LZMAError, zlib.error, gzip.BadGzipFile: an OSError without errno)
+        if isinstance(exc, OSError) and (compression is None or exc.errno is not None):
+            raise ImuFileError(f"{name}: cannot read file ({exc.strerror or exc})") from None
+        if compression is None and not isinstance(exc, (EOFError, ValueError)):
+            raise
         raise ImuFileError(f"{name}: damaged {_SUFFIX_OF[compression or 'lzma']} data, "
                            f"cannot decompress ({_why(exc)})") from None
-    except OSError as exc:
-        if compression is not None and exc.errno is None:  # gzip.BadGzipFile and the like
-            raise ImuFileError(f"{name}: damaged {_SUFFIX_OF[compression]} data, cannot "
-                               f"decompress ({_why(exc)})") from None
-        raise ImuFileError(f"{name}: cannot read file ({exc.strerror or exc})") from None
-    except Exception as exc:  # lzma.LZMAError, zlib.error: the compressed stream is damaged
-        if compression is None:
-            raise
-        raise ImuFileError(f"{name}: damaged {_SUFFIX_OF[compression]} data, cannot "
-                           f"decompress ({_why(exc)})") from None
 
 
 def _no_nul(name: str, data: bytes, offset: int) -> None:

@@ -327,11 +327,6 @@ class _GuardedFile:
     def flush(self) -> None:
         """Nothing is buffered here (``pwrite``)."""
 
-    @property
-    def held_bytes(self) -> int:
-        """Memory held for HDF5 since a write was refused."""
-        return len(self._pages) * self.PAGE
-
 
 #: (path, guard) of the results files open for writing in this process (atomic_h5)
 _WRITING: list[tuple[Path, _GuardedFile]] = []
@@ -923,12 +918,10 @@ def read_imu(path: Path) -> ImuData:
         check_increments(f"{path}: /imu", t, dtheta, dv, ts)
         extra: dict = {k: _vector_attr(g, k, path) for k in ("site", "att0", "v0_n")
                        if k in g.attrs}
-        if "site" in extra and not abs(extra["site"][0]) < math.pi / 2:
-            raise ScenarioError(f"{path}: /imu attribute 'site': latitude must lie within "
-                                f"(-pi/2, pi/2) rad, got {extra['site'][0]!r}")
-        if "att0" in extra and not abs(extra["att0"][0]) < math.pi / 2:
-            raise ScenarioError(f"{path}: /imu attribute 'att0': pitch must lie within "
-                                f"(-pi/2, pi/2) rad, got {extra['att0'][0]!r}")
+        for key, what in (("site", "latitude"), ("att0", "pitch")):
+            if key in extra and not abs(extra[key][0]) < math.pi / 2:
+                raise ScenarioError(f"{path}: /imu attribute {key!r}: {what} must lie within "
+                                    f"(-pi/2, pi/2) rad, got {extra[key][0]!r}")
         motion = scenario.get("motion") if isinstance(scenario, dict) else None
         kind = motion.get("kind") if isinstance(motion, dict) else None
         q_bs = None
@@ -950,8 +943,9 @@ def read_scenario(path: Path):
     """The scenario stored in a results file, parsed safely (a mapping, or None)."""
     from gcalign.io.scenario.loader import loads
 
-    text = read_scenario_yaml(path)
-    data = loads(text, f"{path}: root attribute 'scenario_yaml'") if text.strip() else None
+    with open_results(path) as f:
+        text = text_attr(f, "scenario_yaml", path)
+    data = loads(text, f"{path}: root attribute 'scenario_yaml'")
     if data is not None and not isinstance(data, dict):
         raise ScenarioError(f"{path}: root attribute 'scenario_yaml' must be a YAML mapping, "
                             f"got {type(data).__name__}")

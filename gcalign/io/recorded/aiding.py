@@ -99,11 +99,9 @@ def read_gnss(path, format: str = "i2nav-gnss", columns=None, lever_arm_b=(0.0, 
         _ranges(name, lat, lon, s_enu, where)
     pos = np.column_stack([lat * DEG, lon * DEG, h])
     record = {"format": format, "path": name, "epochs": int(len(t)),
-              "first": {"t_s": float(t[0]), "lat_deg": float(lat[0]), "lon_deg": float(lon[0]),
-                        "h_m": float(h[0]), "sigma_enu_m": s_enu[0].tolist()},
-              "last": {"t_s": float(t[-1]), "lat_deg": float(lat[-1]),
-                       "lon_deg": float(lon[-1]), "h_m": float(h[-1]),
-                       "sigma_enu_m": s_enu[-1].tolist()},
+              **{end: {"t_s": float(t[k]), "lat_deg": float(lat[k]), "lon_deg": float(lon[k]),
+                       "h_m": float(h[k]), "sigma_enu_m": s_enu[k].tolist()}
+                 for end, k in (("first", 0), ("last", -1))},
               "sigma_enu_median_m": np.median(s_enu, axis=0).tolist(),
               "time_origin": origin, "lever_arm_b_m": lever.tolist()}
     return PositionFixes(t, pos, s_enu, lever, record)
