@@ -46,6 +46,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -90,7 +91,7 @@ class ImuFileError(ScenarioError):
 COMPRESSED = {".gz": "gzip", ".xz": "lzma"}
 
 
-def data_suffix(path) -> str:
+def data_suffix(path: str | os.PathLike[str]) -> str:
     """The suffix that says what a file holds, under a compression suffix (x.imu.xz: .imu)."""
     suffixes = [x.lower() for x in Path(os.fspath(path)).suffixes]
     if suffixes and suffixes[-1] in COMPRESSED:
@@ -283,7 +284,8 @@ def _parse_block(name, lines, start, ncols, comment, delimiter, labels) -> np.nd
     return data
 
 
-def _finite(name: str, a: np.ndarray, labels, where) -> None:
+def _finite(name: str, a: np.ndarray, labels: Sequence[str], where: Callable[[int], str]
+            ) -> None:
     """ImuFileError naming the row (`where(k)`) and the field of the first value of the
     table `a` that is not finite."""
     bad = ~np.isfinite(a)
@@ -293,7 +295,7 @@ def _finite(name: str, a: np.ndarray, labels, where) -> None:
                            f"finite, got {float(a[row, col])!r}")
 
 
-def _data_lineno(lines, start, comment, row) -> int:
+def _data_lineno(lines: list[str], start: int, comment: str, row: int) -> int:
     """1-based file line of data row `row` (counting only non-blank, non-comment lines)."""
     k = -1
     for i in range(start, len(lines)):
@@ -361,7 +363,8 @@ def check_increments(name: str, t, dtheta, dv, ts, where=None) -> None:
             f"over {REGULAR_TOL:.0%} are not supported: split the file at the gap)")
 
 
-def _increasing(name: str, t: np.ndarray, where, got: str = "t = ") -> None:
+def _increasing(name: str, t: np.ndarray, where: Callable[[int], str], got: str = "t = "
+                ) -> None:
     """ImuFileError naming the row (`where(k)`) where the times `t` stop increasing."""
     dt = np.diff(t)
     if (dt <= 0).any():
@@ -604,7 +607,7 @@ def read_imu_file(path, ts: float | None = None) -> ImuData:
     return read_psins_imu(p) if guess_format(p) == "psins" else read_csv_imu(p, ts=ts)
 
 
-def guess_format(path) -> str:
+def guess_format(path: str | os.PathLike[str]) -> str:
     """The format a file's name (or signature) implies: ``.imu`` psins, ``.mat`` psins-mat,
     otherwise csv (a ``%`` first line: psins)."""
     suffix = data_suffix(path)
