@@ -137,6 +137,18 @@ def test_series_and_dataframe(nav):
     assert df.attrs["units"]["pos_h"] == "m" and df.attrs["units"]["pos_lat"] == "rad"
 
 
+@pytest.mark.parametrize("reader", [results.series, results.columns])
+def test_a_group_without_series_is_named_by_every_reader(nav, reader):
+    """series() and columns() (and so dataframe()) refuse a missing group, or one without
+    a time, in the same words: not as a damaged file."""
+    with pytest.raises(ValueError, match=r"--group: .*nav\.h5 has no group 'nope'; it has "
+                                         r"navigate$"):
+        reader(nav, "nope")
+    with pytest.raises(ValueError, match=r"/navigate/error has no time series \(no 1-D "
+                                         r"dataset 't'\); groups that have: navigate$"):
+        reader(nav, "navigate/error")
+
+
 def test_the_python_result_gives_the_same_series(nav):
     import gcalign
 

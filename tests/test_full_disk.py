@@ -145,3 +145,33 @@ def test_a_refused_write_leaves_hdf5_a_file_it_can_read_back(tmp_path):
     assert guard.seek(0, 2) == 200_005
     guard.truncate(7)
     assert guard.seek(0, 2) == 7 and guard.seek(0) == 0 and guard.read(9) == b"aaaaabb\0\0"
+
+
+def test_a_refused_write_ends_write_fields_before_its_groups_and_attributes(tmp_path):
+    """The generic writer asks, like every writer of the results module, whether the file
+    system refused a write before it makes a group or writes an attribute, not only before
+    a dataset: a full disk ends the run there, in one line, with nothing kept."""
+    from dataclasses import dataclass, field
+
+    from gcalign.errors import GcalignError
+    from gcalign.io.stored import write_fields
+    from gcalign.schema import stored
+
+    @dataclass
+    class Settings:
+        rate_hz: float = field(metadata=stored("Hz", attr=True))
+
+    @dataclass
+    class Run:
+        settings: Settings = field(metadata=stored(None))
+
+    seen: dict[str, object] = {}  # (atomic_h5 turns whatever ends it into the write error)
+    with pytest.raises(GcalignError, match=r"cannot write .*r\.h5: File too large"):
+        with results.atomic_h5(tmp_path / "r.h5") as f:
+            results._WRITING[-1][1].error = OSError(27, "File too large")  # as refused
+            try:
+                write_fields(f, Run(Settings(100.0)))
+            except GcalignError as err:
+                seen.update(error=str(err), groups=list(f))
+    assert "File too large" in str(seen.get("error")) and seen["groups"] == [], seen
+    assert list(tmp_path.iterdir()) == []

@@ -46,6 +46,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -90,7 +91,7 @@ class ImuFileError(ScenarioError):
 COMPRESSED = {".gz": "gzip", ".xz": "lzma"}
 
 
-def data_suffix(path) -> str:
+def data_suffix(path: str | os.PathLike[str]) -> str:
     """The suffix that says what a file holds, under a compression suffix (x.imu.xz: .imu)."""
     suffixes = [x.lower() for x in Path(os.fspath(path)).suffixes]
     if suffixes and suffixes[-1] in COMPRESSED:
@@ -162,19 +163,14 @@ def read_bytes(path, head: int | None = None, text: bool = False) -> tuple[str, 
             return name, bytes(out)
     except (ScenarioError, MemoryError):  # ours (the limits), or out of memory
         raise
-    except (EOFError, ValueError) as exc:
+    except Exception as exc:  # noqa: BLE001 - what a damaged compressed stream raises varies
+        # (EOFError, lzma.LZMAError, zlib.error, gzip.BadGzipFile: an OSError without errno)
+        if isinstance(exc, OSError) and (compression is None or exc.errno is not None):
+            raise ImuFileError(f"{name}: cannot read file ({exc.strerror or exc})") from None
+        if compression is None and not isinstance(exc, (EOFError, ValueError)):
+            raise
         raise ImuFileError(f"{name}: damaged {_SUFFIX_OF[compression or 'lzma']} data, "
                            f"cannot decompress ({_why(exc)})") from None
-    except OSError as exc:
-        if compression is not None and exc.errno is None:  # gzip.BadGzipFile and the like
-            raise ImuFileError(f"{name}: damaged {_SUFFIX_OF[compression]} data, cannot "
-                               f"decompress ({_why(exc)})") from None
-        raise ImuFileError(f"{name}: cannot read file ({exc.strerror or exc})") from None
-    except Exception as exc:  # lzma.LZMAError, zlib.error: the compressed stream is damaged
-        if compression is None:
-            raise
-        raise ImuFileError(f"{name}: damaged {_SUFFIX_OF[compression]} data, cannot "
-                           f"decompress ({_why(exc)})") from None
 
 
 def _no_nul(name: str, data: bytes, offset: int) -> None:
@@ -284,18 +280,22 @@ def _parse_block(name, lines, start, ncols, comment, delimiter, labels) -> np.nd
     if data.shape[1] != ncols:
         # Consistent but wrong column count everywhere: report the first data line.
         raise _diagnose(name, lines, start, ncols, comment, delimiter, labels)
-    bad = ~np.isfinite(data)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        lineno = _data_lineno(lines, start, comment, int(row))
-        raise ImuFileError(
-            f"{name}:{lineno}: field {col + 1} ({labels[col]}) must be finite, "
-            f"got {float(data[row, col])!r}"
-        )
+    _finite(name, data, labels, lambda k: f":{_data_lineno(lines, start, comment, k)}")
     return data
 
 
-def _data_lineno(lines, start, comment, row) -> int:
+def _finite(name: str, a: np.ndarray, labels: Sequence[str], where: Callable[[int], str]
+            ) -> None:
+    """ImuFileError naming the row (`where(k)`) and the field of the first value of the
+    table `a` that is not finite."""
+    bad = ~np.isfinite(a)
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        raise ImuFileError(f"{name}{where(int(row))}: field {col + 1} ({labels[col]}) must be "
+                           f"finite, got {float(a[row, col])!r}")
+
+
+def _data_lineno(lines: list[str], start: int, comment: str, row: int) -> int:
     """1-based file line of data row `row` (counting only non-blank, non-comment lines)."""
     k = -1
     for i in range(start, len(lines)):
@@ -363,11 +363,13 @@ def check_increments(name: str, t, dtheta, dv, ts, where=None) -> None:
             f"over {REGULAR_TOL:.0%} are not supported: split the file at the gap)")
 
 
-def _increasing(name: str, t: np.ndarray, where) -> None:
+def _increasing(name: str, t: np.ndarray, where: Callable[[int], str], got: str = "t = "
+                ) -> None:
+    """ImuFileError naming the row (`where(k)`) where the times `t` stop increasing."""
     dt = np.diff(t)
     if (dt <= 0).any():
         k = int(np.argmax(dt <= 0)) + 1
-        raise ImuFileError(f"{name}{where(k)}: time must increase strictly, got t = "
+        raise ImuFileError(f"{name}{where(k)}: time must increase strictly, got {got}"
                            f"{float(t[k])!r} after {float(t[k - 1])!r}")
 
 
@@ -525,10 +527,8 @@ def read_csv_imu(path, ts: float | None = None) -> ImuData:
     delimiter = "," if "," in first else None
     names = None
     parts = _fields(first, delimiter)
-    if not all(_is_number(p) for p in parts) and any(c.isalpha() for c in first):
-        if not any(_is_number(p) for p in parts):
-            names = parts
-            i += 1
+    if any(c.isalpha() for c in first) and not any(map(_is_number, parts)):  # a header row
+        names, i = parts, i + 1
     data = _parse_block(name, lines, i, 7, "#", delimiter, _CSV_COLUMNS)
     t = data[:, 0].copy()
     dt = np.diff(t)
@@ -584,10 +584,9 @@ def read_imu_file(path, ts: float | None = None) -> ImuData:
     """Read IMU increments from a PSINS ``.imu`` or a text/CSV file, plain or compressed
     (``.gz``, ``.xz``: ``lasergyro.imu.xz``).
 
-    Dispatch on the suffix under any compression suffix: ``.imu`` -> :func:`read_psins_imu`;
-    ``.csv``/``.txt`` -> :func:`read_csv_imu`; HDF5 (by extension or signature) ->
-    :class:`ImuFileError` (read by the results layer); any other name: PSINS if the first
-    non-blank line is a ``%`` comment, else CSV. `ts` is passed to the CSV reader only
+    Dispatch as :func:`guess_format` (``.imu`` or a ``%`` first line: :func:`read_psins_imu`;
+    otherwise :func:`read_csv_imu`); HDF5 (by extension or signature) ->
+    :class:`ImuFileError` (read by the results layer). `ts` is passed to the CSV reader only
     (PSINS files carry their own interval). Other layouts (MAT files, KF-GINS text, rates,
     other body axes) are read by :func:`gcalign.io.recorded.read_recording`.
     """
@@ -599,20 +598,29 @@ def read_imu_file(path, ts: float | None = None) -> ImuData:
             f"{name}: HDF5 IMU files (from `gcalign simulate`) are read by the results "
             "module, not by read_imu_file; expected a PSINS .imu or a .csv/.txt file"
         )
-    if suffix == ".imu":
-        return read_psins_imu(p)
-    if suffix in (".csv", ".txt"):
-        return read_csv_imu(p, ts=ts)
-    if p.is_file():
-        head = read_bytes(p, head=4096)[1]
-        if head.startswith(_HDF5_MAGIC):
-            raise ImuFileError(
-                f"{name}: is an HDF5 file; HDF5 IMU data is read by the results module, "
-                "expected a PSINS .imu or a .csv/.txt file"
-            )
-        first = next(
-            (ln.strip() for ln in head.decode("utf-8", "replace").splitlines() if ln.strip()), ""
+    if suffix not in (".imu", ".csv", ".txt") and p.is_file() and \
+            read_bytes(p, head=8)[1].startswith(_HDF5_MAGIC):
+        raise ImuFileError(
+            f"{name}: is an HDF5 file; HDF5 IMU data is read by the results module, "
+            "expected a PSINS .imu or a .csv/.txt file"
         )
-        if first.startswith("%"):
-            return read_psins_imu(p)
-    return read_csv_imu(p, ts=ts)
+    return read_psins_imu(p) if guess_format(p) == "psins" else read_csv_imu(p, ts=ts)
+
+
+def guess_format(path: str | os.PathLike[str]) -> str:
+    """The format a file's name (or signature) implies: ``.imu`` psins, ``.mat`` psins-mat,
+    otherwise csv (a ``%`` first line: psins)."""
+    suffix = data_suffix(path)
+    if suffix == ".imu":
+        return "psins"
+    if suffix == ".mat":
+        return "psins-mat"
+    if suffix in (".csv", ".txt"):
+        return "csv"
+    try:
+        _, head = read_bytes(path, head=4096)
+    except ImuFileError:
+        return "csv"
+    first = next((ln.strip() for ln in head[:4096].decode("utf-8", "replace").splitlines()
+                  if ln.strip()), "")
+    return "psins" if first.startswith("%") else "csv"

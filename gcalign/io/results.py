@@ -57,9 +57,7 @@ def check_output(path, what: str = "--output") -> Path:
                             f"{p / 'result.h5'})")
     if p.exists() and not p.is_file() and not p.is_symlink():
         raise ScenarioError(f"{what}: {p} exists and is not a regular file")
-    parent = p.parent
-    while not parent.exists() and parent != parent.parent:
-        parent = parent.parent
+    parent = _existing(p.parent)
     if parent.exists() and not parent.is_dir():
         raise ScenarioError(f"{what}: {parent} is not a directory, so {p} cannot be written")
     return p
@@ -74,15 +72,20 @@ def check_output_dir(path, what: str = "--output") -> Path:
     if p.exists() and not p.is_dir():
         raise ScenarioError(f"{what}: {p} exists and is not a folder; give a folder for the "
                             "figures")
-    parent = p
-    while not parent.exists() and parent != parent.parent:
-        parent = parent.parent
+    parent = _existing(p)
     if not parent.is_dir():
         raise ScenarioError(f"{what}: {parent} is not a folder, so {p} cannot be made")
     try:
         p.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise write_error(p, err) from None
+    return p
+
+
+def _existing(p: Path) -> Path:
+    """`p`, or the nearest folder above it that exists (the root at the latest)."""
+    while not p.exists() and p != p.parent:
+        p = p.parent
     return p
 
 
@@ -175,7 +178,8 @@ class _GuardedFile:
     read zero bytes of metadata it believed written and crashed (``observability`` under
     ``ulimit -f 256``: a segmentation fault). :func:`atomic_h5` raises the recorded error
     once HDF5 is done, and :func:`check_writes`, called by every writer of this module
-    (:func:`put`, :class:`Series`, :func:`write_header`), stops the run at its next write,
+    (:func:`put`, :class:`Series`, :func:`write_header`, :func:`write_recording`) and by
+    :func:`gcalign.io.stored.write_fields` at each group, stops the run at its next write,
     so that the pages held stay about one dataset. Reads past the end are zeros, as HDF5's
     own POSIX driver gives them."""
 
@@ -322,11 +326,6 @@ class _GuardedFile:
 
     def flush(self) -> None:
         """Nothing is buffered here (``pwrite``)."""
-
-    @property
-    def held_bytes(self) -> int:
-        """Memory held for HDF5 since a write was refused."""
-        return len(self._pages) * self.PAGE
 
 
 #: (path, guard) of the results files open for writing in this process (atomic_h5)
@@ -483,8 +482,7 @@ def put(group: h5py.Group, name: str, data, units: str, frame: str | None = None
     ds.attrs["units"] = units
     if frame:
         ds.attrs["frame"] = frame
-    for k, v in attrs.items():
-        ds.attrs[k] = v
+    ds.attrs.update(attrs)
     return ds
 
 
@@ -513,30 +511,19 @@ class Series:
                  chunk_rows: int = 4096, **attrs):
         self.group = group
         self.chunk_rows = chunk_rows
-        self._held: dict[str, list[np.ndarray]] = {}
-        self._held_rows: dict[str, int] = {}
+        self._held: dict[str, list[np.ndarray]] = {name: [] for name in spec}
         self._datasets: dict[str, h5py.Dataset] = {}
         for name, (width, units, frame) in spec.items():
             shape = (0,) if width is None else (0, width)
-            ds = group.create_dataset(
-                name, shape=shape, maxshape=(None,) + shape[1:], dtype="f8",
-                chunks=(chunk_rows,) + shape[1:], compression="gzip", compression_opts=4,
-                shuffle=True)
-            ds.attrs["units"] = units
-            if frame:
-                ds.attrs["frame"] = frame
-            self._datasets[name] = ds
-            self._held[name] = []
-            self._held_rows[name] = 0
-        for k, v in attrs.items():
-            group.attrs[k] = v
+            self._datasets[name] = put(group, name, np.empty(shape), units, frame, create={
+                "maxshape": (None,) + shape[1:], "chunks": (chunk_rows,) + shape[1:],
+                "compression": "gzip", "compression_opts": 4, "shuffle": True})
+        group.attrs.update(attrs)
 
     def append(self, **arrays) -> None:
         for name, a in arrays.items():
-            a = np.array(a, dtype=float)
-            self._held[name].append(a)
-            self._held_rows[name] += len(a)
-            if self._held_rows[name] >= self.chunk_rows:
+            self._held[name].append(np.array(a, dtype=float))
+            if sum(map(len, self._held[name])) >= self.chunk_rows:
                 self._write(name, whole_chunks=True)
 
     def flush(self) -> None:
@@ -555,7 +542,6 @@ class Series:
         ds.resize(m + n, axis=0)
         ds[m:] = rows[:n]
         self._held[name] = [rows[n:]] if n < len(rows) else []
-        self._held_rows[name] = len(rows) - n
 
 
 def write_header(f: h5py.File, kind: str, scenario_yaml: str, seed: int | None, summary: dict):
@@ -578,6 +564,7 @@ def write_recording(f: h5py.File, record: dict) -> None:
     origin, rate, gaps, gravity check; :func:`gcalign.io.recorded.read_recording`), one
     attribute per entry (text, number, or JSON for lists and mappings) and the whole
     record as ``record_json``."""
+    check_writes()
     g = f.create_group("recording")
     for key, value in record.items():
         if isinstance(value, (str, int, float)) and not isinstance(value, bool):
@@ -585,19 +572,6 @@ def write_recording(f: h5py.File, record: dict) -> None:
         elif value is not None:
             g.attrs[key] = json.dumps(value)
     g.attrs["record_json"] = json.dumps(record)
-
-
-def read_recording_record(path: Path) -> dict | None:
-    """The ``/recording`` record of a results file, or None if it has none."""
-    with open_results(path) as f:
-        if "recording" not in f:
-            return None
-        text = text_attr(f["recording"], "record_json", path)
-    try:
-        record = json.loads(text)
-    except ValueError:
-        raise ScenarioError(f"{path}: /recording attribute 'record_json' is not JSON") from None
-    return record if isinstance(record, dict) else None
 
 
 def _raised_in_h5py(err: BaseException) -> bool:
@@ -898,8 +872,7 @@ def imu_series(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, s
             if n < 1 or a.shape != shape:
                 raise ScenarioError(f"{path}: dataset /imu/{k} must have shape "
                                     f"{(len(t),) + shape[1:]}, got {a.shape}")
-        frame = g["dtheta"].attrs.get("frame", "body")
-        frame = frame.decode() if isinstance(frame, bytes) else str(frame)
+        frame = _text(g["dtheta"].attrs.get("frame", "body"))
     return t, dtheta, dv, ts, frame.split(":")[0]
 
 
@@ -945,12 +918,10 @@ def read_imu(path: Path) -> ImuData:
         check_increments(f"{path}: /imu", t, dtheta, dv, ts)
         extra: dict = {k: _vector_attr(g, k, path) for k in ("site", "att0", "v0_n")
                        if k in g.attrs}
-        if "site" in extra and not abs(extra["site"][0]) < math.pi / 2:
-            raise ScenarioError(f"{path}: /imu attribute 'site': latitude must lie within "
-                                f"(-pi/2, pi/2) rad, got {extra['site'][0]!r}")
-        if "att0" in extra and not abs(extra["att0"][0]) < math.pi / 2:
-            raise ScenarioError(f"{path}: /imu attribute 'att0': pitch must lie within "
-                                f"(-pi/2, pi/2) rad, got {extra['att0'][0]!r}")
+        for key, what in (("site", "latitude"), ("att0", "pitch")):
+            if key in extra and not abs(extra[key][0]) < math.pi / 2:
+                raise ScenarioError(f"{path}: /imu attribute {key!r}: {what} must lie within "
+                                    f"(-pi/2, pi/2) rad, got {extra[key][0]!r}")
         motion = scenario.get("motion") if isinstance(scenario, dict) else None
         kind = motion.get("kind") if isinstance(motion, dict) else None
         q_bs = None
@@ -972,8 +943,9 @@ def read_scenario(path: Path):
     """The scenario stored in a results file, parsed safely (a mapping, or None)."""
     from gcalign.io.scenario.loader import loads
 
-    text = read_scenario_yaml(path)
-    data = loads(text, f"{path}: root attribute 'scenario_yaml'") if text.strip() else None
+    with open_results(path) as f:
+        text = text_attr(f, "scenario_yaml", path)
+    data = loads(text, f"{path}: root attribute 'scenario_yaml'")
     if data is not None and not isinstance(data, dict):
         raise ScenarioError(f"{path}: root attribute 'scenario_yaml' must be a YAML mapping, "
                             f"got {type(data).__name__}")
@@ -1057,30 +1029,34 @@ def timed_groups(path: Path, under: str = "") -> list[str]:
         return found
 
 
+def _timed(f: h5py.File, group: str, path: Path) -> list[tuple[str, h5py.Dataset]]:
+    """``(name, dataset)`` of the time series of `group`: ``t`` first, then every numeric
+    dataset of its length (:func:`_time_datasets`). ScenarioError naming the file and group
+    when there is no such group or it has no time ``t``."""
+    g = f.get(group.strip("/"))
+    if not isinstance(g, h5py.Group):
+        have = [k for k in f if isinstance(f[k], h5py.Group)]
+        raise ScenarioError(f"--group: {path} has no group {group!r}; it has "
+                            f"{', '.join(have) or 'none'}")
+    t = g.get("t")
+    if not (isinstance(t, h5py.Dataset) and t.ndim == 1 and t.dtype.kind == "f"):
+        timed: list[str] = []
+        f.visititems(lambda n, o: timed.append(n) if isinstance(o, h5py.Group)
+                     and _is_time(o.get("t")) else None)
+        raise ScenarioError(f"--group: {path}: /{group.strip('/')} has no time series "
+                            f"(no 1-D dataset 't'); groups that have: "
+                            f"{', '.join(timed[:8]) or 'none'}")
+    return [("t", t), *_time_datasets(g, len(t))]
+
+
 def series(path: Path, group: str = "navigate") -> dict[str, tuple[np.ndarray, str]]:
     """The time series of a group of a results file: ``{name: (array, units)}``, ``t``
     first, then every dataset of the same length along axis 0 (attitude, velocity,
     position, errors, ...), as stored (SI; time along axis 0). ScenarioError naming the
     file and group when there is no such group or it has no time ``t``."""
     with open_results(path) as f:
-        g = f.get(group.strip("/"))
-        if not isinstance(g, h5py.Group):
-            have = [k for k in f if isinstance(f[k], h5py.Group)]
-            raise ScenarioError(f"--group: {path} has no group {group!r}; it has "
-                                f"{', '.join(have) or 'none'}")
-        t = g.get("t")
-        if not (isinstance(t, h5py.Dataset) and t.ndim == 1 and t.dtype.kind == "f"):
-            timed: list[str] = []
-            f.visititems(lambda n, o: timed.append(n) if isinstance(o, h5py.Group)
-                         and _is_time(o.get("t")) else None)
-            raise ScenarioError(f"--group: {path}: /{group.strip('/')} has no time series "
-                                f"(no 1-D dataset 't'); groups that have: "
-                                f"{', '.join(timed[:8]) or 'none'}")
-        n = len(t)
-        out = {"t": (read_dataset(t, path), _units_of(t))}
-        for name, ds in _time_datasets(g, n):
-            out[name] = (read_dataset(ds, path), _units_of(ds))
-        return out
+        return {name: (read_dataset(ds, path), _text(ds.attrs.get("units", "")))
+                for name, ds in _timed(f, group, path)}
 
 
 def _time_datasets(g: h5py.Group, n: int, prefix: str = ""):
@@ -1094,32 +1070,21 @@ def _time_datasets(g: h5py.Group, n: int, prefix: str = ""):
             yield prefix + name, obj
 
 
-def series_components(path: Path, group: str = "navigate") -> dict[str, tuple[str, ...]]:
-    """Column labels of each (N, k) series: ``att -> (pitch, roll, yaw)``, ``v_n -> (e, n,
-    u)``, ``pos -> (lat, lon, h)``; a series with a ``names`` attribute by those names
-    (``innovation -> (dvE, dvN)``), one in the order of its group's ``states`` attribute
-    by the states (``estimate -> (phiE, …, dKaz)``), otherwise ``0, 1, ...``."""
-    return {name: labels for name, (labels, _) in _component_meta(path, group).items()}
-
-
-def _component_meta(path: Path, group: str) -> dict[str, tuple[tuple[str, ...], list[str]]]:
-    """``{name: (labels, units per component or [])}`` of the (N, k) series of a group."""
-    with open_results(path) as f:
-        g = f[group.strip("/")]
-        out = {}
-        for name, ds in _time_datasets(g, len(g["t"])):
-            if ds.ndim == 2:
-                out[name] = _components(ds)
-        return out
+def _text(v) -> str:
+    return v.decode() if isinstance(v, bytes) else str(v)
 
 
 def _list_attr(obj, name: str) -> list[str]:
-    v = obj.attrs.get(name, "")
-    v = v.decode() if isinstance(v, bytes) else str(v)
+    v = _text(obj.attrs.get(name, ""))
     return [p.strip() for p in v.split(",")] if v else []
 
 
 def _components(ds: h5py.Dataset) -> tuple[tuple[str, ...], list[str]]:
+    """Column labels of an (N, k) series and its units per component (or []):
+    ``att -> (pitch, roll, yaw)``, ``v_n -> (e, n, u)``, ``pos -> (lat, lon, h)``; a series
+    with a ``names`` attribute by those names (``innovation -> (dvE, dvN)``), one in the
+    order of its group's ``states`` attribute by the states (``estimate -> (phiE, …,
+    dKaz)``), otherwise ``0, 1, ...``."""
     k = ds.shape[1]
     names = _list_attr(ds, "names")
     if len(names) == k:
@@ -1143,18 +1108,19 @@ def _components(ds: h5py.Dataset) -> tuple[tuple[str, ...], list[str]]:
 def columns(path: Path, group: str = "navigate") -> list[tuple[str, np.ndarray, str]]:
     """The group's series as flat columns ``(name, values (N,), units)``: ``t``, then each
     vector series by component (``att_pitch``, ``v_n_e``, ``pos_lat``, ``estimate_ebx``,
-    ...), each with its own unit where the file gives one per component."""
-    meta = _component_meta(path, group)
+    ...; :func:`_components`), each with its own unit where the file gives one per
+    component."""
     out = []
-    for name, (a, units) in series(path, group).items():
-        if a.ndim == 1:
-            out.append((name, a, units))
-            continue
-        labels, own = meta[name]
-        parts = own or [p.strip() for p in units.split(",")]
-        for j, label in enumerate(labels):
-            out.append((f"{name}_{label}", a[:, j], parts[j] if len(parts) == a.shape[1]
-                        else units))
+    with open_results(path) as f:
+        for name, ds in _timed(f, group, path):
+            a, units = read_dataset(ds, path), _text(ds.attrs.get("units", ""))
+            if a.ndim == 1:
+                out.append((name, a, units))
+                continue
+            labels, own = _components(ds)
+            parts = own or [p.strip() for p in units.split(",")]
+            out.extend((f"{name}_{label}", a[:, j], parts[j] if len(parts) == a.shape[1]
+                        else units) for j, label in enumerate(labels))
     return out
 
 
@@ -1173,7 +1139,3 @@ def dataframe(path: Path, group: str = "navigate"):
     df.attrs["units"] = {name: units for name, _, units in cols}
     return df
 
-
-def _units_of(ds: h5py.Dataset) -> str:
-    u = ds.attrs.get("units", "")
-    return u.decode() if isinstance(u, bytes) else str(u)

@@ -29,6 +29,7 @@ T = TypeVar("T")
 def write_fields(g: h5py.Group, result: Any, outer: Any = None) -> None:
     """Write the stored fields of the dataclass `result` into the group `g`; the ``{name}``
     of a field's texts are attributes of `result`, or of the result that holds it (`outer`)."""
+    check_writes()  # its attributes and groups too: a full disk ends the run here
     outer = result if outer is None else outer
     for f in dataclasses.fields(result):
         how = spec(f)

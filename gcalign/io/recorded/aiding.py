@@ -31,10 +31,9 @@ import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.gaps import default_max_gap
-from gcalign.io.imu_files import ImuFileError, read_bytes, text_of
+from gcalign.io.imu_files import ImuFileError, _finite, _increasing, read_bytes, text_of
 from gcalign.io.recorded.axes import _DIRECTIONS
-from gcalign.io.recorded.imu import _table, _table_of, _text_lines
-from gcalign.io.recorded.rows import _check_rows, _columns, _finite
+from gcalign.io.recorded.rows import _columns, _read_columns
 from gcalign.units import DEG
 
 __all__ = ["PositionFixes", "Velocities", "read_gnss", "read_velocity", "read_odometer",
@@ -93,21 +92,16 @@ def read_gnss(path, format: str = "i2nav-gnss", columns=None, lever_arm_b=(0.0, 
         t, lat, lon, h, s_enu, origin = _rtklib(name, data)
     else:
         cols = _GNSS_COLUMNS if format == "i2nav-gnss" else _columns(columns, _GNSS_COLUMNS)
-        rows, (_, where) = _table_of(name, data, len(cols), cols)
-        _finite(name, rows, cols, where)
-        c = {k: rows[:, cols.index(k)] for k in _GNSS_COLUMNS}
-        _check_rows(name, c["t"], where)
+        c, where = _read_columns(name, data, cols, _GNSS_COLUMNS)
         t, lat, lon, h = c["t"], c["lat"], c["lon"], c["h"]
         s_enu = np.column_stack([c["se"], c["sn"], c["sd"]])
         origin = "GNSS seconds of week" if format == "i2nav-gnss" else "the file's time column"
         _ranges(name, lat, lon, s_enu, where)
     pos = np.column_stack([lat * DEG, lon * DEG, h])
     record = {"format": format, "path": name, "epochs": int(len(t)),
-              "first": {"t_s": float(t[0]), "lat_deg": float(lat[0]), "lon_deg": float(lon[0]),
-                        "h_m": float(h[0]), "sigma_enu_m": s_enu[0].tolist()},
-              "last": {"t_s": float(t[-1]), "lat_deg": float(lat[-1]),
-                       "lon_deg": float(lon[-1]), "h_m": float(h[-1]),
-                       "sigma_enu_m": s_enu[-1].tolist()},
+              **{end: {"t_s": float(t[k]), "lat_deg": float(lat[k]), "lon_deg": float(lon[k]),
+                       "h_m": float(h[k]), "sigma_enu_m": s_enu[k].tolist()}
+                 for end, k in (("first", 0), ("last", -1))},
               "sigma_enu_median_m": np.median(s_enu, axis=0).tolist(),
               "time_origin": origin, "lever_arm_b_m": lever.tolist()}
     return PositionFixes(t, pos, s_enu, lever, record)
@@ -165,7 +159,7 @@ def _rtklib(name: str, data: bytes):
                                f"{', '.join(need)}, got {' '.join(parts)[:80]!r}") from None
     where = lambda k: f":{body[k][0]}"  # noqa: E731
     _finite(name, values, need, where)
-    _check_rows(name, t, where)
+    _increasing(name, t, where, got="")
     lat, lon, h = values[:, 0], values[:, 1], values[:, 2]
     s_enu = values[:, [4, 3, 5]]
     _ranges(name, lat, lon, s_enu, where)
@@ -183,11 +177,7 @@ def read_velocity(path, frame: str = "ENU", columns=None) -> Velocities:
         raise ScenarioError(f"aiding.frame: {frame!r}; allowed: ENU, NED")
     default = ("t", "ve", "vn", "vu") if frame == "ENU" else ("t", "vn", "ve", "vd")
     cols = _columns(columns, default)
-    text = read_bytes(name, text=True)[1]
-    rows, (_, where) = _table(name, _text_lines(name, text), len(cols), cols)
-    _finite(name, rows, cols, where)
-    c = {k: rows[:, cols.index(k)] for k in default}
-    _check_rows(name, c["t"], where)
+    c = _read_columns(name, read_bytes(name, text=True)[1], cols, default)[0]
     v = (np.column_stack([c["ve"], c["vn"], c["vu"]]) if frame == "ENU"
          else np.column_stack([c["ve"], c["vn"], -c["vd"]]))
     return Velocities(c["t"], v_n=v, record={"format": f"velocity csv ({frame})", "path": name,
@@ -206,12 +196,9 @@ def read_odometer(path, axis: str = "F", columns=None) -> Velocities:
     axis_b = np.zeros(3)
     axis_b[i] = sign
     cols = _columns(columns, ("t", "speed"))
-    text = read_bytes(name, text=True)[1]
-    rows, (_, where) = _table(name, _text_lines(name, text), len(cols), cols)
-    _finite(name, rows, cols, where)
-    t, speed = rows[:, cols.index("t")], rows[:, cols.index("speed")]
-    _check_rows(name, t, where)
-    return Velocities(t, speed=speed, axis_b=axis_b,
+    c = _read_columns(name, read_bytes(name, text=True)[1], cols, ("t", "speed"))[0]
+    t = c["t"]
+    return Velocities(t, speed=c["speed"], axis_b=axis_b,
                       record={"format": "odometer csv", "path": name, "axis": letter,
                               "epochs": int(len(t)), "t_first_s": float(t[0]),
                               "t_last_s": float(t[-1])})

@@ -55,7 +55,7 @@ from gcalign.io.imu_files import (
     _is_number,
     _parse_block,
     check_increments,
-    data_suffix,
+    guess_format,
     read_bytes,
     read_psins_imu,
     text_of,
@@ -170,30 +170,9 @@ class _Raw:
 # --------------------------------------------------------------------------- formats
 
 
-def guess_format(path) -> str:
-    """The format a file's name (or signature) implies: ``.imu`` psins, ``.mat`` psins-mat,
-    otherwise csv (a ``%`` first line: psins)."""
-    suffix = data_suffix(path)
-    if suffix == ".imu":
-        return "psins"
-    if suffix == ".mat":
-        return "psins-mat"
-    if suffix in (".csv", ".txt"):
-        return "csv"
-    try:
-        _, head = read_bytes(path, head=4096)
-    except ImuFileError:
-        return "csv"
-    first = next((ln.strip() for ln in head[:4096].decode("utf-8", "replace").splitlines()
-                  if ln.strip()), "")
-    return "psins" if first.startswith("%") else "csv"
-
-
 def _text_lines(name: str, data: bytes) -> list[str]:
-    """Lines with ``#`` and ``%`` comments cut off (line numbers kept)."""
-    if data.startswith(_HDF5_MAGIC):
-        raise ImuFileError(f"{name}: is an HDF5 file, not text (a gcalign results file is "
-                           "read without format; a MAT v7.3 file: format psins-mat)")
+    """Lines with ``#`` and ``%`` comments cut off (line numbers kept); ImuFileError for
+    what is not text (:func:`~gcalign.io.imu_files.text_of`)."""
     return [_uncommented(line) for line in text_of(name, data).splitlines()]
 
 

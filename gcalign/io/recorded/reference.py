@@ -30,10 +30,10 @@ import numpy as np
 
 from gcalign.errors import ScenarioError
 from gcalign.gaps import Outage, default_max_gap, find_outages
-from gcalign.io.imu_files import ImuFileError, read_bytes
+from gcalign.io.imu_files import ImuFileError, _finite, _increasing, read_bytes
 from gcalign.io.recorded import mat
 from gcalign.io.recorded.imu import _table_of
-from gcalign.io.recorded.rows import _check_rows, _columns, _finite
+from gcalign.io.recorded.rows import _columns
 from gcalign.nav.rotation import dcm_to_euler, euler_to_dcm
 from gcalign.units import DEG
 
@@ -90,7 +90,6 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
         origin = "seconds, the avp array's last column"
     elif format == "i2nav-nav":
         rows, (_, where) = _table_of(name, data, 11, _NAV_LABELS)
-        _finite(name, rows, _NAV_LABELS, where)
         t = rows[:, 1]
         att = np.column_stack([rows[:, 9], rows[:, 8], -rows[:, 10]]) * DEG  # yaw = -heading
         v = np.column_stack([rows[:, 6], rows[:, 5], -rows[:, 7]])
@@ -100,14 +99,13 @@ def read_reference(path, format: str = "psins-mat", variable: str | None = None,
     else:
         cols = _columns(columns, _CSV_COLUMNS)
         rows, (_, where) = _table_of(name, data, len(cols), cols)
-        _finite(name, rows, cols, where)
         c = {k: rows[:, cols.index(k)] for k in _CSV_COLUMNS}
         t = c["t"]
         att = np.column_stack([c["pitch"], c["roll"], c["yaw"]]) * DEG
         v = np.column_stack([c["ve"], c["vn"], c["vu"]])
         pos = np.column_stack([c["lat"] * DEG, c["lon"] * DEG, c["h"]])
         origin = "the file's time column"
-    _check_rows(name, t, where)
+    _increasing(name, t, where, got="")
     if len(t) < 2:
         raise ImuFileError(f"{name}: {len(t)} epoch(s); a reference needs at least 2")
     if att is not None:

@@ -1,28 +1,25 @@
-"""Row checks shared by the aiding and reference readers: strictly increasing times, finite
-fields, the declared columns; each failure one line naming the file, the row and the field."""
+"""What the aiding and reference readers share: their columns read with strictly increasing
+times, the declared columns; each failure one line naming the file, the row and the field."""
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
 from gcalign.errors import ScenarioError
-from gcalign.io.imu_files import ImuFileError
+from gcalign.io.imu_files import _increasing
+from gcalign.io.recorded.imu import _table_of
 
 
-def _check_rows(name: str, t: np.ndarray, where) -> None:
-    dt = np.diff(t)
-    if (dt <= 0).any():
-        k = int(np.argmax(dt <= 0)) + 1
-        raise ImuFileError(f"{name}{where(k)}: time must increase strictly, got "
-                           f"{float(t[k])!r} after {float(t[k - 1])!r}")
-
-
-def _finite(name: str, a: np.ndarray, labels, where) -> None:
-    bad = ~np.isfinite(a)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        raise ImuFileError(f"{name}{where(int(row))}: field {col + 1} ({labels[col]}) must be "
-                           f"finite, got {float(a[row, col])!r}")
+def _read_columns(name: str, data: bytes, cols: tuple[str, ...], keep: tuple[str, ...]
+                  ) -> tuple[dict[str, np.ndarray], Callable[[int], str]]:
+    """The columns `keep` of the text table `data` whose columns are `cols` (every field
+    finite, the time ``t`` strictly increasing), and where(k), the file line of row k."""
+    rows, (_, where) = _table_of(name, data, len(cols), cols)
+    c = {k: rows[:, cols.index(k)] for k in keep}
+    _increasing(name, c["t"], where, got="")
+    return c, where
 
 
 def _columns(columns, default, allowed_extra=("-",)) -> tuple[str, ...]:
