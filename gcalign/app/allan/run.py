@@ -55,7 +55,9 @@ TAU_POINTS_S = (1.0, 10.0, 100.0)
 FORCE_SPREAD = 20e-3 * u.G0
 
 
-def _window(cfg: AllanConfig, n: int, ts: float) -> tuple[int, int]:
+def window(cfg: AllanConfig, n: int, ts: float) -> tuple[int, int]:
+    """The samples [k0, k1) of `n` at interval `ts` the section's window takes; a start
+    past the end is refused (the preflight's check and the run's)."""
     k0 = int(round(cfg.start_s / ts))
     if k0 >= n:
         raise ScenarioError(f"allan.start_s: {cfg.start_s:g} s is past the end of the data "
@@ -164,7 +166,7 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
                             "needs the sensors still (remove the mechanism)")
     ts = imu.ts
     cfg = sc.allan or AllanConfig()
-    k0, k1 = _window(cfg, len(imu), ts)
+    k0, k1 = window(cfg, len(imu), ts)
     dtheta, dv = imu.dtheta[k0:k1], imu.dv[k0:k1]
     if progress is not None:
         progress(0.0, 1.0, "Allan deviation")
