@@ -107,6 +107,13 @@ def test_a_full_disk_under_every_writer_is_one_line_and_leaves_nothing(folder, w
         out = out_dir / ("out" if writer == "plot" else "out.h5")
         res = _run(folder, argv, out, limit)
         what = f"{writer} under ulimit -f {limit} B of {size}"
+        if res.exit_code == 0 and limit == size - 1 and out.is_file():
+            # its last byte: the same run's file is not the same size every time (realtime's
+            # came out 64 bytes smaller with 3 more bytes of text: HDF5 lays out its metadata
+            # as the writes come) and this one fitted; then it is whole and within the limit
+            assert _size(out) <= limit and D._cli(["show", out]).exit_code == 0, what
+            shutil.rmtree(out_dir, ignore_errors=True)
+            continue
         assert res.exit_code == 1, (what, res.exit_code, res.stderr, res.exception)
         lines = res.stderr.strip().splitlines()
         assert len(lines) == 1 and "Traceback" not in res.stderr, (what, res.stderr)
