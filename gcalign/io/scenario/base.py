@@ -8,6 +8,7 @@ from pathlib import PurePath
 from typing import Annotated, Any
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -44,6 +45,15 @@ def span(v: list[float] | None) -> list[float] | None:
     if v is not None and (len(v) != 2 or not 0 < v[0] < v[1]):
         raise ValueError(f"must be [lo, hi] in s with 0 < lo < hi, got {v}")
     return v
+
+
+def one_of(names: tuple[str, ...], what: str) -> AfterValidator:
+    """A text among `names`: ``'TEXT' is not a WHAT; allowed: NAMES`` otherwise."""
+    def check(v: str) -> str:
+        if v not in names:
+            raise ValueError(f"{v!r} is not a {what}; allowed: {', '.join(names)}")
+        return v
+    return AfterValidator(check)
 
 
 def vector(value: float | tuple[float, float, float] = 0.0, **field: Any) -> Any:

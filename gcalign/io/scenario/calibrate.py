@@ -295,8 +295,7 @@ class CalibrateConfig(Model):
                                 f"got aiding {self.aiding!r}"
                                 + ("" if self.files is not None else " without files"))
         if self.aiding == "file":
-            need = {"velocity": ["velocity"], "position": ["position"],
-                    "both": ["velocity", "position"]}[self.measure]
+            need = ["velocity", "position"] if self.measure == "both" else [self.measure]
             assert self.files is not None
             for key in need:
                 if getattr(self.files, key) is None:

@@ -231,16 +231,13 @@ class Scenario(Model):
     def resolve_paths(self, folder) -> None:
         """Relative file paths (imu_file, reference.path, align.aiding.path,
         calibrate.files.*.path) taken from `folder` (the scenario file's)."""
-        if self.imu_file is not None and not self.imu_file.is_absolute():
-            self.imu_file = (Path(folder) / self.imu_file).resolve()
-        if self.reference is not None and not self.reference.path.is_absolute():
-            self.reference.path = (Path(folder) / self.reference.path).resolve()
-        files: list = [self.align.aiding] if self.align is not None else []
-        if self.calibrate is not None and self.calibrate.files is not None:
-            files += [self.calibrate.files.velocity, self.calibrate.files.position]
-        for f in files:  # the aiding files
-            if f is not None and f.path is not None and not f.path.is_absolute():
-                f.path = (Path(folder) / f.path).resolve()
+        files = self.calibrate.files if self.calibrate is not None else None
+        for holder, key in ((self, "imu_file"), (self.reference, "path"),
+                            (self.align and self.align.aiding, "path"),
+                            (files and files.velocity, "path"), (files and files.position, "path")):
+            path = getattr(holder, key, None)
+            if path is not None and not path.is_absolute():
+                setattr(holder, key, (Path(folder) / path).resolve())
 
     @property
     def reads_own_recording(self) -> bool:

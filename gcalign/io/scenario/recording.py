@@ -31,7 +31,7 @@ from gcalign.io.recorded.axes import rotation_to_rfu
 from gcalign.io.recorded.imu import ACCEL_UNITS, FORMAT_NAMES, GYRO_UNITS, Layout
 from gcalign.io.recorded.reference import REFERENCE_FORMATS
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, Pos3, Vec3, vector
+from gcalign.io.scenario.base import Model, Pos3, Vec3, one_of, vector
 
 
 class Units(Model):
@@ -42,7 +42,7 @@ class Units(Model):
 class ImuLayout(Model):
     """Everything of ``imu_file`` but its path (see the module docstring)."""
 
-    format: str = "auto"
+    format: Annotated[str, one_of(FORMAT_NAMES, "format")] = "auto"
     axes: str | list[list[float]] | None = None
     columns: list[str] | None = None
     units: Units | None = None
@@ -56,13 +56,6 @@ class ImuLayout(Model):
         True, description="refuse a recording that contradicts itself: gyros against the "
         "accelerometers and the earth rate, the forward axis against a velocity (wrong units "
         "or axes)")
-
-    @field_validator("format")
-    @classmethod
-    def _known_format(cls, v):
-        if v not in FORMAT_NAMES:
-            raise ValueError(f"{v!r} is not a format; allowed: {', '.join(FORMAT_NAMES)}")
-        return v
 
     @field_validator("axes")
     @classmethod
@@ -92,7 +85,7 @@ class ReferenceFile(Model):
     INS, a post-processed trajectory; :mod:`gcalign.io.recorded.reference`)."""
 
     path: Path
-    format: str = "psins-mat"
+    format: Annotated[str, one_of(REFERENCE_FORMATS, "reference format")] = "psins-mat"
     variable: str | None = None
     columns: list[str] | None = None
     max_gap_s: float | None = Field(None, gt=0, description="epochs further apart are a gap: "
@@ -101,14 +94,6 @@ class ReferenceFile(Model):
     check_attitude: bool = Field(True, description="refuse an attitude that turns 57.3 times "
                                  "too little or too much against the gyros (radians read as "
                                  "degrees, or degrees as radians)")
-
-    @field_validator("format")
-    @classmethod
-    def _known_format(cls, v):
-        if v not in REFERENCE_FORMATS:
-            raise ValueError(f"{v!r} is not a reference format; allowed: "
-                             f"{', '.join(REFERENCE_FORMATS)}")
-        return v
 
     @model_validator(mode="after")
     def _keys_of_the_format(self):
