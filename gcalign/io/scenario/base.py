@@ -101,12 +101,13 @@ def _number_text(value: Any) -> str | None:
     return next((t for t in map(_number_text, items) if t is not None), None)
 
 
-def _has_bool(value: Any) -> bool:
+def _first_bool(value: Any) -> bool | None:
+    """The first boolean in `value` (a boolean, or nested lists holding one), or None."""
     if isinstance(value, bool):
-        return True
+        return value
     if isinstance(value, list):
-        return any(_has_bool(v) for v in value[:10_000])
-    return False
+        return next((b for b in map(_first_bool, value[:10_000]) if b is not None), None)
+    return None
 
 
 class Model(BaseModel):
@@ -139,28 +140,21 @@ class Model(BaseModel):
     @model_validator(mode="before")
     @classmethod
     def _no_bool_for_number(cls, data: Any) -> Any:
-        if isinstance(data, dict):
-            for name, value in data.items():
-                field = cls.model_fields.get(name) if isinstance(name, str) else None
-                if field is not None and _has_bool(value) and not _takes_bool(field.annotation):
-                    raise ValueError(f"{name}: a boolean ({_yaml_bool(value)}) where a number "
-                                     "or text is expected (YAML reads yes/no/on/off/true/false "
-                                     "as booleans)")
-                if (field is not None and _takes(field.annotation, (int, float))
-                        and not _takes(field.annotation, (str, PurePath))):
-                    text = _number_text(value)
-                    if text is not None:
-                        raise ValueError(f"{name}: a number written as text ({clip(text, 40)!r}"
-                                         ", quoted or tagged !!str in the YAML); write the "
-                                         "number itself")
+        for name, value in data.items() if isinstance(data, dict) else ():
+            field = cls.model_fields.get(name) if isinstance(name, str) else None
+            if field is None:
+                continue
+            found = _first_bool(value)
+            if found is not None and not _takes_bool(field.annotation):
+                raise ValueError(f"{name}: a boolean ({'true' if found else 'false'}) where a "
+                                 "number or text is expected (YAML reads yes/no/on/off/true/false "
+                                 "as booleans)")
+            text = _number_text(value) if _takes(field.annotation, (int, float)) and not _takes(
+                field.annotation, (str, PurePath)) else None
+            if text is not None:
+                raise ValueError(f"{name}: a number written as text ({clip(text, 40)!r}, quoted "
+                                 "or tagged !!str in the YAML); write the number itself")
         return data
-
-
-def _yaml_bool(value: Any) -> str:
-    """The first boolean in `value` (a boolean or nested lists holding one), as YAML."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return next(_yaml_bool(v) for v in value[:10_000] if _has_bool(v))
 
 
 def _one_line(e: Any) -> str:

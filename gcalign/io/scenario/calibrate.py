@@ -176,7 +176,6 @@ class Coarse(Model):
 LeverArm = Annotated[Vec3, B.LEVER_ARM_M]
 _LEVER_HELP = ("the point the file measures (a GNSS antenna, a reference INS) from the IMU, "
                "body axes x right, y forward, z up, m; the filter applies it")
-REFERENCE_POSITION_FORMATS = ("psins-mat", "i2nav-nav", "reference-csv")
 _INTERVAL_HELP = ("use only the epochs at whole multiples of this many seconds (a 10 Hz "
                   "solution as 1 Hz fixes); default every epoch")
 
