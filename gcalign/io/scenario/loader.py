@@ -27,9 +27,8 @@ from gcalign.io.scenario.models import Scenario
 def parse_scenario(data: dict, source: str = "scenario") -> Scenario:
     """Validate a mapping (parsed YAML) as a scenario; raise ScenarioError on bad input."""
     if not isinstance(data, dict):
-        raise ScenarioError(
-            f"{source}: the scenario must be a YAML mapping, got {type(data).__name__}"
-        )
+        raise ScenarioError(f"{source}: the scenario must be a YAML mapping, got "
+                            f"{type(data).__name__}")
     if "base" in data:  # no scenario key: a sweep's
         raise ScenarioError(f"{source}: a sweep file (it has 'base'): run it with gcalign "
                             "batch (gcalign validate checks it)")

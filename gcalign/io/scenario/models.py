@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
@@ -26,7 +26,13 @@ from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
 from gcalign.io.scenario.realtime import RealtimeConfig
-from gcalign.io.scenario.recording import ImuLayout, Initial, ReferenceFile, split_imu_file
+from gcalign.io.scenario.recording import (
+    FILE_KEYS,
+    ImuLayout,
+    Initial,
+    ReferenceFile,
+    split_imu_file,
+)
 from gcalign.io.scenario.sensors import (
     AccelGaussMarkov,
     GyroGaussMarkov,
@@ -229,15 +235,18 @@ class Scenario(Model):
         return out
 
     def resolve_paths(self, folder) -> None:
-        """Relative file paths (imu_file, reference.path, align.aiding.path,
-        calibrate.files.*.path) taken from `folder` (the scenario file's)."""
-        files = self.calibrate.files if self.calibrate is not None else None
-        for holder, key in ((self, "imu_file"), (self.reference, "path"),
-                            (self.align and self.align.aiding, "path"),
-                            (files and files.velocity, "path"), (files and files.position, "path")):
-            path = getattr(holder, key, None)
+        """The relative file paths (:data:`~gcalign.io.scenario.recording.FILE_KEYS`) taken
+        from `folder` (the scenario file's)."""
+        for key in FILE_KEYS:
+            *head, last = key.split(".")
+            parent: Any = self
+            for k in head:
+                parent = getattr(parent, k, None)
+            node = getattr(parent, last, None)
+            holder, name = (parent, last) if isinstance(node, Path) else (node, "path")
+            path = getattr(holder, name, None)
             if path is not None and not path.is_absolute():
-                setattr(holder, key, (Path(folder) / path).resolve())
+                setattr(holder, name, (Path(folder) / path).resolve())
 
     @property
     def reads_own_recording(self) -> bool:

@@ -226,22 +226,22 @@ def recorded_scenario(section: str, imu_file) -> dict:
     return data
 
 
+#: Where a scenario names a file: a path, or a mapping whose ``path`` is one (``align.aiding``
+#: is always a mapping); a relative path is taken from the scenario file's folder.
+FILE_KEYS = ("imu_file", "reference", "align.aiding", "calibrate.files.velocity",
+             "calibrate.files.position")
+
+
 def absolute_paths(data: Any, folder) -> None:
-    """In a scenario mapping (before validation), the relative file paths -- ``imu_file``
-    (a path or its ``path``), ``reference.path``, ``align.aiding.path`` and
-    ``calibrate.files.*.path`` -- made absolute from `folder`, in place (batch workers may
-    run elsewhere)."""
-    if not isinstance(data, dict):
-        return
-    align, calibrate = data.get("align"), data.get("calibrate")
-    files = calibrate.get("files") if isinstance(calibrate, dict) else None
-    nodes = [(data, "imu_file"), (data, "reference"),
-             (align if isinstance(align, dict) else {}, "aiding"),
-             *(((files, k) for k in ("velocity", "position")) if isinstance(files, dict)
-               else ())]
-    for parent, key in nodes:
-        node = parent.get(key)
-        holder, field = (parent, key) if isinstance(node, str) and key != "aiding" else (
+    """In a scenario mapping (before validation), the relative paths of :data:`FILE_KEYS`
+    made absolute from `folder`, in place (batch workers may run elsewhere)."""
+    for key in FILE_KEYS:
+        *head, last = key.split(".")
+        parent = data
+        for k in head:
+            parent = parent.get(k) if isinstance(parent, dict) else None
+        node = parent.get(last) if isinstance(parent, dict) else None
+        holder, field = (parent, last) if isinstance(node, str) and last != "aiding" else (
             node, "path")
         if isinstance(holder, dict) and isinstance(holder.get(field), str):
             p = Path(holder[field])
