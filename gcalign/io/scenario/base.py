@@ -25,6 +25,12 @@ NonNegVec3 = Annotated[list[Annotated[float, Field(ge=0)]], Field(min_length=3, 
 PosVec3 = Annotated[list[Annotated[float, Field(gt=0)]], Field(min_length=3, max_length=3)]
 
 
+#: Where a scenario names a file: a path, or a mapping whose ``path`` is one (``align.aiding``
+#: is always a mapping); a relative path is taken from the scenario file's folder.
+FILE_KEYS = ("imu_file", "reference", "align.aiding", "calibrate.files.velocity",
+             "calibrate.files.position")
+
+
 def is_number(x: Any) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 

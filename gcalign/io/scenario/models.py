@@ -19,20 +19,14 @@ from gcalign import units as u
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.align import AlignConfig
 from gcalign.io.scenario.allan import AllanConfig
-from gcalign.io.scenario.base import Model, PerAxis, span, vector
+from gcalign.io.scenario.base import FILE_KEYS, Model, PerAxis, span, vector
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 from gcalign.io.scenario.modulate import ModulateConfig
 from gcalign.io.scenario.motion import MotionModel
 from gcalign.io.scenario.navigation import MechanismConfig, NavigationConfig, OutputConfig
 from gcalign.io.scenario.northfind import NorthfindConfig
 from gcalign.io.scenario.realtime import RealtimeConfig
-from gcalign.io.scenario.recording import (
-    FILE_KEYS,
-    ImuLayout,
-    Initial,
-    ReferenceFile,
-    split_imu_file,
-)
+from gcalign.io.scenario.recording import ImuLayout, Initial, ReferenceFile, split_imu_file
 from gcalign.io.scenario.sensors import (
     AccelGaussMarkov,
     GyroGaussMarkov,
@@ -235,7 +229,7 @@ class Scenario(Model):
         return out
 
     def resolve_paths(self, folder) -> None:
-        """The relative file paths (:data:`~gcalign.io.scenario.recording.FILE_KEYS`) taken
+        """The relative file paths (:data:`~gcalign.io.scenario.base.FILE_KEYS`) taken
         from `folder` (the scenario file's)."""
         for key in FILE_KEYS:
             *head, last = key.split(".")

@@ -31,7 +31,7 @@ from gcalign.io.recorded.axes import rotation_to_rfu
 from gcalign.io.recorded.imu import ACCEL_UNITS, FORMAT_NAMES, GYRO_UNITS, Layout
 from gcalign.io.recorded.reference import REFERENCE_FORMATS
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, Pos3, Vec3, one_of, vector
+from gcalign.io.scenario.base import FILE_KEYS, Model, Pos3, Vec3, one_of, vector
 
 
 class Units(Model):
@@ -224,12 +224,6 @@ def recorded_scenario(section: str, imu_file) -> dict:
     if section in RECORDED_DEFAULTS:
         data[section] = dict(RECORDED_DEFAULTS[section])
     return data
-
-
-#: Where a scenario names a file: a path, or a mapping whose ``path`` is one (``align.aiding``
-#: is always a mapping); a relative path is taken from the scenario file's folder.
-FILE_KEYS = ("imu_file", "reference", "align.aiding", "calibrate.files.velocity",
-             "calibrate.files.position")
 
 
 def absolute_paths(data: Any, folder) -> None:
