@@ -293,22 +293,19 @@ class Scenario(Model):
         simulated IMU with recorded data, and what the command's `section` reports itself
         (its ``unused(sc)``). The commands show them as warnings (stderr, table, JSON)."""
         out = []
+        model = getattr(self, section, None) if section else None  # a section of the file
         if self.imu_file is not None:
             keys = _set_keys(self.imu, "imu")
             if keys:
                 out.append(f"{', '.join(keys)}: cannot matter with recorded data (imu_file): "
                            "the recording carries its own rate and sensor errors")
         for key in ("reference", "initial"):
-            if getattr(self, key) is not None and section is not None \
-                    and section not in USED_BY[key] \
-                    and getattr(self, section, None) is not None:  # a section of the file
+            if getattr(self, key) is not None and model is not None and section not in USED_BY[key]:
                 out.append(f"{key}: read and checked (gcalign validate shows it), but "
                            f"{section} does not use it yet")
-        if self.initial is not None and self.initial.sigma is not None \
-                and section == "navigation":
+        if self.initial is not None and self.initial.sigma is not None and section == "navigation":
             out.append("initial.sigma: cannot matter to navigate (no filter); it is the P0 "
                        "of calibrate")
-        model = getattr(self, section, None) if section else None
         if model is not None and hasattr(model, "unused"):
             out += model.unused(self)
         return out

@@ -150,9 +150,8 @@ class Initial(Model):
 
     @model_validator(mode="after")
     def _position_together(self):
-        given = [k for k in ("lat_deg", "lon_deg", "height_m") if getattr(self, k) is not None]
-        if given and len(given) < 3:
-            missing = [k for k in ("lat_deg", "lon_deg", "height_m") if k not in given]
+        missing = [k for k in ("lat_deg", "lon_deg", "height_m") if getattr(self, k) is None]
+        if 0 < len(missing) < 3:
             raise ValueError(f"{', '.join(missing)}: missing; the start position takes "
                              "lat_deg, lon_deg and height_m together")
         return self
