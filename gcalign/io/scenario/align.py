@@ -226,13 +226,12 @@ class AlignConfig(Model):
             out.append(f"align.realtime: cannot matter in mode {self.mode!r} (it applies to "
                        "conventional mode only)")
         if self.mode == "conventional":
-            counts = [s.passes for s in self.stages]
             if len(self.stages) > 1:
                 out.append(f"align.stages: {len(self.stages)} stages, but conventional mode "
                            "runs one pass, on stage 1; the others cannot matter")
-            elif counts[0] not in (None, 1):
-                out.append(f"align.stages.0.passes: {counts[0]} cannot matter in conventional "
-                           "mode (one forward pass)")
+            elif self.stages[0].passes not in (None, 1):
+                out.append(f"align.stages.0.passes: {self.stages[0].passes} cannot matter in "
+                           "conventional mode (one forward pass)")
         if self.aiding.source in ("none", "file") and "noise_mps" in \
                 self.aiding.model_fields_set and self.aiding.noise_mps:
             out.append(f"align.aiding.noise_mps: cannot matter with aiding source "

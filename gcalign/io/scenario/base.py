@@ -8,6 +8,7 @@ from pathlib import PurePath
 from typing import Annotated, Any
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -22,6 +23,12 @@ from gcalign.errors import ScenarioError, clip
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 NonNegVec3 = Annotated[list[Annotated[float, Field(ge=0)]], Field(min_length=3, max_length=3)]
 PosVec3 = Annotated[list[Annotated[float, Field(gt=0)]], Field(min_length=3, max_length=3)]
+
+
+#: Where a scenario names a file: a path, or a mapping whose ``path`` is one (``align.aiding``
+#: is always a mapping); a relative path is taken from the scenario file's folder.
+FILE_KEYS = ("imu_file", "reference", "align.aiding", "calibrate.files.velocity",
+             "calibrate.files.position")
 
 
 def is_number(x: Any) -> bool:
@@ -44,6 +51,15 @@ def span(v: list[float] | None) -> list[float] | None:
     if v is not None and (len(v) != 2 or not 0 < v[0] < v[1]):
         raise ValueError(f"must be [lo, hi] in s with 0 < lo < hi, got {v}")
     return v
+
+
+def one_of(names: tuple[str, ...], what: str) -> AfterValidator:
+    """A text among `names`: ``'TEXT' is not a WHAT; allowed: NAMES`` otherwise."""
+    def check(v: str) -> str:
+        if v not in names:
+            raise ValueError(f"{v!r} is not a {what}; allowed: {', '.join(names)}")
+        return v
+    return AfterValidator(check)
 
 
 def vector(value: float | tuple[float, float, float] = 0.0, **field: Any) -> Any:
@@ -91,12 +107,13 @@ def _number_text(value: Any) -> str | None:
     return next((t for t in map(_number_text, items) if t is not None), None)
 
 
-def _has_bool(value: Any) -> bool:
+def _first_bool(value: Any) -> bool | None:
+    """The first boolean in `value` (a boolean, or nested lists holding one), or None."""
     if isinstance(value, bool):
-        return True
+        return value
     if isinstance(value, list):
-        return any(_has_bool(v) for v in value[:10_000])
-    return False
+        return next((b for b in map(_first_bool, value[:10_000]) if b is not None), None)
+    return None
 
 
 class Model(BaseModel):
@@ -129,28 +146,21 @@ class Model(BaseModel):
     @model_validator(mode="before")
     @classmethod
     def _no_bool_for_number(cls, data: Any) -> Any:
-        if isinstance(data, dict):
-            for name, value in data.items():
-                field = cls.model_fields.get(name) if isinstance(name, str) else None
-                if field is not None and _has_bool(value) and not _takes_bool(field.annotation):
-                    raise ValueError(f"{name}: a boolean ({_yaml_bool(value)}) where a number "
-                                     "or text is expected (YAML reads yes/no/on/off/true/false "
-                                     "as booleans)")
-                if (field is not None and _takes(field.annotation, (int, float))
-                        and not _takes(field.annotation, (str, PurePath))):
-                    text = _number_text(value)
-                    if text is not None:
-                        raise ValueError(f"{name}: a number written as text ({clip(text, 40)!r}"
-                                         ", quoted or tagged !!str in the YAML); write the "
-                                         "number itself")
+        for name, value in data.items() if isinstance(data, dict) else ():
+            field = cls.model_fields.get(name) if isinstance(name, str) else None
+            if field is None:
+                continue
+            found = _first_bool(value)
+            if found is not None and not _takes_bool(field.annotation):
+                raise ValueError(f"{name}: a boolean ({'true' if found else 'false'}) where a "
+                                 "number or text is expected (YAML reads yes/no/on/off/true/false "
+                                 "as booleans)")
+            text = _number_text(value) if _takes(field.annotation, (int, float)) and not _takes(
+                field.annotation, (str, PurePath)) else None
+            if text is not None:
+                raise ValueError(f"{name}: a number written as text ({clip(text, 40)!r}, quoted "
+                                 "or tagged !!str in the YAML); write the number itself")
         return data
-
-
-def _yaml_bool(value: Any) -> str:
-    """The first boolean in `value` (a boolean or nested lists holding one), as YAML."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return next(_yaml_bool(v) for v in value[:10_000] if _has_bool(v))
 
 
 def _one_line(e: Any) -> str:

@@ -176,7 +176,6 @@ class Coarse(Model):
 LeverArm = Annotated[Vec3, B.LEVER_ARM_M]
 _LEVER_HELP = ("the point the file measures (a GNSS antenna, a reference INS) from the IMU, "
                "body axes x right, y forward, z up, m; the filter applies it")
-REFERENCE_POSITION_FORMATS = ("psins-mat", "i2nav-nav", "reference-csv")
 _INTERVAL_HELP = ("use only the epochs at whole multiples of this many seconds (a 10 Hz "
                   "solution as 1 Hz fixes); default every epoch")
 
@@ -295,8 +294,7 @@ class CalibrateConfig(Model):
                                 f"got aiding {self.aiding!r}"
                                 + ("" if self.files is not None else " without files"))
         if self.aiding == "file":
-            need = {"velocity": ["velocity"], "position": ["position"],
-                    "both": ["velocity", "position"]}[self.measure]
+            need = ["velocity", "position"] if self.measure == "both" else [self.measure]
             assert self.files is not None
             for key in need:
                 if getattr(self.files, key) is None:

@@ -27,9 +27,8 @@ from gcalign.io.scenario.models import Scenario
 def parse_scenario(data: dict, source: str = "scenario") -> Scenario:
     """Validate a mapping (parsed YAML) as a scenario; raise ScenarioError on bad input."""
     if not isinstance(data, dict):
-        raise ScenarioError(
-            f"{source}: the scenario must be a YAML mapping, got {type(data).__name__}"
-        )
+        raise ScenarioError(f"{source}: the scenario must be a YAML mapping, got "
+                            f"{type(data).__name__}")
     if "base" in data:  # no scenario key: a sweep's
         raise ScenarioError(f"{source}: a sweep file (it has 'base'): run it with gcalign "
                             "batch (gcalign validate checks it)")
@@ -114,27 +113,24 @@ _Loader.add_implicit_resolver(
     list("-+.0123456789"))
 
 
-def _construct_int(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> int:
-    text = loader.construct_scalar(node)
-    try:
-        return int(text, 0) if text[:2] in ("0o", "0x") else int(text, 10)
-    except ValueError:
-        raise yaml.constructor.ConstructorError(
-            None, None, f"not an integer: {_cut(text)}", node.start_mark) from None
+def _constructor(convert, what: str):
+    """A constructor of scalars read by `convert`; a text it refuses is a YAML error at its
+    line, ``not WHAT: TEXT``."""
+    def construct(loader: yaml.SafeLoader, node: yaml.ScalarNode):
+        text = loader.construct_scalar(node)
+        try:
+            return convert(text)
+        except ValueError:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"not {what}: {_cut(text)}", node.start_mark) from None
+    return construct
 
 
-def _construct_float(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
-    text = loader.construct_scalar(node)
-    special = {".inf": math.inf, "+.inf": math.inf, "-.inf": -math.inf, ".nan": math.nan}
-    try:
-        return special[text.lower()] if text.lower() in special else float(text)
-    except ValueError:
-        raise yaml.constructor.ConstructorError(
-            None, None, f"not a number: {_cut(text)}", node.start_mark) from None
-
-
-_Loader.add_constructor(_INT, _construct_int)
-_Loader.add_constructor(_FLOAT, _construct_float)
+_SPECIAL = {".inf": math.inf, "+.inf": math.inf, "-.inf": -math.inf, ".nan": math.nan}
+_Loader.add_constructor(_INT, _constructor(
+    lambda t: int(t, 0) if t[:2] in ("0o", "0x") else int(t, 10), "an integer"))
+_Loader.add_constructor(_FLOAT, _constructor(
+    lambda t: _SPECIAL[t.lower()] if t.lower() in _SPECIAL else float(t), "a number"))
 
 
 MAX_DEPTH = 200  #: nesting of flow collections ([ {) refused beyond this

@@ -33,10 +33,8 @@ CUT = 80  #: characters of a bad value echoed in a message
 def _cut(value) -> str:
     """A value as a message shows it: repr, at most about CUT characters (a bad value
     can be megabytes long, or an alias bomb)."""
-    text = value if isinstance(value, str) else _REPR.repr(value)
-    if isinstance(value, str):
-        text = repr(clip(value, CUT))
-    return text if len(text) <= CUT + 2 else text[:CUT - 3] + "..."
+    text = repr(clip(value, CUT)) if isinstance(value, str) else _REPR.repr(value)
+    return text if len(text) <= CUT + 2 else clip(text, CUT)
 
 
 def scenario_errors(err: ValidationError, source: str = "", root: type | None = None) -> str:
@@ -70,16 +68,11 @@ def scenario_errors(err: ValidationError, source: str = "", root: type | None = 
                 MOTION_KINDS)
             msg = (f"allowed: {allowed}, got {_cut(ctx['tag'])}" if "tag" in ctx
                    else f"missing; allowed: {allowed}")
-            by_field.setdefault(where, [])
-            if msg not in by_field[where]:
-                by_field[where].append(msg)
-            continue
         elif e["type"] not in {"missing", "model_type", "value_error"}:
             got_of[where] = f", got {_cut(e.get('input'))}"
-        by_field.setdefault(where, [])
-        if msg not in by_field[where]:
-            by_field[where].append(msg)
-    lines = [
-        f"{where}: {' or '.join(msgs)}{got_of.get(where, '')}" for where, msgs in by_field.items()
-    ]
+        msgs = by_field.setdefault(where, [])
+        if msg not in msgs:
+            msgs.append(msg)
+    lines = [f"{where}: {' or '.join(msgs)}{got_of.get(where, '')}"
+             for where, msgs in by_field.items()]
     return "\n".join(f"{source}: {line}" if source else line for line in lines)

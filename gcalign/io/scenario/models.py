@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
@@ -19,7 +19,7 @@ from gcalign import units as u
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.align import AlignConfig
 from gcalign.io.scenario.allan import AllanConfig
-from gcalign.io.scenario.base import Model, PerAxis, span, vector
+from gcalign.io.scenario.base import FILE_KEYS, Model, PerAxis, span, vector
 from gcalign.io.scenario.calibrate import CalibrateConfig, ObservabilityConfig
 from gcalign.io.scenario.modulate import ModulateConfig
 from gcalign.io.scenario.motion import MotionModel
@@ -229,18 +229,18 @@ class Scenario(Model):
         return out
 
     def resolve_paths(self, folder) -> None:
-        """Relative file paths (imu_file, reference.path, align.aiding.path,
-        calibrate.files.*.path) taken from `folder` (the scenario file's)."""
-        if self.imu_file is not None and not self.imu_file.is_absolute():
-            self.imu_file = (Path(folder) / self.imu_file).resolve()
-        if self.reference is not None and not self.reference.path.is_absolute():
-            self.reference.path = (Path(folder) / self.reference.path).resolve()
-        files: list = [self.align.aiding] if self.align is not None else []
-        if self.calibrate is not None and self.calibrate.files is not None:
-            files += [self.calibrate.files.velocity, self.calibrate.files.position]
-        for f in files:  # the aiding files
-            if f is not None and f.path is not None and not f.path.is_absolute():
-                f.path = (Path(folder) / f.path).resolve()
+        """The relative file paths (:data:`~gcalign.io.scenario.base.FILE_KEYS`) taken
+        from `folder` (the scenario file's)."""
+        for key in FILE_KEYS:
+            *head, last = key.split(".")
+            parent: Any = self
+            for k in head:
+                parent = getattr(parent, k, None)
+            node = getattr(parent, last, None)
+            holder, name = (parent, last) if isinstance(node, Path) else (node, "path")
+            path = getattr(holder, name, None)
+            if path is not None and not path.is_absolute():
+                setattr(holder, name, (Path(folder) / path).resolve())
 
     @property
     def reads_own_recording(self) -> bool:
@@ -293,22 +293,19 @@ class Scenario(Model):
         simulated IMU with recorded data, and what the command's `section` reports itself
         (its ``unused(sc)``). The commands show them as warnings (stderr, table, JSON)."""
         out = []
+        model = getattr(self, section, None) if section else None  # a section of the file
         if self.imu_file is not None:
             keys = _set_keys(self.imu, "imu")
             if keys:
                 out.append(f"{', '.join(keys)}: cannot matter with recorded data (imu_file): "
                            "the recording carries its own rate and sensor errors")
         for key in ("reference", "initial"):
-            if getattr(self, key) is not None and section is not None \
-                    and section not in USED_BY[key] \
-                    and getattr(self, section, None) is not None:  # a section of the file
+            if getattr(self, key) is not None and model is not None and section not in USED_BY[key]:
                 out.append(f"{key}: read and checked (gcalign validate shows it), but "
                            f"{section} does not use it yet")
-        if self.initial is not None and self.initial.sigma is not None \
-                and section == "navigation":
+        if self.initial is not None and self.initial.sigma is not None and section == "navigation":
             out.append("initial.sigma: cannot matter to navigate (no filter); it is the P0 "
                        "of calibrate")
-        model = getattr(self, section, None) if section else None
         if model is not None and hasattr(model, "unused"):
             out += model.unused(self)
         return out

@@ -125,10 +125,9 @@ def plan_of(sc) -> Plan:
                 _check_cycle(mech)
             cfg_e = mech
         elif name in BUILTIN_NAMES:
-            kept = {} if mech is None or mech.steps is not None else {
-                k: getattr(mech, k) for k in _TIMING if getattr(mech, k) is not None}
-            if mech is not None and mech.lever_arm_cm is not None:
-                kept["lever_arm_cm"] = mech.lever_arm_cm
+            keys = _TIMING if mech is not None and mech.steps is None else ("lever_arm_cm",)
+            kept = {} if mech is None else {k: getattr(mech, k) for k in keys
+                                            if getattr(mech, k) is not None}
             try:
                 cfg_e = MechanismConfig(scheme=name, **kept)
             except ValidationError as err:  # the mechanism's timing does not suit this scheme

@@ -235,23 +235,15 @@ class NorthfindConfig(Model):
         tilt, direction = self.tilt_rad()
         try:
             return NorthfindSetup(
-                azimuths=self.azimuths_deg() * u.DEG,
-                lat=sc.site.lat_deg * u.DEG,
-                positions=self.positions,
-                dwell_s=self.dwell_s,
-                rate_hz=sc.imu.rate_hz,
-                tilt=tilt,
-                tilt_direction=direction,
-                tilt_direction_ref=self.reference,
-                repeats=self.repeats,
-                height=sc.site.height_m,
+                azimuths=self.azimuths_deg() * u.DEG, lat=sc.site.lat_deg * u.DEG,
+                positions=self.positions, dwell_s=self.dwell_s, rate_hz=sc.imu.rate_hz,
+                tilt=tilt, tilt_direction=direction, tilt_direction_ref=self.reference,
+                repeats=self.repeats, height=sc.site.height_m,
                 gyro_bias=axis(g.bias_dph, 1) * u.DPH,  # the in-plane gyro is body y
-                gyro_arw=axis(g.arw_dprh, 1) * u.DPSH,
-                gyro_scale=axis(g.scale_ppm, 1) * u.PPM,
+                gyro_arw=axis(g.arw_dprh, 1) * u.DPSH, gyro_scale=axis(g.scale_ppm, 1) * u.PPM,
                 accel_bias=np.array([axis(a.bias_ug, 0), axis(a.bias_ug, 1)]) * u.UG,  # x, y
                 accel_vrw=axis(a.vrw_ugrhz, 0) * u.UGPSHZ,
-                index_error=self.index_error_arcsec * u.ARCSEC,
-            )
+                index_error=self.index_error_arcsec * u.ARCSEC)
         except ValueError as err:  # a combination the checks above did not foresee
             raise ScenarioError(f"northfind: {err}") from None
 
@@ -259,10 +251,8 @@ class NorthfindConfig(Model):
         """Rows for `gcalign validate` (runs the cross-section checks too)."""
         setup = self.to_setup(sc)
         az = self.azimuths_deg()
-        if self.sweep is not None:
-            az_text = f"sweep {self.sweep.label()} °: {az.size} azimuths"
-        else:
-            az_text = f"{_fmt(az[0])} °"
+        az_text = (f"sweep {self.sweep.label()} °: {az.size} azimuths" if self.sweep is not None
+                   else f"{_fmt(az[0])} °")
         tilt, direction = self.tilt_rad()
         dwell_sigma = setup.gyro_arw / np.sqrt(setup.n_samples / setup.rate_hz)
         accel_sigma = setup.accel_vrw / np.sqrt(setup.n_samples / setup.rate_hz)

@@ -128,10 +128,7 @@ class FilterConfig(Model):
         return self
 
     def to_settings(self) -> FilterSettings:
-        return FilterSettings(fs_hz=self.fs_hz, align_order=self.align_order,
-                              align_cutoff_hz=self.align_cutoff_hz, nav_order=self.nav_order,
-                              nav_cutoff_hz=self.nav_cutoff_hz, notch_hz=self.notch_hz,
-                              notch_q=self.notch_q, window=self.window, chain=self.chain)
+        return FilterSettings(**self.model_dump())  # the same keys, in Hz as they are
 
 
 class SensorConfig(Model):

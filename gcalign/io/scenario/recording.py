@@ -31,7 +31,7 @@ from gcalign.io.recorded.axes import rotation_to_rfu
 from gcalign.io.recorded.imu import ACCEL_UNITS, FORMAT_NAMES, GYRO_UNITS, Layout
 from gcalign.io.recorded.reference import REFERENCE_FORMATS
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, Pos3, Vec3, vector
+from gcalign.io.scenario.base import FILE_KEYS, Model, Pos3, Vec3, one_of, vector
 
 
 class Units(Model):
@@ -42,7 +42,7 @@ class Units(Model):
 class ImuLayout(Model):
     """Everything of ``imu_file`` but its path (see the module docstring)."""
 
-    format: str = "auto"
+    format: Annotated[str, one_of(FORMAT_NAMES, "format")] = "auto"
     axes: str | list[list[float]] | None = None
     columns: list[str] | None = None
     units: Units | None = None
@@ -56,13 +56,6 @@ class ImuLayout(Model):
         True, description="refuse a recording that contradicts itself: gyros against the "
         "accelerometers and the earth rate, the forward axis against a velocity (wrong units "
         "or axes)")
-
-    @field_validator("format")
-    @classmethod
-    def _known_format(cls, v):
-        if v not in FORMAT_NAMES:
-            raise ValueError(f"{v!r} is not a format; allowed: {', '.join(FORMAT_NAMES)}")
-        return v
 
     @field_validator("axes")
     @classmethod
@@ -92,7 +85,7 @@ class ReferenceFile(Model):
     INS, a post-processed trajectory; :mod:`gcalign.io.recorded.reference`)."""
 
     path: Path
-    format: str = "psins-mat"
+    format: Annotated[str, one_of(REFERENCE_FORMATS, "reference format")] = "psins-mat"
     variable: str | None = None
     columns: list[str] | None = None
     max_gap_s: float | None = Field(None, gt=0, description="epochs further apart are a gap: "
@@ -101,14 +94,6 @@ class ReferenceFile(Model):
     check_attitude: bool = Field(True, description="refuse an attitude that turns 57.3 times "
                                  "too little or too much against the gyros (radians read as "
                                  "degrees, or degrees as radians)")
-
-    @field_validator("format")
-    @classmethod
-    def _known_format(cls, v):
-        if v not in REFERENCE_FORMATS:
-            raise ValueError(f"{v!r} is not a reference format; allowed: "
-                             f"{', '.join(REFERENCE_FORMATS)}")
-        return v
 
     @model_validator(mode="after")
     def _keys_of_the_format(self):
@@ -165,9 +150,8 @@ class Initial(Model):
 
     @model_validator(mode="after")
     def _position_together(self):
-        given = [k for k in ("lat_deg", "lon_deg", "height_m") if getattr(self, k) is not None]
-        if given and len(given) < 3:
-            missing = [k for k in ("lat_deg", "lon_deg", "height_m") if k not in given]
+        missing = [k for k in ("lat_deg", "lon_deg", "height_m") if getattr(self, k) is None]
+        if 0 < len(missing) < 3:
             raise ValueError(f"{', '.join(missing)}: missing; the start position takes "
                              "lat_deg, lon_deg and height_m together")
         return self
@@ -242,21 +226,15 @@ def recorded_scenario(section: str, imu_file) -> dict:
 
 
 def absolute_paths(data: Any, folder) -> None:
-    """In a scenario mapping (before validation), the relative file paths -- ``imu_file``
-    (a path or its ``path``), ``reference.path``, ``align.aiding.path`` and
-    ``calibrate.files.*.path`` -- made absolute from `folder`, in place (batch workers may
-    run elsewhere)."""
-    if not isinstance(data, dict):
-        return
-    align, calibrate = data.get("align"), data.get("calibrate")
-    files = calibrate.get("files") if isinstance(calibrate, dict) else None
-    nodes = [(data, "imu_file"), (data, "reference"),
-             (align if isinstance(align, dict) else {}, "aiding"),
-             *(((files, k) for k in ("velocity", "position")) if isinstance(files, dict)
-               else ())]
-    for parent, key in nodes:
-        node = parent.get(key)
-        holder, field = (parent, key) if isinstance(node, str) and key != "aiding" else (
+    """In a scenario mapping (before validation), the relative paths of :data:`FILE_KEYS`
+    made absolute from `folder`, in place (batch workers may run elsewhere)."""
+    for key in FILE_KEYS:
+        *head, last = key.split(".")
+        parent = data
+        for k in head:
+            parent = parent.get(k) if isinstance(parent, dict) else None
+        node = parent.get(last) if isinstance(parent, dict) else None
+        holder, field = (parent, last) if isinstance(node, str) and last != "aiding" else (
             node, "path")
         if isinstance(holder, dict) and isinstance(holder.get(field), str):
             p = Path(holder[field])

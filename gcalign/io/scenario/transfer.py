@@ -153,10 +153,8 @@ def resolved_rows(cfg) -> list[tuple[str, str, str]]:
 
 def unused(cfg) -> list[str]:
     """The keys of `align` that mode transfer makes void, then the section's own."""
-    void = sorted(cfg.model_fields_set - {"mode", "transfer"})
-    out = [f"align.{k}: cannot matter in align.mode 'transfer' (a gyrocompass key)"
-           for k in void]
-    return out + cfg.transfer.unused()
+    return [f"align.{k}: cannot matter in align.mode 'transfer' (a gyrocompass key)"
+            for k in sorted(cfg.model_fields_set - {"mode", "transfer"})] + cfg.transfer.unused()
 
 
 def check_align_mode(cfg):
