@@ -122,6 +122,9 @@ def from_fields(cls: type, under: str = "", **sizes: str) -> dict[str, Data]:
 
 V3 = num(("N", 3))
 INDEX = num(("_",), rule="range")  # the dimension scales of HDF5's netCDF view
+#: a filter's states S, named by the group's attributes with a display unit and scale each
+STATES = (("S", ".", "states"), ("S", ".", "display_units"))
+SCALES = (("S", ".", "display_scale"),)
 
 TRUTH = Block("truth", {**from_fields(Truth), "segment_names?": text(("G",)),
                         "component*?": INDEX})
@@ -139,15 +142,12 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
         Block("align/pass_*", {**from_fields(PassRows), "component*?": INDEX}),
         Block("align/result", from_fields(AlignmentAt)),
         Block("align/transfer", {**from_fields(TransferResult), "nis?": num(("K",)),
-                                 "component*?": INDEX},
-              names=(("S", ".", "states"), ("S", ".", "display_units")),
-              numbers=(("S", ".", "display_scale"),)),
+                                 "component*?": INDEX}, STATES, SCALES),
         TRUTH, REFERENCE),
     "northfind": (Block("northfind", from_fields(NorthfindResult),
                         counts=(("P", "positions", 0), ("R", "repeats", 0))),),
     "calibrate": (
-        Block("calibrate", {}, names=(("S", ".", "states"), ("S", ".", "display_units")),
-              numbers=(("S", ".", "display_scale"),)),
+        Block("calibrate", {}, STATES, SCALES),
         Block("calibrate/segments", from_fields(Spans)),
         Block("calibrate/outages", {"start": times("O"), "end": times("O"),
                                     "length": num(("O",))}),
