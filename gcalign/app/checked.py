@@ -6,8 +6,8 @@ Each dataset is checked alone first (:func:`gcalign.io.results.check_layout`: nu
 with their units, finite, times monotonic), then against the kind's :data:`SCHEMAS`: the
 datasets the readers need are there, and every dataset has the shape its writer gives it,
 with sizes that agree across the group (the time ``t`` of length N and every series
-(N, k); an attitude (N, 3); the estimates (K + 1, n) of the n states named by the
-``states`` attribute; innovations one row fewer), whole numbers where indices are stored,
+(N, k); an attitude (N, 3); the estimates (K, n) of the n states named by the ``states``
+attribute; innovations one row per update), whole numbers where indices are stored,
 unit quaternions, segment indices within the segment names. A size is what most of the
 datasets that share it say (the odd one is named, not the time it disagrees with).
 
@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import fnmatch
+import typing
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -37,16 +38,18 @@ from gcalign.modulate.analysis import SchemeAnalysis
 from gcalign.modulate.linear import LinearSeries
 from gcalign.northfind.run import NorthfindResult
 from gcalign.realtime.filters import ChainResponse
-from gcalign.schema import nested
+from gcalign.realtime.result import CaseResult
+from gcalign.schema import field_type, nested
 from gcalign.schema import spec as stored_spec
 from gcalign.sim.motions import Truth
+from gcalign.transfer.filter import TransferResult
 
 #: kinds whose every dataset has units and finite values when written (north-finding stores
 #: NaN for a prediction it cannot make, a batch for a failed run's metrics, navigation for
 #: errors without truth; /imu and /truth have readers of their own)
 STRICT = frozenset({"align", "calibrate", "observability", "realtime", "modulate"})
 
-Dim = int | str  #: a fixed size, a size named within the kind ("N", "N-1"), or "_" (any)
+Dim = int | str  #: a fixed size, a size named within the kind ("N"), or "_" (any)
 
 
 @dataclass(frozen=True)
@@ -95,9 +98,9 @@ class Block:
 def from_fields(cls: type, under: str = "", **sizes: str) -> dict[str, Data]:
     """A block's entries from the stored fields of a result dataclass that say their dims
     (:class:`gcalign.schema.Stored`), in its subgroup `under` (``"linear/"``), if any, and
-    those of the results it holds (in their subgroup, ``*/`` for a list or a mapping), a size
-    named otherwise in that block by `sizes` (``D="Q"``): a new field is checked as it is
-    declared."""
+    those of the results it holds (in their subgroup, ``*/`` for a list or a mapping; a
+    mapping of arrays: ``name/*``), a size named otherwise in that block by `sizes`
+    (``D="Q"``): a new field is checked as it is declared."""
     items: dict[str, Data] = {}
     for f in dataclasses.fields(cls):
         how = stored_spec(f)
@@ -107,8 +110,9 @@ def from_fields(cls: type, under: str = "", **sizes: str) -> dict[str, Data]:
                                  under + (how.name or f.name) + "/" + ("*/" if listed else ""))
         if how is None or how.dims is None:
             continue
+        mapping = typing.get_origin(field_type(cls, f)) is dict
         key = (under + ("*/" if how.per else "") + (how.name or f.name)
-               + ("?" if how.optional else ""))
+               + ("/*" if mapping else "") + ("?" if how.optional else ""))
         shapes = tuple(tuple(int(d) if d.isdigit() else sizes.get(d, d) for d in alt.split())
                        for alt in how.dims.split("|"))
         items[key] = Data(shapes, text=how.units is None, finite=how.finite, whole=how.whole,
@@ -117,8 +121,10 @@ def from_fields(cls: type, under: str = "", **sizes: str) -> dict[str, Data]:
 
 
 V3 = num(("N", 3))
-STATES = num(("K", "S"))
 INDEX = num(("_",), rule="range")  # the dimension scales of HDF5's netCDF view
+#: a filter's states S, named by the group's attributes with a display unit and scale each
+STATES = (("S", ".", "states"), ("S", ".", "display_units"))
+SCALES = (("S", ".", "display_scale"),)
 
 TRUTH = Block("truth", {**from_fields(Truth), "segment_names?": text(("G",)),
                         "component*?": INDEX})
@@ -135,18 +141,13 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
     "align": (
         Block("align/pass_*", {**from_fields(PassRows), "component*?": INDEX}),
         Block("align/result", from_fields(AlignmentAt)),
-        Block("align/transfer", {"t": times("K"), "estimate": STATES, "sigma": STATES,
-                                 "sigma0?": num(("S",)), "nis?": num(("K",)), "att?": num(("K", 3)),
-                                 "v_n?": num(("K", 3)), "attitude_error?": num(("K", 3)),
-                                 "bias_fed?": num(("K", 6)), "component*?": INDEX},
-              names=(("S", ".", "states"), ("S", ".", "display_units")),
-              numbers=(("S", ".", "display_scale"),)),
+        Block("align/transfer", {**from_fields(TransferResult), "nis?": num(("K",)),
+                                 "component*?": INDEX}, STATES, SCALES),
         TRUTH, REFERENCE),
     "northfind": (Block("northfind", from_fields(NorthfindResult),
                         counts=(("P", "positions", 0), ("R", "repeats", 0))),),
     "calibrate": (
-        Block("calibrate", {}, names=(("S", ".", "states"), ("S", ".", "display_units")),
-              numbers=(("S", ".", "display_scale"),)),
+        Block("calibrate", {}, STATES, SCALES),
         Block("calibrate/segments", from_fields(Spans)),
         Block("calibrate/outages", {"start": times("O"), "end": times("O"),
                                     "length": num(("O",))}),
@@ -169,11 +170,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
             names=(("S", ".", "states"), ("C", ".", "covariance_states|states"))),
         TRUTH),
     "realtime": (
-        Block("realtime/cases/*", {
-            "t": times("P"), "k?": num(("P",), whole=True), "dt_true?": num(("P",)),
-            "dt?": num(("P",)), "t_valid?": num(("P",)), "latched": num(("P", 3)),
-            "truth": num(("P", 3)), "ins_ref": num(("P", 3)), "predicted/*": num(("P", 3)),
-            "component*?": INDEX}),
+        Block("realtime/cases/*", {**from_fields(CaseResult), "component*?": INDEX}),
         Block("realtime/filter", from_fields(ChainResponse), counts=(("H", "order", 1),))),
     "modulate": (Block("modulate/*", {
         **NAVIGATION, "error/pos": V3, "error/phi": V3,
@@ -247,10 +244,6 @@ class _Tree:
                         zip(name.split("/"), parts, strict=True))]
 
 
-def _base(dim: str) -> str:
-    return dim[:-2] if dim.endswith("-1") else dim
-
-
 @dataclass
 class _Votes:
     """The sizes each named dimension of a group is given, and by what (in order)."""
@@ -258,7 +251,7 @@ class _Votes:
     by: dict[str, list[tuple[int, str]]] = field(default_factory=dict)
 
     def add(self, dim: str, size: int, what: str) -> None:
-        self.by.setdefault(_base(dim), []).append((size + (dim != _base(dim)), what))
+        self.by.setdefault(dim, []).append((size, what))
 
     def sizes(self) -> dict[str, tuple[int, str]]:
         """Each dimension's size (the most given; of a tie, the first) and who gave it."""
@@ -273,9 +266,7 @@ class _Votes:
 def _size(dim: Dim, sizes: dict[str, tuple[int, str]]) -> int | None:
     if isinstance(dim, int):
         return dim
-    if _base(dim) not in sizes:  # "_", or a size nothing gave
-        return None
-    return sizes[_base(dim)][0] - (dim != _base(dim))
+    return sizes[dim][0] if dim in sizes else None  # (not: "_", or a size nothing gave)
 
 
 def _attribute_votes(path: Path, f: h5py.File, g: h5py.Group, block: Block,
@@ -362,8 +353,8 @@ def _check_block(path: Path, f: h5py.File, g: h5py.Group, block: Block) -> None:
         if len(expected) != ds.ndim or any(e is not None and e != n for e, n in
                                            zip(expected, ds.shape, strict=True)):
             shown = " or ".join(_shown(tuple(_size(d, sizes) for d in s)) for s in spec.shapes)
-            why = [f"{sizes[_base(d)][0]} as {sizes[_base(d)][1]}" for s in spec.shapes
-                   for d in s if isinstance(d, str) and _base(d) in sizes]
+            why = [f"{sizes[d][0]} as {sizes[d][1]}" for s in spec.shapes for d in s
+                   if isinstance(d, str) and d in sizes]
             raise ScenarioError(f"{path}: dataset {ds.name} must have shape {shown}, got "
                                 f"{ds.shape}" + (f" ({'; '.join(dict.fromkeys(why))})"
                                                  if why else ""))

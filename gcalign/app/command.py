@@ -197,7 +197,7 @@ class Command:
 
     def execute(self, sc: Scenario, seed: int | None = None, cache_key: str | None = None,
                 *, recording: Recording | None = None, **options: Any) -> Outcome:
-        """Run the scenario (after its preflight: :func:`gcalign.app.preflight.checked_execute`):
+        """Run the scenario (after its preflight: :func:`gcalign.app.preflight.checked_run`):
         the summary and the writer of its results. `recording`: the scenario's recorded file
         as the preflight read it (:class:`Inputs`), for a command that reads recordings
         (``options.recorded``); without it such a command reads the file itself."""

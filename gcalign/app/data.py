@@ -184,12 +184,15 @@ def _recorded(scenario: Scenario, recording: Recording | None = None) -> RunData
     elif scenario.reference is not None:  # where the reference solution starts
         site = np.asarray(scenario.reference.read().pos[0], float)
     else:
-        raise ScenarioError(
-            f"site: missing: {scenario.imu_file} does not give the site (a CSV file has no "
-            "header); give --lat/--lon/--height, a site section in the scenario, "
-            "initial: {lat_deg, lon_deg, height_m}, or a reference (--reference)"
-        )
+        raise no_site(scenario)
     return RunData(imu=imu, truth=truth, site=site, seed=None, earth=scenario.earth_model)
+
+
+def no_site(sc: Scenario) -> ScenarioError:
+    """The refusal of a recording run when neither the file nor the scenario gives a site."""
+    return ScenarioError(f"site: missing: {sc.imu_file} does not give the site (a CSV file has "
+                         "no header); give --lat/--lon/--height, a site section in the "
+                         "scenario, initial: {lat_deg, lon_deg, height_m}, or a reference)")
 
 
 def _simulation(scenario: Scenario):
@@ -287,28 +290,23 @@ def gather(stream: Stream) -> RunData:
     n = stream.samples
     t = np.empty(n)
     dtheta, dv = np.empty((n, 3)), np.empty((n, 3))
-    with_truth = stream.truth0 is not None
-    att, v, pos = (np.empty((n + 1, 3)) for _ in range(3)) if with_truth else (None,) * 3
-    seg = np.empty(n + 1, np.int64) if with_truth else None
     q_bs = np.empty((n, 4)) if stream.has_mechanism else None
-    if with_truth:
-        assert stream.truth0 is not None and att is not None and v is not None
-        assert pos is not None and seg is not None
-        att[0], v[0], pos[0] = stream.truth0.att[0], stream.truth0.v_n[0], stream.truth0.pos[0]
-        seg[0] = 0 if stream.truth0.segment is None else stream.truth0.segment[0]
+    truth, first = None, stream.truth0
+    if first is not None:  # the truth at sample 0, then at the end of each increment
+        seg, rows = np.empty(n + 1, np.int64), (n + 1, 3)
+        truth = Truth(np.empty(n + 1), np.empty(rows), np.empty(rows), np.empty(rows), seg)
+        truth.t[0], truth.att[0], truth.v_n[0], truth.pos[0] = (stream.t0, first.att[0],
+                                                                first.v_n[0], first.pos[0])
+        seg[0] = 0 if first.segment is None else first.segment[0]
     for b in stream.blocks():
         sl = slice(b.k0, b.k0 + len(b.t))
         t[sl], dtheta[sl], dv[sl] = b.t, b.dtheta, b.dv
-        if b.truth is not None:
+        if truth is not None and b.truth is not None:
             s1 = slice(b.k0 + 1, b.k0 + 1 + len(b.t))
-            att[s1], v[s1], pos[s1] = b.truth.att, b.truth.v_n, b.truth.pos  # type: ignore
-            seg[s1] = b.truth.segment  # type: ignore[index]
+            truth.t[s1], truth.att[s1], truth.v_n[s1] = b.t, b.truth.att, b.truth.v_n
+            truth.pos[s1], seg[s1] = b.truth.pos, b.truth.segment
         if q_bs is not None and b.q_bs is not None:
             q_bs[sl] = b.q_bs
-    truth = None
-    if with_truth:
-        assert att is not None and v is not None and pos is not None
-        truth = Truth(np.concatenate([[stream.t0], t]), att, v, pos, seg)
     if stream.header is not None:
         imu = replace(stream.header, t=t, dtheta=dtheta, dv=dv, q_bs=q_bs)
     else:

@@ -143,14 +143,8 @@ def truth_figure(t: np.ndarray, att: np.ndarray, v_n: np.ndarray,
         plot_series(axes[0], x, np.degrees(y), name)
     for j, name in enumerate(ENU):
         plot_series(axes[1], x, v_n[:, j], name)
-    axes[0].set_ylabel("attitude (deg)\npitch, roll, yaw")
-    axes[1].set_ylabel("velocity (m/s)\neast, north, up")
-    axes[1].set_xlabel(xlabel)
-    for ax in axes:
-        ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, xlabel, title, ("attitude (deg)\npitch, roll, yaw",
+                                            "velocity (m/s)\neast, north, up"))
 
 
 def imu_figure(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, ts: float,

@@ -6,7 +6,7 @@ its data come from (simulated motion or a recorded file, read and validated), th
 command's own :meth:`~gcalign.app.command.Command.check` and
 :meth:`~gcalign.app.command.Command.cost`, refusing a run with one line when a limit of
 :mod:`gcalign.limits` would be exceeded (:func:`budget`). ``gcalign validate`` calls it for
-every section of the scenario; a run calls it for its own command (:func:`checked_execute`),
+every section of the scenario; a run calls it for its own command (:func:`checked_run`),
 so both take the same decisions. Nothing here imports numba or scipy.
 """
 
@@ -26,9 +26,8 @@ from gcalign.io.scenario import Scenario
 if TYPE_CHECKING:
     from gcalign.app.data import Recording
 
-__all__ = ["Extent", "budget", "check_seed", "checked_execute", "checked_run", "extent", "load",
-           "preflight",
-           "sensor_errors", "total_runs"]
+__all__ = ["Extent", "budget", "check_seed", "checked_run", "load", "preflight", "sensor_errors",
+           "total_runs"]
 
 BATCH_DOUBLES = 30  #: per sample held by a batch variant: its noise-free run and its errors
 
@@ -46,6 +45,7 @@ def load(sc: Scenario, read_recorded: bool = True,
             if not sc.imu_file.is_file():
                 raise ScenarioError(f"imu_file: {sc.imu_file}: {not_a_file(sc.imu_file)}")
             return Inputs(sc)
+        from gcalign.app.data import no_site
         from gcalign.app.data import read_recorded as read
 
         recording = recording or read(sc)
@@ -54,20 +54,12 @@ def load(sc: Scenario, read_recorded: bool = True,
         ext = Extent(len(imu), float(imu.ts), True, recording.truth is not None, lat)
         start_pos = sc.initial is not None and sc.initial.position() is not None
         if sc.site is None and ext.lat is None and sc.reference is None and not start_pos:
-            raise ScenarioError(
-                f"site: missing: {sc.imu_file} does not give the site (a CSV file has no "
-                "header); give --lat/--lon/--height, a site section in the scenario, "
-                "initial: {lat_deg, lon_deg, height_m}, or a reference)")
+            raise no_site(sc)
         return Inputs(sc, recording, ext)
     if sc.motion is None:
         return Inputs(sc)
     ts = sc.imu.ts
     return Inputs(sc, None, Extent(int(round(sc.motion.duration() / ts)), ts, False, True))
-
-
-def extent(sc: Scenario, read_recorded: bool = True) -> Extent | None:
-    """Samples and interval of the scenario's data, or None if it has none (:func:`load`)."""
-    return load(sc, read_recorded).extent
 
 
 def preflight(sc: Scenario, name: str | None = None, read_recorded: bool = True,
@@ -191,21 +183,16 @@ def _commands_of(sc: Scenario) -> list[Command]:
                   and c.section is not None and getattr(sc, c.section, None) is not None]
 
 
-def checked_execute(name: str, sc: Scenario, seed: int | None = None, *args: Any,
-                    progress: Any = None, **options: Any) -> Outcome:
-    """Command `name`'s ``execute`` after its preflight (the checks and the cost estimate
-    ``gcalign validate`` makes), with the seed checked to lie in [0, 2^63); the summary is
-    checked to be finite. `progress` goes to a command whose ``execute`` takes it (asked
-    after the preflight: the run's modules load only for a run that will happen)."""
-    return checked_run(name, sc, seed, *args, progress=progress, **options)[0]
-
-
 def checked_run(name: str, sc: Scenario, seed: int | None = None, *args: Any,
                 progress: Any = None, recording: Recording | None = None,
                 **options: Any) -> tuple[Outcome, Inputs]:
-    """:func:`checked_execute`, and the inputs the preflight loaded and the run used (the
-    recorded file read once, for both; `recording`: as an earlier run of the same scenario
-    read it, which a batch's runs of a variant pass along)."""
+    """Command `name`'s ``execute`` after its preflight (the checks and the cost estimate
+    ``gcalign validate`` makes), with the seed checked to lie in [0, 2^63); the summary is
+    checked to be finite. `progress` goes to a command whose ``execute`` takes it (asked
+    after the preflight: the run's modules load only for a run that will happen). Returns
+    the outcome and the inputs the preflight loaded and the run used (the recorded file
+    read once, for both; `recording`: as an earlier run of the same scenario read it, which
+    a batch's runs of a variant pass along)."""
     from gcalign.io.results import finite_summary
 
     check_seed(seed)

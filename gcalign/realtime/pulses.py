@@ -35,12 +35,14 @@ class Pulses:
     """
 
     t: np.ndarray = field(metadata=stored("s", frame="pulse edge times (INS clock)",
-                                          compress=True))
+                                          compress=True, dims="P", rule="increasing"))
     k: np.ndarray = field(metadata=stored(
-        "1", frame="index of the latched solution, t_update = k / solution_hz", compress=True))
-    dt_true: np.ndarray = field(metadata=stored("s", frame="t - t_update", compress=True))
+        "1", frame="index of the latched solution, t_update = k / solution_hz", compress=True,
+        dims="P", whole=True, optional=True))
+    dt_true: np.ndarray = field(metadata=stored("s", frame="t - t_update", compress=True,
+                                                dims="P", optional=True))
     dt: np.ndarray = field(metadata=stored("s", frame="Δt as the counter measures it",
-                                           compress=True))
+                                           compress=True, dims="P", optional=True))
 
     def __len__(self) -> int:
         return len(self.t)

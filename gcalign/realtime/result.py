@@ -74,16 +74,18 @@ class CaseResult:
     pulses: Pulses = field(metadata=stored(None, inline=True))
     t_update: np.ndarray
     t_valid: np.ndarray = field(metadata=stored(
-        "s", frame="time of validity of the latched attitude", compress=True))
+        "s", frame="time of validity of the latched attitude", compress=True, dims="P",
+        optional=True))
     latched: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME + "; unwrapped",
-                                                compress=True))
+                                                compress=True, dims="P 3"))
     predicted: dict[str, np.ndarray] = field(metadata=stored(
-        "rad", frame=ATT_FRAME + "; at the pulse time (extrapolated)", compress=True))
+        "rad", frame=ATT_FRAME + "; at the pulse time (extrapolated)", compress=True,
+        dims="P 3"))
     truth: np.ndarray = field(metadata=stored("rad", frame=ATT_FRAME + "; at the pulse time",
-                                              compress=True))
+                                              compress=True, dims="P 3"))
     ins_ref: np.ndarray = field(metadata=stored(
         "rad", frame=ATT_FRAME + "; the INS's output T after the pulse (the seed's reference)",
-        compress=True))
+        compress=True, dims="P 3"))
     series: Series | None = None
 
     def error(self, predictor: str, metric: str = "truth") -> np.ndarray:

@@ -192,25 +192,28 @@ class TransferResult:
     rad/s the ω_in^n of those steps, dt (K,) s their length.
     """
 
-    t: np.ndarray = field(metadata=stored("s"))
-    x: np.ndarray = field(metadata=stored("SI", name="estimate", description=STATE_SERIES))
-    sigma: np.ndarray = field(metadata=stored("SI", description=STATE_SERIES))
+    t: np.ndarray = field(metadata=stored("s", dims="K", rule="increasing"))
+    x: np.ndarray = field(metadata=stored("SI", name="estimate", description=STATE_SERIES,
+                                          dims="K S"))
+    sigma: np.ndarray = field(metadata=stored("SI", description=STATE_SERIES, dims="K S"))
     P: np.ndarray
-    sigma0: np.ndarray = field(metadata=stored("SI"))
+    sigma0: np.ndarray = field(metadata=stored("SI", dims="S", optional=True))
     names: tuple[str, ...] = field(metadata=stored(None, attr=True, name="states"))
     bias_fed: np.ndarray = field(metadata=stored(
-        "rad/s, m/s^2", description="ε (3), ∇ (3) fed back into the compensation so far"))
+        "rad/s, m/s^2", description="ε (3), ∇ (3) fed back into the compensation so far",
+        dims="K 6", optional=True))
     nis: np.ndarray
     m: int
     q_slave: np.ndarray
     att_slave: np.ndarray = field(metadata=stored(
         "rad", name="att", frame=ATT_FRAME,
-        description="slave attitude corrected by the φ estimate"))
-    v_slave: np.ndarray = field(metadata=stored("m/s", name="v_n", frame="ENU"))
+        description="slave attitude corrected by the φ estimate", dims="K 3", optional=True))
+    v_slave: np.ndarray = field(metadata=stored("m/s", name="v_n", frame="ENU", dims="K 3",
+                                                optional=True))
     q_master: np.ndarray
     attitude_error: np.ndarray = field(metadata=stored(
         "rad", frame="ENU", description="corrected slave against master ∘ (μ + θ estimates), "
-        "misalignment φ"))
+        "misalignment φ", dims="K 3", optional=True))
     t0: float
     settings: TransferSettings
     C_nb: np.ndarray

@@ -430,7 +430,7 @@ def summaries_of_seeds(sc: Scenario, seeds: list[int],
     seed's numbers to the bit those of its own run; ``compute_s`` is the lockstep's time
     per run). A seed whose run fails has its exception in its place. For a batch: the
     noise-free simulation is shared through `cache_key`, and the caller has made the
-    preflight (:func:`gcalign.app.preflight.checked_execute`'s) for the variant."""
+    preflight (:func:`gcalign.app.preflight.checked_run`'s) for the variant."""
     from gcalign.align.lockstep import align_runs
     from gcalign.io.results import finite_summary
 

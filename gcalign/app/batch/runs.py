@@ -211,7 +211,7 @@ def run_seeds(tasks: list[dict]) -> list[dict] | None:
     keep_freed_memory()
     results: list[Any] = [None] * len(tasks)
     todo = []
-    for i, t in enumerate(tasks):  # in checked_execute's order: the seed, the preflight
+    for i, t in enumerate(tasks):  # in checked_run's order: the seed, the preflight
         try:
             check_seed(t["seed"])
             todo.append(i)
