@@ -149,20 +149,19 @@ def aiding_input(cfg: CalibrateConfig, t0: float, t_run: np.ndarray) -> AidingIn
     max_gap = cfg.max_gap_s if cfg.max_gap_s is not None else default_max_gap(fixes.t)
     outages = find_outages(fixes.t, float(t_run[0]), float(t_run[-1]), max_gap)
     inside = (main.t >= t_data[0] - _TOL) & (main.t <= t_data[-1] + _TOL)
-    end_gap = float(t_data[-1] - main.t[inside][-1])
-    if end_gap > max_gap:
-        warnings.append(f"calibrate.files.{key}: {path} ends at {main.t[inside][-1]:.3f} s, "
-                        f"{end_gap:.1f} s before the end of the run: the rest ran unaided "
-                        "(listed as an outage)")
-    start_gap = float(main.t[inside][0] - t_data[0])
-    if start_gap > max_gap:
-        warnings.append(f"calibrate.files.{key}: {path} begins at {main.t[inside][0]:.3f} s, "
-                        f"{start_gap:.1f} s after the start of the run: its first part ran "
+    first, last = float(main.t[inside][0]), float(main.t[inside][-1])
+    if t_data[-1] - last > max_gap:
+        warnings.append(f"calibrate.files.{key}: {path} ends at {last:.3f} s, "
+                        f"{t_data[-1] - last:.1f} s before the end of the run: the rest ran "
                         "unaided (listed as an outage)")
+    if first - t_data[0] > max_gap:
+        warnings.append(f"calibrate.files.{key}: {path} begins at {first:.3f} s, "
+                        f"{first - t_data[0]:.1f} s after the start of the run: its first part "
+                        "ran unaided (listed as an outage)")
     sig = None if pos is None or pos.sigma is None else pos.sigma[inside]
     info = {"path": str(path), "format": main.record.get("format"),
             "epochs": int(inside.sum()), "epochs_in_file": int(len(main.t)),
-            "first_s": float(main.t[inside][0]), "last_s": float(main.t[inside][-1]),
+            "first_s": first, "last_s": last,
             "median_interval_s": fixes.median_interval, "max_gap_s": float(max_gap),
             "max_gap_source": "calibrate.max_gap_s" if cfg.max_gap_s is not None
             else "twice the median interval",

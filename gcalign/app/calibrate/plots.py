@@ -120,6 +120,12 @@ def _panel(ax, name: str, unit: str, lim: float) -> None:
     ax.grid(True, alpha=0.3)
 
 
+def _display(attrs: dict) -> tuple[list[str], list[str], np.ndarray]:
+    """The file's state names, their display units and the factors from SI to them."""
+    return (attrs["states"].split(","), attrs["display_units"].split(","),
+            np.asarray(attrs["display_scale"]))
+
+
 def _finish(fig, axes, xlabel: str, title: str) -> Figure:
     """A 2 × 3 grid: time labels on the bottom row, one legend below the panels."""
     for ax in axes[3:]:
@@ -131,9 +137,7 @@ def _finish(fig, axes, xlabel: str, title: str) -> Figure:
 
 def estimates_figure(runs: list[ShownRun], attrs, states: list[str], title: str) -> Figure:
     """Estimates of `states` (2 rows × 3 axes) against time with ±3σ and the truth."""
-    names = attrs["states"].split(",")
-    units = attrs["display_units"].split(",")
-    scale = np.asarray(attrs["display_scale"])
+    names, units, scale = _display(attrs)
     fig, axes = new_figure(2, 3, width=12.0, height=6.0)
     for ax, name in zip(axes, states, strict=True):
         i = names.index(name)
@@ -216,9 +220,7 @@ def _plain_log_ticks(ax) -> None:
 def navigation_figure(run: CalibrationResult, attrs, title: str) -> Figure:
     """φ and δv of the corrected INS solution (estimate − truth: what the closed loop
     leaves; feed-forward: the error of the estimate) with the filter's ±3σ."""
-    names = attrs["states"].split(",")
-    units = attrs["display_units"].split(",")
-    scale = np.asarray(attrs["display_scale"])
+    names, units, scale = _display(attrs)
     assert run.truth is not None  # drawn only with truth
     fig, axes = new_figure(2, 3, width=12.0, height=6.0)
     tx, xlabel = _time_axis(run.t)
