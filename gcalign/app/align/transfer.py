@@ -31,9 +31,22 @@ SI_UNIT = {"phi": "rad", "dv": "m/s", "eb": "rad/s", "db": "m/s^2", "mu": "rad",
            "w": "rad/s"}
 
 
+#: the state groups in the filter's order, and what each is (the figures' axes)
+GROUPS = {"phi": "φ attitude error", "dv": "δv velocity error", "eb": "ε gyro bias",
+          "db": "∇ accel bias", "mu": "μ mounting misalignment", "th": "θ flexure angle",
+          "w": "ω flexure rate"}
+COLOURS = ("tab:blue", "tab:orange", "tab:green")  #: a group's three states in the figures
+
+
 def group_of(name: str) -> str:
     """The state group of a state name (``phiE`` -> ``phi``, ``dbx`` -> ``db``)."""
-    return next(g for g in ("phi", "dv", "eb", "db", "mu", "th", "w") if name.startswith(g))
+    return next(g for g in GROUPS if name.startswith(g))
+
+
+def state_groups(names) -> list[tuple[str, list[int]]]:
+    """The state groups among `names`, in the filter's order, with their states' indices."""
+    return [(gr, idx) for gr in GROUPS
+            if (idx := [i for i, n in enumerate(names) if group_of(n) == gr])]
 
 
 def display(names) -> dict[str, dict]:
@@ -333,18 +346,12 @@ def figures(f, name: str) -> dict:
     names, t, x, sig = r.names, r.t, r.x, r.sigma
     units = str(g.attrs["display_units"]).split(",")
     scale = np.asarray(g.attrs["display_scale"], dtype=float)
-    groups = [gr for gr in ("phi", "dv", "eb", "db", "mu", "th", "w")
-              if any(group_of(n) == gr for n in names)]
-    label = {"phi": "φ attitude error", "dv": "δv velocity error", "eb": "ε gyro bias",
-             "db": "∇ accel bias", "mu": "μ mounting misalignment", "th": "θ flexure angle",
-             "w": "ω flexure rate"}
+    groups = state_groups(names)
     stored = {"eb": "psins_eb0", "db": "psins_db0", "mu": "psins_mu0"}
-    colours = ("tab:blue", "tab:orange", "tab:green")
     fig, axes = new_figure(len(groups), width=9.0, height=2.2 * len(groups) + 1.2)
     ylabels = []
-    for ax, gr in zip(axes, groups, strict=True):
-        idx = [i for i, n in enumerate(names) if group_of(n) == gr]
-        for c, i in zip(colours, idx, strict=True):
+    for ax, (gr, idx) in zip(axes, groups, strict=True):
+        for c, i in zip(COLOURS, idx, strict=True):
             k = scale[i]
             ax.plot(t, x[:, i] * k, color=c, linewidth=1.0, label=names[i])
             ax.fill_between(t, (x[:, i] - sig[:, i]) * k, (x[:, i] + sig[:, i]) * k,
@@ -353,7 +360,7 @@ def figures(f, name: str) -> dict:
         has_ref = bool(key) and key in g.attrs
         if has_ref:
             ref = np.asarray(g.attrs[key], dtype=float)
-            for c, i, v in zip(colours, idx, ref, strict=True):
+            for c, i, v in zip(COLOURS, idx, ref, strict=True):
                 ax.axhline(v * scale[i], color=c, linestyle="--", linewidth=0.9,
                            label=f"PSINS {key[6:]} {names[i][-1]}")
         # the ±σ band of the first seconds spans P0: the axis shows the estimates after
@@ -366,7 +373,7 @@ def figures(f, name: str) -> dict:
         v = np.concatenate([np.ravel(a) for a in vals])
         pad = 0.1 * (np.nanmax(v) - np.nanmin(v)) + 1e-9
         ax.set_ylim(np.nanmin(v) - pad, np.nanmax(v) + pad)
-        ylabels.append(f"{label[gr]}\n({units[idx[0]]})")
+        ylabels.append(f"{GROUPS[gr]}\n({units[idx[0]]})")
     matching = g.attrs.get("matching", "")
     return {"transfer_states": finish(
         fig, axes, "time (s)",
