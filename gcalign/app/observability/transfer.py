@@ -26,20 +26,6 @@ PWCS_N = 15
 PIECE_OPS = 40.0 * PWCS_N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, QR
 
 
-def _config(sc):
-    from gcalign.io.scenario.calibrate import ObservabilityConfig
-
-    return sc.observability or ObservabilityConfig()
-
-
-def check(sc, loaded=None) -> None:
-    """The transfer run's refusals (files, variables, matching, settings, cover); `loaded`:
-    the files as the preflight read them."""
-    from gcalign.app.align import transfer
-
-    transfer.check(sc, loaded)
-
-
 def cost(sc) -> Cost:
     """One filter run (:func:`gcalign.app.align.transfer.cost`) and the PWCS pieces, at
     most one per master epoch (the bound: the files' headers give no times), each F, Φ, R
@@ -62,9 +48,10 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None,
             progress: Any = None, recording: Any = None) -> Outcome:
     """The filter's run and its table (no randomness: the seed only names the run)."""
     from gcalign.app.align.transfer import run_filter
+    from gcalign.io.scenario.calibrate import ObservabilityConfig
     from gcalign.transfer.observability import transfer_observability
 
-    cfg = _config(sc)
+    cfg = sc.observability or ObservabilityConfig()
     if progress is not None:
         progress(0, 2, f"transfer filter ({sc.align.transfer.matching})")
     result, _, _, filter_s = run_filter(sc, recording)
