@@ -14,13 +14,19 @@ PSINS ``.mat`` files are read by the recorded-data readers of that format
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from gcalign.app.command import DOUBLE, Cost, Outcome
 from gcalign.errors import ScenarioError
 from gcalign.units import ARCMIN, DPH, UG
+
+#: what :func:`load_inputs` reads: the slave's increments and times, the master, the file's
+#: stored PSINS values and the master's path
+Inputs = tuple[np.ndarray, np.ndarray, np.ndarray, Any, dict[str, np.ndarray], Path]
 
 #: display unit and the factor from SI, per state group (the table's and figures')
 DISPLAY = {"phi": ("arcmin", 1 / ARCMIN), "dv": ("m/s", 1.0), "eb": ("deg/h", 1 / DPH),
@@ -43,13 +49,13 @@ def group_of(name: str) -> str:
     return next(g for g in GROUPS if name.startswith(g))
 
 
-def state_groups(names) -> list[tuple[str, list[int]]]:
+def state_groups(names: Sequence[str]) -> list[tuple[str, list[int]]]:
     """The state groups among `names`, in the filter's order, with their states' indices."""
     return [(gr, idx) for gr in GROUPS
             if (idx := [i for i, n in enumerate(names) if group_of(n) == gr])]
 
 
-def display(names) -> dict[str, dict]:
+def display(names: Sequence[str]) -> dict[str, dict[str, Any]]:
     """Per state its SI unit, the unit the table and figures give it in and the factor from
     SI: a summary's ``units``, ``display_units`` and ``display_scale``."""
     return {"units": {n: SI_UNIT[group_of(n)] for n in names},
@@ -57,7 +63,7 @@ def display(names) -> dict[str, dict]:
             "display_scale": {n: DISPLAY[group_of(n)][1] for n in names}}
 
 
-def write_display(g, names) -> None:
+def write_display(g: Any, names: Sequence[str]) -> None:
     """The states' display units and factors from SI as attributes of the group `g`."""
     g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in names)
     g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in names])
@@ -72,7 +78,7 @@ def reference_path(sc) -> Path:
     return path if path.is_absolute() else sc.imu_file.parent / path
 
 
-def load_inputs(sc):
+def load_inputs(sc: Any) -> Inputs:
     """The slave's increments, the master series and the file's stored PSINS values
     (``eb0``, ``db0``, ``mu0`` in SI, those present), read by the recorded-data readers of
     the psins-mat format (:mod:`gcalign.io.recorded`): the slave as a recording with the
@@ -129,7 +135,7 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
     conv = r.convergence_s()
     last = r.t >= r.t[-1] - 10.0
 
-    def final_and_rms(e: np.ndarray) -> dict:  # in arcmin, the RMS over the last 10 s
+    def final_and_rms(e: np.ndarray) -> dict[str, list[float]]:  # arcmin; RMS: last 10 s
         return {"final": (e[-1] / ARCMIN).tolist(),
                 "rms_last_10s": (np.sqrt(np.mean(e[last] ** 2, axis=0)) / ARCMIN).tolist()}
 
@@ -246,7 +252,8 @@ def cost(sc, runs: int = 1) -> Cost:
                 memory_what="the inputs and every epoch's covariance")
 
 
-def run_filter(sc, recording=None) -> tuple:
+def run_filter(sc: Any, recording: Inputs | None = None
+               ) -> tuple[Any, dict[str, np.ndarray], Path, float]:
     """The filter over the slave and the master (`recording`: as the preflight read them,
     :func:`load_inputs`): its result, the file's stored PSINS values, the master's path
     and the filter's CPU time (s)."""
