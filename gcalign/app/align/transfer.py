@@ -14,13 +14,19 @@ PSINS ``.mat`` files are read by the recorded-data readers of that format
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from gcalign.app.command import DOUBLE, Cost, Outcome
 from gcalign.errors import ScenarioError
 from gcalign.units import ARCMIN, DPH, UG
+
+#: what :func:`load_inputs` reads: the slave's increments and times, the master, the file's
+#: stored PSINS values and the master's path
+Inputs = tuple[np.ndarray, np.ndarray, np.ndarray, Any, dict[str, np.ndarray], Path]
 
 #: display unit and the factor from SI, per state group (the table's and figures')
 DISPLAY = {"phi": ("arcmin", 1 / ARCMIN), "dv": ("m/s", 1.0), "eb": ("deg/h", 1 / DPH),
@@ -31,12 +37,25 @@ SI_UNIT = {"phi": "rad", "dv": "m/s", "eb": "rad/s", "db": "m/s^2", "mu": "rad",
            "w": "rad/s"}
 
 
+#: the state groups in the filter's order, and what each is (the figures' axes)
+GROUPS = {"phi": "φ attitude error", "dv": "δv velocity error", "eb": "ε gyro bias",
+          "db": "∇ accel bias", "mu": "μ mounting misalignment", "th": "θ flexure angle",
+          "w": "ω flexure rate"}
+COLOURS = ("tab:blue", "tab:orange", "tab:green")  #: a group's three states in the figures
+
+
 def group_of(name: str) -> str:
     """The state group of a state name (``phiE`` -> ``phi``, ``dbx`` -> ``db``)."""
-    return next(g for g in ("phi", "dv", "eb", "db", "mu", "th", "w") if name.startswith(g))
+    return next(g for g in GROUPS if name.startswith(g))
 
 
-def display(names) -> dict[str, dict]:
+def state_groups(names: Sequence[str]) -> list[tuple[str, list[int]]]:
+    """The state groups among `names`, in the filter's order, with their states' indices."""
+    return [(gr, idx) for gr in GROUPS
+            if (idx := [i for i, n in enumerate(names) if group_of(n) == gr])]
+
+
+def display(names: Sequence[str]) -> dict[str, dict[str, Any]]:
     """Per state its SI unit, the unit the table and figures give it in and the factor from
     SI: a summary's ``units``, ``display_units`` and ``display_scale``."""
     return {"units": {n: SI_UNIT[group_of(n)] for n in names},
@@ -44,7 +63,7 @@ def display(names) -> dict[str, dict]:
             "display_scale": {n: DISPLAY[group_of(n)][1] for n in names}}
 
 
-def write_display(g, names) -> None:
+def write_display(g: Any, names: Sequence[str]) -> None:
     """The states' display units and factors from SI as attributes of the group `g`."""
     g.attrs["display_units"] = ",".join(DISPLAY[group_of(n)][0] for n in names)
     g.attrs["display_scale"] = np.array([DISPLAY[group_of(n)][1] for n in names])
@@ -59,7 +78,7 @@ def reference_path(sc) -> Path:
     return path if path.is_absolute() else sc.imu_file.parent / path
 
 
-def load_inputs(sc):
+def load_inputs(sc: Any) -> Inputs:
     """The slave's increments, the master series and the file's stored PSINS values
     (``eb0``, ``db0``, ``mu0`` in SI, those present), read by the recorded-data readers of
     the psins-mat format (:mod:`gcalign.io.recorded`): the slave as a recording with the
@@ -116,7 +135,7 @@ def summary(sc, result, stored: dict, ref_path: Path, compute_s: float) -> dict:
     conv = r.convergence_s()
     last = r.t >= r.t[-1] - 10.0
 
-    def final_and_rms(e: np.ndarray) -> dict:  # in arcmin, the RMS over the last 10 s
+    def final_and_rms(e: np.ndarray) -> dict[str, list[float]]:  # arcmin; RMS: last 10 s
         return {"final": (e[-1] / ARCMIN).tolist(),
                 "rms_last_10s": (np.sqrt(np.mean(e[last] ** 2, axis=0)) / ARCMIN).tolist()}
 
@@ -233,7 +252,8 @@ def cost(sc, runs: int = 1) -> Cost:
                 memory_what="the inputs and every epoch's covariance")
 
 
-def run_filter(sc, recording=None) -> tuple:
+def run_filter(sc: Any, recording: Inputs | None = None
+               ) -> tuple[Any, dict[str, np.ndarray], Path, float]:
     """The filter over the slave and the master (`recording`: as the preflight read them,
     :func:`load_inputs`): its result, the file's stored PSINS values, the master's path
     and the filter's CPU time (s)."""
@@ -333,18 +353,12 @@ def figures(f, name: str) -> dict:
     names, t, x, sig = r.names, r.t, r.x, r.sigma
     units = str(g.attrs["display_units"]).split(",")
     scale = np.asarray(g.attrs["display_scale"], dtype=float)
-    groups = [gr for gr in ("phi", "dv", "eb", "db", "mu", "th", "w")
-              if any(group_of(n) == gr for n in names)]
-    label = {"phi": "φ attitude error", "dv": "δv velocity error", "eb": "ε gyro bias",
-             "db": "∇ accel bias", "mu": "μ mounting misalignment", "th": "θ flexure angle",
-             "w": "ω flexure rate"}
+    groups = state_groups(names)
     stored = {"eb": "psins_eb0", "db": "psins_db0", "mu": "psins_mu0"}
-    colours = ("tab:blue", "tab:orange", "tab:green")
     fig, axes = new_figure(len(groups), width=9.0, height=2.2 * len(groups) + 1.2)
     ylabels = []
-    for ax, gr in zip(axes, groups, strict=True):
-        idx = [i for i, n in enumerate(names) if group_of(n) == gr]
-        for c, i in zip(colours, idx, strict=True):
+    for ax, (gr, idx) in zip(axes, groups, strict=True):
+        for c, i in zip(COLOURS, idx, strict=True):
             k = scale[i]
             ax.plot(t, x[:, i] * k, color=c, linewidth=1.0, label=names[i])
             ax.fill_between(t, (x[:, i] - sig[:, i]) * k, (x[:, i] + sig[:, i]) * k,
@@ -353,7 +367,7 @@ def figures(f, name: str) -> dict:
         has_ref = bool(key) and key in g.attrs
         if has_ref:
             ref = np.asarray(g.attrs[key], dtype=float)
-            for c, i, v in zip(colours, idx, ref, strict=True):
+            for c, i, v in zip(COLOURS, idx, ref, strict=True):
                 ax.axhline(v * scale[i], color=c, linestyle="--", linewidth=0.9,
                            label=f"PSINS {key[6:]} {names[i][-1]}")
         # the ±σ band of the first seconds spans P0: the axis shows the estimates after
@@ -366,7 +380,7 @@ def figures(f, name: str) -> dict:
         v = np.concatenate([np.ravel(a) for a in vals])
         pad = 0.1 * (np.nanmax(v) - np.nanmin(v)) + 1e-9
         ax.set_ylim(np.nanmin(v) - pad, np.nanmax(v) + pad)
-        ylabels.append(f"{label[gr]}\n({units[idx[0]]})")
+        ylabels.append(f"{GROUPS[gr]}\n({units[idx[0]]})")
     matching = g.attrs.get("matching", "")
     return {"transfer_states": finish(
         fig, axes, "time (s)",

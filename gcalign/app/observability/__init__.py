@@ -71,8 +71,8 @@ class Observability(Command):
         from gcalign.io.scenario.calibrate import ObservabilityConfig
 
         (sc.observability or ObservabilityConfig()).check(sc)
-        if transfer_mode(sc):
-            from gcalign.app.observability import transfer
+        if transfer_mode(sc):  # the run's inputs: the align command's transfer check
+            from gcalign.app.align import transfer
 
             transfer.check(sc, inputs.recording)
 

@@ -18,26 +18,12 @@ from typing import Any
 
 import h5py
 
-from gcalign.app.align.transfer import DECIMALS, display, group_of, write_display
+from gcalign.app.align.transfer import DECIMALS, display, write_display
 from gcalign.app.command import DOUBLE, Cost, Outcome
 from gcalign.io.results import put
 
 PWCS_N = 15
 PIECE_OPS = 40.0 * PWCS_N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, QR
-
-
-def _config(sc):
-    from gcalign.io.scenario.calibrate import ObservabilityConfig
-
-    return sc.observability or ObservabilityConfig()
-
-
-def check(sc, loaded=None) -> None:
-    """The transfer run's refusals (files, variables, matching, settings, cover); `loaded`:
-    the files as the preflight read them."""
-    from gcalign.app.align import transfer
-
-    transfer.check(sc, loaded)
 
 
 def cost(sc) -> Cost:
@@ -62,9 +48,10 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None,
             progress: Any = None, recording: Any = None) -> Outcome:
     """The filter's run and its table (no randomness: the seed only names the run)."""
     from gcalign.app.align.transfer import run_filter
+    from gcalign.io.scenario.calibrate import ObservabilityConfig
     from gcalign.transfer.observability import transfer_observability
 
-    cfg = _config(sc)
+    cfg = sc.observability or ObservabilityConfig()
     if progress is not None:
         progress(0, 2, f"transfer filter ({sc.align.transfer.matching})")
     result, _, _, filter_s = run_filter(sc, recording)
@@ -199,6 +186,7 @@ def table(s: dict):
 def figures(f, name: str) -> dict:
     """The cumulative degree η per window (heat map, windows × 15 states), the covariance
     degree σ0/σ likewise (all states), and σ/σ0 against time per state group."""
+    from gcalign.app.align.transfer import COLOURS, GROUPS, state_groups
     from gcalign.app.observability.plots import heat_map
     from gcalign.app.plots import finish, new_figure
     from gcalign.io.stored import read_fields
@@ -219,15 +207,11 @@ def figures(f, name: str) -> dict:
             "log10 σ(0)/σ(t)", exponents=False),
     }
     t, sig, sig0 = g["t"][()], g["sigma"][()], obs.sigma0
-    groups = [gr for gr in ("phi", "dv", "eb", "db", "mu", "th", "w")
-              if any(group_of(n) == gr for n in cov_states)]
-    label = {"phi": "φ", "dv": "δv", "eb": "ε", "db": "∇", "mu": "μ", "th": "θ", "w": "ω"}
+    groups = state_groups(cov_states)
     fig, axes = new_figure(len(groups), width=9.0, height=1.6 * len(groups) + 1.2)
-    colours = ("tab:blue", "tab:orange", "tab:green")
-    for ax, gr in zip(axes, groups, strict=True):
-        idx = [i for i, n in enumerate(cov_states) if group_of(n) == gr]
+    for ax, (_, idx) in zip(axes, groups, strict=True):
         ratio = sig[:, idx] / sig0[idx]
-        for c, i, y in zip(colours, idx, ratio.T, strict=True):
+        for c, i, y in zip(COLOURS, idx, ratio.T, strict=True):
             ax.plot(t, y, color=c, linewidth=1.0, label=cov_states[i])
         if ratio.max() > 10 * ratio.min():  # decades: log; within one, linear reads better
             ax.set_yscale("log")
@@ -235,5 +219,5 @@ def figures(f, name: str) -> dict:
     figs["sigma_reduction"] = finish(
         fig, axes, "time from the start of the run (s)",
         f"{name}: the filter's σ / σ0 ({how}); 1 = nothing learnt",
-        [f"{label[gr]} σ/σ0" for gr in groups])
+        [f"{GROUPS[gr].split()[0]} σ/σ0" for gr, _ in groups])  # its symbol
     return figs
