@@ -208,6 +208,14 @@ def test_bad_options_exit_2(tmp_path, args, field, more):
         ({"northfind": {"azimuth_deg": 48}}, "northfind.sweep", ("not both",)),
         ({"northfind": {"sweep": None}}, "northfind.azimuth_deg", ("missing",)),
         ({"northfind": {"tilt_degrees": 5}}, "northfind.tilt_degrees", ("unknown key",)),
+        # sensor terms the north-finder does not model are refused, never silently dropped
+        ({"imu": {"gyro": {"bias_gm": {"std_dph": 0.01, "tau_s": 300}}}}, "imu.gyro.bias_gm",
+         ("not modelled", "allowed: none", "'std_dph'")),
+        ({"imu": {"gyro": {"bias_instability_dph": 0.01}}}, "imu.gyro.bias_instability_dph",
+         ("allowed: 0", "got [0.01, 0.01, 0.01]")),
+        ({"imu": {"accel": {"bias_rw_ughrh": [1, 1, 1]}}}, "imu.accel.bias_rw_ughrh",
+         ("allowed: 0", "got [1.0, 1.0, 1.0]")),
+        ({"imu": {"gyro": {"asym_ppm": [0, 5, 0]}}}, "imu.gyro.asym_ppm", ("allowed: 0",)),
     ],
 )
 def test_bad_scenario_exit_2(tmp_path, change, field, more):

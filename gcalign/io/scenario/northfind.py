@@ -40,8 +40,9 @@ Rules
   z-axis values are unused. A constant bias cancels (it is the R of seed eq. 4); the
   scatter of the azimuth comes from the white noise, whose dwell mean has the standard
   deviation ``arw/√dwell`` (gyro) and ``vrw/√dwell`` (accelerometers). Terms the
-  north-finder model does not have (misalignment, quantisation, accelerometer scale) must
-  be zero: a non-zero value is an error rather than silently ignored.
+  north-finder model does not have (misalignment, quantisation, accelerometer scale,
+  asymmetry, bias instability, random walks and Gauss–Markov processes, :data:`UNMODELLED`)
+  must be zero or absent: a non-zero value is an error rather than silently ignored.
 
 Converted once to :class:`gcalign.northfind.NorthfindSetup` (SI, radians) by
 :meth:`NorthfindConfig.to_setup`.
@@ -52,7 +53,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
-from pydantic import Field, field_validator, model_validator
+from pydantic import BaseModel, Field, field_validator, model_validator
 
 from gcalign import limits
 from gcalign import units as u
@@ -67,6 +68,15 @@ MethodName = Literal["coordinate", "vector", "naive", "none", "vector_literal"]
 DEFAULT_METHODS: list[MethodName] = ["coordinate", "vector", "naive", "none"]
 MAX_AZIMUTHS = 100_000
 _TOL = 1e-9
+
+
+#: the IMU keys the north-finder's sensor model has no place for (it simulates one in-plane
+#: gyro and two accelerometers with bias, scale factor and white noise): refused unless zero
+UNMODELLED = tuple(f"{s}.{k}" for s, keys in (
+    ("gyro", ("misalignment_arcsec", "quantum_arcsec", "asym_ppm", "bias_gm", "bias_rw_dphrh",
+              "scale_gm", "bias_instability_dph")),
+    ("accel", ("misalignment_arcsec", "scale_ppm", "quantum_ugs", "asym_ppm", "bias_gm",
+               "bias_rw_ughrh", "scale_gm", "bias_instability_ug"))) for k in keys)
 
 
 def _fmt(x: float) -> str:
@@ -216,15 +226,16 @@ class NorthfindConfig(Model):
         if vrw[0] != vrw[1]:
             raise ScenarioError(f"imu.accel.vrw_ugrhz: the north-finder's x and y accelerometers "
                                 f"share one noise density; x and y must be equal, got {vrw}")
-        for key in ("gyro.misalignment_arcsec", "gyro.quantum_arcsec",
-                    "accel.misalignment_arcsec", "accel.scale_ppm", "accel.quantum_ugs"):
+        for key in UNMODELLED:
             sensor, name = key.split(".")
             value = getattr(getattr(sc.imu, sensor), name)
             used = per_axis(value)[:2] if name == "scale_ppm" else value  # x and y only
-            if used is not None and np.any(np.asarray(used, float) != 0):
+            process = isinstance(value, BaseModel)  # a Gauss-Markov process is set
+            if process or (used is not None and np.any(np.asarray(used, float) != 0)):
                 raise ScenarioError(f"imu.{key}: not modelled by the north-finder (one in-plane "
                                     "gyro, two accelerometers with bias and white noise); "
-                                    f"allowed: 0, got {value}")
+                                    f"allowed: {'none' if process else 0}, got "
+                                    f"{value.model_dump() if process else value}")
 
     def to_setup(self, sc) -> NorthfindSetup:
         """The SI setup for :func:`gcalign.northfind.run_northfind` (runs :meth:`check`)."""
