@@ -369,9 +369,7 @@ def previous_records(sweep: Sweep, output: Path, log=None) -> tuple[dict, str]:
     """Finished runs of an earlier batch into `output` that this sweep still contains:
     from the journal, else from the HDF5 file. Failed runs are not kept (they run again),
     nor records that are damaged or hold metrics that are not finite."""
-    jpath = journal_path(output)
-    if jpath.exists() and not jpath.is_file():
-        raise ScenarioError(f"{jpath}: not a regular file (the journal of {output})")
+    jpath = journal_path(output)  # (a journal that is not a file is refused by run_batch)
     if jpath.is_file():
         recs, where = read_journal(jpath, sweep.metrics, log), str(jpath)
     elif Path(output).is_file():
