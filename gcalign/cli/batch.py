@@ -7,6 +7,7 @@ failed or the cluster is unreachable, 2 bad sweep, 130 interrupted).
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 
@@ -176,31 +177,18 @@ def batch(
         sys.stderr.write(f"warning: {line}\n")
 
     bar = _progress_bar(bar_label(sw))
-    task = None
 
     def progress(done: int, total: int, failed: int) -> None:
-        nonlocal task
-        if bar is None:
-            return
-        if task is None:
-            task = bar.add_task("runs", total=total, completed=done, failed="")
-        bar.update(task, completed=done, failed=f"[red]{failed} failed" if failed else "")
+        assert bar is not None
+        if not bar.task_ids:
+            bar.add_task("runs", total=total, completed=done, failed="")
+        bar.update(bar.task_ids[0], completed=done,
+                   failed=f"[red]{failed} failed" if failed else "")
 
-    if bar is not None:
-        bar.start()
-    try:
-        result = run_batch(
-            sw,
-            out,
-            workers=workers,
-            scheduler=scheduler,
-            resume=resume,
-            progress=progress,
-            log=lambda msg: err.print(f"[dim]{msg}[/dim]", soft_wrap=True),
-        )
-    finally:
-        if bar is not None:
-            bar.stop()
+    with bar or contextlib.nullcontext():
+        result = run_batch(sw, out, workers=workers, scheduler=scheduler, resume=resume,
+                           progress=progress if bar else None,
+                           log=lambda msg: err.print(f"[dim]{msg}[/dim]", soft_wrap=True))
     summary = result.summary
     sys.stderr.write(f"wrote {out}\n")
     consoles(as_json).print(COMMAND.table(summary))

@@ -323,9 +323,3 @@ def dask_workers(address: str, command: str, timeout: float = SCHEDULER_TIMEOUT_
                    f"Dask scheduler {address}, {len(nthreads)} worker(s)", check=check,
                    stop=stop)
 
-
-def make_backend(command: str, workers: int | None = None,
-                 scheduler: str | None = None) -> Workers:
-    if scheduler is not None:
-        return dask_workers(check_address(scheduler), command)
-    return local_workers(workers or os.cpu_count() or 1, command)

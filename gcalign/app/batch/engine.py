@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from gcalign.app.batch.aggregate import batch_summary
-from gcalign.app.batch.backends import WorkerLost, make_backend
+from gcalign.app.batch.backends import WorkerLost, check_address, dask_workers, local_workers
 from gcalign.app.batch.store import (
     Journal,
     OutputLock,
@@ -52,14 +52,11 @@ Progress = Callable[[int, int, int], None]  # (finished, total, failed)
 
 
 def _tasks(sweep: Sweep, keys: list[tuple[int, int]]) -> list[dict]:
-    by_index = {v.index: v for v in sweep.variants}
-    out = []
-    for vi, seed in keys:
-        v = by_index[vi]
-        out.append({"command": sweep.command, "variant": vi, "vkey": v.key, "seed": seed,
-                    "scenario": v.scenario, "source": f"{sweep.source}: variant {v.label}",
-                    "metrics": list(sweep.metrics)})
-    return out
+    variants = {v.index: v for v in sweep.variants}
+    return [{"command": sweep.command, "variant": vi, "vkey": variants[vi].key, "seed": seed,
+             "scenario": variants[vi].scenario,
+             "source": f"{sweep.source}: variant {variants[vi].label}",
+             "metrics": list(sweep.metrics)} for vi, seed in keys]
 
 
 def _chunks(tasks: list[dict], workers: int, size: int | None) -> list[list[dict]]:
@@ -89,8 +86,6 @@ def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
     from gcalign.io.results import check_output, clean_stale_temps
 
     if scheduler is not None:  # "" is refused too: it ran locally in silence
-        from gcalign.app.batch.backends import check_address
-
         scheduler = check_address(scheduler)
     output = check_output(output)
     jpath = journal_path(output)
@@ -114,12 +109,13 @@ def run_batch(sweep: Sweep, output: Path, *, workers: int | None = None,
             else:
                 notes.append(f"nothing to resume at {output}: starting afresh")
         todo = [k for k in keys if k not in records]
-        budget_check(sweep, n_workers if not scheduler else 1)
+        budget_check(sweep, n_workers)
 
         # Connect before touching the journal: an unreachable scheduler loses nothing, and
         # a new batch leaves no file behind.
         if backend is None and todo:
-            backend = make_backend(sweep.command, min(n_workers, len(todo)), scheduler)
+            backend = (dask_workers(scheduler, sweep.command) if scheduler else
+                       local_workers(min(n_workers, len(todo)), sweep.command))
         for note in notes:
             log(note)
         if not resume and jpath.is_file():

@@ -17,20 +17,14 @@ from matplotlib.figure import Figure
 
 from gcalign.app.batch.aggregate import metric_label, metric_units
 from gcalign.app.batch.sweep import CASE_KEY, FILE_KEY
+from gcalign.app.batch.tables import short_keys, written
 from gcalign.app.plots import _s, angle_scale, legend_below, new_figure, suptitle
-
-
-def _short_keys(keys: list[str]) -> dict[str, str]:
-    """The last part of each dotted key where it is unique (``t_z_s``), else the key."""
-    tails = [k.rsplit(".", 1)[-1] for k in keys]
-    return {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
 
 
 def _pairs(overrides: dict, keys: list[str], sep: str) -> str:
     """``key=value`` of the given override keys, short key names, floats as ``%g``."""
-    short = _short_keys(keys)
-    return sep.join(f"{short[k]}={overrides[k]:g}" if isinstance(overrides[k], float) else
-                    f"{short[k]}={overrides[k]}" for k in keys if k in overrides)
+    short = short_keys(keys)
+    return sep.join(f"{short[k]}={written(overrides[k])}" for k in keys if k in overrides)
 
 
 def _variant_label(overrides: dict, grid_keys: list[str]) -> str:
@@ -228,7 +222,7 @@ def figures(f, name: str) -> dict[str, Figure]:
     overrides = [v["overrides"] for v in summary["variants"]]
     labels = [_variant_label(o, grid_keys) for o in overrides]
     x_keys = numeric_axes(grid)
-    short = _short_keys(x_keys)
+    short = short_keys(x_keys)
     for m in summary["metrics"]:
         st = next((v["stats"].get(m) for v in summary["variants"]
                    if v["stats"].get(m, {}).get("components")), None) or {}

@@ -332,7 +332,7 @@ def write_batch_h5(output: Path, sweep: Sweep, records: dict, summary: dict) -> 
                         arr[i, : len(v)] = v
                 mg.attrs[m + ".length"] = k
             else:
-                arr = np.array([np.nan if v is None else v for v in vals], dtype=float)
+                arr = np.array(vals, dtype=float)  # (None as NaN)
             ds = results.put(mg, m, arr, metric_units(m))
             comps = components(sweep.command, m, arr.shape[1] if arr.ndim == 2 else None)
             if comps:
@@ -351,13 +351,8 @@ def write_batch_h5(output: Path, sweep: Sweep, records: dict, summary: dict) -> 
                 mg.attrs["n"] = st["n"]
                 if st.get("components"):
                     mg.attrs["components"] = ", ".join(st["components"])
-                for s in STATS:
-                    val = st[s]
-                    if val is None:
-                        val = np.nan
-                    results.put(mg, s, np.array(val, dtype=float) if not isinstance(val, list)
-                                else np.array([np.nan if x is None else x for x in val]),
-                                metric_units(m))
+                for s in STATS:  # (None, in a list too, as NaN)
+                    results.put(mg, s, np.array(st[s], dtype=float), metric_units(m))
 
 
 def _attr(value):
@@ -374,9 +369,7 @@ def previous_records(sweep: Sweep, output: Path, log=None) -> tuple[dict, str]:
     """Finished runs of an earlier batch into `output` that this sweep still contains:
     from the journal, else from the HDF5 file. Failed runs are not kept (they run again),
     nor records that are damaged or hold metrics that are not finite."""
-    jpath = journal_path(output)
-    if jpath.exists() and not jpath.is_file():
-        raise ScenarioError(f"{jpath}: not a regular file (the journal of {output})")
+    jpath = journal_path(output)  # (a journal that is not a file is refused by run_batch)
     if jpath.is_file():
         recs, where = read_journal(jpath, sweep.metrics, log), str(jpath)
     elif Path(output).is_file():

@@ -15,12 +15,12 @@ variants are not masked by different noise.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import hashlib
 import itertools
 import json
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -45,7 +45,7 @@ SWEEP_KEYS = ("name", "base", "command", "cases", "grid", "seeds", "seed_start",
 CASE_KEY = "case"  # the pseudo grid key of a variant's case (not a scenario key)
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Variant:
     """One grid point: its overrides (dotted key -> value; ``case`` -> the case's name when
     the sweep has cases) and the resulting scenario."""
@@ -62,7 +62,7 @@ class Variant:
         return ", ".join(f"{k}={_short(v)}" for k, v in self.overrides.items())
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Sweep:
     """A validated sweep: every variant's scenario has passed ``parse_scenario``."""
 
@@ -460,17 +460,14 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
                                 "command": command, "seeds": seeds, "seed_start": seed_start,
                                 "metrics": spec["metrics"]}, "batch")
     variants, unused = [], {}
-    for i, (label, data) in enumerate(zip(labels, datas, strict=True)):
-        where = f"{paths[i]}"
-        unused.update(dict.fromkeys(
-            f"{where}: {line}"
-            for line in _check_section(parse_scenario(copy.deepcopy(data), where), command,
-                                       where)))
+    for i, (path, label, data) in enumerate(zip(paths, labels, datas, strict=True)):
+        lines = _check_section(parse_scenario(copy.deepcopy(data), str(path)), command,
+                               str(path))
+        unused.update(dict.fromkeys(f"{path}: {line}" for line in lines))
         variants.append(Variant(i, {FILE_KEY: label}, data,
                                 _hash(command, list(sweep.metrics), data)))
-    base_text = "".join(f"# --- {p}\n{t}\n" for p, t in zip(paths, texts, strict=True))
-    return Sweep(name=name, command=command, source="batch of " + ", ".join(map(str, paths)),
-                 text=yaml.safe_dump(spec, sort_keys=False), base_source=", ".join(
-                     map(str, paths)), base_text=base_text, grid={FILE_KEY: labels}, cases={},
-                 seeds=sweep.seeds, seed_start=sweep.seed_start, metrics=sweep.metrics,
-                 variants=tuple(variants), warnings=tuple(unused))
+    return dataclasses.replace(
+        sweep, source="batch of " + ", ".join(map(str, paths)),
+        text=yaml.safe_dump(spec, sort_keys=False), base_source=", ".join(map(str, paths)),
+        base_text="".join(f"# --- {p}\n{t}\n" for p, t in zip(paths, texts, strict=True)),
+        grid={FILE_KEY: labels}, variants=tuple(variants), warnings=tuple(unused))

@@ -20,8 +20,15 @@ STATS = (("mean", "mean"), ("std", "std"), ("RMS", "rms"), ("median", "median"),
 NAME_WIDTH = 28
 
 
-def _plain(x) -> str:  # an override value as the user wrote it (150, 0.5, full-cycle)
+def written(x) -> str:
+    """An override value as the user wrote it (150, 0.5, full-cycle)."""
     return x if isinstance(x, str) else f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def short_keys(keys: list[str]) -> dict[str, str]:
+    """The last part of each dotted key where it is unique (``t_z_s``), else the key."""
+    tails = [k.rsplit(".", 1)[-1] for k in keys]
+    return {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
 
 
 def _file_label(name: str) -> str:
@@ -38,12 +45,10 @@ def _file_label(name: str) -> str:
 
 def _names(s: dict) -> list[str]:
     """Each variant's overrides, one per line (a batch of files: the file name alone)."""
-    keys = list(s.get("grid") or {})
-    tails = [k.rsplit(".", 1)[-1] for k in keys]
-    short = {k: (t if tails.count(t) == 1 else k) for k, t in zip(keys, tails, strict=True)}
+    short = short_keys(list(s.get("grid") or {}))
     out = []
     for v in s["variants"]:
-        lines = [_file_label(_plain(x)) if k == "scenario" else f"{short.get(k, k)}={_plain(x)}"
+        lines = [_file_label(written(x)) if k == "scenario" else f"{short.get(k, k)}={written(x)}"
                  for k, x in v["overrides"].items()]
         name = "\n".join(lines) or "base"
         if v["failed"]:
