@@ -454,6 +454,21 @@ def test_batch_over_a_plain_list_of_scenario_files(tmp_path):
     assert bad.exit_code == 2 and "--command: applies to a list of scenario files" in bad.stderr
 
 
+@pytest.mark.parametrize("first", [True, False])
+def test_a_file_of_a_batch_that_fails_its_checks_is_named(tmp_path, first):
+    """Whichever place it has in the list, the file is named, not 'grid: variant'."""
+    good, bad = small_align(tmp_path, mode="conventional"), tmp_path / "late.yaml"
+    d = yaml.safe_load(good.read_text())
+    d["align"]["t2_s"] = d["motion"]["duration_s"] + 100
+    d["align"]["t3_s"] = d["align"]["t2_s"] + 10
+    bad.write_text(yaml.safe_dump(d))
+    files = [bad, good] if first else [good, bad]
+    out = tmp_path / "b.h5"
+    res = runner.invoke(app, ["batch", *map(str, files), "-o", str(out)])
+    assert res.exit_code == 2 and not out.exists(), res.output
+    assert res.stderr.startswith(f"error: {bad}: align.t2_s: ") and "grid" not in res.stderr
+
+
 def test_top_help_names_each_seed_once():
     """The seeds come from the commands' help lines, whatever follows their '(seed N)'."""
     res = runner.invoke(app, ["--help"], prog_name="gcalign", env={"COLUMNS": "200"})

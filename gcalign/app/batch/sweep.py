@@ -423,7 +423,7 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
     if not paths:
         raise ScenarioError("batch: give a sweep file or one or more scenario files")
     paths = [Path(p) for p in paths]
-    datas, texts = [], []
+    datas, models, texts = [], [], []
     for path in paths:
         data = read_yaml(path)
         if isinstance(data, dict) and "base" in data:
@@ -433,8 +433,9 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
         model = parse_scenario(copy.deepcopy(data), str(path))
         if sets and isinstance(data, dict):
             apply_sets(data, sets, model)
-            parse_scenario(copy.deepcopy(data), str(path))
+            model = parse_scenario(copy.deepcopy(data), str(path))
         datas.append(data)
+        models.append(model)
         texts.append(path.read_text(encoding="utf-8"))
     if command is None:
         found = {c for d in datas for c in batchable() if isinstance(d, dict) and c in d}
@@ -455,17 +456,16 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
         spec["set"] = dict(sets)
     stems = [p.name.split(".")[0] for p in paths]
     name = "+".join(stems) if len(stems) <= 3 else f"{stems[0]}+{len(stems) - 1}-more"
+    unused: dict[str, None] = {}
+    for path, model in zip(paths, models, strict=True):  # each file refused by its own name
+        unused.update(dict.fromkeys(f"{path}: {line}"
+                                    for line in _check_section(model, command, str(path))))
     # The checks of seeds, seed_start and metrics are the sweep's (one variant: file 1).
     sweep = sweep_from_mapping({"name": name, "base": copy.deepcopy(datas[0]),
                                 "command": command, "seeds": seeds, "seed_start": seed_start,
                                 "metrics": spec["metrics"]}, "batch")
-    variants, unused = [], {}
-    for i, (path, label, data) in enumerate(zip(paths, labels, datas, strict=True)):
-        lines = _check_section(parse_scenario(copy.deepcopy(data), str(path)), command,
-                               str(path))
-        unused.update(dict.fromkeys(f"{path}: {line}" for line in lines))
-        variants.append(Variant(i, {FILE_KEY: label}, data,
-                                _hash(command, list(sweep.metrics), data)))
+    variants = [Variant(i, {FILE_KEY: label}, data, _hash(command, list(sweep.metrics), data))
+                for i, (label, data) in enumerate(zip(labels, datas, strict=True))]
     return dataclasses.replace(
         sweep, source="batch of " + ", ".join(map(str, paths)),
         text=yaml.safe_dump(spec, sort_keys=False), base_source=", ".join(map(str, paths)),
