@@ -105,10 +105,7 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
     """The dataclass `cls` from the group `g` as :func:`write_fields` wrote it; `given` fills
     fields the file does not hold; a field it cannot hold (not stored, no default) is None.
     A field stored as a flag comes back as bool, one stored as names as a tuple of str."""
-    values: dict[str, Any] = {
-        f.name: None for f in dataclasses.fields(cls)  # type: ignore[arg-type]
-        if spec(f) is None and f.init and f.default is dataclasses.MISSING
-        and f.default_factory is dataclasses.MISSING}
+    values: dict[str, Any] = {}
     for f, how, kind, inner in _stored_fields(cls):  # type: ignore[arg-type]
         if f.name in given or not f.init:
             continue
@@ -136,9 +133,10 @@ def read_fields(g: h5py.Group, cls: type[T], **given: Any) -> T:
                                        for x in g[name][()])
             else:
                 values[f.name] = _get(g[name], how)
-        if f.name not in values and f.default is dataclasses.MISSING and \
+    for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+        if f.init and f.name not in values and f.default is dataclasses.MISSING and \
                 f.default_factory is dataclasses.MISSING:
-            values[f.name] = None  # not in the file (an optional series the run did not make)
+            values[f.name] = None  # not in the file (an optional series), or not stored
     return cls(**(values | given))
 
 

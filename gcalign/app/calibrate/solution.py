@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gcalign.calibrate.fixes import Outage, inside
-from gcalign.estimation.calibration import Errors as Series
+from gcalign.estimation.calibration import Errors as ErrorSeries
 from gcalign.io.recorded.reference import Reference, reference_at
 from gcalign.nav.earth import EarthModel
 from gcalign.nav.navigate import position_error_enu
@@ -193,12 +193,12 @@ def add_split(stats: dict[str, ErrorStats], ok: np.ndarray, out: np.ndarray,
 def epoch_errors(errors: Errors, t: np.ndarray, t0: float, index: np.ndarray | None,
                  att: np.ndarray, v_n: np.ndarray, pos: np.ndarray,
                  outages: tuple[Outage, ...], what: str = "", tol: float = 1e-9
-                 ) -> tuple[dict[str, dict | None], Series]:
+                 ) -> tuple[dict[str, dict | None], ErrorSeries]:
     """A solution at the filter epochs (the forward filter's or the smoother's) against
     the truth or the reference (:meth:`Errors.of`, `tol`): its statistics inside and
     outside the outages, and the errors themselves at the epochs compared, as the results
     file keeps them (`what` they are the errors of)."""
     ok, err = errors.of(index, t + t0, att, v_n, pos, tol)
     stats = add_split({k: ErrorStats() for k in SPLIT}, ok, inside(t, outages), err)
-    return ({k: s.summary() for k, s in stats.items()}, Series(
+    return ({k: s.summary() for k, s in stats.items()}, ErrorSeries(
         what, t[ok], err["attitude"][ok], err["velocity"][ok], err["position"][ok]))

@@ -40,16 +40,15 @@ def resolved_rows(sc: Scenario, imu=None) -> list[tuple[str, str, str]]:
         imu, err = sc.imu, sc.imu.errors()
         rows += [("imu.rate_hz", _v(imu.rate_hz) + " Hz", _v(imu.ts) + " s"),
                  ("imu.seed", str(imu.seed), "")]
-        for key, unit, si, si_unit in (
-                ("gyro.bias_dph", "°/h", err.gyro.bias, " rad/s"),
-                ("gyro.arw_dprh", "°/√h", err.gyro.noise, " rad/√s"),
-                ("gyro.scale_ppm", "ppm", err.gyro.scale, ""),
-                ("accel.bias_ug", "µg", err.accel.bias, " m/s²"),
-                ("accel.vrw_ugrhz", "µg/√Hz", err.accel.noise, " m/s/√s"),
-                ("accel.scale_ppm", "ppm", err.accel.scale, "")):
-            sensor, name = key.split(".")
-            rows.append((f"imu.{key}", f"{_v(getattr(getattr(imu, sensor), name))} {unit}",
-                         _v(si) + si_unit))
+        g, a = imu.gyro, imu.accel
+        for key, value, unit, si, si_unit in (
+                ("gyro.bias_dph", g.bias_dph, "°/h", err.gyro.bias, " rad/s"),
+                ("gyro.arw_dprh", g.arw_dprh, "°/√h", err.gyro.noise, " rad/√s"),
+                ("gyro.scale_ppm", g.scale_ppm, "ppm", err.gyro.scale, ""),
+                ("accel.bias_ug", a.bias_ug, "µg", err.accel.bias, " m/s²"),
+                ("accel.vrw_ugrhz", a.vrw_ugrhz, "µg/√Hz", err.accel.noise, " m/s/√s"),
+                ("accel.scale_ppm", a.scale_ppm, "ppm", err.accel.scale, "")):
+            rows.append((f"imu.{key}", f"{_v(value)} {unit}", _v(si) + si_unit))
         for name, sensor, m in (("gyro", imu.gyro, err.gyro), ("accel", imu.accel, err.accel)):
             if sensor.misalignment_arcsec is not None:
                 rows.append((f"imu.{name}.misalignment_arcsec",
