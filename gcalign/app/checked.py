@@ -164,8 +164,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
             names=(("S", "calibrate", "states"), ("m", ".", "measure_names"))),
         TRUTH, REFERENCE),
     "observability": (
-        Block("observability", {**from_fields(ObservabilityTable), "t0": times("Q"),
-                                 "t1": times("Q")},
+        Block("observability", from_fields(ObservabilityTable),
             # a transfer run's σ tables span its filter's states, the others the PWCS ones
             names=(("S", ".", "states"), ("C", ".", "covariance_states|states"))),
         TRUTH),
