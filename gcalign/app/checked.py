@@ -36,6 +36,7 @@ from gcalign.estimation.degrees import ObservabilityTable
 from gcalign.io import results
 from gcalign.modulate.analysis import SchemeAnalysis
 from gcalign.modulate.linear import LinearSeries
+from gcalign.nav.rows import NavRows
 from gcalign.northfind.run import NorthfindResult
 from gcalign.realtime.filters import ChainResponse
 from gcalign.realtime.result import CaseResult
@@ -131,8 +132,7 @@ TRUTH = Block("truth", {**from_fields(Truth), "segment_names?": text(("G",)),
 REFERENCE = Block("reference", {"t": times("N"), "att": V3, "component*?": INDEX})
 IMU = Block("imu", {"t": times("N"), "dtheta": V3, "dv": V3,
                     "q_bs?": num(("N", 4), rule="unit"), "component*?": INDEX})
-NAVIGATION = {"t": times("N"), "att?": V3, "v_n?": V3, "pos?": V3, "error/att?": V3,
-              "error/v_n?": V3, "error/pos?": V3, "error/phi?": V3, "component*?": INDEX}
+NAVIGATION = {**from_fields(NavRows), "component*?": INDEX}
 
 SCHEMAS: dict[str, tuple[Block, ...]] = {
     "simulate": (TRUTH, IMU),
@@ -164,8 +164,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
             names=(("S", "calibrate", "states"), ("m", ".", "measure_names"))),
         TRUTH, REFERENCE),
     "observability": (
-        Block("observability", {**from_fields(ObservabilityTable), "t0": times("Q"),
-                                 "t1": times("Q")},
+        Block("observability", from_fields(ObservabilityTable),
             # a transfer run's σ tables span its filter's states, the others the PWCS ones
             names=(("S", ".", "states"), ("C", ".", "covariance_states|states"))),
         TRUTH),

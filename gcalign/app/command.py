@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 from gcalign.errors import ScenarioError
 
 if TYPE_CHECKING:
-    from gcalign.app.data import Recording
+    from gcalign.app.data import Recording, Stream
     from gcalign.io.scenario import Scenario
 
 #: The id of the process that runs one command and ends, set by the command line's ``main``
@@ -245,8 +245,9 @@ def builtin_text(name: str) -> str:
     return resources.files("gcalign.scenarios").joinpath(name).read_text(encoding="utf-8")
 
 
-def stride(sc: Scenario, ext: Extent) -> int:
-    """Samples per stored row (``output.rate_hz``); ScenarioError naming the field."""
+def stride(sc: Scenario, ext: Extent | Stream) -> int:
+    """Samples per stored row (``output.rate_hz``) of the data `ext` (its extent, or the
+    stream itself); ScenarioError naming the field."""
 
     try:
         return sc.output.stride(1.0 / ext.ts, ext.samples * ext.ts)

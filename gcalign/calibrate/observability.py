@@ -124,4 +124,5 @@ def observability_table(truth: Trajectory, segments: tuple[Span, ...], measure: 
         tom_rank=tab.tom_rank, null_residual=tab.null_residual,
         condition=tab.null_residual <= null_tol, eta_cum=tab.eta_cum, rank_cum=tab.rank_cum,
         tom_rank_cum=tab.tom_rank_cum, cov_degree=cov, cov_degree_segment=cov_seg,
+        t0=np.array([sp.start for sp in segments]), t1=np.array([sp.end for sp in segments]),
         margin=tab.margin, margin_cum=tab.margin_cum)

@@ -28,6 +28,7 @@ class ObservabilityTable:
         cumulative (:attr:`gcalign.estimation.observability.Degree.margin`).
     cov_degree : (S, 21) σ_k(0)/σ_k(t_end); cov_degree_segment : σ_k(t_start)/σ_k(t_end);
         None without the covariance run.
+    t0, t1 : (S,) each segment's start and end, s.
     """
 
     segments: tuple[str, ...] = field(metadata=stored(None, name="segment_name", dims="Q"))
@@ -56,6 +57,8 @@ class ObservabilityTable:
     cov_degree_segment: np.ndarray | None = field(metadata=stored(
         "1", shape=DEGREE, description="sigma(t_start)/sigma(t_end)", dims="Q C",
         optional=True))
+    t0: np.ndarray | None = field(default=None, metadata=stored("s", dims="Q", rule="increasing"))
+    t1: np.ndarray | None = field(default=None, metadata=stored("s", dims="Q", rule="increasing"))
     margin: np.ndarray = field(default_factory=lambda: np.zeros(0))
     margin_cum: np.ndarray = field(default_factory=lambda: np.zeros(0))
     names: tuple[str, ...] = field(default=ie.STATE_NAMES,

@@ -62,13 +62,29 @@ def write_fields(g: h5py.Group, result: Any, outer: Any = None) -> None:
             _put(g, name, value, _filled(how, result, outer))
 
 
+def columns(result: Any, outer: Any = None, under: str = "") -> dict[str, tuple[Any, Stored]]:
+    """The stored arrays of the dataclass `result` by their path in its group (those of a
+    result it holds under its name), each with how it is stored, its texts filled as
+    :func:`write_fields` fills them: the columns of rows written block by block
+    (:class:`gcalign.io.results.Series`)."""
+    outer = result if outer is None else outer
+    out: dict[str, tuple[Any, Stored]] = {}
+    for f in dataclasses.fields(result):
+        how, value = spec(f), getattr(result, f.name)
+        if how is not None and value is not None:
+            name = under + (how.name or f.name)
+            out |= (columns(value, outer, name + "/") if dataclasses.is_dataclass(value)
+                    else {name: (value, _filled(how, result, outer))})
+    return out
+
+
 def _filled(how: Stored, result: Any, outer: Any) -> Stored:
     """`how` with each ``{name}`` of its texts replaced by that attribute of `result` (else
     of `outer`; a tuple joined by commas): what follows the result's settings."""
     def value(m: re.Match[str]) -> str:
         return _text(getattr(result, m.group(1), None) or getattr(outer, m.group(1)))
 
-    texts = {k: getattr(how, k) for k in ("units", "shape", "names", "description")}
+    texts = {k: getattr(how, k) for k in ("units", "frame", "shape", "names", "description")}
     texts = {k: re.sub(r"\{(\w+)\}", value, v) for k, v in texts.items()
              if v is not None and "{" in v}
     return dataclasses.replace(how, **texts) if texts else how

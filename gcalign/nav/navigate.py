@@ -35,8 +35,9 @@ from gcalign.errors import InputError
 from gcalign.nav import _kernels as K
 from gcalign.nav.earth import WGS84, EarthModel
 from gcalign.nav.rotation import euler_to_quat, quat_conj, quat_mult
+from gcalign.nav.rows import NavErrors, NavRows
 from gcalign.nav.strapdown import Navigator, NavState, Vertical
-from gcalign.schema import ATT_FRAME, PHI_FRAME, stored
+from gcalign.schema import stored
 
 __all__ = ["NavErrors", "NavRows", "NavTruth", "Navigation", "navigate", "navigate_blocks",
            "position_error_enu"]
@@ -114,39 +115,6 @@ class Increments:
     dv: Array
     truth: NavTruth | None = None
     q_bs: Array | None = None
-
-
-@dataclass(frozen=True)
-class NavErrors:
-    """Errors (or their largest magnitudes) per component: att (Euler differences est −
-    true, roll and yaw wrapped, rad), v_n (m/s ENU), pos (m ENU), phi (misalignment, rad).
-    Stored under ``error/`` of the rows (the frame names what they are against) and
-    summarised in degrees, m/s and m."""
-
-    att: Array = field(metadata=stored(
-        "rad", frame="Euler differences est - {against}, roll and yaw wrapped",
-        summary="deg", label="attitude"))
-    v_n: Array = field(metadata=stored("m/s", frame="ENU", summary="mps", label="velocity"))
-    pos: Array = field(metadata=stored("m", frame="ENU (east, north, up)", summary="m",
-                                       label="position"))
-    phi: Array = field(metadata=stored("rad", frame=PHI_FRAME, summary="deg",
-                                       label="misalignment"))
-
-    def stack(self) -> Array:
-        """(4, 3): att, v_n, pos, phi."""
-        return np.stack([self.att, self.v_n, self.pos, self.phi])
-
-
-@dataclass(frozen=True)
-class NavRows:
-    """Stored rows: record time t (n,), body attitude att, v_n, pos (n, 3), and the
-    errors against the truth (None without truth) as in :class:`NavErrors`."""
-
-    t: Array = field(metadata=stored("s"))
-    att: Array = field(metadata=stored("rad", frame=ATT_FRAME))
-    v_n: Array = field(metadata=stored("m/s", frame="ENU"))
-    pos: Array = field(metadata=stored("rad, rad, m", frame="[latitude, longitude, height]"))
-    error: NavErrors | None = field(default=None, metadata=stored(""))
 
 
 @dataclass(frozen=True)

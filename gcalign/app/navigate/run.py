@@ -21,12 +21,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
 from gcalign.app.command import Outcome
+from gcalign.app.command import stride as output_stride
 from gcalign.app.data import DataBlock, Stream, scenario_stream
 from gcalign.errors import InputError, ScenarioError
 from gcalign.io.recorded.reference import Reference, initial_state, reference_at, reference_gaps
@@ -36,7 +38,7 @@ from gcalign.nav.navigate import NavErrors, Navigation, NavRows, NavTruth, navig
 from gcalign.nav.navigate import position_error_enu as position_error_enu  # its old home
 from gcalign.nav.rotation import attitude_error, misalignment_q
 from gcalign.nav.strapdown import NavState, Vertical
-from gcalign.schema import Stored, placed, spec, summary_of
+from gcalign.schema import placed, summary_of
 
 
 @dataclass(frozen=True)
@@ -132,19 +134,6 @@ def _start_error(state: NavState, ref: Reference, t: float, earth) -> NavErrors:
                      misalignment_q(state.q_nb, tr.q_nb)[None])
 
 
-def _columns(rows: NavRows | NavErrors, under: str = "") -> dict[str, tuple[np.ndarray, Stored]]:
-    """The stored series of `rows` by their names in the results file (the errors under
-    ``error/``), each with how its field says it is stored."""
-    out: dict[str, tuple[np.ndarray, Stored]] = {}
-    for f in fields(rows):
-        value, how = getattr(rows, f.name), spec(f)
-        if isinstance(value, NavErrors):
-            out |= _columns(value, f"{under}{f.name}/")
-        elif value is not None and how is not None:
-            out[under + f.name] = (value, how)
-    return out
-
-
 def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: int,
                     duration_s: float | None = None, sink=None, on_rows=None,
                     progress=None, reference: Reference | None = None,
@@ -157,6 +146,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
     hears of every block (seconds of data navigated). With `reference` (recorded data) the
     errors are against it (see the module docstring)."""
     from gcalign.io.results import Series
+    from gcalign.io.stored import columns
 
     ts = stream.ts
     k_end = stream.samples if duration_s is None else min(
@@ -166,16 +156,16 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         t_a, t_b = reference_window(reference, stream, start.k, k_end)
         blocks = against_reference(blocks, reference, t_a, t_b, ref_gaps)
     series = None
+    texts = SimpleNamespace(against="true" if reference is None else "reference")  # {against}
     if sink is not None:
         t_start = start.k * ts + stream.t0
         error = None if stream.truth0 is None and reference is None else (
             NavErrors(*[np.zeros((1, 3))] * 4) if reference is None
             else _start_error(start.state, reference, t_start, stream.earth))
-        row0 = _columns(NavRows(np.array([t_start]), start.state.att[None],
-                                start.state.v_n[None], start.state.pos[None], error))
-        against = "reference" if reference is not None else "true"
+        row0 = columns(NavRows(np.array([t_start]), start.state.att[None],
+                               start.state.v_n[None], start.state.pos[None], error), texts)
         series = Series(sink, {name: (a.shape[1] if a.ndim > 1 else None, how.units or "",
-                                      how.frame and how.frame.replace("{against}", against))
+                                      how.frame)
                                for name, (a, how) in row0.items()},
                         stride=stride, rate_hz=1.0 / (stride * ts), vertical=vertical.mode)
         if reference is not None:
@@ -183,7 +173,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         series.append(**{name: a for name, (a, _) in row0.items()})
 
     def rows_out(rows: NavRows) -> None:  # always given, so the rows are never all held
-        data = {name: a for name, (a, _) in _columns(rows).items()}
+        data = {name: a for name, (a, _) in columns(rows, texts).items()}
         if series is not None:
             series.append(**data)
         if on_rows is not None:
@@ -218,7 +208,7 @@ def _run(sc: Scenario, seed: int | None, init: str | Path | None, sink, on_rows,
     ref = sc.reference.read() if sc.reference is not None else None
     kind = None if stream.header is None else stream.header.meta.get("motion_kind")
     vertical = vertical_of(cfg, sc, kind)
-    stride = _stride(sc, stream)
+    stride = output_stride(sc, stream)
 
     if init is not None and init not in ("truth", "header"):
         if cfg.start_s:
@@ -273,13 +263,6 @@ def _recorded_start(sc: Scenario, stream: Stream, k: int, ref: Reference | None,
         if not source.startswith("reference"):
             source += f"; position: the reference at {t:g} s"
     return NavState.from_euler(att, v, pos), source
-
-
-def _stride(sc: Scenario, stream: Stream) -> int:
-    try:
-        return sc.output.stride(1.0 / stream.ts, stream.samples * stream.ts)
-    except ValueError as err:
-        raise ScenarioError(str(err)) from None
 
 
 def _summary(sc: Scenario, stream: Stream, start: Start, vertical: Vertical, stride: int,

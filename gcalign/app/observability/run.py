@@ -138,13 +138,10 @@ def execute(sc: Scenario, seed: int | None = None, cache_key: str | None = None,
 
 def write_observability(f: h5py.File, tab: ObservabilityTable, truth: Any,
                         spans: tuple[Span, ...]) -> None:
-    """/observability: the table as its fields say (:class:`ObservabilityTable`), and each
-    segment's start and end; the segments of /truth."""
-    from gcalign.io.results import put, write_segments
+    """/observability: the table as its fields say (:class:`ObservabilityTable`); the
+    segments of /truth."""
+    from gcalign.io.results import write_segments
     from gcalign.io.stored import write_fields
 
     write_segments(f, truth, spans)
-    g = f.create_group("observability")
-    write_fields(g, tab)
-    put(g, "t0", [s.start for s in spans], "s")
-    put(g, "t1", [s.end for s in spans], "s")
+    write_fields(f.create_group("observability"), tab)
