@@ -8,7 +8,7 @@ from __future__ import annotations
 from rich.table import Table
 from rich.text import Text
 
-from gcalign.app.report import DASH, angles, run_line
+from gcalign.app.report import DASH, angles, run_line, titled
 
 
 def _rms(values) -> float | None:
@@ -22,13 +22,9 @@ def northfind_table(s: dict) -> Table:
     r, m = s["shape"]
     order, ms = s["method_order"], s["methods"]
     ref = "from the reference axis" if s["tilt_reference"] == "table" else "true azimuth"
-    table = Table(
-        title=f"gcalign northfind: {s['scenario']} — {s['positions']} positions × "
-        f"{s['dwell_s']:g} s, lat {s['latitude_deg']:g}°, tilt {s['tilt_deg']:.4g}° toward "
-        f"{s['tilt_direction_deg']:.4g}° ({ref})",
-        title_justify="left",
-        header_style="bold",
-    )
+    table = titled(f"gcalign northfind: {s['scenario']} — {s['positions']} positions × "
+                   f"{s['dwell_s']:g} s, lat {s['latitude_deg']:g}°, tilt {s['tilt_deg']:.4g}° "
+                   f"toward {s['tilt_direction_deg']:.4g}° ({ref})")
     tilt = s["tilt_est_deg"]
     tail = run_line(s, "compute")
 
@@ -104,5 +100,4 @@ def northfind_table(s: dict) -> Table:
             f"tilt error; predicted σ and std: RMS over the sweep; estimated tilt "
             f"{min(tilt):.4f}…{max(tilt):.4f}°\n{tail}"
         )
-    table.caption_justify = "left"
     return table
