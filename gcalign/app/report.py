@@ -33,20 +33,6 @@ UNIT_TEXT = {"arcsec": "″", "arcmin": "′", "deg/h": "°/h", "ug": "µg", "pp
 """Printed symbols of the display units (:data:`gcalign.estimation.ins_error.DISPLAY_UNITS`)."""
 
 
-def fmt(x, digits: int = 4) -> str:
-    """A number or a vector of numbers in a compact form (one value at a time; tables
-    that compare values use :func:`numbers` instead)."""
-    if x is None:
-        return DASH
-    if isinstance(x, (list, tuple)):
-        return "  ".join(fmt(v, digits) for v in x)
-    if isinstance(x, float):
-        if x != 0 and (abs(x) < 10 ** -(digits - 1) or abs(x) >= 1e6):
-            return f"{x:.{digits - 1}e}"
-        return f"{x:.{digits}f}"
-    return str(x)
-
-
 def _finite(values) -> list[float]:
     return [abs(float(v)) for v in values
             if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)]
@@ -175,14 +161,16 @@ def stacked(title: str, tables: Iterable[RenderableType], notes: str,
     return outer
 
 
-def kv_table(title: str, rows: Iterable[Sequence], headers: Sequence[str] = ("", ""),
+def kv_table(title: str, rows: Iterable[Sequence[str]], headers: Sequence[str] = ("", ""),
              justify: Sequence[str] | None = None) -> Table:
+    """Rows of text (never read as markup) under `headers`: the first column on the left,
+    the others on the right unless `justify` says otherwise."""
     table = titled(title)
     for i, h in enumerate(headers):
         j = justify[i] if justify else ("left" if i == 0 else "right")
         table.add_column(h, justify=j)  # type: ignore[arg-type]
     for row in rows:
-        table.add_row(*(Text(c if isinstance(c, str) else fmt(c)) for c in row))
+        table.add_row(*map(Text, row))
     return table
 
 

@@ -11,7 +11,7 @@ from rich import box
 from rich.table import Column, Table
 from rich.text import Text
 
-from gcalign.app.report import DASH, UNIT_TEXT, number, numbers, run_line, stacked, titled
+from gcalign.app.report import DASH, UNIT_TEXT, number, run_line, stacked, titled, vector
 from gcalign.units import angle_text
 
 GROUP_ENDS = ("phiU", "dvU", "dh", "ebz", "dbz", "dKgz", "dKaz")
@@ -70,9 +70,8 @@ def run_table(s: dict) -> Table:
                  f"{'  '.join(number(x, 3) for x in inn['standardized_std'])}")
     att = s["attitude_deg"]
     notes.append(f"INS attitude at the end (pitch, roll, yaw) {att[0]:.4f}°, {att[1]:.4f}°, "
-                 f"{att[2]:.4f}°" + (
-                     f"; coarse {'  '.join(numbers(s['coarse_attitude_deg'], most=4))}°"
-                     if s.get("coarse_attitude_deg") else ""))
+                 f"{att[2]:.4f}°" + (f"; coarse {vector(s['coarse_attitude_deg'], most=4)}°"
+                                     if s.get("coarse_attitude_deg") else ""))
     notes += aided_notes(s)
     for key, f in (s.get("aiding_files") or {}).items():
         lever = f["lever_arm_m"]
@@ -94,8 +93,8 @@ def run_table(s: dict) -> Table:
     if e:
         a = [angle_text(math.radians(x)) for x in e["attitude_deg"]]
         notes.append(f"against the reference at {e['t_s']:.2f} s: attitude (pitch, roll, yaw) "
-                     f"{', '.join(a)}; velocity {'  '.join(numbers(e['velocity_mps'], most=3))}"
-                     f" m/s; position {'  '.join(numbers(e['position_m'], most=3))} m ENU")
+                     f"{', '.join(a)}; velocity {vector(e['velocity_mps'], most=3)} m/s; "
+                     f"position {vector(e['position_m'], most=3)} m ENU")
     notes.append("navigation states at the end: estimate = estimated error of the INS before "
                  "the last correction; error = what the correction leaves; injected at t = 0")
     notes.append(f"truth {s['truth_source'] or 'unknown (recorded data)'}; "
@@ -132,7 +131,7 @@ def aided_notes(s: dict) -> list[str]:
         att = start.get("attitude_deg")
         notes.append(f"start at {start['t_data_s']:.3f} s (the recording's time): "
                      f"{start['source']}" + ("" if att is None else
-                                             f"; attitude {'  '.join(numbers(att, most=4))}°"))
+                                             f"; attitude {vector(att, most=4)}°"))
     fx = s.get("fixes")
     if fx:
         sig = ("σ per fix " + "–".join(f"{x:.3g}" for x in fx["sigma_enu_range_m"]) + " m"
