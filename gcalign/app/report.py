@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
+from typing import Any
 
 from rich.console import Group, RenderableType
-from rich.table import Table
+from rich.table import Column, Table
 from rich.text import Text
 
 from gcalign import units
@@ -30,20 +31,6 @@ DASH = "—"
 UNIT_TEXT = {"arcsec": "″", "arcmin": "′", "deg/h": "°/h", "ug": "µg", "ppm": "ppm",
              "m/s": "m/s", "m": "m"}
 """Printed symbols of the display units (:data:`gcalign.estimation.ins_error.DISPLAY_UNITS`)."""
-
-
-def fmt(x, digits: int = 4) -> str:
-    """A number or a vector of numbers in a compact form (one value at a time; tables
-    that compare values use :func:`numbers` instead)."""
-    if x is None:
-        return DASH
-    if isinstance(x, (list, tuple)):
-        return "  ".join(fmt(v, digits) for v in x)
-    if isinstance(x, float):
-        if x != 0 and (abs(x) < 10 ** -(digits - 1) or abs(x) >= 1e6):
-            return f"{x:.{digits - 1}e}"
-        return f"{x:.{digits}f}"
-    return str(x)
 
 
 def _finite(values) -> list[float]:
@@ -84,9 +71,10 @@ def numbers(values: Sequence, sig: int = 4, most: int = 6,
     return [number(v, d, sig) for v in values]
 
 
-def vector(values: Sequence | None, sig: int = 4, most: int = 6) -> str:
-    """A vector in one cell, its components in one format."""
-    return DASH if values is None else "  ".join(numbers(list(values), sig, most))
+def vector(values: Sequence[float | None] | None, **kw: Any) -> str:
+    """A vector in one cell, its components in one format (:func:`numbers`, `kw` its
+    options)."""
+    return DASH if values is None else "  ".join(numbers(list(values), **kw))
 
 
 #: Angle units: factor from degrees and the decimals shown (resolution 0.36″, 0.06″, 0.01″).
@@ -148,14 +136,41 @@ def run_line(s: dict, compute: str | None = "compute") -> str:
     return "; ".join(parts)
 
 
-def kv_table(title: str, rows: Iterable[Sequence], headers: Sequence[str] = ("", ""),
+def titled(title: str | None, labels: Sequence[str | Column] = (),
+           values: Sequence[str] = (), **options: Any) -> Table:
+    """A command's table: the title and the caption on the left, bold headers, the `labels`
+    columns (left-justified; a :class:`~rich.table.Column` for one with options of its own),
+    then the `values` columns, right-justified (numbers are read down them); `options`
+    those of :class:`~rich.table.Table`."""
+    table = Table(*labels, title=title, title_justify="left", caption_justify="left",
+                  header_style="bold", **options)
+    for name in values:
+        table.add_column(name, justify="right")
+    return table
+
+
+def stacked(title: str, tables: Iterable[RenderableType], notes: str,
+            padding: tuple[int, int] = (0, 0)) -> Table:
+    """Tables one above the other (`padding`: lines and columns around each) under one
+    title, with `notes` under them all."""
+    outer = Table.grid(padding=padding)
+    outer.title, outer.title_justify = title, "left"
+    outer.caption, outer.caption_justify = notes, "left"
+    for table in tables:
+        outer.add_row(table)
+    return outer
+
+
+def kv_table(title: str, rows: Iterable[Sequence[str]], headers: Sequence[str] = ("", ""),
              justify: Sequence[str] | None = None) -> Table:
-    table = Table(title=title, title_justify="left", header_style="bold")
+    """Rows of text (never read as markup) under `headers`: the first column on the left,
+    the others on the right unless `justify` says otherwise."""
+    table = titled(title)
     for i, h in enumerate(headers):
         j = justify[i] if justify else ("left" if i == 0 else "right")
         table.add_column(h, justify=j)  # type: ignore[arg-type]
     for row in rows:
-        table.add_row(*(Text(c if isinstance(c, str) else fmt(c)) for c in row))
+        table.add_row(*map(Text, row))
     return table
 
 

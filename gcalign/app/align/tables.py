@@ -7,7 +7,7 @@ from __future__ import annotations
 from rich.table import Table
 from rich.text import Text
 
-from gcalign.app.report import DASH, UNIT_NAME, angle_unit, angles, flat, number, run_line
+from gcalign.app.report import DASH, UNIT_NAME, angle_unit, angles, flat, number, run_line, titled
 
 
 def _pass_label(p: dict) -> str:
@@ -33,12 +33,8 @@ def align_table(s: dict) -> Table:
             if len(passes) > 1 else "1 pass")
     comp = ("real time (no compensation)" if s["compensation"] == "real time"
             else f"compensation {s['compensation']} T2 → T3")
-    table = Table(
-        title=f"gcalign align: {s['scenario']} — {s['mode']}, {plan}, {comp}, azimuth "
-        f"poles {s['azimuth_poles']}",
-        title_justify="left", header_style="bold")
-    for name in ("", "t (s)", "pitch", "roll", "yaw"):
-        table.add_column(name, justify="left" if not name else "right")
+    table = titled(f"gcalign align: {s['scenario']} — {s['mode']}, {plan}, {comp}, azimuth "
+                   f"poles {s['azimuth_poles']}", ("",), ("t (s)", "pitch", "roll", "yaw"))
     has_truth = s.get("truth_t3_deg") is not None
     against = s.get("error_source") or "truth"  # or "reference" (recorded data)
 
@@ -97,5 +93,4 @@ def align_table(s: dict) -> Table:
         notes.append("recorded data: no truth, so no errors; the estimate only")
     notes.append(run_line(s, "compute (the passes)"))
     table.caption = "\n".join(notes)
-    table.caption_justify = "left"
     return table

@@ -279,22 +279,24 @@ def execute(sc, seed: int | None = None, cache_key: str | None = None,
 
 # -- table and figures (rich and matplotlib loaded by the caller's import of this module) --
 
+#: the last state of each group but the last: a line under it in the tables
+GROUP_ENDS = ("phiU", "dvU", "ebz", "dbz", "muz", "thz")
+
+
 def table(s: dict):
     """One row per state: estimate ± σ (display units), σ0, convergence, PSINS's stored
     value where the file has one."""
-    from rich.table import Table
+    from gcalign.app.report import DASH, titled
 
     stored = s.get("psins_stored") or {}
     ref = {"eb": stored.get("eb0_dph"), "db": stored.get("db0_ug"),
            "mu": stored.get("mu0_arcmin")}
     fb = s["feedback"]
     loop = ("bias" if fb["bias"] else "no bias") + (" + attitude" if fb["attitude"] else "")
-    t = Table(title=f"gcalign align --mode transfer: {s['scenario']} — {s['matching']} "
-              f"matching over {s['duration_s']:.1f} s, {len(s['states'])} states, "
-              f"{loop} feedback, gravity {s['gravity']}", title_justify="left",
-              header_style="bold")
-    for head in ("state", "unit", "estimate", "σ", "σ0", "conv. s", "PSINS", "− PSINS"):
-        t.add_column(head, justify="left" if head in ("state", "unit") else "right")
+    t = titled(f"gcalign align --mode transfer: {s['scenario']} — {s['matching']} matching "
+               f"over {s['duration_s']:.1f} s, {len(s['states'])} states, {loop} feedback, "
+               f"gravity {s['gravity']}", ("state", "unit"),
+               ("estimate", "σ", "σ0", "conv. s", "PSINS", "− PSINS"))
     for name, v in s["states"].items():
         k, unit = s["display_scale"][name], s["display_units"][name]
         g = group_of(name)
@@ -303,9 +305,8 @@ def table(s: dict):
         est, d = v["estimate"] * k, DECIMALS[unit]
         t.add_row(name, unit, f"{est:.{d}f}", f"{v['sigma'] * k:.{d}f}",
                   f"{v['sigma0'] * k:.{d}f}", f"{s['convergence_s'][name]:.1f}",
-                  "—" if st is None else f"{st:.{d}f}", "—" if st is None else f"{est - st:+.{d}f}")
-        if name in ("phiU", "dvU", "ebz", "dbz", "muz", "thz"):
-            t.add_section()
+                  *((DASH, DASH) if st is None else (f"{st:.{d}f}", f"{est - st:+.{d}f}")),
+                  end_section=name in GROUP_ENDS)
     e = s["attitude_error_vs_reference_arcmin"]
     notes = ["corrected slave vs master ∘ μ̂: the reference has no attitude" if e is None
              else f"corrected slave vs master ∘ μ̂ (φ E, N, U, ′): final "
@@ -319,7 +320,6 @@ def table(s: dict):
         notes.insert(1, f"corrected slave vs master ∘ PSINS mu0 (′): final "
                         f"{_three(e0['final'])}, RMS last 10 s {_three(e0['rms_last_10s'])}")
     t.caption = "\n".join(notes)
-    t.caption_justify = "left"
     return t
 
 

@@ -7,7 +7,7 @@ import math
 
 from rich.table import Table
 
-from gcalign.app.report import DASH, numbers, run_line, span
+from gcalign.app.report import DASH, numbers, run_line, span, titled, vector
 
 AXES = ("x", "y", "z")
 LABEL = {"quantum_arcsec": "quantization: quantum (″)", "arw_dprh": "ARW (°/√h)",
@@ -51,12 +51,10 @@ def _cells(term: dict) -> list[str]:
 
 
 def allan_table(s: dict) -> Table:
-    table = Table(title=f"gcalign allan: {s['scenario']} ({s['samples']} samples at "
-                  f"{s['rate_hz']:g} Hz, {span(s['duration_s'])} from {s['start_s']:g} s)",
-                  title_justify="left", header_style="bold", show_lines=True)
-    table.add_column("term (scenario key)", justify="left")
-    for a in AXES:
-        table.add_column(f"{a}: value [1σ interval]\nτ range", justify="right")
+    table = titled(f"gcalign allan: {s['scenario']} ({s['samples']} samples at "
+                   f"{s['rate_hz']:g} Hz, {span(s['duration_s'])} from {s['start_s']:g} s)",
+                   ("term (scenario key)",),
+                   [f"{a}: value [1σ interval]\nτ range" for a in AXES], show_lines=True)
     for triad in ("gyro", "accel"):
         for key, term in s[triad].items():
             table.add_row(f"{triad}.{key}\n{LABEL.get(key, key)}", *_cells(term))
@@ -66,7 +64,7 @@ def allan_table(s: dict) -> Table:
         for tau, row in zip(at["tau_s"], rows, strict=True):
             table.add_row(f"{triad} σ(τ = {tau:g} s) ({unit})",
                           *numbers(row, sig=4, most=6))
-    mean = "  ".join(numbers(s["mean_rate_dph"], sig=4))
+    mean = vector(s["mean_rate_dph"], sig=4)
     force = "  ".join(f"{x:.1f}" for x in s["mean_force_ug"])
     mis = "; ".join(f"{t} " + " ".join(DASH if v is None else f"{v:.3g}"
                                         for v in s["misfit"][t]) for t in ("gyro", "accel"))
@@ -76,5 +74,4 @@ def allan_table(s: dict) -> Table:
                      "intervals 1σ from the number of clusters (IEEE Std 952 C.3); bias "
                      "instability = flat σ / 0.664; quantum q = √12·Q\n"
                      + run_line(s, "compute (Allan deviation and fits)"))
-    table.caption_justify = "left"
     return table

@@ -9,10 +9,10 @@ from __future__ import annotations
 import re
 
 from rich import box
-from rich.table import Table
+from rich.table import Column, Table
 from rich.text import Text
 
-from gcalign.app.report import UNIT_NAME, angle_unit, angles, numbers
+from gcalign.app.report import DASH, UNIT_NAME, angle_unit, angles, numbers, stacked, titled
 
 STATS = (("mean", "mean"), ("std", "std"), ("RMS", "rms"), ("median", "median"),
          ("5 %", "p05"), ("95 %", "p95"))
@@ -73,11 +73,7 @@ def batch_table(s: dict) -> Table:
     names = _names(s)
     width = min(NAME_WIDTH, max((len(line) for n in names for line in n.split("\n")),
                                 default=7))
-    outer = Table.grid(padding=(0, 0))
-    outer.title = (f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) "
-                   f"× {s['seeds']} seed(s) {s['seed_start']}…"
-                   f"{s['seed_start'] + s['seeds'] - 1}")
-    outer.title_justify = "left"
+    tables = []
     ns = {st["n"] for v in variants for st in v["stats"].values() if st}
     for m in s["metrics"]:
         per = [(v, v["stats"].get(m)) for v in variants]
@@ -96,15 +92,14 @@ def batch_table(s: dict) -> Table:
             label = m + (f" {comp}" if comp is not None else "") + (f" ({unit})" if unit else "")
             if ci == len(shown) - 1 and comps and len(comps) > len(shown):
                 label += f"; +{len(comps) - len(shown)} more components in --json and the file"
-            table = Table(title=label, title_justify="left", title_style="bold",
-                          header_style="bold", box=box.SIMPLE_HEAD, pad_edge=False,
-                          padding=(0, 0, 0, 1))
-            table.add_column("variant", justify="left", min_width=width, overflow="fold")
+            table = titled(label, [Column("variant", min_width=width, overflow="fold")],
+                           title_style="bold", box=box.SIMPLE_HEAD, pad_edge=False,
+                           padding=(0, 0, 0, 1))
             for head, _ in STATS:
                 table.add_column(head, justify="right", no_wrap=True)
             for j, name in enumerate(names):
                 table.add_row(Text(name), *cells[j * len(STATS):(j + 1) * len(STATS)])
-            outer.add_row(table)
+            tables.append(table)
     done = f"{s['runs']} runs" if s["complete"] else f"{s['finished']} of {s['runs']} runs finished"
     per_variant = f"; {ns.pop()} seed(s) per statistic" if len(ns) == 1 else ""
     notes = [f"{done}: {s['ok']} ok, {s['failed']} failed{per_variant}"]
@@ -112,7 +107,7 @@ def batch_table(s: dict) -> Table:
         notes.append(f"failed: variant {f['variant']} seed {f['seed']}: {f['error']}")
     if s.get("wall_s") is not None:
         notes.append(f"{s.get('executor') or ''}; wall {s['wall_s']:.2f} s".lstrip("; "))
-    notes.append(f"output {s.get('output') or '—'}")
-    outer.caption = "\n".join(notes)
-    outer.caption_justify = "left"
-    return outer
+    notes.append(f"output {s.get('output') or DASH}")
+    return stacked(f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) "
+                   f"× {s['seeds']} seed(s) {s['seed_start']}…"
+                   f"{s['seed_start'] + s['seeds'] - 1}", tables, "\n".join(notes))

@@ -8,10 +8,10 @@ import math
 from pathlib import Path
 
 from rich import box
-from rich.table import Table
+from rich.table import Column, Table
 from rich.text import Text
 
-from gcalign.app.report import UNIT_TEXT, number, numbers, run_line
+from gcalign.app.report import DASH, UNIT_TEXT, number, run_line, stacked, titled, vector
 from gcalign.units import angle_text
 
 GROUP_ENDS = ("phiU", "dvU", "dh", "ebz", "dbz", "dKgz", "dKaz")
@@ -21,24 +21,15 @@ SHORT = {"velocity": "v", "position": "p", "both": "v+p"}
 DECIMALS = {"arcsec": 2, "arcmin": 3, "m/s": 4, "m": 2, "deg/h": 4, "ug": 1, "ppm": 1}
 
 
-def _g(x, unit: str) -> str:
-    if x is None or (isinstance(x, float) and not math.isfinite(x)):
-        return "—"
-    return number(x, DECIMALS.get(unit, 3))
+def _g(x, k: float, unit: str) -> str:
+    """An SI value `x` in its display unit (`k` the factor), at that unit's resolution."""
+    if x is None or not math.isfinite(x):
+        return DASH
+    return number(x * k, DECIMALS.get(unit, 3))
 
 
 def _display(s: dict):
     return list(s["units"]), s["display_scale"], s["display_units"]
-
-
-def _captioned(table: Table, notes: list[str]) -> Table:
-    table.caption = "\n".join(notes)
-    table.caption_justify = "left"
-    return table
-
-
-def _scaled(v, k):
-    return None if v is None else v * k
 
 
 def calibrate_table(s: dict) -> Table:
@@ -55,18 +46,15 @@ def run_table(s: dict) -> Table:
     names, scale, units = _display(s)
     aid = {"zero-velocity": "zero-velocity updates",
            "file": f"{s['measure']} from files"}.get(s["aiding"], f"DGNSS {s['measure']}")
-    table = Table(title=_title(s, f"{aid} over {s['duration_s']:.0f} s"),
-                  title_justify="left", header_style="bold")
-    heads = ("state", "unit", "injected", "estimate", "error", "σ final", "σ0", "error/σ")
-    for h in heads:
-        table.add_column(h, justify="left" if h in ("state", "unit") else "right")
+    table = titled(_title(s, f"{aid} over {s['duration_s']:.0f} s"), ("state", "unit"),
+                   ("injected", "estimate", "error", "σ final", "σ0", "error/σ"))
     for name in names:
         st, k, u = s["states"][name], scale[name], units[name]
         err = st["error"]
-        table.add_row(Text(name), UNIT_TEXT.get(u, u), *(_g(_scaled(st[c], k), u) for c in (
+        table.add_row(Text(name), UNIT_TEXT.get(u, u), *(_g(st[c], k, u) for c in (
             "injected", "estimate", "error", "sigma", "sigma0")),
-                      "—" if err is None else f"{err / st['sigma']:+.2f}".replace("-0.00",
-                                                                                 "+0.00"),
+                      DASH if err is None else f"{err / st['sigma']:+.2f}".replace("-0.00",
+                                                                                  "+0.00"),
                       end_section=name in GROUP_ENDS)
     notes = []
     nees = s.get("nees")
@@ -82,9 +70,8 @@ def run_table(s: dict) -> Table:
                  f"{'  '.join(number(x, 3) for x in inn['standardized_std'])}")
     att = s["attitude_deg"]
     notes.append(f"INS attitude at the end (pitch, roll, yaw) {att[0]:.4f}°, {att[1]:.4f}°, "
-                 f"{att[2]:.4f}°" + (
-                     f"; coarse {'  '.join(numbers(s['coarse_attitude_deg'], most=4))}°"
-                     if s.get("coarse_attitude_deg") else ""))
+                 f"{att[2]:.4f}°" + (f"; coarse {vector(s['coarse_attitude_deg'], most=4)}°"
+                                     if s.get("coarse_attitude_deg") else ""))
     notes += aided_notes(s)
     for key, f in (s.get("aiding_files") or {}).items():
         lever = f["lever_arm_m"]
@@ -106,13 +93,14 @@ def run_table(s: dict) -> Table:
     if e:
         a = [angle_text(math.radians(x)) for x in e["attitude_deg"]]
         notes.append(f"against the reference at {e['t_s']:.2f} s: attitude (pitch, roll, yaw) "
-                     f"{', '.join(a)}; velocity {'  '.join(numbers(e['velocity_mps'], most=3))}"
-                     f" m/s; position {'  '.join(numbers(e['position_m'], most=3))} m ENU")
+                     f"{', '.join(a)}; velocity {vector(e['velocity_mps'], most=3)} m/s; "
+                     f"position {vector(e['position_m'], most=3)} m ENU")
     notes.append("navigation states at the end: estimate = estimated error of the INS before "
                  "the last correction; error = what the correction leaves; injected at t = 0")
     notes.append(f"truth {s['truth_source'] or 'unknown (recorded data)'}; "
                  + run_line(s, "compute (the filter)"))
-    return _captioned(table, notes)
+    table.caption = "\n".join(notes)
+    return table
 
 
 
@@ -143,7 +131,7 @@ def aided_notes(s: dict) -> list[str]:
         att = start.get("attitude_deg")
         notes.append(f"start at {start['t_data_s']:.3f} s (the recording's time): "
                      f"{start['source']}" + ("" if att is None else
-                                             f"; attitude {'  '.join(numbers(att, most=4))}°"))
+                                             f"; attitude {vector(att, most=4)}°"))
     fx = s.get("fixes")
     if fx:
         sig = ("σ per fix " + "–".join(f"{x:.3g}" for x in fx["sigma_enu_range_m"]) + " m"
@@ -185,26 +173,19 @@ def compare_table(s: dict) -> Table:
     shown = names[2:3] + names[9:]  # φU and the twelve sensor errors
     blocks = []
     for what in ("error", "sigma"):
-        t = Table(title="estimate − truth at the end" if what == "error" else "final σ",
-                  title_justify="left", header_style="bold", box=box.SIMPLE_HEAD,
-                  pad_edge=False, padding=(0, 0), collapse_padding=True)
-        t.add_column("state", min_width=5)
-        t.add_column("unit", min_width=4)
+        t = titled("estimate − truth at the end" if what == "error" else "final σ",
+                   [Column("state", min_width=5), Column("unit", min_width=4)],
+                   box=box.SIMPLE_HEAD, pad_edge=False, padding=(0, 0), collapse_padding=True)
         t.add_column("injected", justify="right", min_width=8)
         for r in runs:
             t.add_column(_tag(r), justify="right", min_width=8, no_wrap=True)
         for name in shown:
             k, u = scale[name], units[name]
-            cells = [_g(_scaled(r["states"][name][what], k), u) for r in runs]
+            cells = [_g(r["states"][name][what], k, u) for r in runs]
             t.add_row(Text(name), UNIT_TEXT.get(u, u),
-                      _g(_scaled(runs[0]["states"][name]["injected"], k), u), *cells,
+                      _g(runs[0]["states"][name]["injected"], k, u), *cells,
                       end_section=name in GROUP_ENDS)
         blocks.append(t)
-    outer = Table(title=_title(s, "designed vs conventional take-off (seed Table 3)"),
-                  title_justify="left", box=None, show_header=False, padding=(0, 0))
-    outer.add_column()
-    for b in blocks:
-        outer.add_row(b)
     durations = {r["label"]: (r["duration_s"], len(r["segments"])) for r in runs}
     notes = [f"{lab}: {n} segments, {d:.0f} s of filter steps" for lab, (d, n)
              in durations.items()]
@@ -214,4 +195,5 @@ def compare_table(s: dict) -> Table:
     notes.append("v: velocity, p: position, v+p: both; φU: the INS heading error the "
                  "correction leaves; the same data and DGNSS noise in every column")
     notes.append(run_line(s, "compute (the six filter runs)"))
-    return _captioned(outer, notes)
+    return stacked(_title(s, "designed vs conventional take-off (seed Table 3)"), blocks,
+                   "\n".join(notes))

@@ -5,13 +5,15 @@ from __future__ import annotations
 
 from rich import box
 from rich.console import Group, RenderableType
-from rich.table import Table
+from rich.table import Column, Table
 from rich.text import Text
+
+from gcalign.app.report import DASH, titled
 
 
 def metres(x: float | None) -> str:
     if x is None:
-        return "—"
+        return DASH
     return f"{x:,.1f}" if abs(x) < 10 else f"{x:,.0f}"
 
 
@@ -25,7 +27,7 @@ def _diag(C) -> str:
 def _triple(v, fmt: str) -> str:
     """Three numbers, "0" for exact zeros; one "0" when all are (the cancelled terms)."""
     if v is None:
-        return "—"
+        return DASH
     if all(x == 0 for x in v):
         return "0"
     return " ".join("0" if x == 0 else fmt.format(x) for x in v)
@@ -63,24 +65,20 @@ def _ratios(r: dict) -> list[str]:
     """The ratios to the unrotated run: last hour, whole-run maxima, RMS."""
     q = r.get("ratio_to_fixed")
     if not q:
-        return ["—"] * 3
-    return ["—" if q[k] is None else f"{q[k]:.3g}" for k in ("last_hour", "max", "rms")]
+        return [DASH] * 3
+    return [DASH if q[k] is None else f"{q[k]:.3g}" for k in ("last_hour", "max", "rms")]
 
 
 def _schemes(title: str, width: int, *columns: str) -> Table:
     """A table of one row per scheme: its name (`width` wide), then `columns` of numbers."""
-    t = Table(title=title, title_justify="left", header_style="bold", box=box.SIMPLE_HEAD)
-    t.add_column("scheme", no_wrap=True, min_width=width)
-    for col in columns:
-        t.add_column(col, justify="right")
-    return t
+    return titled(title, [Column("scheme", no_wrap=True, min_width=width)], columns,
+                  box=box.SIMPLE_HEAD)
 
 
 def _terms_table(rows: list[list[str]]) -> Table:
     """The invariant terms per scheme; each column at least as wide as its numbers (the
     headers wrap instead)."""
-    t = Table(title="invariants over one cycle, for these errors", title_justify="left",
-              header_style="bold", box=box.SIMPLE_HEAD)
+    t = titled("invariants over one cycle, for these errors", box=box.SIMPLE_HEAD)
     heads = ("scheme", "peak ∫C dt (s)", "ε excursion (″)", "δk term (″)", "M term (″)")
     for k, col in enumerate(heads):
         t.add_column(col, justify="left" if k == 0 else "right",
@@ -126,8 +124,8 @@ def modulate_table(s: dict) -> Group:
         cmp.add_row(*map(Text, [name, metres(lin_v)] + (_ratios(r) if ratios else [])))
         inv.add_row(*map(Text, [
             name, {"navigation": "nav"}.get(r["reference"], r["reference"])
-            if r["mechanism"] else "—",
-            "—" if r["cycle_s"] is None else f"{r['cycle_s'] / 60:.1f}", _diag(r["cycle_mean"]),
+            if r["mechanism"] else DASH,
+            DASH if r["cycle_s"] is None else f"{r['cycle_s'] / 60:.1f}", _diag(r["cycle_mean"]),
             " ".join(f"{x:.0f}" if x >= 10 else f"{x:.2g}"
                      for x in r["max_misalignment_arcsec"]),
             "warn" if r["schuler_warnings"] else "–"]))
@@ -153,7 +151,7 @@ def modulate_table(s: dict) -> Group:
         "the cycle / peak in it / cycle mean: the standing attitude offset the navigation "
         "sees as an initial attitude error, which a net 0 does not cancel), E N U",
         _errors_line(s["errors"]), *residuals,
-        f"output {s.get('output') or '—'}; {s['wall_s']:.1f} s",
+        f"output {s.get('output') or DASH}; {s['wall_s']:.1f} s",
     ]
     tables: list[RenderableType] = [head, pos, cmp, inv]
     if term_rows:

@@ -8,7 +8,7 @@ from __future__ import annotations
 from rich.table import Table
 from rich.text import Text
 
-from gcalign.app.report import UNIT_NAME, angle_unit, angles, flat, numbers, run_line, span
+from gcalign.app.report import UNIT_NAME, angle_unit, angles, flat, numbers, run_line, span, titled
 
 #: Velocity and position at 1 µm/s and 1 µm at most: below that is round-off.
 METRIC = {"sig": 4, "most": 6, "tiny_as_zero": True}
@@ -34,15 +34,9 @@ def _pair(table: Table, label: str, final, peak, kind: str) -> None:
 
 def navigate_table(s: dict) -> Table:
     tau = f" (τ {s['vertical_tau_s']:g} s)" if s.get("vertical_tau_s") else ""
-    table = Table(
-        title=f"gcalign navigate: {s['scenario']} — {span(s['duration_s'])} "
-        f"({s['samples']} samples) from {s['start_s']:g} s, vertical channel "
-        f"{s['vertical']}{tau}",
-        title_justify="left", header_style="bold")
-    table.add_column("")
-    table.add_column("")
-    for name in ("pitch · E", "roll · N", "yaw · U"):
-        table.add_column(name, justify="right")
+    table = titled(f"gcalign navigate: {s['scenario']} — {span(s['duration_s'])} "
+                   f"({s['samples']} samples) from {s['start_s']:g} s, vertical channel "
+                   f"{s['vertical']}{tau}", ("", ""), ("pitch · E", "roll · N", "yaw · U"))
     fe, me = s.get("final_error"), s.get("max_error") or {}
     st = s["final_state"]
     if fe is None:
@@ -85,5 +79,4 @@ def navigate_table(s: dict) -> Table:
     notes.append(f"series stored at {s['output_rate_hz']:g} Hz; "
                  + run_line(s, "compute (the strapdown kernel)"))
     table.caption = "\n".join(notes)
-    table.caption_justify = "left"
     return table

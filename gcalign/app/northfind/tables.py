@@ -5,10 +5,10 @@ Azimuths in degrees (4 decimals, 0.36″); errors, spreads and predictions in ar
 
 from __future__ import annotations
 
-from rich.table import Table
+from rich.table import Column, Table
 from rich.text import Text
 
-from gcalign.app.report import DASH, angles, run_line
+from gcalign.app.report import DASH, angles, run_line, titled
 
 
 def _rms(values) -> float | None:
@@ -22,23 +22,17 @@ def northfind_table(s: dict) -> Table:
     r, m = s["shape"]
     order, ms = s["method_order"], s["methods"]
     ref = "from the reference axis" if s["tilt_reference"] == "table" else "true azimuth"
-    table = Table(
-        title=f"gcalign northfind: {s['scenario']} — {s['positions']} positions × "
-        f"{s['dwell_s']:g} s, lat {s['latitude_deg']:g}°, tilt {s['tilt_deg']:.4g}° toward "
-        f"{s['tilt_direction_deg']:.4g}° ({ref})",
-        title_justify="left",
-        header_style="bold",
-    )
+    title = (f"gcalign northfind: {s['scenario']} — {s['positions']} positions × "
+             f"{s['dwell_s']:g} s, lat {s['latitude_deg']:g}°, tilt {s['tilt_deg']:.4g}° "
+             f"toward {s['tilt_direction_deg']:.4g}° ({ref})")
     tilt = s["tilt_est_deg"]
     tail = run_line(s, "compute")
 
-    def columns(*names: str) -> None:
-        for name in names:
-            table.add_column(name, justify="left" if name in ("method", "") else "right",
-                             no_wrap=name in ("method", ""))
+    def columns(label: str, *values: str) -> Table:
+        return titled(title, [Column(label, no_wrap=True)], values)  # the labels whole
 
     if m == 1 and r == 1:
-        columns("method", "azimuth (deg)", "error (′)", "pred. σ (′)", "tilt est (deg)")
+        table = columns("method", "azimuth (deg)", "error (′)", "pred. σ (′)", "tilt est (deg)")
         for name in order:
             d = ms[name]
             table.add_row(
@@ -54,7 +48,7 @@ def northfind_table(s: dict) -> Table:
             f"from north)\n{tail}"
         )
     elif m == 1:
-        columns("", *(f"{n} (deg)" for n in order), "tilt est (deg)")
+        table = columns("", *(f"{n} (deg)" for n in order), "tilt est (deg)")
         shown = range(r) if r <= 25 else [*range(10), None, *range(r - 5, r)]
         for i in shown:
             if i is None:
@@ -83,7 +77,7 @@ def northfind_table(s: dict) -> Table:
                 "closed form max (′)", "pred. σ (′)"]
         if r > 1:
             cols.append("std over repeats (′)")
-        columns(*cols)
+        table = columns(*cols)
         for name in order:
             d = ms[name]
             bias = [b for b in d["bias_deg"] if b is not None]
@@ -104,5 +98,4 @@ def northfind_table(s: dict) -> Table:
             f"tilt error; predicted σ and std: RMS over the sweep; estimated tilt "
             f"{min(tilt):.4f}…{max(tilt):.4f}°\n{tail}"
         )
-    table.caption_justify = "left"
     return table

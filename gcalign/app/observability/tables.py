@@ -9,6 +9,8 @@ from rich import box
 from rich.table import Table
 from rich.text import Text
 
+from gcalign.app.report import DASH, stacked, titled
+
 CELL = 4  # a state column: "-12"; headers are at most 4 characters, columns 1 space apart
 
 
@@ -20,13 +22,13 @@ def _exp(eta: float) -> str:
 def margin(m: float | None) -> str:
     """A rank's margin from the cut-off as ×factor ('—': nothing near it)."""
     if m is None:
-        return "—"
+        return DASH
     return f"×{m:.2g}" if m < 100 else f"×{m:.0e}".replace("e+0", "e")
 
 
 def _block(title: str | None) -> Table:
-    t = Table(title=title, title_justify="left", header_style="bold", box=box.SIMPLE_HEAD,
-              pad_edge=False, padding=(0, 0), show_edge=False, collapse_padding=True)
+    t = titled(title, box=box.SIMPLE_HEAD, pad_edge=False, padding=(0, 0), show_edge=False,
+               collapse_padding=True)
     t.add_column("#", justify="right", min_width=2)
     return t
 
@@ -56,14 +58,9 @@ def observability_table(s: dict) -> Table:
     b.add_row("all", *(_exp(last["degree"][n]) for n in rest))
     margins = " ".join(f"{i + 1}:{margin(seg.get('rank_margin'))}"  # a pair never split
                         for i, (seg, _) in enumerate(rows))
-    outer = Table(
-        title=f"gcalign observability: {s['scenario']} — {s['measure']} matching, scaling "
-        f"{s['scaling']}, {len(rows)} segments in {s['piece_s']:g} s pieces",
-        title_justify="left", box=None, show_header=False, padding=(0, 0))
-    outer.add_column()
-    outer.add_row(a)
-    outer.add_row(b)
-    outer.caption = (
+    return stacked(
+        f"gcalign observability: {s['scenario']} — {s['measure']} matching, scaling "
+        f"{s['scaling']}, {len(rows)} segments in {s['piece_s']:g} s pieces", (a, b),
         "cells: log10 of the degree η = σ_(k)/σ_0 (seed eq. 17; σ_0 the measured states' "
         "largest singular value), rounded: −3 ≈ 1e-3; · = 0 (unobservable, or below the rank "
         f"tolerance {s['rank_rtol']:g}·σ_max). rank, TOM: the segment's SOM and TOM ranks; "
@@ -73,6 +70,4 @@ def observability_table(s: dict) -> Table:
         f"or of the units): {margins}; whole run {margin(last.get('rank_margin'))}.\n"
         "The values, eq. 12's null-space residual and the covariance degree σ(0)/σ(t) are in "
         f"--json and the results file. Compute {s['compute_s']:.2f} s; output "
-        f"{s.get('output') or '—'}")
-    outer.caption_justify = "left"
-    return outer
+        f"{s.get('output') or DASH}")

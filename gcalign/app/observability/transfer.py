@@ -18,7 +18,7 @@ from typing import Any
 
 import h5py
 
-from gcalign.app.align.transfer import DECIMALS, display, write_display
+from gcalign.app.align.transfer import DECIMALS, GROUP_ENDS, display, write_display
 from gcalign.app.command import DOUBLE, Cost, Outcome
 from gcalign.io.results import put
 
@@ -119,10 +119,6 @@ def write(f: h5py.File, obs, result) -> None:
 
 # -- table and figures (rich and matplotlib loaded by the caller's import of this module) --
 
-def _sci(x: float) -> str:
-    return "0" if x == 0 else f"{x:.1e}"
-
-
 def _ratio(x: float) -> str:
     """σ0/σ with one decimal (1.0: nothing learnt), scientific from 10⁴."""
     return f"{x:.1f}" if x < 1e4 else f"{x:.1e}"
@@ -131,31 +127,26 @@ def _ratio(x: float) -> str:
 def table(s: dict):
     """One row per state: σ0, σ at the end (display units), σ0/σ, the whole run's degree η
     and separation."""
-    from rich.table import Table
-
     from gcalign.app.observability.tables import margin
+    from gcalign.app.report import DASH, titled
 
     last = s["cumulative"][-1]
-    t = Table(title=f"gcalign observability: {s['scenario']} — transfer alignment, "
-              f"{s['matching']} matching, scaling {s['scaling']}, {s['pieces']} pieces of "
-              f"{s['piece_s']:g} s in {len(s['segments'])} windows of {s['window_s']:g} s",
-              title_justify="left", header_style="bold")
-    for head in ("state", "unit", "σ0", "σ end", "σ0/σ", "η", "sep."):
-        t.add_column(head, justify="left" if head in ("state", "unit") else "right")
+    t = titled(f"gcalign observability: {s['scenario']} — transfer alignment, "
+               f"{s['matching']} matching, scaling {s['scaling']}, {s['pieces']} pieces of "
+               f"{s['piece_s']:g} s in {len(s['segments'])} windows of {s['window_s']:g} s",
+               ("state", "unit"), ("σ0", "σ end", "σ0/σ", "η", "sep."))
     unobs = set(s["unobservable"])
     for name in s["covariance_states"]:
         k, unit = s["display_scale"][name], s["display_units"][name]
         d = DECIMALS[unit]
         eta = last["degree"].get(name)
         sep = s["separation"].get(name)
-        eta_text = ("—" if eta is None else "n/a" if eta == 0 and name not in unobs
-                    else _sci(eta))
+        eta_text = (DASH if eta is None else f"{eta:.1e}" if eta != 0 else "0" if name in unobs
+                    else "n/a")
         t.add_row(name + (" ·" if name in unobs else ""), unit,
                   f"{s['sigma0'][name] * k:.{d}f}", f"{s['sigma_final'][name] * k:.{d}f}",
                   _ratio(s["covariance_degree_final"][name]), eta_text,
-                  "—" if sep is None else f"{sep:.1e}")
-        if name in ("phiU", "dvU", "ebz", "dbz", "muz", "thz"):
-            t.add_section()
+                  DASH if sep is None else f"{sep:.1e}", end_section=name in GROUP_ENDS)
     w = s["weakest"]
     parts = sorted(((v, n) for n, v in w["vector"].items() if abs(v) >= 0.05),
                    key=lambda p: -abs(p[0]))
@@ -176,10 +167,9 @@ def table(s: dict):
         "(0: a combination of them; unchanged by P0 and units). θ, ω (flexure, a "
         "noise-driven Markov process): σ only.",
         f"Per window and cumulative: --json, the results file, gcalign plot. Compute "
-        f"{s['compute_s']:.2f} s; output {s.get('output') or '—'}",
+        f"{s['compute_s']:.2f} s; output {s.get('output') or DASH}",
     ]
     t.caption = "\n".join(notes)
-    t.caption_justify = "left"
     return t
 
 

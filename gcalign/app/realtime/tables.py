@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from rich.table import Table
+from rich.table import Column, Table
 from rich.text import Text
 
-from gcalign.app.report import run_line
+from gcalign.app.report import DASH, run_line, stacked, titled
 
 REFERENCE_TEXT = {
     "seed": "the INS's own output T after the pulse (the seed's semi-physical reference)",
@@ -14,7 +14,7 @@ REFERENCE_TEXT = {
 
 
 def _a(x, digits: int = 3) -> str:
-    return "—" if x is None else f"{x:.{digits}f}"
+    return DASH if x is None else f"{x:.{digits}f}"
 
 
 def _before(c: dict) -> str:
@@ -27,13 +27,13 @@ def _theory(c: dict) -> str:
     if c["motion"] == "accel":
         return f"{_a(c['before_theory_arcsec_per_s'], 1)}″/s"
     v = c.get("before_theory_arcsec")
-    return "—" if v is None else f"{v:.1f}″"
+    return DASH if v is None else f"{v:.1f}″"
 
 
 def _tdelay(c: dict, T_ms: float) -> str:
     lo, hi = c["dt_us"]["min"], c["dt_us"]["max"]
     if lo is None:
-        return "—"
+        return DASH
     if hi - lo < 1e-3:
         return f"{T_ms + lo * 1e-3:.3f}"
     return f"{T_ms + lo * 1e-3:.1f}–{T_ms + hi * 1e-3:.1f}"
@@ -41,11 +41,7 @@ def _tdelay(c: dict, T_ms: float) -> str:
 
 def _cases(title: str, *columns: str) -> Table:
     """A table of one row per case: its name, then `columns` of numbers."""
-    table = Table(title=title, title_justify="left", header_style="bold")
-    table.add_column("case", justify="left", no_wrap=True)
-    for name in columns:
-        table.add_column(name, justify="right")
-    return table
+    return titled(title, [Column("case", no_wrap=True)], columns)
 
 
 def realtime_table(s: dict) -> Table:
@@ -64,9 +60,9 @@ def realtime_table(s: dict) -> Table:
                    f"truth: max ({' / '.join(after)})")
 
     for c in s["cases"]:
-        before.add_row(Text(c["name"]), _tdelay(c, T), c["seed_before"] or "—", _before(c),
+        before.add_row(Text(c["name"]), _tdelay(c, T), c["seed_before"] or DASH, _before(c),
                        _theory(c))
-        cells = [Text(c["name"]), c["seed_after"] or "—"]
+        cells = [Text(c["name"]), c["seed_after"] or DASH]
         for p in after:
             cells.append(f"{_a(c['after_max_arcsec'][p])} ({_a(c['after_rms_arcsec'][p])})")
         cells.append(" / ".join(_a(c["truth"]["after_max_arcsec"][p], 2) for p in after))
@@ -75,17 +71,10 @@ def realtime_table(s: dict) -> Table:
         if cm:  # the ramp's corners, where the seed's bound does not hold: max only
             later.add_row(Text(f"  corners ±{s['corner_ms']:g} ms", style="dim"), "",
                           *(_a(cm[p]) for p in after), "")
-    table = Table.grid(padding=(1, 0))
-    table.title = (f"gcalign realtime: {s['scenario']} — {setting}; the designed chain's own "
-                   f"delay {s['chain_delay_ms']:.4f} ms (FIR {s['fir_delay_ms']:.3f} ms + "
-                   f"notch {s['notch_delay_us']:.2f} µs)")
-    table.title_justify = "left"
-    table.add_row(before)
-    table.add_row(later)
     m = s["model"]
     truth = " / ".join(after)
     lags = [f"{c['name']} {c['lag_ms']:.3f} ms" for c in s["cases"] if c.get("lag_ms")]
-    table.caption = (
+    notes = (
         f"″ of the turned Euler angle against {REFERENCE_TEXT[s['reference']]}"
         + (f" (truth: {truth} against the true attitude at the pulse time)"
            if s["reference"] != "truth" else "") + f", after "
@@ -98,5 +87,6 @@ def realtime_table(s: dict) -> Table:
         + (f"INS lag behind the table at uniform rate (seed Fig. 4: 4.4 ms): "
            f"{'; '.join(lags)}. " if lags else "")
         + "\n" + run_line(s, f"compute ({len(s['cases'])} cases)"))
-    table.caption_justify = "left"
-    return table
+    return stacked(f"gcalign realtime: {s['scenario']} — {setting}; the designed chain's own "
+                   f"delay {s['chain_delay_ms']:.4f} ms (FIR {s['fir_delay_ms']:.3f} ms + "
+                   f"notch {s['notch_delay_us']:.2f} µs)", (before, later), notes, padding=(1, 0))

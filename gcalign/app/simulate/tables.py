@@ -4,11 +4,7 @@ from __future__ import annotations
 
 from rich.table import Table
 
-from gcalign.app.report import DASH, angles, kv_table, numbers, run_line, span
-
-
-def _vec(values, **kw) -> str:
-    return DASH if values is None else "  ".join(numbers(values, **kw))
+from gcalign.app.report import DASH, angles, kv_table, run_line, span, vector
 
 
 def simulate_table(s: dict) -> Table:
@@ -22,14 +18,13 @@ def simulate_table(s: dict) -> Table:
          DASH if att0 is None else "  ".join(angles(att0, "deg"))),
         ("final attitude (pitch, roll, yaw) (deg)",
          DASH if att1 is None else "  ".join(angles(att1, "deg"))),
-        ("final velocity ENU (m/s)", _vec(s["final_velocity_mps"], **metric)),
-        ("distance travelled (m)", _vec(None if s["distance_m"] is None else
-                                        [s["distance_m"]], **metric)),
-        ("height range (m)", _vec(s.get("height_range_m"), **metric)),
-        ("final displacement ENU (m)", _vec(s.get("final_displacement_m"), **metric)),
+        ("final velocity ENU (m/s)", vector(s["final_velocity_mps"], **metric)),
+        ("distance travelled (m)", vector(None if s["distance_m"] is None else
+                                          [s["distance_m"]], **metric)),
+        ("height range (m)", vector(s.get("height_range_m"), **metric)),
+        ("final displacement ENU (m)", vector(s.get("final_displacement_m"), **metric)),
     ]
     table = kv_table(f"gcalign simulate: {s['scenario']} (earth {s.get('earth', 'wgs84')})",
                      rows, ("", "value"))
     table.caption = run_line(s, "compute (simulation and writing)")
-    table.caption_justify = "left"
     return table
