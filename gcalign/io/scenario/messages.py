@@ -9,13 +9,16 @@ import reprlib
 from pydantic import ValidationError
 
 from gcalign.errors import clip
-from gcalign.io.scenario.motion import MOTION_KINDS
 from gcalign.io.scenario.walk import keys_at
 
 # Model-level checks name their field at the start of the message ("segments: ..."),
 # since pydantic gives them the model's location only.
 _FIELD_PREFIX = re.compile(r"^([a-z_0-9]+(?:\.[a-z_0-9]+)*): ")
 
+
+#: The tags of the discriminated motion union (``kind`` of gcalign.io.scenario.motion's
+#: models), here since the models' own refusals use this module (motion imports the base).
+MOTION_KINDS = ("static", "swing", "moving", "turntable", "flight")
 
 # Location parts that name a member of a union type, not a key the user wrote (also the
 # tags of the discriminated motion union).
@@ -38,10 +41,10 @@ def cut(value) -> str:
 
 
 def scenario_errors(err: ValidationError, source: str = "", root: type | None = None,
-                    whole: str = "scenario") -> str:
+                    whole: str = "scenario", at: str = "") -> str:
     """One line per invalid field: ``source: field: what is wrong, got VALUE``; an unknown
     key lists the keys of its mapping in `root` (the model that was validated: the
-    `whole` scenario, or a sweep).
+    `whole` scenario, or a sweep; or its section at the dotted key `at`).
 
     Pydantic reports every failed member of a union (``float | 'measured'``) separately;
     those become one line whose alternatives are joined by "or".
@@ -49,7 +52,8 @@ def scenario_errors(err: ValidationError, source: str = "", root: type | None = 
     by_field: dict[str, list[str]] = {}
     got_of: dict[str, str] = {}
     for e in err.errors():
-        loc = [str(x) for x in e["loc"] if not _UNION_TAG.match(str(x))]
+        loc = [*filter(None, at.split(".")),
+               *(str(x) for x in e["loc"] if not _UNION_TAG.match(str(x)))]
         msg = e["msg"].removeprefix("Value error, ")
         m = _FIELD_PREFIX.match(msg)
         if m:
