@@ -184,8 +184,13 @@ def test_a_grid_key_that_cannot_matter_is_a_warning_of_validate_and_batch(tmp_pa
 
 
 def test_bad_sweep_keys_and_options(tmp_path):
+    has = "the sweep has: name, base, command, cases, grid, seeds, seed_start, metrics"
     res = batch_cli(write_sweep(tmp_path, frobnicate=1))
-    assert res.exit_code == 2 and "frobnicate: unknown key" in res.stderr
+    assert res.exit_code == 2 and f"frobnicate: unknown key; {has}" in res.stderr
+    with pytest.raises(ScenarioError) as err:  # the misspelt key is named, not the base
+        sweep_from_mapping({"bse": "s.yaml", "grid": {}, "Seeds": 2}, "sw.yaml")
+    assert str(err.value).splitlines() == [f"sw.yaml: bse: unknown key; {has}",
+                                           f"sw.yaml: Seeds: unknown key; {has}"]
     res = batch_cli(write_sweep(tmp_path, seeds=0))
     assert res.exit_code == 2 and "seeds: must be a whole number" in res.stderr
     res = batch_cli(write_sweep(tmp_path), "--workers", 0)
@@ -225,11 +230,11 @@ def test_cases_are_crossed_with_the_grid_and_applied_first(tmp_path):
 
 @pytest.mark.parametrize(("cases", "grid", "message"), [
     ({"q": {"imu.gyro.arw": 0}}, GRID, "cases: q: imu.gyro.arw = 0: imu.gyro.arw: unknown key"),
-    ({"q": [1]}, GRID, "cases: q: must be a mapping"),
+    ({"q": [1]}, GRID, "cases.q: must be a mapping"),
     ([], GRID, "cases: must be a non-empty mapping"),
     ({"q": {"align.stages.0.passes": 4}}, GRID,
      "cases: q: align.stages: mode 'full-cycle' needs an odd number"),
-    ({"q": {}}, {"case": ["a"]}, "grid: case: reserved"),
+    ({"q": {}}, {"case": ["a"]}, "grid.case: reserved"),
 ])
 def test_bad_cases_exit_2_before_any_run(tmp_path, cases, grid, message):
     out = tmp_path / "o.h5"

@@ -236,6 +236,37 @@ def test_long_runs_are_stored_at_the_output_rate_and_summed_increments_are_refus
     assert json.loads(res.stdout)["vertical"] == "hold"
 
 
+def test_a_bad_stored_sample_interval_is_refused_in_one_wording_by_every_reader(tmp_path):
+    """The /imu interval of a simulate file (every sample, or summed) is checked once: the
+    figures' reader and navigation's say the same line (navigation divided by a zero
+    interval before: an internal error)."""
+    import shutil
+
+    from gcalign.errors import ScenarioError
+    from gcalign.io.results import imu_series, read_imu
+
+    sim, bad = tmp_path / "sim.h5", tmp_path / "bad.h5"
+    sc = dict(SCENARIO, motion={**SCENARIO["motion"], "duration_s": 1})
+    res = runner.invoke(app, ["simulate", str(write(tmp_path, sc)), "-o", str(sim)])
+    assert res.exit_code == 0, res.output
+    for ts, got in ((0.0, "0.0"), (float("nan"), "nan"), ("fast", "'fast'"), (None, "nothing")):
+        for summed in (False, True):
+            shutil.copy(sim, bad)
+            with h5py.File(bad, "a") as f:
+                f["imu"].attrs.pop("ts") if ts is None else f["imu"].attrs.create("ts", ts)
+                if summed:
+                    f["imu"].attrs["summed_from_ts"] = 0.01
+            line = (f"{bad}: /imu attribute 'ts' (sample interval, s) must be a positive "
+                    f"number, got {got}")
+            for read in (imu_series, read_imu):
+                with pytest.raises(ScenarioError) as err:
+                    read(bad)
+                assert str(err.value) == line, (ts, summed, read)
+    res = runner.invoke(app, ["navigate", str(bad), "-o", str(tmp_path / "n.h5")])
+    assert (res.exit_code, res.stderr.strip()) == (2, f"error: {line}")
+    assert not (tmp_path / "n.h5").exists()
+
+
 def test_output_rate_must_divide_the_imu_rate(tmp_path):
     sc = dict(SCENARIO, output={"rate_hz": 3})
     res = runner.invoke(app, ["navigate", str(write(tmp_path, sc)), "-o", str(tmp_path / "n.h5")])

@@ -165,7 +165,11 @@ BY_NAME = {c.name: c for c in CASES}
     ("CSV 90 s gap", r"d\.csv:1002: time jumps from 10(\.0)? to 100\.01 s"),
     ("PSINS header latitude 90", r"d\.imu: header row 2 field 1 \(latitude, deg\)"),
     ("navigate on results file: NaN rows", r"d\.h5: /imu: row 101: dtheta must be finite"),
-    ("navigate on results file: ts 0", r"d\.h5: /imu: sample interval must lie in"),
+    ("navigate on results file: ts 0",
+     r"d\.h5: /imu attribute 'ts' \(sample interval, s\) must be a positive number, got 0\.0$"),
+    ("navigate on results file: ts missing",
+     r"d\.h5: /imu attribute 'ts' \(sample interval, s\) must be a positive number, got nothing$"),
+    ("navigate on results file: ts 1e300", r"d\.h5: /imu: sample interval must lie in"),
     ("long bad value", r"align\.mode: .*got 'm{60,90}\.\.\.'$"),
     ("--seed -5", r"--seed: must be a whole number within \[0, 2\^63\), got -5$"),
 ])

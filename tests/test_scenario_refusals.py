@@ -71,6 +71,11 @@ def test_a_velocity_aiding_file_refuses_a_mat_variable_too():
     ("align.t2_s", math.nan, "align.t2_s: Input should be a finite number, got nan"),
     ("imu.gyro.bias_dph", [math.nan, 0, 0], "imu.gyro.bias_dph.0: Input should be a finite"),
     ("align.stages.0.xi", 2.0, "align.stages.0.xi: Input should be less than 1, got 2"),
+    # a section's own check and a union name the key as a file's error does
+    ("align.t2_s", 5.0, "align.t2_s: must be greater than t1_s (10.0 s), got 5.0"),
+    ("align.t3_s", math.nan, "align.t3_s: Input should be a finite number or Input should be "
+     "'measured', got nan"),
+    ("output.rate_hz", -2, "output.rate_hz: must be > 0 or 'full', got -2"),
 ])
 def test_an_assignment_in_the_python_api_is_refused_as_a_scenario_error(key, value, message):
     sc = gcalign.load(ROOT / "configs" / "seed000_moving_conventional.yaml")
@@ -95,3 +100,15 @@ def test_a_recording_scenario_without_its_section_runs_as_the_recording_alone(tm
     a, b = json.loads(by_file.stdout), json.loads(alone.stdout)
     assert a["attitude_t3_deg"] == b["attitude_t3_deg"]
     assert a["attitude_t3_deg"][2] == pytest.approx(-90.6, abs=0.05)  # DESIGN: −90.58…−90.62°
+
+
+def test_the_messages_know_the_tag_of_every_motion_kind():
+    """The formatter drops the motion union's tag from an error's location
+    (``motion.duration_s``, not ``motion.static.duration_s``): it must know every kind."""
+    from typing import get_args
+
+    from gcalign.io.scenario.messages import MOTION_KINDS
+    from gcalign.io.scenario.motion import MotionModel
+
+    arms = get_args(get_args(MotionModel)[0])
+    assert MOTION_KINDS == tuple(get_args(a.model_fields["kind"].annotation)[0] for a in arms)

@@ -851,21 +851,29 @@ def _vector_attr(g, name: str, path: Path, n: int = 3) -> np.ndarray | None:
     return a
 
 
+def _imu_group(f: h5py.File, path: Path) -> tuple[h5py.Group, float]:
+    """The ``/imu`` group of a results file and its sample interval (s); ScenarioError when
+    the group is missing or its attribute ``ts`` is not a positive number."""
+    g = f.get("imu")
+    if not isinstance(g, h5py.Group):
+        raise ScenarioError(f"{path}: holds no /imu group (write one with 'gcalign simulate')")
+    ts = g.attrs.get("ts")
+    try:
+        ts = float(np.asarray(ts).reshape(()))
+    except (TypeError, ValueError):
+        pass
+    if not (isinstance(ts, float) and math.isfinite(ts) and ts > 0):
+        raise ScenarioError(f"{path}: /imu attribute 'ts' (sample interval, s) must be a "
+                            f"positive number, got {_short(ts) if 'ts' in g.attrs else 'nothing'}")
+    return g, ts
+
+
 def imu_series(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, str]:
     """``(t, dtheta, dv, ts, frame)`` of the ``/imu`` group for a figure (decimated sums
     allowed, unlike :func:`read_imu`); ScenarioError naming the dataset or attribute when
     they are missing, not numbers or of mismatched shapes."""
     with open_results(path) as f:
-        g = f["imu"] if "imu" in f and isinstance(f["imu"], h5py.Group) else None
-        if g is None:
-            raise ScenarioError(f"{path}: holds no /imu group")
-        try:
-            ts = float(np.asarray(g.attrs["ts"]).reshape(()))
-        except (KeyError, TypeError, ValueError):
-            raise ScenarioError(f"{path}: /imu attribute 'ts' (sample interval, s) must be a "
-                                f"number, got {_short(g.attrs.get('ts'))}") from None
-        if not (math.isfinite(ts) and ts > 0):
-            raise ScenarioError(f"{path}: /imu attribute 'ts' must be positive, got {ts!r}")
+        g, ts = _imu_group(f, path)
         t, dtheta, dv = (_dataset(g, k, path) for k in ("t", "dtheta", "dv"))
         n = len(t) if t.ndim == 1 else -1
         for k, a, shape in (("t", t, (n,)), ("dtheta", dtheta, (n, 3)), ("dv", dv, (n, 3))):
@@ -899,16 +907,7 @@ def read_imu(path: Path) -> ImuData:
 
     scenario = read_scenario(path)
     with open_results(path) as f:
-        if "imu" not in f or not isinstance(f["imu"], h5py.Group):
-            raise ScenarioError(f"{path}: holds no /imu group (write one with 'gcalign simulate')")
-        g = f["imu"]
-        if "ts" not in g.attrs:
-            raise ScenarioError(f"{path}: /imu attribute 'ts' (sample interval, s) missing")
-        try:
-            ts = float(np.asarray(g.attrs["ts"]).reshape(()))
-        except (TypeError, ValueError):
-            raise ScenarioError(f"{path}: /imu attribute 'ts' must be a number, got "
-                                f"{_short(g.attrs['ts'])}") from None
+        g, ts = _imu_group(f, path)
         if "summed_from_ts" in g.attrs:
             raise ScenarioError(
                 f"{path}: /imu holds increments summed to {1 / ts:g} Hz "

@@ -29,7 +29,7 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 from gcalign.app.batch.overrides import apply_override
 from gcalign.errors import ScenarioError, clip
 from gcalign.io.scenario.base import Model
-from gcalign.io.scenario.messages import _cut
+from gcalign.io.scenario.messages import cut, scenario_errors
 from gcalign.io.scenario.recording import absolute_paths
 from gcalign.limits import SEED_MAX
 
@@ -41,7 +41,6 @@ def batchable() -> dict[str, tuple[str, ...]]:
     return {name: c.options.batch_metrics for name, c in registered().items()}
 
 
-SWEEP_KEYS = ("name", "base", "command", "cases", "grid", "seeds", "seed_start", "metrics")
 CASE_KEY = "case"  # the pseudo grid key of a variant's case (not a scenario key)
 
 
@@ -116,7 +115,7 @@ def load_sweep(path: Path) -> Sweep:
 
 def _whole(v: Any, least: int, what: str) -> int:
     if isinstance(v, bool) or not isinstance(v, int) or v < least:
-        raise ValueError(f"must be a whole number ≥ {least}{what}, got {_cut(v)}")
+        raise ValueError(f"must be a whole number ≥ {least}{what}, got {cut(v)}")
     return v
 
 
@@ -135,11 +134,8 @@ class SweepFile(Model):
 
     @model_validator(mode="before")
     @classmethod
-    def _keys(cls, data: Any) -> Any:
-        for k in data:
-            if k not in SWEEP_KEYS:
-                raise ValueError(f"{k}: unknown key (a sweep has: {', '.join(SWEEP_KEYS)})")
-        if "base" not in data:
+    def _base_given(cls, data: Any) -> Any:
+        if "base" not in data and set(data) <= set(cls.model_fields):  # else: name the unknown key
             raise ValueError("base: missing; give a scenario file (relative to the sweep "
                              "file) or an inline scenario mapping")
         return data
@@ -148,7 +144,7 @@ class SweepFile(Model):
     @classmethod
     def _word(cls, v: Any) -> Any:
         if v is not None and (not isinstance(v, str) or not v or any(c in v for c in "/\\ \t")):
-            raise ValueError(f"must be a non-empty word (used in file names), got {_cut(v)}")
+            raise ValueError(f"must be a non-empty word (used in file names), got {cut(v)}")
         return v
 
     @field_validator("base", mode="before")
@@ -156,7 +152,7 @@ class SweepFile(Model):
     def _base(cls, v: Any) -> Any:
         if not isinstance(v, (str, dict)):
             raise ValueError(f"must be a scenario file name or a mapping, got "
-                             f"{type(v).__name__} {_cut(v)}")
+                             f"{type(v).__name__} {cut(v)}")
         return v
 
     @field_validator("seeds", mode="before")
@@ -177,13 +173,13 @@ class SweepFile(Model):
         v = [v] if isinstance(v, str) else v
         if not isinstance(v, list) or not v:
             raise ValueError("must be a non-empty list of dotted paths into the run summary "
-                             f"(e.g. [error_t3_deg]), got {_cut(v)}")
+                             f"(e.g. [error_t3_deg]), got {cut(v)}")
         for m in v:
             if not isinstance(m, str) or not m or "/" in m or "" in m.split("."):
-                raise ValueError(f"{_cut(m)} is not a dotted path (e.g. error_t3_deg, "
+                raise ValueError(f"{cut(m)} is not a dotted path (e.g. error_t3_deg, "
                                  "passes.2.error_deg)")
         if len(set(v)) != len(v):
-            raise ValueError(f"{_cut(v)} names a metric twice")
+            raise ValueError(f"{cut(v)} names a metric twice")
         return v
 
     @field_validator("grid", mode="before")
@@ -197,7 +193,7 @@ class SweepFile(Model):
         axes = {}
         for key, values in v.items():
             if not isinstance(key, str) or not key:
-                raise ValueError(f"{_cut(key)}: keys must be dotted paths (e.g. align.mode)")
+                raise ValueError(f"{cut(key)}: keys must be dotted paths (e.g. align.mode)")
             if key == CASE_KEY:
                 raise ValueError(f"{CASE_KEY}: reserved for the names of the sweep's cases; "
                                  "give settings under 'cases:'")
@@ -207,7 +203,7 @@ class SweepFile(Model):
             seen = [json.dumps(x, sort_keys=True, default=str) for x in values]
             for i, text in enumerate(seen):
                 if text in seen[:i]:
-                    raise ValueError(f"{key}: value {_cut(values[i])} appears twice")
+                    raise ValueError(f"{key}: value {cut(values[i])} appears twice")
             axes[key] = values
         return axes
 
@@ -219,18 +215,18 @@ class SweepFile(Model):
             return {}
         if not isinstance(v, dict) or not v:
             raise ValueError("must be a non-empty mapping of case name -> overrides (dotted "
-                             f"key -> value), got {_cut(v)}")
+                             f"key -> value), got {cut(v)}")
         out: dict[str, dict] = {}
         for name, over in v.items():
             if not isinstance(name, str) or not name.strip():
-                raise ValueError(f"{_cut(name)}: a case name must be a non-empty string")
+                raise ValueError(f"{cut(name)}: a case name must be a non-empty string")
             over = {} if over is None else over
             if not isinstance(over, dict):
                 raise ValueError(f"{name}: must be a mapping of dotted key -> value (or "
-                                 f"empty), got {_cut(over)}")
+                                 f"empty), got {cut(over)}")
             for key in over:
                 if not isinstance(key, str) or not key:
-                    raise ValueError(f"{name}: {_cut(key)}: keys must be dotted paths (e.g. "
+                    raise ValueError(f"{name}: {cut(key)}: keys must be dotted paths (e.g. "
                                      "imu.gyro.arw_dprh)")
             out[name] = dict(over)
         return out
@@ -244,18 +240,6 @@ class SweepFile(Model):
         return self
 
 
-def _errors(err: ValidationError, source: str) -> str:
-    """One line per error: ``source: key: what is wrong`` (a validator's message may name a
-    part of the key first: ``cases: q: must be a mapping ...``)."""
-    lines = []
-    for e in err.errors():
-        msg = e["msg"].removeprefix("Value error, ")
-        if e["type"] != "value_error":
-            msg += f", got {_cut(e.get('input'))}"
-        lines.append(": ".join([source, *(str(x) for x in e["loc"][:1]), msg]))
-    return "\n".join(lines)
-
-
 def _read_base(spec: SweepFile, source: str, base_dir: Path) -> tuple[dict, str, str, Path]:
     """The base scenario's mapping (``imu_file`` made absolute), source and text, and the
     folder its relative paths start from."""
@@ -267,7 +251,7 @@ def _read_base(spec: SweepFile, source: str, base_dir: Path) -> tuple[dict, str,
     if isinstance(base, str):
         path = (base_dir / base) if not Path(base).is_absolute() else Path(base)
         if not path.is_file():
-            raise ScenarioError(f"{source}: base: {_cut(base)}: file not found ({path})")
+            raise ScenarioError(f"{source}: base: {cut(base)}: file not found ({path})")
         data, where, text, folder = read_yaml(path), str(path), path.read_text(
             encoding="utf-8"), path.parent
     else:
@@ -290,7 +274,7 @@ def _command_of(spec: SweepFile, base_data: Any, source: str) -> str:
         command = has[0] if has else "align"
     if command not in commands:
         raise ScenarioError(f"{source}: command: must be one of {', '.join(commands)}, "
-                            f"got {_cut(command)}")
+                            f"got {cut(command)}")
     return str(command)
 
 
@@ -312,7 +296,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     try:
         spec = SweepFile.model_validate(data)
     except ValidationError as err:
-        raise ScenarioError(_errors(err, source)) from None
+        raise ScenarioError(scenario_errors(err, source, SweepFile, "sweep")) from None
     text = text if text is not None else yaml.safe_dump(data, sort_keys=False)
     base_data, base_source, base_text, _ = _read_base(spec, source, Path(base_dir or "."))
     base_model = parse_scenario(base_data, base_source)
@@ -337,7 +321,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
             try:
                 apply_override(scenario, key, value, base_model)
             except ScenarioError as err:
-                at = f"{where}: {key} = {_cut(value)}" if name_key else where
+                at = f"{where}: {key} = {cut(value)}" if name_key else where
                 raise ScenarioError(f"{at}: {err}") from None
         return scenario, _check_section(parse_scenario(scenario, where), command, where)
 
@@ -347,7 +331,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
         variant(over.items(), f"{source}: cases: {case}", name_key=True)
     for key, values in axes.items():
         for value in values:
-            variant([(key, value)], f"{source}: grid: {key} = {_cut(value)}")
+            variant([(key, value)], f"{source}: grid: {key} = {cut(value)}")
 
     # Then every combination (a value may be valid alone but not with another one). A case's
     # overrides are applied first, then the grid's.
@@ -357,7 +341,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     variants, unused = [], {}
     for i, combo in enumerate(itertools.product(*(axes[k] for k in keys))):
         overrides = dict(zip(keys, combo, strict=True))
-        label = ", ".join(f"{k} = {_cut(v)}" for k, v in overrides.items())
+        label = ", ".join(f"{k} = {cut(v)}" for k, v in overrides.items())
         applied = [*cases.get(str(overrides.get(CASE_KEY)), {}).items(),
                    *((k, v) for k, v in overrides.items() if k != CASE_KEY)]
         scenario, lines = variant(applied, f"{source}: grid: variant {label}")
@@ -377,7 +361,7 @@ def _check_section(sc, command: str, where: str) -> list[str]:
 
     section = getattr(sc, command, None)
     if section is None and command != "align":
-        raise ScenarioError(f"{where}: {command}: missing; command {_cut(command)} needs a "
+        raise ScenarioError(f"{where}: {command}: missing; command {cut(command)} needs a "
                             f"'{command}' section in the base scenario")
     try:
         preflight(sc, command, read_recorded=False)

@@ -16,7 +16,7 @@ count is the sum of the stages' ``passes``. Two kinds of keys that cannot matter
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -32,11 +32,14 @@ from gcalign.io.scenario.base import Model, Vec3, vector
 DEFAULT_PASSES = {"conventional": 1, "full-cycle": 5, "half-cycle": 5}
 
 
-def _removed(data, key: str, instead: str):
-    """A key that was dropped: say what replaced it (pydantic would say 'unknown key')."""
-    if isinstance(data, dict) and key in data:
-        raise ValueError(f"{key}: removed; {instead}")
-    return data
+def _removed(key: str, instead: str) -> Any:
+    """A model's check of a key that was dropped: say what replaced it (pydantic would say
+    'unknown key')."""
+    def check(cls, data):
+        if isinstance(data, dict) and key in data:
+            raise ValueError(f"{key}: removed; {instead}")
+        return data
+    return model_validator(mode="before")(check)
 
 
 class Coarse(Model):
@@ -46,11 +49,8 @@ class Coarse(Model):
     offset_deg: Vec3 = vector(description="methods analytic and inertial: added to their "
                               "result (studies of the initial error on recorded data)")
 
-    @model_validator(mode="before")
-    @classmethod
-    def _one_window(cls, data):
-        return _removed(data, "duration_s", "the coarse window is [start_s, t1_s]: set "
-                        "align.t1_s (and align.start_s for a later window)")
+    _one_window = _removed("duration_s", "the coarse window is [start_s, t1_s]: set "
+                           "align.t1_s (and align.start_s for a later window)")
 
     @model_validator(mode="after")
     def _one_error_key(self):
@@ -141,11 +141,8 @@ class AlignConfig(Model):
     stages: list[StageModel] = Field(default_factory=lambda: [StageModel()], min_length=1)
     transfer: transfer_section.TransferConfig | None = None  # mode transfer (spec 006)
 
-    @model_validator(mode="before")
-    @classmethod
-    def _one_pass_count(cls, data):
-        return _removed(data, "passes", "the pass count is the sum of the stages' passes: "
-                        "set align.stages.N.passes on the last stage (or --passes N)")
+    _one_pass_count = _removed("passes", "the pass count is the sum of the stages' passes: "
+                               "set align.stages.N.passes on the last stage (or --passes N)")
 
     @model_validator(mode="after")
     def _timeline(self):

@@ -138,8 +138,9 @@ class Model(BaseModel):
         try:
             super().__setattr__(name, value)
         except ValidationError as err:
-            prefix = f"{self._where}." if self._where else ""
-            raise ScenarioError("; ".join(prefix + _one_line(e) for e in err.errors())
+            from gcalign.io.scenario.messages import scenario_errors  # imports the models
+
+            raise ScenarioError(scenario_errors(err, at=self._where).replace("\n", "; ")
                                 ) from None
         locate(getattr(self, name), prefix_of(self._where, name))
 
@@ -161,17 +162,6 @@ class Model(BaseModel):
                 raise ValueError(f"{name}: a number written as text ({clip(text, 40)!r}, quoted "
                                  "or tagged !!str in the YAML); write the number itself")
         return data
-
-
-def _one_line(e: Any) -> str:
-    """One pydantic error of an assignment as ``key: what is wrong, got VALUE`` (the file's
-    errors have :func:`gcalign.io.scenario.messages.scenario_errors`, which imports the
-    models)."""
-    where = ".".join(str(x) for x in e["loc"])
-    msg = str(e["msg"]).removeprefix("Value error, ")
-    got = "" if e["type"] in ("missing", "model_type", "value_error") else (
-        f", got {clip(repr(e.get('input')), 60)}")
-    return f"{where}: {msg}{got}"
 
 
 def prefix_of(where: str, name: str) -> str:

@@ -20,7 +20,7 @@ from gcalign import limits
 from gcalign.errors import ScenarioError
 from gcalign.io.paths import not_a_file
 from gcalign.io.scenario.base import locate
-from gcalign.io.scenario.messages import CUT, _cut, scenario_errors
+from gcalign.io.scenario.messages import CUT, cut, scenario_errors
 from gcalign.io.scenario.models import Scenario
 
 
@@ -76,7 +76,7 @@ def check_nodes(root, source: str) -> None:
                     ident = (k.tag, k.value)
                     if ident in seen:
                         raise ScenarioError(
-                            f"{source}: {_mark(k)}: key {_cut(k.value)} given twice in one "
+                            f"{source}: {_mark(k)}: key {cut(k.value)} given twice in one "
                             f"mapping (first at {_mark(seen[ident])}); remove one")
                     seen[ident] = k
         stack.append((node, True))
@@ -122,7 +122,7 @@ def _constructor(convert, what: str):
             return convert(text)
         except ValueError:
             raise yaml.constructor.ConstructorError(
-                None, None, f"not {what}: {_cut(text)}", node.start_mark) from None
+                None, None, f"not {what}: {cut(text)}", node.start_mark) from None
     return construct
 
 
@@ -179,7 +179,7 @@ def parse_override(item: str, option: str = "--set") -> tuple[str, object]:
     key = key.strip()
     if not sep or not key:
         raise ScenarioError(f"{option}: expected KEY=VALUE (e.g. align.mode=conventional), "
-                            f"got {_cut(item)}")
+                            f"got {cut(item)}")
     if not text.strip():
         raise ScenarioError(f"{option} {key}: give a value (KEY=VALUE; KEY=null for the "
                             "key's default where it has one)")

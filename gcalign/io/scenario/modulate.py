@@ -134,7 +134,7 @@ def plan_of(sc) -> Plan:
                 from gcalign.io.scenario.messages import scenario_errors
 
                 raise ScenarioError(f"modulate.compare: {name} with the mechanism's timing: "
-                                    f"mechanism.{scenario_errors(err)}") from None
+                                    f"{scenario_errors(err, at='mechanism')}") from None
         else:
             allowed = ", ".join(BUILTIN_NAMES) + (f", {own}" if own and own not in
                                                   BUILTIN_NAMES else "")

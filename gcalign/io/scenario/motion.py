@@ -18,8 +18,6 @@ from gcalign.io.scenario.base import Model, NonNegVec3, PosVec3, Vec3, vector
 from gcalign.io.scenario.schedule import RowModel, schedule_of
 from gcalign.sim import motions as M
 
-MOTION_KINDS = ("static", "swing", "moving", "turntable", "flight")
-
 
 class _Base(Model):
     attitude_deg: Vec3 = vector(description="[pitch, roll, yaw]: initial (or mean, swing)")

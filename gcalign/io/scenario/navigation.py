@@ -12,6 +12,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
+from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
 from gcalign.io.scenario.base import Model, Vec3
 from gcalign.io.scenario.schedule import RowModel, quat_of, schedule_of
@@ -204,7 +205,7 @@ class OutputConfig(Model):
         return self
 
     def stride(self, imu_rate_hz: float, duration_s: float) -> int:
-        """Samples per stored row; ValueError unless the IMU rate is a multiple of the rate."""
+        """Samples per stored row; ScenarioError unless the IMU rate is a multiple of the rate."""
         rate = self.rate_hz
         if rate is None:
             rate = "full" if duration_s <= FULL_RATE_UP_TO_S else min(1.0, imu_rate_hz)
@@ -212,6 +213,7 @@ class OutputConfig(Model):
             return 1
         k = imu_rate_hz / float(rate)
         if abs(k - round(k)) > 1e-9 or round(k) < 1:
-            raise ValueError(f"output.rate_hz: {rate:g} Hz does not divide the IMU rate "
-                             f"{imu_rate_hz:g} Hz; allowed: IMU rate / n for a whole n, or 'full'")
+            raise ScenarioError(f"output.rate_hz: {rate:g} Hz does not divide the IMU rate "
+                                f"{imu_rate_hz:g} Hz; allowed: IMU rate / n for a whole n, "
+                                "or 'full'")
         return int(round(k))
