@@ -16,6 +16,7 @@ from gcalign.app.command import (
     Inputs,
     Options,
     Outcome,
+    config,
     warm_run,
 )
 
@@ -37,15 +38,9 @@ WARM_SCENARIO = {  # a tiny flight: every kernel of a calibration, in millisecon
 }
 
 
-def config(sc):
-    from gcalign.io.scenario.calibrate import CalibrateConfig
-
-    return sc.calibrate or CalibrateConfig()
-
-
 def steps(sc, ext: Extent | None) -> tuple[float, float, float]:
     """(IMU samples, navigation steps, filter epochs) of the calibration window."""
-    cfg = config(sc)
+    cfg = config(sc, "calibrate")
     if ext is None:
         return 0.0, 0.0, 0.0
     rate = 1.0 / ext.ts
@@ -91,16 +86,12 @@ class Calibrate(Command):
 
         return figures(f, name)
 
-    def check(self, inputs: Inputs) -> None:
-        sc = inputs.scenario
-        config(sc).check(sc)
-
     def cost(self, inputs: Inputs) -> Cost:
         """The simulation (or the recorded data) held whole, the flight at the navigation
         rate, the filter's epochs (and the smoother's P and Φ per epoch)."""
         sc, ext = inputs.scenario, inputs.extent
         n, nav, epochs = steps(sc, ext)
-        cfg = config(sc)
+        cfg = config(sc, "calibrate")
         recorded = ext is not None and ext.recorded
         per_epoch = EPOCH_DOUBLES + (SMOOTHER_DOUBLES if cfg.smoother else 0)
         memory = n * (RECORDED_DOUBLES if recorded else SIMULATION_DOUBLES) + (
