@@ -54,15 +54,6 @@ def steps(sc, ext: Extent | None) -> tuple[float, float, float]:
     return float(ext.samples), nav, epochs
 
 
-def state_components(metric: str, k: int) -> list[str]:
-    """Names of a batch metric's components: 21-vectors are the states."""
-    from gcalign.estimation.ins_error import STATE_NAMES
-
-    if k == len(STATE_NAMES):
-        return list(STATE_NAMES)
-    return [str(i) for i in range(k)]
-
-
 class Calibrate(Command):
     name = "calibrate"
     help = "In-flight calibration, 21-state Kalman filter (seed 002)."
@@ -107,7 +98,12 @@ class Calibrate(Command):
                     memory_what="the simulation and the filter's epochs")
 
     def components(self, metric: str, k: int) -> list[str]:
-        return state_components(metric, k)
+        """Names of a batch metric's components: 21-vectors are the states."""
+        from gcalign.estimation.ins_error import STATE_NAMES
+
+        if k == len(STATE_NAMES):
+            return list(STATE_NAMES)
+        return [str(i) for i in range(k)]
 
     def warm_up(self) -> None:
         warm_run(self, WARM_SCENARIO)

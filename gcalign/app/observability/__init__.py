@@ -9,12 +9,7 @@ from typing import Any
 
 from gcalign.app.align import Align
 from gcalign.app.calibrate import COMMAND as CALIBRATE
-from gcalign.app.calibrate import (
-    SIMULATION_DOUBLES,
-    STEP_DOUBLES,
-    state_components,
-    steps,
-)
+from gcalign.app.calibrate import SIMULATION_DOUBLES, STEP_DOUBLES, Calibrate, steps
 from gcalign.app.command import DOUBLE, KALMAN_OPS, Command, Cost, Inputs, Options, Outcome, config
 
 N = 21  #: states
@@ -98,8 +93,7 @@ class Observability(Command):
                     work_what="PWCS pieces × 40 · 21³",
                     memory_what="the PWCS pieces (observability.piece_s)")
 
-    def components(self, metric: str, k: int) -> list[str]:
-        return state_components(metric, k)
+    components = Calibrate.components  # the 21 states
 
     def warm_up(self) -> None:
         CALIBRATE.warm_up()
