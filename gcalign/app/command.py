@@ -279,10 +279,11 @@ def streamed(inputs: Inputs, row_doubles: int, ops: float, what: str) -> Cost:
                 work=n * (ops + (0.0 if ext.recorded else SIMULATE_OPS)), work_what=what)
 
 
-def warm_run(command: Command, scenario: dict[str, Any]) -> None:
-    """A tiny run of `command` on `scenario` (a mapping), so that its kernels are loaded."""
+def warm_scenario(scenario: dict[str, Any]) -> Scenario:
+    """`scenario` (a mapping) parsed afresh, for a tiny run that loads a command's kernels
+    (:meth:`Command.warm_up`)."""
     import copy
 
     from gcalign.io.scenario import parse_scenario
 
-    command.execute(parse_scenario(copy.deepcopy(scenario), "warm-up"), 1)
+    return parse_scenario(copy.deepcopy(scenario), "warm-up")

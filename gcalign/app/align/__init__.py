@@ -20,7 +20,7 @@ from gcalign.app.command import (
     Outcome,
     config,
     stride,
-    warm_run,
+    warm_scenario,
 )
 from gcalign.errors import ScenarioError
 
@@ -152,14 +152,10 @@ class Align(Command):
 
     def warm_up(self) -> None:
         """A tiny run alone and two seeds in lockstep (a batch worker's two routes)."""
-        warm_run(self, WARM_SCENARIO)
-        import copy
-
+        self.execute(warm_scenario(WARM_SCENARIO), 1)
         from gcalign.app.align.run import summaries_of_seeds
-        from gcalign.io.scenario import parse_scenario
 
-        summaries_of_seeds(parse_scenario(copy.deepcopy(WARM_SCENARIO), "warm-up"), [1, 2],
-                           None)
+        summaries_of_seeds(warm_scenario(WARM_SCENARIO), [1, 2], None)
 
 
 COMMAND = Align()

@@ -17,7 +17,7 @@ from gcalign.app.command import (
     Options,
     Outcome,
     config,
-    warm_run,
+    warm_scenario,
 )
 
 SIMULATION_DOUBLES = 24  #: per IMU sample of the noise-free simulation held (truth + IMU)
@@ -106,7 +106,7 @@ class Calibrate(Command):
         return [str(i) for i in range(k)]
 
     def warm_up(self) -> None:
-        warm_run(self, WARM_SCENARIO)
+        self.execute(warm_scenario(WARM_SCENARIO), 1)
 
 
 COMMAND = Calibrate()
