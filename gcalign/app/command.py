@@ -136,8 +136,8 @@ class Cost:
 class Options:
     """How a command runs.
 
-    recorded : it can run on recorded data (the command line adds the recorded-data
-        options, :mod:`gcalign.cli.options`).
+    recorded : it can run on recorded data (the preflight reads the recording for it; its
+        command line declares the recorded-data options of :mod:`gcalign.cli.options`).
     streams : its ``execute`` writes series into an open results file (``sink=``).
     self_contained : it simulates its own data from its section (no motion needed).
     batch_metrics : default metrics of a batch; () = not batchable.
