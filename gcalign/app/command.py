@@ -17,6 +17,7 @@ from __future__ import annotations
 import gc
 import inspect
 import os
+import typing
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -54,6 +55,7 @@ def loading() -> Iterator[None]:
 
 
 DOUBLE = 8  #: bytes of one float64
+BLOCK = 1 << 16  #: samples a streaming run simulates and navigates at a time
 #: Operations (multiply-adds) of one step, for the work of the cost models: a strapdown
 #: update (quaternion, velocity, position and the earth terms), the simulation of one IMU
 #: sample with its sensor errors, a 21-state Kalman predict + update (Φ P Φᵀ and the gain).
@@ -134,8 +136,8 @@ class Cost:
 class Options:
     """How a command runs.
 
-    recorded : it can run on recorded data (the command line adds the recorded-data
-        options, :mod:`gcalign.cli.options`).
+    recorded : it can run on recorded data (the preflight reads the recording for it; its
+        command line declares the recorded-data options of :mod:`gcalign.cli.options`).
     streams : its ``execute`` writes series into an open results file (``sink=``).
     self_contained : it simulates its own data from its section (no motion needed).
     batch_metrics : default metrics of a batch; () = not batchable.
@@ -167,13 +169,15 @@ class Command:
     def check(self, inputs: Inputs) -> None:
         """Refuse (ScenarioError, one line naming the field) what the run would refuse;
         ``inputs.extent`` is the scenario's data (None: it has none, or a recorded file not
-        read)."""
+        read). By default: a section the command cannot run without, missing, and the
+        section's own ``check(sc)`` (of its defaults where the scenario has none)."""
         sc = inputs.scenario
-        section = getattr(sc, self.section) if self.section else None
-        if section is None and self.section_keys is not None:
+        if self.section is None:
+            return
+        if getattr(sc, self.section) is None and self.section_keys is not None:
             raise ScenarioError(f"{self.section}: missing; the scenario needs a "
                                 f"'{self.section}' section ({self.section_keys})")
-        check = getattr(section, "check", None)
+        check = getattr(config(sc, self.section), "check", None)
         if callable(check):
             check(sc)
 
@@ -245,16 +249,41 @@ def builtin_text(name: str) -> str:
     return resources.files("gcalign.scenarios").joinpath(name).read_text(encoding="utf-8")
 
 
+def config(sc: Scenario, section: str, values: dict[str, Any] | None = None) -> Any:
+    """Scenario section `section` of `sc` (``align``, ``calibrate``, ...); where the scenario
+    has none, the section's model built from `values` (default: the model's defaults)."""
+    given = getattr(sc, section)
+    if given is not None:
+        return given
+    kinds = typing.get_args(type(sc).model_fields[section].annotation)  # Model | None
+    return next(t for t in kinds if t is not type(None)).model_validate(values or {})
+
+
 def stride(sc: Scenario, ext: Extent | Stream) -> int:
     """Samples per stored row (``output.rate_hz``) of the data `ext` (its extent, or the
     stream itself); ScenarioError naming the field."""
     return sc.output.stride(1.0 / ext.ts, ext.samples * ext.ts)
 
 
-def warm_run(command: Command, scenario: dict[str, Any]) -> None:
-    """A tiny run of `command` on `scenario` (a mapping), so that its kernels are loaded."""
+def streamed(inputs: Inputs, row_doubles: int, ops: float, what: str) -> Cost:
+    """The cost of a run that streams its data in blocks (:data:`BLOCK` samples held at
+    once), `ops` operations a sample (and a sample's simulation where the data are
+    simulated), and stores `row_doubles` per row at ``output.rate_hz``; nothing without
+    data."""
+    ext = inputs.extent
+    if ext is None:
+        return Cost()
+    n = float(ext.samples)
+    return Cost(samples=n, memory_bytes=min(n, BLOCK) * row_doubles * DOUBLE,
+                output_bytes=n / stride(inputs.scenario, ext) * row_doubles * DOUBLE,
+                work=n * (ops + (0.0 if ext.recorded else SIMULATE_OPS)), work_what=what)
+
+
+def warm_scenario(scenario: dict[str, Any]) -> Scenario:
+    """`scenario` (a mapping) parsed afresh, for a tiny run that loads a command's kernels
+    (:meth:`Command.warm_up`)."""
     import copy
 
     from gcalign.io.scenario import parse_scenario
 
-    command.execute(parse_scenario(copy.deepcopy(scenario), "warm-up"), 1)
+    return parse_scenario(copy.deepcopy(scenario), "warm-up")

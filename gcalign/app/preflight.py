@@ -12,12 +12,11 @@ so both take the same decisions. Nothing here imports numba or scipy.
 
 from __future__ import annotations
 
-import typing
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from gcalign import limits
-from gcalign.app.command import DOUBLE, Command, Cost, Extent, Inputs, Outcome, loading
+from gcalign.app.command import DOUBLE, Command, Cost, Extent, Inputs, Outcome, config, loading
 from gcalign.app.registry import COMMANDS, command
 from gcalign.errors import GcalignError, ScenarioError, clip
 from gcalign.io.paths import not_a_file
@@ -153,11 +152,8 @@ def recorded_defaults(sc: Scenario, section: str | None) -> None:
     'given', which needs truth), set on `sc` in place."""
     from gcalign.io.scenario.recording import RECORDED_DEFAULTS
 
-    if sc.imu_file is None or section not in RECORDED_DEFAULTS or getattr(sc, section) is not None:
-        return
-    model = type(sc).model_fields[section].annotation
-    kind = next(t for t in typing.get_args(model) if t is not type(None))
-    setattr(sc, section, kind.model_validate(RECORDED_DEFAULTS[section]))
+    if sc.imu_file is not None and section in RECORDED_DEFAULTS and getattr(sc, section) is None:
+        setattr(sc, section, config(sc, section, RECORDED_DEFAULTS[section]))
 
 
 def setup_error(section: str, err: Exception) -> ScenarioError:

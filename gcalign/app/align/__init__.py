@@ -18,8 +18,9 @@ from gcalign.app.command import (
     Inputs,
     Options,
     Outcome,
+    config,
     stride,
-    warm_run,
+    warm_scenario,
 )
 from gcalign.errors import ScenarioError
 
@@ -39,15 +40,9 @@ WARM_SCENARIO = {  # a tiny align scenario: every align kernel, in milliseconds
 }
 
 
-def _config(sc):
-    from gcalign.io.scenario.align import AlignConfig
-
-    return sc.align or AlignConfig()
-
-
 def window(sc, ext: Extent) -> tuple[int, int]:
     """First and last sample the alignment reads; ScenarioError for a time past the end."""
-    cfg = _config(sc)
+    cfg = config(sc, "align")
     his = []
     for field in ("start_s", "t1_s", "t2_s", "t3_s"):
         t = 0.0 if field == "start_s" else getattr(cfg, field)
@@ -89,7 +84,7 @@ class Align(Command):
 
     def read_own(self, sc) -> Any:
         """In mode transfer the slave and the master (:func:`transfer.load_inputs`)."""
-        if _config(sc).mode != "transfer":
+        if config(sc, "align").mode != "transfer":
             return None
         from gcalign.app.align.transfer import load_inputs
 
@@ -100,7 +95,7 @@ class Align(Command):
         times against the data, the stored-row stride; in mode transfer its files, settings
         and the master's cover of the run."""
         sc, ext = inputs.scenario, inputs.extent
-        cfg = _config(sc)
+        cfg = config(sc, "align")
         if cfg.mode == "transfer":
             from gcalign.app.align import transfer
 
@@ -127,14 +122,14 @@ class Align(Command):
 
     def cost(self, inputs: Inputs) -> Cost:
         sc, ext = inputs.scenario, inputs.extent
-        if _config(sc).mode == "transfer":
+        if config(sc, "align").mode == "transfer":
             from gcalign.app.align import transfer
 
             return transfer.cost(sc)
         if ext is None:
             return Cost()
         lo, hi = window(sc, ext)
-        passes = _config(sc).pass_count
+        passes = config(sc, "align").pass_count
         ops = passes * (hi - lo) * GYROCOMPASS_OPS + (0 if ext.recorded else hi * SIMULATE_OPS)
         return Cost(samples=float(hi), memory_bytes=(hi - lo) * HELD_DOUBLES * DOUBLE,
                     output_bytes=passes * (hi - lo) / stride(sc, ext) * ROW_DOUBLES * DOUBLE,
@@ -157,14 +152,10 @@ class Align(Command):
 
     def warm_up(self) -> None:
         """A tiny run alone and two seeds in lockstep (a batch worker's two routes)."""
-        warm_run(self, WARM_SCENARIO)
-        import copy
-
+        self.execute(warm_scenario(WARM_SCENARIO), 1)
         from gcalign.app.align.run import summaries_of_seeds
-        from gcalign.io.scenario import parse_scenario
 
-        summaries_of_seeds(parse_scenario(copy.deepcopy(WARM_SCENARIO), "warm-up"), [1, 2],
-                           None)
+        summaries_of_seeds(warm_scenario(WARM_SCENARIO), [1, 2], None)
 
 
 COMMAND = Align()

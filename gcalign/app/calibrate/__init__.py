@@ -16,7 +16,8 @@ from gcalign.app.command import (
     Inputs,
     Options,
     Outcome,
-    warm_run,
+    config,
+    warm_scenario,
 )
 
 SIMULATION_DOUBLES = 24  #: per IMU sample of the noise-free simulation held (truth + IMU)
@@ -37,15 +38,9 @@ WARM_SCENARIO = {  # a tiny flight: every kernel of a calibration, in millisecon
 }
 
 
-def config(sc):
-    from gcalign.io.scenario.calibrate import CalibrateConfig
-
-    return sc.calibrate or CalibrateConfig()
-
-
 def steps(sc, ext: Extent | None) -> tuple[float, float, float]:
     """(IMU samples, navigation steps, filter epochs) of the calibration window."""
-    cfg = config(sc)
+    cfg = config(sc, "calibrate")
     if ext is None:
         return 0.0, 0.0, 0.0
     rate = 1.0 / ext.ts
@@ -57,15 +52,6 @@ def steps(sc, ext: Extent | None) -> tuple[float, float, float]:
     except Exception:  # noqa: BLE001 - the check names what does not fit; the cost is rough
         nav, epochs = float(ext.samples), float(ext.samples)
     return float(ext.samples), nav, epochs
-
-
-def state_components(metric: str, k: int) -> list[str]:
-    """Names of a batch metric's components: 21-vectors are the states."""
-    from gcalign.estimation.ins_error import STATE_NAMES
-
-    if k == len(STATE_NAMES):
-        return list(STATE_NAMES)
-    return [str(i) for i in range(k)]
 
 
 class Calibrate(Command):
@@ -91,16 +77,12 @@ class Calibrate(Command):
 
         return figures(f, name)
 
-    def check(self, inputs: Inputs) -> None:
-        sc = inputs.scenario
-        config(sc).check(sc)
-
     def cost(self, inputs: Inputs) -> Cost:
         """The simulation (or the recorded data) held whole, the flight at the navigation
         rate, the filter's epochs (and the smoother's P and Φ per epoch)."""
         sc, ext = inputs.scenario, inputs.extent
         n, nav, epochs = steps(sc, ext)
-        cfg = config(sc)
+        cfg = config(sc, "calibrate")
         recorded = ext is not None and ext.recorded
         per_epoch = EPOCH_DOUBLES + (SMOOTHER_DOUBLES if cfg.smoother else 0)
         memory = n * (RECORDED_DOUBLES if recorded else SIMULATION_DOUBLES) + (
@@ -116,10 +98,15 @@ class Calibrate(Command):
                     memory_what="the simulation and the filter's epochs")
 
     def components(self, metric: str, k: int) -> list[str]:
-        return state_components(metric, k)
+        """Names of a batch metric's components: 21-vectors are the states."""
+        from gcalign.estimation.ins_error import STATE_NAMES
+
+        if k == len(STATE_NAMES):
+            return list(STATE_NAMES)
+        return [str(i) for i in range(k)]
 
     def warm_up(self) -> None:
-        warm_run(self, WARM_SCENARIO)
+        self.execute(warm_scenario(WARM_SCENARIO), 1)
 
 
 COMMAND = Calibrate()

@@ -7,6 +7,7 @@ from collections.abc import Callable
 from typing import Any
 
 from gcalign.app.command import (
+    BLOCK,
     DOUBLE,
     SIMULATE_OPS,
     STRAPDOWN_OPS,
@@ -19,7 +20,6 @@ from gcalign.app.command import (
 from gcalign.app.navigate import ROW_DOUBLES
 
 MECHANISM_OPS = 100.0  #: per sample: the mechanism's C_s^b and the increments it turns
-BLOCK = 1 << 16  #: samples simulated and navigated at a time (the stream's blocks)
 
 
 class Modulate(Command):

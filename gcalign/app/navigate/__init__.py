@@ -6,14 +6,14 @@ from collections.abc import Callable
 from typing import Any
 
 from gcalign.app.command import (
-    DOUBLE,
-    SIMULATE_OPS,
     STRAPDOWN_OPS,
     Command,
     Cost,
     Inputs,
     Options,
     Outcome,
+    config,
+    streamed,
     stride,
 )
 from gcalign.errors import ScenarioError
@@ -47,23 +47,14 @@ class Navigate(Command):
         sc, ext = inputs.scenario, inputs.extent
         if ext is None:
             return
-        from gcalign.io.scenario.navigation import NavigationConfig
-
-        cfg = sc.navigation or NavigationConfig()
+        cfg = config(sc, "navigation")
         if int(round(cfg.start_s / ext.ts)) >= ext.samples:
             raise ScenarioError(f"navigation.start_s: {cfg.start_s:g} s is past the end of the "
                                 f"data ({ext.samples * ext.ts:g} s)")
         stride(sc, ext)
 
     def cost(self, inputs: Inputs) -> Cost:
-        sc, ext = inputs.scenario, inputs.extent
-        if ext is None:
-            return Cost()
-        n = float(ext.samples)
-        ops = STRAPDOWN_OPS + (0.0 if ext.recorded else SIMULATE_OPS)
-        return Cost(samples=n, memory_bytes=min(n, 1 << 16) * ROW_DOUBLES * DOUBLE,
-                    output_bytes=n / stride(sc, ext) * ROW_DOUBLES * DOUBLE,
-                    work=n * ops, work_what="strapdown steps")
+        return streamed(inputs, ROW_DOUBLES, STRAPDOWN_OPS, "strapdown steps")
 
 
 COMMAND = Navigate()

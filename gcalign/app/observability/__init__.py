@@ -9,13 +9,8 @@ from typing import Any
 
 from gcalign.app.align import Align
 from gcalign.app.calibrate import COMMAND as CALIBRATE
-from gcalign.app.calibrate import (
-    SIMULATION_DOUBLES,
-    STEP_DOUBLES,
-    state_components,
-    steps,
-)
-from gcalign.app.command import DOUBLE, KALMAN_OPS, Command, Cost, Inputs, Options, Outcome
+from gcalign.app.calibrate import SIMULATION_DOUBLES, STEP_DOUBLES, Calibrate, steps
+from gcalign.app.command import DOUBLE, KALMAN_OPS, Command, Cost, Inputs, Options, Outcome, config
 
 N = 21  #: states
 PIECE_OPS = 40.0 * N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, its QR
@@ -67,27 +62,22 @@ class Observability(Command):
     read_own = Align.read_own  # a transfer scenario's slave and master
 
     def check(self, inputs: Inputs) -> None:
-        sc = inputs.scenario
-        from gcalign.io.scenario.calibrate import ObservabilityConfig
-
-        (sc.observability or ObservabilityConfig()).check(sc)
-        if transfer_mode(sc):  # the run's inputs: the align command's transfer check
+        super().check(inputs)
+        if transfer_mode(inputs.scenario):  # the run's inputs: the align command's check
             from gcalign.app.align import transfer
 
-            transfer.check(sc, inputs.recording)
+            transfer.check(inputs.scenario, inputs.recording)
 
     def cost(self, inputs: Inputs) -> Cost:
         """Per PWCS piece F, Φ, R and the stacked observability matrix (measurements × 21
         rows of 21) held at once, and their products; the flight at the navigation rate;
         the covariance run's epochs."""
         sc, ext = inputs.scenario, inputs.extent
-        from gcalign.io.scenario.calibrate import ObservabilityConfig
-
         if transfer_mode(sc):
             from gcalign.app.observability import transfer
 
             return transfer.cost(sc)
-        cfg = sc.observability or ObservabilityConfig()
+        cfg = config(sc, "observability")
         n, nav, epochs = steps(sc, ext)
         segments = len(sc.motion.segments) if sc.motion is not None and hasattr(
             sc.motion, "segments") else 1
@@ -103,8 +93,7 @@ class Observability(Command):
                     work_what="PWCS pieces × 40 · 21³",
                     memory_what="the PWCS pieces (observability.piece_s)")
 
-    def components(self, metric: str, k: int) -> list[str]:
-        return state_components(metric, k)
+    components = Calibrate.components  # the 21 states
 
     def warm_up(self) -> None:
         CALIBRATE.warm_up()

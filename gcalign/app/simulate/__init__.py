@@ -5,16 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from gcalign.app.command import (
-    DOUBLE,
-    SIMULATE_OPS,
-    Command,
-    Cost,
-    Inputs,
-    Options,
-    Outcome,
-    stride,
-)
+from gcalign.app.command import Command, Cost, Inputs, Options, Outcome, streamed, stride
 
 #: doubles stored per row: /truth t, att, v_n, pos, segment and /imu t, dtheta, dv, q_bs
 ROW_DOUBLES = 26
@@ -41,13 +32,7 @@ class Simulate(Command):
             stride(sc, ext)
 
     def cost(self, inputs: Inputs) -> Cost:
-        sc, ext = inputs.scenario, inputs.extent
-        if ext is None:
-            return Cost()
-        n = float(ext.samples)
-        return Cost(samples=n, memory_bytes=min(n, 1 << 16) * ROW_DOUBLES * DOUBLE,
-                    output_bytes=n / stride(sc, ext) * ROW_DOUBLES * DOUBLE,
-                    work=n * SIMULATE_OPS, work_what="samples × their simulation")
+        return streamed(inputs, ROW_DOUBLES, 0.0, "samples × their simulation")
 
     def figures(self, f: Any, name: str) -> dict[str, Any]:
         """The truth and the IMU output (the shared figures of :mod:`gcalign.app.plots`)."""
