@@ -7,7 +7,7 @@ import math
 
 from rich.table import Table
 
-from gcalign.app.report import DASH, numbers, run_line, span, titled, vector
+from gcalign.app.report import DASH, numbers, run_line, span, titled
 
 AXES = ("x", "y", "z")
 LABEL = {"quantum_arcsec": "quantization: quantum (″)", "arw_dprh": "ARW (°/√h)",
@@ -64,7 +64,7 @@ def allan_table(s: dict) -> Table:
         for tau, row in zip(at["tau_s"], rows, strict=True):
             table.add_row(f"{triad} σ(τ = {tau:g} s) ({unit})",
                           *numbers(row, sig=4, most=6))
-    mean = vector(s["mean_rate_dph"], sig=4)
+    mean = "  ".join(numbers(s["mean_rate_dph"], sig=4))
     force = "  ".join(f"{x:.1f}" for x in s["mean_force_ug"])
     mis = "; ".join(f"{t} " + " ".join(DASH if v is None else f"{v:.3g}"
                                         for v in s["misfit"][t]) for t in ("gyro", "accel"))

@@ -73,6 +73,8 @@ def batch_table(s: dict) -> Table:
     names = _names(s)
     width = min(NAME_WIDTH, max((len(line) for n in names for line in n.split("\n")),
                                 default=7))
+    title = (f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) "
+             f"× {s['seeds']} seed(s) {s['seed_start']}…{s['seed_start'] + s['seeds'] - 1}")
     tables = []
     ns = {st["n"] for v in variants for st in v["stats"].values() if st}
     for m in s["metrics"]:
@@ -108,6 +110,4 @@ def batch_table(s: dict) -> Table:
     if s.get("wall_s") is not None:
         notes.append(f"{s.get('executor') or ''}; wall {s['wall_s']:.2f} s".lstrip("; "))
     notes.append(f"output {s.get('output') or DASH}")
-    return stacked(f"gcalign batch: {s['sweep']} — {s['command']}, {len(variants)} variant(s) "
-                   f"× {s['seeds']} seed(s) {s['seed_start']}…"
-                   f"{s['seed_start'] + s['seeds'] - 1}", tables, "\n".join(notes))
+    return stacked(title, tables, "\n".join(notes))

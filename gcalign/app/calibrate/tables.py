@@ -11,7 +11,7 @@ from rich import box
 from rich.table import Column, Table
 from rich.text import Text
 
-from gcalign.app.report import DASH, UNIT_TEXT, number, run_line, stacked, titled, vector
+from gcalign.app.report import DASH, UNIT_TEXT, number, numbers, run_line, stacked, titled, vector
 from gcalign.units import angle_text
 
 GROUP_ENDS = ("phiU", "dvU", "dh", "ebz", "dbz", "dKgz", "dKaz")
@@ -23,9 +23,10 @@ DECIMALS = {"arcsec": 2, "arcmin": 3, "m/s": 4, "m": 2, "deg/h": 4, "ug": 1, "pp
 
 def _g(x, k: float, unit: str) -> str:
     """An SI value `x` in its display unit (`k` the factor), at that unit's resolution."""
-    if x is None or not math.isfinite(x):
+    y = None if x is None else x * k
+    if y is None or (isinstance(y, float) and not math.isfinite(y)):
         return DASH
-    return number(x * k, DECIMALS.get(unit, 3))
+    return number(y, DECIMALS.get(unit, 3))
 
 
 def _display(s: dict):
@@ -93,8 +94,8 @@ def run_table(s: dict) -> Table:
     if e:
         a = [angle_text(math.radians(x)) for x in e["attitude_deg"]]
         notes.append(f"against the reference at {e['t_s']:.2f} s: attitude (pitch, roll, yaw) "
-                     f"{', '.join(a)}; velocity {vector(e['velocity_mps'], most=3)} m/s; "
-                     f"position {vector(e['position_m'], most=3)} m ENU")
+                     f"{', '.join(a)}; velocity {'  '.join(numbers(e['velocity_mps'], most=3))}"
+                     f" m/s; position {'  '.join(numbers(e['position_m'], most=3))} m ENU")
     notes.append("navigation states at the end: estimate = estimated error of the INS before "
                  "the last correction; error = what the correction leaves; injected at t = 0")
     notes.append(f"truth {s['truth_source'] or 'unknown (recorded data)'}; "
@@ -186,6 +187,7 @@ def compare_table(s: dict) -> Table:
                       _g(runs[0]["states"][name]["injected"], k, u), *cells,
                       end_section=name in GROUP_ENDS)
         blocks.append(t)
+    title = _title(s, "designed vs conventional take-off (seed Table 3)")
     durations = {r["label"]: (r["duration_s"], len(r["segments"])) for r in runs}
     notes = [f"{lab}: {n} segments, {d:.0f} s of filter steps" for lab, (d, n)
              in durations.items()]
@@ -195,5 +197,4 @@ def compare_table(s: dict) -> Table:
     notes.append("v: velocity, p: position, v+p: both; φU: the INS heading error the "
                  "correction leaves; the same data and DGNSS noise in every column")
     notes.append(run_line(s, "compute (the six filter runs)"))
-    return stacked(_title(s, "designed vs conventional take-off (seed Table 3)"), blocks,
-                   "\n".join(notes))
+    return stacked(title, blocks, "\n".join(notes))

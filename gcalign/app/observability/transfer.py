@@ -141,8 +141,8 @@ def table(s: dict):
         d = DECIMALS[unit]
         eta = last["degree"].get(name)
         sep = s["separation"].get(name)
-        eta_text = (DASH if eta is None else f"{eta:.1e}" if eta != 0 else "0" if name in unobs
-                    else "n/a")
+        eta_text = (DASH if eta is None else "n/a" if eta == 0 and name not in unobs
+                    else "0" if eta == 0 else f"{eta:.1e}")
         t.add_row(name + (" ·" if name in unobs else ""), unit,
                   f"{s['sigma0'][name] * k:.{d}f}", f"{s['sigma_final'][name] * k:.{d}f}",
                   _ratio(s["covariance_degree_final"][name]), eta_text,

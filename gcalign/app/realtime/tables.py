@@ -71,6 +71,9 @@ def realtime_table(s: dict) -> Table:
         if cm:  # the ramp's corners, where the seed's bound does not hold: max only
             later.add_row(Text(f"  corners ±{s['corner_ms']:g} ms", style="dim"), "",
                           *(_a(cm[p]) for p in after), "")
+    title = (f"gcalign realtime: {s['scenario']} — {setting}; the designed chain's own delay "
+             f"{s['chain_delay_ms']:.4f} ms (FIR {s['fir_delay_ms']:.3f} ms + notch "
+             f"{s['notch_delay_us']:.2f} µs)")
     m = s["model"]
     truth = " / ".join(after)
     lags = [f"{c['name']} {c['lag_ms']:.3f} ms" for c in s["cases"] if c.get("lag_ms")]
@@ -87,6 +90,4 @@ def realtime_table(s: dict) -> Table:
         + (f"INS lag behind the table at uniform rate (seed Fig. 4: 4.4 ms): "
            f"{'; '.join(lags)}. " if lags else "")
         + "\n" + run_line(s, f"compute ({len(s['cases'])} cases)"))
-    return stacked(f"gcalign realtime: {s['scenario']} — {setting}; the designed chain's own "
-                   f"delay {s['chain_delay_ms']:.4f} ms (FIR {s['fir_delay_ms']:.3f} ms + "
-                   f"notch {s['notch_delay_us']:.2f} µs)", (before, later), notes, padding=(1, 0))
+    return stacked(title, (before, later), notes, padding=(1, 0))
