@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.align.result import PassRows
-from gcalign.app.plots import ANGLES, _s, angle_scale, legend_below, new_figure, suptitle
+from gcalign.app.plots import ANGLES, _s, angle_scale, finish, new_figure
 from gcalign.errors import ScenarioError
 
 PASS_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
@@ -105,14 +105,10 @@ def align_error_figure(passes: list[PassRows], title: str = "alignment error") -
         zoom.set_ylabel(f"{name} error ({zunit})")
         for ax in (full, zoom):
             ax.axhline(0.0, color="0.6", linewidth=0.6, label="_zero")
-            ax.grid(True, alpha=0.3)
     axes[0].set_title("all passes", fontsize="medium")
     axes[1].set_title(f"{what} (zoom)", fontsize="medium")
-    for ax in axes[-2:]:
-        ax.set_xlabel(_xlabel(passes, zoom=ax is axes[-1]))
-    legend_below(fig, axes[0], ncols=min(3, len(with_err)))
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, [_xlabel(passes), _xlabel(passes, zoom=True)], title,
+                  legend="below", ncols=min(3, len(with_err)))
 
 
 def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = None,
@@ -122,7 +118,7 @@ def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = N
     `label`) at the same data times, against equivalent time; one subplot per angle."""
     xs, bounds = equivalent_time(passes)
     fig, axes = new_figure(3)
-    for j, (ax, name) in enumerate(zip(axes, ANGLES, strict=True)):
+    for j, ax in enumerate(axes):
         for x, p in zip(xs, passes, strict=True):
             y = np.degrees(np.unwrap(p.att[:, j]) if j == 2 else p.att[:, j])
             ax.plot(x, y, color=_color(p), linewidth=1.0, label=_pass_label(p))
@@ -134,12 +130,8 @@ def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = N
             ax.plot(tx, np.degrees(ty), color="black", linestyle="--", linewidth=1.0,
                     label=label)
         _mark_boundaries(ax, bounds)
-        ax.set_ylabel(f"{name} (deg)")
-        ax.grid(True, alpha=0.3)
-    legend_below(fig, axes[0], ncols=min(4, len(passes) + 1))
-    axes[-1].set_xlabel(_xlabel(passes))
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, _xlabel(passes), title, [f"{n} (deg)" for n in ANGLES],
+                  legend="below", ncols=min(4, len(passes) + 1))
 
 
 def read_passes(f) -> list[PassRows]:
