@@ -107,8 +107,8 @@ def align_error_figure(passes: list[PassRows], title: str = "alignment error") -
             ax.axhline(0.0, color="0.6", linewidth=0.6, label="_zero")
     axes[0].set_title("all passes", fontsize="medium")
     axes[1].set_title(f"{what} (zoom)", fontsize="medium")
-    return finish(fig, axes, [_xlabel(passes), _xlabel(passes, zoom=True)], title,
-                  legend="below", ncols=min(3, len(with_err)))
+    xlabels = [_xlabel(passes), _xlabel(passes, zoom=True)]
+    return finish(fig, axes, xlabels, title, legend="below", ncols=min(3, len(with_err)))
 
 
 def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = None,
@@ -118,7 +118,7 @@ def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = N
     `label`) at the same data times, against equivalent time; one subplot per angle."""
     xs, bounds = equivalent_time(passes)
     fig, axes = new_figure(3)
-    for j, ax in enumerate(axes):
+    for j, (ax, name) in enumerate(zip(axes, ANGLES, strict=True)):
         for x, p in zip(xs, passes, strict=True):
             y = np.degrees(np.unwrap(p.att[:, j]) if j == 2 else p.att[:, j])
             ax.plot(x, y, color=_color(p), linewidth=1.0, label=_pass_label(p))
@@ -130,8 +130,8 @@ def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = N
             ax.plot(tx, np.degrees(ty), color="black", linestyle="--", linewidth=1.0,
                     label=label)
         _mark_boundaries(ax, bounds)
-    return finish(fig, axes, _xlabel(passes), title, [f"{n} (deg)" for n in ANGLES],
-                  legend="below", ncols=min(4, len(passes) + 1))
+        ax.set_ylabel(f"{name} (deg)")
+    return finish(fig, axes, _xlabel(passes), title, legend="below", ncols=min(4, len(passes) + 1))
 
 
 def read_passes(f) -> list[PassRows]:
