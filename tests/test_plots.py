@@ -192,6 +192,25 @@ def test_northfind_difference_at_round_off_is_drawn_as_zero():
     assert ax.get_ylim() == pytest.approx((-0.54, 0.54))
 
 
+def test_realtime_case_figure_reads_in_arcsec_without_an_offset():
+    """A latched error of −288″ ± 0.03″ (20°/s × 4 ms) is labelled −288.0x″ on its axis, not
+    ±0.0x with "−2.88e2" at the axis's end to be added to every label."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from gcalign.app.realtime.plots import case_figure
+    from gcalign.units import ARCSEC
+
+    t = np.arange(0.0, 2.0, 1e-3)
+    before = (-288.0 + 0.03 * np.sin(40.0 * t)) * ARCSEC
+    fig = case_figure(t, t >= 0.5, before, {"taylor": before / 2880.0}, None,
+                      component="yaw", reference="seed", title="rate 20°/s")
+    FigureCanvasAgg(fig).draw()
+    ax = fig.axes[0]
+    assert ax.yaxis.get_offset_text().get_text() == ""
+    ticks = [float(x.get_text().replace("−", "-")) for x in ax.get_yticklabels()]
+    assert ticks and all(-288.05 < v < -287.95 for v in ticks)
+
+
 def test_northfind_figures_from_the_real_command(tmp_path):
     out = tmp_path / "nf.h5"
     res = runner.invoke(app, ["northfind", "-o", str(out)])

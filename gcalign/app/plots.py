@@ -20,6 +20,7 @@ l.get_label().startswith("_")]`` are the data series.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Literal
 
@@ -69,15 +70,30 @@ def legend_right(ax) -> None:
               borderaxespad=0.0)
 
 
-def finish(fig: Figure, axes, xlabel: str, title: str, ylabels=None) -> Figure:
-    """The common ending of a figure of stacked panels: each panel gridded with its legend
-    on the right (and its y label, if given), the x label under the last, the title."""
+def plain_numbers(ax) -> None:
+    """y tick labels that read as values in the axis's unit: no offset ("−2.88e2" at the end
+    of the axis, to be added to every label) and no power of ten."""
+    ax.ticklabel_format(axis="y", useOffset=False, style="plain")
+
+
+def finish(fig: Figure, axes, xlabel: str | Sequence[str], title: str, ylabels=None, *,
+           legend: Literal["right", "below"] | None = "right", ncols: int | None = None
+           ) -> Figure:
+    """The common ending of a figure of panels: each panel gridded (with its y label, if
+    given), the x label under the last panel (a list: one under each panel of the bottom
+    row), each panel's legend on its right, or one legend below the panels from the first
+    panel's series (:func:`legend_below`, `ncols`), or none; the title."""
+    xlabels = [xlabel] if isinstance(xlabel, str) else list(xlabel)
     for i, ax in enumerate(axes):
         if ylabels is not None:
             ax.set_ylabel(ylabels[i])
         ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    axes[-1].set_xlabel(xlabel)
+        if legend == "right":
+            legend_right(ax)
+    for ax, text in zip(axes[len(axes) - len(xlabels):], xlabels, strict=True):
+        ax.set_xlabel(text)
+    if legend == "below":
+        legend_below(fig, axes[0], ncols)
     suptitle(fig, title)
     return fig
 
@@ -159,15 +175,12 @@ def imu_figure(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, ts: float,
         plot_series(axes[j], x, w[:, j] * scale, f"gyro {name}", color=f"C{j}")
         plot_series(axes[3 + j], x, f[:, j], f"accel {name}", color=f"C{j}")
         axes[j].set_title(f"{name} axis", fontsize="medium")
-        axes[3 + j].set_xlabel(xlabel)
     axes[0].set_ylabel(f"angular rate ({unit})")
     axes[3].set_ylabel("specific force (m/s²)")
-    for ax in axes:
-        ax.grid(True, alpha=0.3)
-    suptitle(fig, f"{title}: increments / {ts * 1e3:g} ms, {frame} frame"
-                 + (f"; bins of {math.ceil(len(t) / MAX_POINTS)} samples: mean line, "
-                    "min-max band" if len(t) > MAX_POINTS else ""))
-    return fig
+    bins = (f"; bins of {math.ceil(len(t) / MAX_POINTS)} samples: mean line, min-max band"
+            if len(t) > MAX_POINTS else "")
+    return finish(fig, axes, [xlabel] * 3,
+                  f"{title}: increments / {ts * 1e3:g} ms, {frame} frame{bins}", legend=None)
 
 
 def _s(x) -> str:

@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.align.result import PassRows
-from gcalign.app.plots import ANGLES, _s, angle_scale, legend_below, new_figure, suptitle
+from gcalign.app.plots import ANGLES, _s, angle_scale, finish, new_figure
 from gcalign.errors import ScenarioError
 
 PASS_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
@@ -105,14 +105,10 @@ def align_error_figure(passes: list[PassRows], title: str = "alignment error") -
         zoom.set_ylabel(f"{name} error ({zunit})")
         for ax in (full, zoom):
             ax.axhline(0.0, color="0.6", linewidth=0.6, label="_zero")
-            ax.grid(True, alpha=0.3)
     axes[0].set_title("all passes", fontsize="medium")
     axes[1].set_title(f"{what} (zoom)", fontsize="medium")
-    for ax in axes[-2:]:
-        ax.set_xlabel(_xlabel(passes, zoom=ax is axes[-1]))
-    legend_below(fig, axes[0], ncols=min(3, len(with_err)))
-    suptitle(fig, title)
-    return fig
+    xlabels = [_xlabel(passes), _xlabel(passes, zoom=True)]
+    return finish(fig, axes, xlabels, title, legend="below", ncols=min(3, len(with_err)))
 
 
 def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = None,
@@ -135,11 +131,7 @@ def align_attitude_figure(passes: list[PassRows], truth_t: np.ndarray | None = N
                     label=label)
         _mark_boundaries(ax, bounds)
         ax.set_ylabel(f"{name} (deg)")
-        ax.grid(True, alpha=0.3)
-    legend_below(fig, axes[0], ncols=min(4, len(passes) + 1))
-    axes[-1].set_xlabel(_xlabel(passes))
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, _xlabel(passes), title, legend="below", ncols=min(4, len(passes) + 1))
 
 
 def read_passes(f) -> list[PassRows]:

@@ -354,35 +354,27 @@ def figures(f, name: str) -> dict:
     units = str(g.attrs["display_units"]).split(",")
     scale = np.asarray(g.attrs["display_scale"], dtype=float)
     groups = state_groups(names)
-    stored = {"eb": "psins_eb0", "db": "psins_db0", "mu": "psins_mu0"}
     fig, axes = new_figure(len(groups), width=9.0, height=2.2 * len(groups) + 1.2)
-    ylabels = []
     for ax, (gr, idx) in zip(axes, groups, strict=True):
         for c, i in zip(COLOURS, idx, strict=True):
             k = scale[i]
             ax.plot(t, x[:, i] * k, color=c, linewidth=1.0, label=names[i])
             ax.fill_between(t, (x[:, i] - sig[:, i]) * k, (x[:, i] + sig[:, i]) * k,
                             color=c, alpha=0.18, linewidth=0)
-        key = stored.get(gr, "")
-        has_ref = bool(key) and key in g.attrs
-        if has_ref:
-            ref = np.asarray(g.attrs[key], dtype=float)
-            for c, i, v in zip(COLOURS, idx, ref, strict=True):
-                ax.axhline(v * scale[i], color=c, linestyle="--", linewidth=0.9,
-                           label=f"PSINS {key[6:]} {names[i][-1]}")
         # the ±σ band of the first seconds spans P0: the axis shows the estimates after
         # the first 10 % of the run, ±2σ at the end, and the stored values
         k0 = int(np.searchsorted(t, t[0] + 0.1 * (t[-1] - t[0])))
         vals = [x[k0:, idx] * scale[idx], (x[-1, idx] + 2 * sig[-1, idx]) * scale[idx],
                 (x[-1, idx] - 2 * sig[-1, idx]) * scale[idx]]
-        if has_ref:
-            vals.append(np.asarray(g.attrs[key], dtype=float) * scale[idx])
+        if (ref := g.attrs.get(f"psins_{gr}0")) is not None:  # eb0, db0, mu0
+            vals.append(np.asarray(ref, dtype=float) * scale[idx])
+            for c, i, v in zip(COLOURS, idx, vals[-1], strict=True):
+                ax.axhline(v, color=c, linestyle="--", linewidth=0.9,
+                           label=f"PSINS {gr}0 {names[i][-1]}")
         v = np.concatenate([np.ravel(a) for a in vals])
         pad = 0.1 * (np.nanmax(v) - np.nanmin(v)) + 1e-9
         ax.set_ylim(np.nanmin(v) - pad, np.nanmax(v) + pad)
-        ylabels.append(f"{GROUPS[gr]}\n({units[idx[0]]})")
-    matching = g.attrs.get("matching", "")
+    ylabels = [f"{GROUPS[gr]}\n({units[idx[0]]})" for gr, idx in groups]
     return {"transfer_states": finish(
-        fig, axes, "time (s)",
-        f"{name}: transfer alignment ({matching} matching) — estimates ± 1σ; dashed: the "
-        "file's stored PSINS values", ylabels)}
+        fig, axes, "time (s)", f"{name}: transfer alignment ({g.attrs.get('matching', '')} "
+        "matching) — estimates ± 1σ; dashed: the file's stored PSINS values", ylabels)}

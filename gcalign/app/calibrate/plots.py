@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.plots import _s, finish, legend_below, legend_right, new_figure, suptitle
+from gcalign.app.plots import _s, finish, legend_right, new_figure, plain_numbers, suptitle
 from gcalign.app.report import UNIT_TEXT
 from gcalign.estimation.calibration import CalibrationResult, Errors, Spans
 from gcalign.units import ANGLE_UNITS, angle_unit
@@ -117,22 +117,12 @@ def _panel(ax, name: str, unit: str, lim: float) -> None:
     ax.set_ylim(-lim, lim)
     ax.set_title(name, fontsize="medium")
     ax.set_ylabel(UNIT_WORD.get(unit) or UNIT_TEXT.get(unit, unit))
-    ax.grid(True, alpha=0.3)
 
 
 def _display(attrs: dict) -> tuple[list[str], list[str], np.ndarray]:
     """The file's state names, their display units and the factors from SI to them."""
     return (attrs["states"].split(","), attrs["display_units"].split(","),
             np.asarray(attrs["display_scale"]))
-
-
-def _finish(fig, axes, xlabel: str, title: str) -> Figure:
-    """A 2 × 3 grid: time labels on the bottom row, one legend below the panels."""
-    for ax in axes[3:]:
-        ax.set_xlabel(xlabel)
-    legend_below(fig, axes[0])
-    suptitle(fig, title)
-    return fig
 
 
 def estimates_figure(runs: list[ShownRun], attrs, states: list[str], title: str) -> Figure:
@@ -165,7 +155,7 @@ def estimates_figure(runs: list[ShownRun], attrs, states: list[str], title: str)
                        linestyle=(0, (4, 2)), label="truth")
         _segment_lines(ax, attrs["segments"], minutes)
         _panel(ax, name, units[i], lim)
-    return _finish(fig, axes, xlabel, title)
+    return finish(fig, axes, [xlabel] * 3, title, legend="below")
 
 
 def sigma_figure(runs: list[ShownRun], attrs, title: str) -> Figure:
@@ -195,26 +185,18 @@ def sigma_figure(runs: list[ShownRun], attrs, title: str) -> Figure:
         ax.set_ylabel("1 − σ / σ0" if held else "σ / σ0")
         if not held:
             _plain_log_ticks(ax)
-        ax.grid(True, which="both", alpha=0.3)
-        legend_right(ax)
-    for ax in axes[2:]:
-        ax.set_xlabel(xlabel)
-    suptitle(fig, title)
-    return fig
+        ax.grid(True, which="minor", alpha=0.3)  # of the log scale (the major: finish)
+    return finish(fig, axes, [xlabel] * 2, title)
 
 
 def _plain_log_ticks(ax) -> None:
     """A log axis spanning less than a decade labels its minor ticks, and matplotlib's
     scientific labels then round them alike ("10 × 10⁻¹" on every tick; a scale factor held
     at its 1 ppm prior spans 0.9996–1): such a panel is drawn linear, with plain numbers."""
-    from matplotlib.ticker import ScalarFormatter
-
     lo, hi = ax.get_ylim()
     if lo > 0 and hi / lo < 10:
         ax.set_yscale("linear")
-        plain = ScalarFormatter(useOffset=False)
-        plain.set_scientific(False)
-        ax.yaxis.set_major_formatter(plain)
+        plain_numbers(ax)
 
 
 def navigation_figure(run: CalibrationResult, attrs, title: str) -> Figure:
@@ -233,7 +215,7 @@ def navigation_figure(run: CalibrationResult, attrs, title: str) -> Figure:
                         label="±3σ")
         ax.plot(tx, err, color="black", linewidth=0.8, label="error")
         _panel(ax, name, units[i], _ylim(err, sig, None, run.t))
-    return _finish(fig, axes, xlabel, title)
+    return finish(fig, axes, [xlabel] * 3, title, legend="below")
 
 
 def innovations_figure(run: CalibrationResult, title: str, outages=()) -> Figure:
@@ -345,12 +327,7 @@ def solution_figure(run: ShownRun, attrs, title: str) -> Figure:
             ax.set_title(f"{what} {labels[c]}", fontsize="medium")
             if c == 0:
                 ax.set_ylabel(u)
-            ax.grid(True, alpha=0.3)
-    for ax in axes[6:]:
-        ax.set_xlabel(xlabel)
-    legend_below(fig, axes[0])
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, [xlabel] * 3, title, legend="below")
 
 
 def enu_track(pos: np.ndarray) -> np.ndarray:

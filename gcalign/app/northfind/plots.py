@@ -7,9 +7,10 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.plots import angle_scale, legend_below, legend_right, new_figure, suptitle
+from gcalign.app.plots import angle_scale, finish, new_figure
 
 METHOD_ORDER = ("coordinate", "vector", "naive", "none")
+AZIMUTH = "true azimuth (deg, clockwise from north)"
 
 
 def _methods_in_order(names) -> list[str]:
@@ -48,13 +49,9 @@ def northfind_error_figure(azimuth_true: np.ndarray, errors: dict[str, np.ndarra
             ax.plot(az[order], np.asarray(pred)[order] * scale, color="black",
                     linestyle="--", linewidth=0.8, label="closed form (noise-free)")
         ax.set_ylabel(f"{m}\nerror ({unit})")
-        ax.grid(True, alpha=0.3)
-        legend_right(ax)
-    axes[-1].set_xlabel("true azimuth (deg, clockwise from north)")
     axes[-1].set_xlim(0, 360)
     axes[-1].set_xticks(np.arange(0, 361, 45))
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, AZIMUTH, title)
 
 
 #: Below this the difference of two methods is round-off (arc-seconds).
@@ -90,14 +87,9 @@ def northfind_difference_figure(azimuth_true: np.ndarray, a: np.ndarray, b: np.n
                    label="seed fig. 5 size: ±1e-4°" if sign > 0 else "_seed size")
     lim = max(1.25 * peak, 1.5 * SEED_FIG5_ARCSEC)
     ax.set_ylim(-lim, lim)
-    ax.set_xlabel("true azimuth (deg, clockwise from north)")
-    ax.set_ylabel("difference (arcsec)")
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
-    ax.grid(True, alpha=0.3)
-    legend_below(fig, ax, ncols=1)
-    suptitle(fig, title)
-    return fig
+    return finish(fig, axes, AZIMUTH, title, ["difference (arcsec)"], legend="below", ncols=1)
 
 
 def figures(f, name: str) -> dict[str, Figure]:

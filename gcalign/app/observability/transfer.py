@@ -14,16 +14,29 @@ over the 15 PWCS states, ``cov_degree`` over all the filter's states, named by t
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, field
 from typing import Any
 
 import h5py
+import numpy as np
 
 from gcalign.app.align.transfer import DECIMALS, GROUP_ENDS, display, write_display
 from gcalign.app.command import DOUBLE, Cost, Outcome
-from gcalign.io.results import put
+from gcalign.schema import stored
 
 PWCS_N = 15
 PIECE_OPS = 40.0 * PWCS_N**3  #: per PWCS piece: Φ = expm(F T), the observability matrix, QR
+
+
+@dataclass(frozen=True)
+class SigmaSeries:
+    """What ``/observability`` of a transfer run holds beside the table
+    (:class:`~gcalign.transfer.observability.TransferObservability`): the filter's σ per
+    master epoch, for its σ/σ0 figure."""
+
+    t: np.ndarray = field(metadata=stored("s", description="master epochs, from the start"))
+    sigma: np.ndarray = field(metadata=stored(
+        "SI", description="the filter's sigma per epoch, 'covariance_states' order"))
 
 
 def cost(sc) -> Cost:
@@ -112,9 +125,7 @@ def write(f: h5py.File, obs, result) -> None:
     g.attrs["mode"] = "transfer"
     write_display(g, obs.names)
     write_fields(g, obs)
-    put(g, "t", result.t - result.t0, "s", description="master epochs, from the start")
-    put(g, "sigma", result.sigma, "SI", description="the filter's sigma per epoch, "
-        "'covariance_states' order")
+    write_fields(g, SigmaSeries(result.t - result.t0, result.sigma))
 
 
 # -- table and figures (rich and matplotlib loaded by the caller's import of this module) --
@@ -183,8 +194,7 @@ def figures(f, name: str) -> dict:
     from gcalign.transfer.observability import TransferObservability
 
     g = f["observability"]
-    obs = read_fields(g, TransferObservability)
-    cov_states = obs.names
+    obs, run = read_fields(g, TransferObservability), read_fields(g, SigmaSeries)
     how = f"{obs.matching} matching, scaling {obs.scaling}"
     figs = {
         "observability_cumulative": heat_map(
@@ -192,17 +202,16 @@ def figures(f, name: str) -> dict:
             f"{name}: cumulative degree η from the start (transfer alignment, {how}; grey ·: "
             "0, unobservable)", "log10 η", "·"),
         "covariance_degree": heat_map(
-            obs.cov_degree, [f"after {w}" for w in obs.windows], list(cov_states),
+            obs.cov_degree, [f"after {w}" for w in obs.windows], list(obs.names),
             f"{name}: covariance degree σ(0)/σ(t) at the end of each window ({how})",
             "log10 σ(0)/σ(t)", exponents=False),
     }
-    t, sig, sig0 = g["t"][()], g["sigma"][()], obs.sigma0
-    groups = state_groups(cov_states)
+    groups = state_groups(obs.names)
     fig, axes = new_figure(len(groups), width=9.0, height=1.6 * len(groups) + 1.2)
     for ax, (_, idx) in zip(axes, groups, strict=True):
-        ratio = sig[:, idx] / sig0[idx]
+        ratio = run.sigma[:, idx] / obs.sigma0[idx]
         for c, i, y in zip(COLOURS, idx, ratio.T, strict=True):
-            ax.plot(t, y, color=c, linewidth=1.0, label=cov_states[i])
+            ax.plot(run.t, y, color=c, linewidth=1.0, label=obs.names[i])
         if ratio.max() > 10 * ratio.min():  # decades: log; within one, linear reads better
             ax.set_yscale("log")
         ax.axhline(1.0, color="0.5", linewidth=0.8, linestyle=":", label="_P0")

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from gcalign.app.plots import ANGLES, _s, finish, new_figure
+from gcalign.app.plots import ANGLES, _s, finish, new_figure, plain_numbers
 from gcalign.io.stored import read_fields
 from gcalign.nav.rotation import wrap_pi
 from gcalign.realtime.filters import ChainResponse
@@ -51,6 +51,7 @@ def case_figure(t: np.ndarray, scored: np.ndarray, before: np.ndarray,
         for name, e in series.items():
             ax.plot(t, e / ARCSEC, linewidth=0.6, label=name)
         _limits(ax, [e[scored] / ARCSEC for e in series.values()])
+        plain_numbers(ax)  # −288.01″, not 0.01 and "−2.88e2" at the top of the axis
         ax.set_title(what, fontsize="small", loc="left")
         ax.set_ylabel(f"{component} error (″)")
         if (~scored).any():
