@@ -80,8 +80,8 @@ def finish(fig: Figure, axes, xlabel: str | Sequence[str], title: str, ylabels=N
            legend: Literal["right", "below"] | None = "right", ncols: int | None = None
            ) -> Figure:
     """The common ending of a figure of panels: each panel gridded (with its y label, if
-    given), the x label under the last panel (a list: one under each panel of the bottom
-    row), each panel's legend on its right, or one legend below the panels from the first
+    given), the x label under the last panel (a list: one under each of the last panels,
+    the bottom row), each panel's legend on its right, or one legend below the panels from the first
     panel's series (:func:`legend_below`, `ncols`), or none; the title."""
     xlabels = [xlabel] if isinstance(xlabel, str) else list(xlabel)
     for i, ax in enumerate(axes):

@@ -202,21 +202,16 @@ def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides
     return fig
 
 
-def read_batch(f) -> tuple[dict, dict[str, np.ndarray], np.ndarray, np.ndarray]:
-    summary = json.loads(_s(f.attrs["summary_json"]))
-    r = f["batch/runs"]
-    status = np.array([_s(x) for x in r["status"][()]])
-    ok = status == "ok"
-    metrics = {m: r["metrics"][m][()][ok] for m in r["metrics"]}
-    return summary, metrics, r["variant"][()][ok], ok
-
-
 def figures(f, name: str) -> dict[str, Figure]:
     """The figures of a batch results file."""
     figs: dict[str, Figure] = {}
     if "batch" not in f:
         return figs
-    summary, metrics, variant, _ = read_batch(f)
+    summary = json.loads(_s(f.attrs["summary_json"]))
+    runs = f["batch/runs"]
+    ok = np.array([_s(x) for x in runs["status"][()]]) == "ok"  # the metrics of these runs
+    metrics = {m: runs["metrics"][m][()][ok] for m in runs["metrics"]}
+    variant = runs["variant"][()][ok]
     grid = summary.get("grid") or {}
     grid_keys = list(grid)
     overrides = [v["overrides"] for v in summary["variants"]]
