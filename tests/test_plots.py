@@ -211,6 +211,22 @@ def test_realtime_case_figure_reads_in_arcsec_without_an_offset():
     assert ticks and all(-288.05 < v < -287.95 for v in ticks)
 
 
+def test_imu_figure_of_a_noise_free_sensor_reads_its_constant_output():
+    """Earth rate to round-off (5.245 °/h ± 1e-10): the panel spans ±5 % about it, as
+    matplotlib draws an exact constant, so its labels read °/h and no round-off offset."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from gcalign.units import DPH
+
+    t = np.arange(0.0, 10.0, 0.01)
+    w = np.array([5.245, 9.085, 10.78]) * DPH * (1.0 + 1e-11 * np.sin(t))[:, None]
+    fig = plots.imu_figure(t, w * 0.01, np.tile([0.0, 0.0, 0.0981], (len(t), 1)), 0.01)
+    FigureCanvasAgg(fig).draw()
+    for ax, value in zip(fig.axes[:3], (5.245, 9.085, 10.78), strict=True):
+        assert ax.yaxis.get_offset_text().get_text() == ""
+        assert ax.get_ylim() == pytest.approx((0.95 * value, 1.05 * value), rel=1e-6)
+
+
 def test_northfind_figures_from_the_real_command(tmp_path):
     out = tmp_path / "nf.h5"
     res = runner.invoke(app, ["northfind", "-o", str(out)])

@@ -76,12 +76,22 @@ def plain_numbers(ax) -> None:
     ax.ticklabel_format(axis="y", useOffset=False, style="plain")
 
 
+def steady(ax) -> None:
+    """A panel whose values agree to 1e-6 of their size (a noise-free sensor's output) drawn
+    as matplotlib draws a constant, ±5 % about it: fitted to them, its labels would read the
+    round-off ("1e−10+5.244972887" above the axis)."""
+    lo, hi = ax.dataLim.intervaly
+    mid = 0.5 * (lo + hi)
+    if 0.0 < hi - lo < 1e-6 * abs(mid):
+        ax.set_ylim(mid - 0.05 * abs(mid), mid + 0.05 * abs(mid))
+
+
 def finish(fig: Figure, axes, xlabel: str | Sequence[str], title: str, ylabels=None, *,
            legend: Literal["right", "below"] | None = "right", ncols: int | None = None
            ) -> Figure:
     """The common ending of a figure of panels: each panel gridded (with its y label, if
-    given), the x label under the last panel (a list: one under each panel of the bottom
-    row), each panel's legend on its right, or one legend below the panels from the first
+    given), the x label under the last panel (a list: one under each of the last panels,
+    the bottom row), each panel's legend on its right, or one legend below the panels from the first
     panel's series (:func:`legend_below`, `ncols`), or none; the title."""
     xlabels = [xlabel] if isinstance(xlabel, str) else list(xlabel)
     for i, ax in enumerate(axes):
@@ -177,6 +187,8 @@ def imu_figure(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, ts: float,
         axes[j].set_title(f"{name} axis", fontsize="medium")
     axes[0].set_ylabel(f"angular rate ({unit})")
     axes[3].set_ylabel("specific force (m/s²)")
+    for ax in axes:
+        steady(ax)
     bins = (f"; bins of {math.ceil(len(t) / MAX_POINTS)} samples: mean line, min-max band"
             if len(t) > MAX_POINTS else "")
     return finish(fig, axes, [xlabel] * 3,

@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 from gcalign.app.batch.aggregate import metric_label, metric_units
 from gcalign.app.batch.sweep import CASE_KEY, FILE_KEY
 from gcalign.app.batch.tables import short_keys, written
-from gcalign.app.plots import _s, angle_scale, legend_below, new_figure, suptitle
+from gcalign.app.plots import _s, angle_scale, finish, new_figure, suptitle
 
 
 def _pairs(overrides: dict, keys: list[str], sep: str) -> str:
@@ -188,27 +188,15 @@ def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides
                             max(pos.max(), med_arr.max()) * 1.5)
             elif span.size:
                 ax.set_ylim(0.0, 1.05 * max(span.max(), med_arr.max()))
-            ax.grid(True, which="both", alpha=0.3)
+            ax.grid(True, which="minor", alpha=0.3)  # of a log scale (the major: finish)
             if j == 0 and case is not None:
                 ax.set_title(f"{CASE_KEY}: {case}", fontsize="medium")
             if c == 0:
                 label = f"median |{name}{' ' + comp if comp else ''}|"
                 ax.set_ylabel(f"{label} ({row_units[j]})" if row_units[j] else label)
-            if j == len(comps) - 1:
-                ax.set_xlabel(f"{x_key} ({x_units})" if x_units else x_key)
-    legend_below(fig, axes[0])
-    suptitle(fig, title or f"median |{name}| over seeds against {x_key} "
-                          "(band: 25-75 % of the seeds)")
-    return fig
-
-
-def read_batch(f) -> tuple[dict, dict[str, np.ndarray], np.ndarray, np.ndarray]:
-    summary = json.loads(_s(f.attrs["summary_json"]))
-    r = f["batch/runs"]
-    status = np.array([_s(x) for x in r["status"][()]])
-    ok = status == "ok"
-    metrics = {m: r["metrics"][m][()][ok] for m in r["metrics"]}
-    return summary, metrics, r["variant"][()][ok], ok
+    xlabel = f"{x_key} ({x_units})" if x_units else x_key
+    return finish(fig, axes, [xlabel] * len(cases), title or f"median |{name}| over seeds "
+                  f"against {x_key} (band: 25-75 % of the seeds)", legend="below")
 
 
 def figures(f, name: str) -> dict[str, Figure]:
@@ -216,7 +204,11 @@ def figures(f, name: str) -> dict[str, Figure]:
     figs: dict[str, Figure] = {}
     if "batch" not in f:
         return figs
-    summary, metrics, variant, _ = read_batch(f)
+    summary = json.loads(_s(f.attrs["summary_json"]))
+    runs = f["batch/runs"]
+    ok = np.array([_s(x) for x in runs["status"][()]]) == "ok"  # the metrics of these runs
+    metrics = {m: runs["metrics"][m][()][ok] for m in runs["metrics"]}
+    variant = runs["variant"][()][ok]
     grid = summary.get("grid") or {}
     grid_keys = list(grid)
     overrides = [v["overrides"] for v in summary["variants"]]

@@ -10,7 +10,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
-from gcalign.app.plots import AXES, ENU, _s, angle_scale, new_figure
+from gcalign.app.plots import AXES, ENU, _s, angle_scale, finish, new_figure
 from gcalign.modulate.linear import REPORT_HOURS
 
 COLOURS = ("tab:red", "tab:blue", "tab:green", "tab:purple", "tab:orange", "tab:brown",
@@ -78,14 +78,9 @@ def attitude_error_figure(series: dict, title: str) -> Figure:
         for j in range(3):
             axes[j].plot(t / 3600.0, phi[:, j] * scale, color=COLOURS[i % len(COLOURS)],
                          linewidth=0.9, label=name)
-    for j, ax in enumerate(axes):
-        ax.set_ylabel(f"φ {ENU[j]} ({unit})")
-        ax.grid(True, alpha=0.3)
     axes[0].legend(loc="upper left", fontsize="small", ncols=4)
-    end = max((float(t[-1]) for t, _ in series.values() if len(t)), default=3600.0)
-    hour_axis(axes[-1], end)
-    fig.suptitle(title)
-    return fig
+    hour_axis(axes[-1], max((float(t[-1]) for t, _ in series.values() if len(t)), default=3600.0))
+    return finish(fig, axes, "time (h)", title, [f"φ {e} ({unit})" for e in ENU], legend=None)
 
 
 def mechanism_figure(cycles: dict, title: str) -> Figure:

@@ -7,6 +7,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gcalign.app.calibrate.plots import truth_trajectory
+from gcalign.app.plots import new_figure
 
 
 def heat_map(values: np.ndarray, rows: list[str], cols: list[str], title: str, label: str,
@@ -16,9 +17,7 @@ def heat_map(values: np.ndarray, rows: list[str], cols: list[str], title: str, l
     (unobservable) grey and marked `zero`."""
     with np.errstate(divide="ignore"):
         logv = np.where(values > 0, np.log10(np.where(values > 0, values, 1.0)), np.nan)
-    height = 1.2 + 0.3 * len(rows)
-    fig = Figure(figsize=(13.0, height), dpi=120, layout="constrained")
-    ax = fig.subplots()
+    fig, (ax,) = new_figure(1, width=13.0, height=1.2 + 0.3 * len(rows))
     import matplotlib as mpl
 
     cmap = mpl.colormaps["viridis"].with_extremes(bad="0.85")

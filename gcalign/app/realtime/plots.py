@@ -69,7 +69,6 @@ def filter_figure(freq: np.ndarray, magnitude: dict[str, np.ndarray], group_dela
         axes[0].plot(freq, 20 * np.log10(np.maximum(m, 1e-12)), linewidth=0.9, label=name)
     axes[0].set_ylim(-120, 5)
     axes[0].set_xlim(0, freq[-1])
-    axes[0].set_xlabel("frequency (Hz)")
     axes[0].set_ylabel("magnitude (dB)")
     sel = freq <= 1000.0
     axes[1].plot(freq[sel], group_delay[sel] * 1e3, linewidth=0.9, label="chain group delay")
@@ -81,7 +80,7 @@ def filter_figure(freq: np.ndarray, magnitude: dict[str, np.ndarray], group_dela
     axes[1].set_ylim(lo, hi)
     axes[1].set_xlim(0, 1000)
     axes[1].set_ylabel("group delay (ms)")
-    return finish(fig, axes, "frequency (Hz)", title)
+    return finish(fig, axes, ["frequency (Hz)"] * 2, title)
 
 
 def lag_figure(window: tuple | None,
