@@ -56,10 +56,9 @@ def allan(
     if source is None and given.imu_file is None:
         raise ScenarioError("allan: give a recording, a results file or a scenario (SOURCE), "
                             "or --imu-file FILE")
-    if scenario_out not in (None, "-") and output is not None and \
-            Path(scenario_out).resolve() == Path(output).resolve():
-        raise ScenarioError(f"--scenario: {scenario_out} is also the results file (-o)")
-    if scenario_out not in (None, "-"):
+    if scenario_out not in (None, "-"):  # a file
+        if output is not None and Path(scenario_out).resolve() == Path(output).resolve():
+            raise ScenarioError(f"--scenario: {scenario_out} is also the results file (-o)")
         results.check_output(scenario_out, "--scenario")
     data, _ = data_file(source, ("earth",))
     text = None if data is None else yaml.safe_dump(data)

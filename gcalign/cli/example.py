@@ -13,7 +13,6 @@ import typer
 
 from gcalign.app.registry import COMMANDS
 from gcalign.cli.base import app, consoles, emit_json
-from gcalign.cli.common import builtin_text
 from gcalign.errors import ScenarioError
 
 
@@ -35,11 +34,11 @@ def example(
     as_json: bool = typer.Option(False, "--json", help="The list as one JSON object."),
 ):
     """Print a built-in scenario (YAML) to start your own from, or list them."""
-    known = {cmd: c.builtin for cmd, c in COMMANDS.items() if c.builtin}  # -> package data
+    known = {cmd: c for cmd, c in COMMANDS.items() if c.builtin}
     if name is None:
         from gcalign.app.report import kv_table
 
-        rows = [(cmd, file, first_comment(builtin_text(file))) for cmd, file in known.items()]
+        rows = [(cmd, c.builtin, first_comment(c.builtin_text())) for cmd, c in known.items()]
         consoles(as_json).print(kv_table(
             "built-in scenarios: `gcalign example NAME > mine.yaml`, then "
             "`gcalign NAME mine.yaml`", [(cmd, what) for cmd, _, what in rows],
@@ -50,4 +49,4 @@ def example(
     if name not in known:
         raise ScenarioError(f"example: {name!r} has no built-in scenario; built-in: "
                             f"{', '.join(known)}")
-    sys.stdout.write(builtin_text(known[name]))
+    sys.stdout.write(known[name].builtin_text())
