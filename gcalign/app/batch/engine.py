@@ -53,7 +53,7 @@ Progress = Callable[[int, int, int], None]  # (finished, total, failed)
 
 def _tasks(sweep: Sweep, keys: list[tuple[int, int]]) -> list[dict]:
     variants = {v.index: v for v in sweep.variants}
-    return [{"command": sweep.command, "variant": vi, "vkey": variants[vi].key, "seed": seed,
+    return [{"command": sweep.command, "variant": vi, "vkey": sweep.keys[vi], "seed": seed,
              "scenario": variants[vi].scenario,
              "source": f"{sweep.source}: variant {variants[vi].label}",
              "metrics": list(sweep.metrics)} for vi, seed in keys]

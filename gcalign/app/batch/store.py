@@ -5,9 +5,10 @@ DESIGN.md "Results file". Every finished run is appended to a journal next to th
 The HDF5 file is rebuilt from the journal under a temporary name and renamed
 (:func:`gcalign.io.results.atomic_h5`) every few seconds and at the end, so a SIGKILL never
 leaves a corrupt file, and ``resume=True`` runs only what is missing (from the journal, or
-from the HDF5 file if the journal is gone). Runs are identified by a hash of their
-variant's scenario, command and metrics plus the seed, so a resumed sweep with more seeds
-or more grid values reuses every run it already has.
+from the HDF5 file if the journal is gone). Runs are identified by their variant's key
+(:attr:`~gcalign.app.batch.sweep.Sweep.keys`: its scenario, a file it names by content,
+command and metrics) plus the seed, so a resumed sweep with more seeds or more grid values
+reuses every run it already has, from any folder.
 """
 
 from __future__ import annotations
@@ -378,7 +379,7 @@ def previous_records(sweep: Sweep, output: Path, log=None) -> tuple[dict, str]:
                 or all(_finite_metric(r["metrics"].get(m)) for m in sweep.metrics)]
     else:
         return {}, ""
-    index = {v.key: v.index for v in sweep.variants}
+    index = {key: vi for vi, key in enumerate(sweep.keys)}
     seeds = set(sweep.seed_values)
     kept: dict[tuple[int, int], dict] = {}
     for r in recs:  # a later record of the same run wins

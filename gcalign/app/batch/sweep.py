@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import functools
 import hashlib
 import itertools
 import json
@@ -30,7 +31,7 @@ from gcalign.app.batch.overrides import apply_override
 from gcalign.errors import ScenarioError, clip
 from gcalign.io.scenario.base import Model
 from gcalign.io.scenario.messages import cut, scenario_errors
-from gcalign.io.scenario.recording import absolute_paths
+from gcalign.io.scenario.recording import absolute_paths, replace_paths
 from gcalign.limits import SEED_MAX
 
 
@@ -52,7 +53,6 @@ class Variant:
     index: int
     overrides: dict
     scenario: dict
-    key: str  # hash of command, metrics and scenario: identifies its runs across resumes
 
     @property
     def label(self) -> str:
@@ -89,9 +89,23 @@ class Sweep:
         """``(variant, seed)`` of every run, in canonical order."""
         return [(v.index, s) for v in self.variants for s in self.seed_values]
 
+    @functools.cached_property
+    def keys(self) -> tuple[str, ...]:
+        """Each variant's key, which identifies its runs across resumes: a hash of the
+        command, the metrics and its scenario, in which a file it names stands for its
+        content, not its path (a moved or copied folder resumes, a recording changed in
+        place runs again); each file is read once, when a batch first asks."""
+        content = functools.cache(_digest)
+        keys = []
+        for v in self.variants:
+            scenario = copy.deepcopy(v.scenario)
+            replace_paths(scenario, content)
+            keys.append(_hash(self.command, list(self.metrics), scenario))
+        return tuple(keys)
+
     @property
     def fingerprint(self) -> str:
-        return _hash([v.key for v in self.variants], list(self.seed_values))
+        return _hash(list(self.keys), list(self.seed_values))
 
 
 def _short(v) -> str:
@@ -101,6 +115,21 @@ def _short(v) -> str:
 def _hash(*parts) -> str:
     text = json.dumps(parts, sort_keys=True, default=str, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _digest(path: Path) -> str:
+    """What a file holds: its SHA-256, read in 1 MiB chunks; its path where it is not a
+    readable regular file (a FIFO would block; its runs say why)."""
+    sha = hashlib.sha256()
+    try:
+        if not path.is_file():
+            return str(path)
+        with open(path, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                sha.update(chunk)
+    except OSError:
+        return str(path)
+    return "sha256:" + sha.hexdigest()
 
 
 def load_sweep(path: Path) -> Sweep:
@@ -346,7 +375,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
                    *((k, v) for k, v in overrides.items() if k != CASE_KEY)]
         scenario, lines = variant(applied, f"{source}: grid: variant {label}")
         unused.update(dict.fromkeys(lines))
-        variants.append(Variant(i, overrides, scenario, _hash(command, list(metrics), scenario)))
+        variants.append(Variant(i, overrides, scenario))
     return Sweep(name=spec.name or default_name, command=command, source=source, text=text,
                  base_source=base_source, base_text=base_text, grid=axes, cases=cases,
                  seeds=spec.seeds, seed_start=spec.seed_start, metrics=tuple(metrics),
@@ -448,7 +477,7 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
     sweep = sweep_from_mapping({"name": name, "base": copy.deepcopy(datas[0]),
                                 "command": command, "seeds": seeds, "seed_start": seed_start,
                                 "metrics": spec["metrics"]}, "batch")
-    variants = [Variant(i, {FILE_KEY: label}, data, _hash(command, list(sweep.metrics), data))
+    variants = [Variant(i, {FILE_KEY: label}, data)
                 for i, (label, data) in enumerate(zip(labels, datas, strict=True))]
     return dataclasses.replace(
         sweep, source="batch of " + ", ".join(map(str, paths)),
