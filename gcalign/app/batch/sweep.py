@@ -25,7 +25,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
-from pydantic import Field, ValidationError, field_validator, model_validator
+from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from gcalign.app.batch.overrides import apply_override
 from gcalign.errors import ScenarioError, clip
@@ -142,12 +142,6 @@ def load_sweep(path: Path) -> Sweep:
                               default_name=path.stem)
 
 
-def _whole(v: Any, least: int, what: str) -> int:
-    if isinstance(v, bool) or not isinstance(v, int) or v < least:
-        raise ValueError(f"must be a whole number ≥ {least}{what}, got {cut(v)}")
-    return v
-
-
 class SweepFile(Model):
     """The keys of a sweep file, checked for shape (docs/batch.md); what they mean for the
     base scenario is checked by :func:`sweep_from_mapping`."""
@@ -184,15 +178,13 @@ class SweepFile(Model):
                              f"{type(v).__name__} {cut(v)}")
         return v
 
-    @field_validator("seeds", mode="before")
+    @field_validator("seeds", "seed_start", mode="before")
     @classmethod
-    def _seeds(cls, v: Any) -> int:
-        return _whole(v, 1, " (the seed count)")
-
-    @field_validator("seed_start", mode="before")
-    @classmethod
-    def _seed_start(cls, v: Any) -> int:
-        return _whole(v, 0, "")
+    def _whole(cls, v: Any, info: ValidationInfo) -> int:
+        least, what = (1, " (the seed count)") if info.field_name == "seeds" else (0, "")
+        if isinstance(v, bool) or not isinstance(v, int) or v < least:
+            raise ValueError(f"must be a whole number ≥ {least}{what}, got {cut(v)}")
+        return v
 
     @field_validator("metrics", mode="before")
     @classmethod
@@ -269,25 +261,24 @@ class SweepFile(Model):
         return self
 
 
-def _read_base(spec: SweepFile, source: str, base_dir: Path) -> tuple[dict, str, str, Path]:
-    """The base scenario's mapping (``imu_file`` made absolute), source and text, and the
-    folder its relative paths start from."""
+def _read_base(spec: SweepFile, source: str, base_dir: Path) -> tuple[dict, str, str]:
+    """The base scenario's mapping (its file paths made absolute: workers may run
+    elsewhere), source and text."""
     import yaml
 
     from gcalign.io.scenario.loader import read_yaml
 
-    base = spec.base
-    if isinstance(base, str):
-        path = (base_dir / base) if not Path(base).is_absolute() else Path(base)
-        if not path.is_file():
-            raise ScenarioError(f"{source}: base: {cut(base)}: file not found ({path})")
-        data, where, text, folder = read_yaml(path), str(path), path.read_text(
-            encoding="utf-8"), path.parent
+    if isinstance(spec.base, dict):
+        data, where, folder = copy.deepcopy(spec.base), f"{source}: base", base_dir
+        text = yaml.safe_dump(spec.base, sort_keys=False)
     else:
-        data, where = copy.deepcopy(base), f"{source}: base"
-        text, folder = yaml.safe_dump(base, sort_keys=False), base_dir
-    absolute_paths(data, folder)  # workers may run elsewhere
-    return data, where, text, folder
+        path = base_dir / spec.base  # (an absolute path stays itself)
+        if not path.is_file():
+            raise ScenarioError(f"{source}: base: {cut(spec.base)}: file not found ({path})")
+        data, where, folder = read_yaml(path), str(path), path.parent
+        text = path.read_text(encoding="utf-8")
+    absolute_paths(data, folder)
+    return data, where, text
 
 
 def _command_of(spec: SweepFile, base_data: Any, source: str) -> str:
@@ -327,7 +318,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     except ValidationError as err:
         raise ScenarioError(scenario_errors(err, source, SweepFile, "sweep")) from None
     text = text if text is not None else yaml.safe_dump(data, sort_keys=False)
-    base_data, base_source, base_text, _ = _read_base(spec, source, Path(base_dir or "."))
+    base_data, base_source, base_text = _read_base(spec, source, Path(base_dir or "."))
     base_model = parse_scenario(base_data, base_source)
     if sets:
         grid_keys = set(spec.grid) | {k for over in spec.cases.values() for k in over}
