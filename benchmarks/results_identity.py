@@ -12,7 +12,8 @@ the files of two such folders: the objects present, each dataset's dtype, shape,
 so that files written before are shown to read the same. ``show`` texts are compared
 without timings, dates, folders and line breaks; give both trees names of one length (their
 paths wrap the tables alike). A batch over a recording keys its variants by the recording's
-absolute path: its ``fingerprint`` and ``vkey`` differ between trees in two folders.
+content (trees before 2026-12-04 by its absolute path: their ``fingerprint`` and ``vkey``
+differ from any other folder's).
 """
 
 from __future__ import annotations

@@ -1047,8 +1047,8 @@ def materialize(case: Case, folder) -> list[str]:
             from gcalign.app.batch.sweep import load_sweep
 
             sw = load_sweep(folder / "SW.yaml")
-            for v in sw.variants:
-                body = body.replace(f"@VKEY{v.index}".encode(), v.key.encode())
+            for vi, key in enumerate(sw.keys):
+                body = body.replace(f"@VKEY{vi}".encode(), key.encode())
             (folder / name).write_bytes(body)
     return [a.replace("ro/", READ_ONLY + "/", 1) if a.startswith("ro/") else a
             for a in case.argv]

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import copy
 import json
+import shutil
 import socket
 import subprocess
 import sys
@@ -225,7 +226,7 @@ def test_cases_are_crossed_with_the_grid_and_applied_first(tmp_path):
     assert sc.imu.gyro.bias_dph == [0.01] * 3 and sc.align.stages[0].t_z_s == 60  # grid wins
     noisy = parse_scenario(copy.deepcopy(sw.variants[1].scenario))
     assert noisy.imu.gyro.arw_dprh == [0.001] * 3
-    assert len({x.key for x in sw.variants}) == 12  # every variant its own runs
+    assert len(set(sw.keys)) == 12  # every variant its own runs
 
 
 @pytest.mark.parametrize(("cases", "grid", "message"), [
@@ -433,6 +434,80 @@ def test_resume_skips_a_torn_journal_line(tmp_path):
     assert runs_of(out) == sw.run_keys()
     fresh = run_batch(sw, tmp_path / "u.h5", workers=1)
     assert fresh.summary["variants"] == res.summary["variants"]
+
+
+@pytest.fixture
+def recorded(lasergyro, tmp_path) -> Path:
+    """A folder with the first 80 s of lasergyro.imu (its header, then 100 Hz rows), a
+    scenario that names it by a relative path, and a sweep of two windows of it."""
+    folder = tmp_path / "A"
+    (folder / "data").mkdir(parents=True)
+    lines = lasergyro.read_text(encoding="utf-8").splitlines(keepends=True)
+    (folder / "data" / "short.imu").write_text("".join(lines[:8000]), encoding="utf-8")
+    base = {"imu_file": "data/short.imu",
+            "align": {"coarse": {"method": "inertial"}, "mode": "conventional", "t1_s": 20,
+                      "t2_s": 60, "t3_s": 60, "level_s": 10}}
+    (folder / "base.yaml").write_text(yaml.safe_dump(base))
+    (folder / "sweep.yaml").write_text(yaml.safe_dump(
+        {"base": "base.yaml", "grid": {"align.start_s": [0, 10]}, "metrics": ["attitude_t2_deg"]}))
+    return folder
+
+
+def _change_latitude(recording: Path) -> None:
+    """The same recording with another site latitude in its header (line 13 of PSINS)."""
+    lines = recording.read_text(encoding="utf-8").splitlines(keepends=True)
+    assert lines[12].startswith("34.24604800 ")
+    lines[12] = "40" + lines[12][2:]
+    recording.write_text("".join(lines), encoding="utf-8")
+
+
+def _batch_of(folder: Path, *options) -> tuple[dict, str, str]:
+    """The summary, stderr and fingerprint of the folder's sweep batched into out.h5."""
+    res = batch_cli(folder / "sweep.yaml", "--workers", 1, "-o", folder / "out.h5", "--json",
+                    *options)
+    assert res.exit_code == 0, res.output
+    with h5py.File(folder / "out.h5", "r") as f:
+        return json.loads(res.stdout), res.stderr, str(f["batch"].attrs["fingerprint"])
+
+
+def test_a_moved_or_copied_folder_resumes_its_batch(recorded, tmp_path):
+    """A recording is known by its content, not its path: the batch of a folder moved or
+    copied elsewhere resumes with every run finished, under the same fingerprint."""
+    first, _, fingerprint = _batch_of(recorded)
+    copied = shutil.copytree(recorded, tmp_path / "elsewhere" / "B")
+    moved = Path(shutil.move(recorded, tmp_path / "C"))
+    for folder in (copied, moved):
+        summary, err, again = _batch_of(folder, "--resume")
+        assert "2 of 2 run(s) already finished" in err
+        assert again == fingerprint and summary["variants"] == first["variants"]
+
+
+def test_a_recording_changed_in_place_runs_again(recorded):
+    """The same path with another content: no run of the old recording is resumed, and the
+    file then holds what a fresh batch of the new one gives."""
+    first, _, fingerprint = _batch_of(recorded)
+    _change_latitude(recorded / "data" / "short.imu")
+    resumed, err, again = _batch_of(recorded, "--resume")
+    assert "0 of 2 run(s) already finished" in err and again != fingerprint
+    (recorded / "out.h5").unlink()
+    fresh, _, _ = _batch_of(recorded)
+    assert resumed["variants"] == fresh["variants"] != first["variants"]
+
+
+def test_a_worker_reads_a_recording_changed_in_place_again(recorded):
+    """A worker keeps a variant's scenario and recording as read between batches (a Dask
+    worker lives on): the same variant of a changed recording is another one, read again,
+    its numbers those of a single run."""
+    from gcalign.app.batch.runs import run_task
+
+    def run(sweep):
+        return run_task(_tasks(sweep, [(0, 1)])[0])["metrics"]["attitude_t2_deg"]
+
+    before = run(load_sweep(recorded / "sweep.yaml"))
+    _change_latitude(recorded / "data" / "short.imu")
+    sweep = load_sweep(recorded / "sweep.yaml")
+    single = run_summary("align", parse_scenario(copy.deepcopy(sweep.variants[0].scenario)), 1)
+    assert run(sweep) == single["attitude_t2_deg"] != before
 
 
 @pytest.mark.slow

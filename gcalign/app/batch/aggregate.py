@@ -19,13 +19,9 @@ STATS = ("mean", "std", "rms", "median", "p05", "p95")
 def components(command: str, metric: str, k: int | None) -> list[str] | None:
     """Names of a vector metric's components: the command's room says (attitude triples
     are pitch, roll, yaw in align), else their indices."""
-    if k is None:
-        return None
     from gcalign.app.registry import COMMANDS
 
-    if command in COMMANDS:
-        return COMMANDS[command].components(metric, k)
-    return [str(i) for i in range(k)]
+    return None if k is None else COMMANDS[command].components(metric, k)
 
 
 def metric_label(command: str, metric: str) -> str:

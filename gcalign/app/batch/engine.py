@@ -52,10 +52,9 @@ Progress = Callable[[int, int, int], None]  # (finished, total, failed)
 
 
 def _tasks(sweep: Sweep, keys: list[tuple[int, int]]) -> list[dict]:
-    variants = {v.index: v for v in sweep.variants}
-    return [{"command": sweep.command, "variant": vi, "vkey": variants[vi].key, "seed": seed,
-             "scenario": variants[vi].scenario,
-             "source": f"{sweep.source}: variant {variants[vi].label}",
+    return [{"command": sweep.command, "variant": vi, "vkey": sweep.keys[vi], "seed": seed,
+             "scenario": sweep.variants[vi].scenario,
+             "source": f"{sweep.source}: variant {sweep.variants[vi].label}",
              "metrics": list(sweep.metrics)} for vi, seed in keys]
 
 
@@ -156,11 +155,9 @@ def budget_check(sweep: Sweep, workers: int) -> None:
 
 
 def _duration(scenario: dict) -> float:
-    motion = scenario.get("motion") if isinstance(scenario, dict) else None
-    d = motion.get("duration_s") if isinstance(motion, dict) else None
-    rate = (scenario.get("imu") or {}).get("rate_hz", 100.0) if isinstance(
-        scenario.get("imu"), dict) else 100.0
-    return float(d or 0.0) * float(rate or 0.0)
+    """The samples of a variant's simulation (a validated scenario: sections are mappings)."""
+    motion, imu = scenario.get("motion") or {}, scenario.get("imu") or {}
+    return float(motion.get("duration_s") or 0.0) * float(imu.get("rate_hz", 100.0) or 0.0)
 
 
 def _run(sweep, output, jpath, records, reused, todo, backend, progress, keys, chunk_size,
@@ -214,7 +211,7 @@ def _run(sweep, output, jpath, records, reused, todo, backend, progress, keys, c
 
 
 def _drive(backend, sweep, todo, records, journal, progress, total, chunk_size, rebuild,
-           rebuild_every_s) -> int:
+           rebuild_every_s) -> None:
     """Submit chunks (a bounded window), collect results, journal them, rebuild the file."""
     queue = _chunks(_tasks(sweep, todo), backend.workers, chunk_size)
     queue.reverse()  # pop() from the end = canonical order
@@ -228,16 +225,21 @@ def _drive(backend, sweep, todo, records, journal, progress, total, chunk_size, 
             chunk = queue.pop()
             in_flight[backend.submit(chunk)] = chunk
         done = backend.wait(list(in_flight), timeout=0.5)
-        lost: list[dict] = []
-        broken = None
         for fut in done:
             chunk = in_flight.pop(fut)
             try:
                 recs = backend.result(fut)
-            except WorkerLost as err:
-                lost.extend(chunk)
-                broken = err
-                continue
+            except WorkerLost as err:  # its runs retried alone: a crasher only takes itself down
+                recs = []
+                for t in chunk:
+                    k = (t["variant"], t["seed"])
+                    attempts[k] = attempts.get(k, 0) + 1
+                    if attempts[k] < MAX_ATTEMPTS:
+                        queue.append([t])
+                    else:
+                        recs.append({"variant": t["variant"], "vkey": t["vkey"], "seed": t["seed"],
+                                     "status": "failed", "metrics": {}, "wall_s": float("nan"),
+                                     "error": f"worker process died while running it ({err})"})
             for r in recs:
                 if r["status"] == "bad-metric":
                     raise ScenarioError(f"{sweep.source}: metrics: {r['error']}")
@@ -245,25 +247,8 @@ def _drive(backend, sweep, todo, records, journal, progress, total, chunk_size, 
             for r in recs:
                 records[(r["variant"], r["seed"])] = r
                 failed += r["status"] != "ok"
-        if broken is not None:
-            dead = []
-            for t in lost:
-                k = (t["variant"], t["seed"])
-                attempts[k] = attempts.get(k, 0) + 1
-                if attempts[k] >= MAX_ATTEMPTS:
-                    dead.append({"variant": t["variant"], "vkey": t["vkey"], "seed": t["seed"],
-                                 "status": "failed", "metrics": {}, "wall_s": float("nan"),
-                                 "error": f"worker process died while running it ({broken})"})
-                else:
-                    queue.append([t])  # retried alone: a crasher only takes itself down
-            if dead:
-                journal.append(dead)
-                for r in dead:
-                    records[(r["variant"], r["seed"])] = r
-                failed += len(dead)
         if progress and done:
             progress(len(records), total, failed)
         if time.monotonic() - last_rebuild >= rebuild_every_s and (queue or in_flight):
             rebuild()
             last_rebuild = time.monotonic()
-    return failed

@@ -19,6 +19,7 @@ from gcalign.app.batch.aggregate import metric_label, metric_units
 from gcalign.app.batch.sweep import CASE_KEY, FILE_KEY
 from gcalign.app.batch.tables import short_keys, written
 from gcalign.app.plots import _s, angle_scale, finish, new_figure, suptitle
+from gcalign.io.scenario.base import is_number
 
 
 def _pairs(overrides: dict, keys: list[str], sep: str) -> str:
@@ -106,15 +107,11 @@ def batch_figure(metric: str, values: np.ndarray, variant: np.ndarray, labels: l
     return fig
 
 
-def _is_number(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool)
-
-
 def numeric_axes(grid: dict) -> list[str]:
     """Grid keys whose values are all numbers, at least two of them distinct: the x axes of
     :func:`sweep_figure`."""
     return [k for k, vals in grid.items()
-            if k != CASE_KEY and all(map(_is_number, vals)) and len(set(vals)) >= 2]
+            if k != CASE_KEY and all(map(is_number, vals)) and len(set(vals)) >= 2]
 
 
 def sweep_figure(metric: str, values: np.ndarray, variant: np.ndarray, overrides: list[dict],

@@ -5,9 +5,9 @@ DESIGN.md "Results file". Every finished run is appended to a journal next to th
 The HDF5 file is rebuilt from the journal under a temporary name and renamed
 (:func:`gcalign.io.results.atomic_h5`) every few seconds and at the end, so a SIGKILL never
 leaves a corrupt file, and ``resume=True`` runs only what is missing (from the journal, or
-from the HDF5 file if the journal is gone). Runs are identified by a hash of their
-variant's scenario, command and metrics plus the seed, so a resumed sweep with more seeds
-or more grid values reuses every run it already has.
+from the HDF5 file if the journal is gone). Runs are identified by their variant's key
+(:attr:`~gcalign.app.batch.sweep.Sweep.keys`) and seed, so a resumed sweep with more seeds
+or more grid values reuses every run it already has, also from another folder.
 """
 
 from __future__ import annotations
@@ -374,16 +374,15 @@ def previous_records(sweep: Sweep, output: Path, log=None) -> tuple[dict, str]:
         recs, where = read_journal(jpath, sweep.metrics, log), str(jpath)
     elif Path(output).is_file():
         recs, where = read_runs_h5(output), str(output)
-        recs = [r for r in recs if r["status"] != "ok"
-                or all(_finite_metric(r["metrics"].get(m)) for m in sweep.metrics)]
     else:
         return {}, ""
-    index = {v.key: v.index for v in sweep.variants}
+    index = {key: vi for vi, key in enumerate(sweep.keys)}
     seeds = set(sweep.seed_values)
     kept: dict[tuple[int, int], dict] = {}
     for r in recs:  # a later record of the same run wins
         vi = index.get(str(r.get("vkey")))
-        if vi is None or r.get("seed") not in seeds or r.get("status") != "ok":
+        if vi is None or r.get("seed") not in seeds or r.get("status") != "ok" or not all(
+                _finite_metric(r["metrics"].get(m)) for m in sweep.metrics):
             continue
         r = {k: v for k, v in r.items() if k != "type"}
         r["variant"] = vi

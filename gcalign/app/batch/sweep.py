@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import functools
 import hashlib
 import itertools
 import json
@@ -24,13 +25,13 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
-from pydantic import Field, ValidationError, field_validator, model_validator
+from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from gcalign.app.batch.overrides import apply_override
 from gcalign.errors import ScenarioError, clip
 from gcalign.io.scenario.base import Model
 from gcalign.io.scenario.messages import cut, scenario_errors
-from gcalign.io.scenario.recording import absolute_paths
+from gcalign.io.scenario.recording import absolute_paths, replace_paths
 from gcalign.limits import SEED_MAX
 
 
@@ -52,7 +53,6 @@ class Variant:
     index: int
     overrides: dict
     scenario: dict
-    key: str  # hash of command, metrics and scenario: identifies its runs across resumes
 
     @property
     def label(self) -> str:
@@ -89,9 +89,23 @@ class Sweep:
         """``(variant, seed)`` of every run, in canonical order."""
         return [(v.index, s) for v in self.variants for s in self.seed_values]
 
+    @functools.cached_property
+    def keys(self) -> tuple[str, ...]:
+        """Each variant's key, which identifies its runs across resumes: a hash of the
+        command, the metrics and its scenario, in which a file it names stands for its
+        content, not its path (a moved or copied folder resumes, a recording changed in
+        place runs again); each file is read once, when a batch first asks."""
+        content = functools.cache(_digest)
+        keys = []
+        for v in self.variants:
+            scenario = copy.deepcopy(v.scenario)
+            replace_paths(scenario, content)
+            keys.append(_hash(self.command, list(self.metrics), scenario))
+        return tuple(keys)
+
     @property
     def fingerprint(self) -> str:
-        return _hash([v.key for v in self.variants], list(self.seed_values))
+        return _hash(list(self.keys), list(self.seed_values))
 
 
 def _short(v) -> str:
@@ -103,6 +117,21 @@ def _hash(*parts) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
+def _digest(path: Path) -> str:
+    """What a file holds: its SHA-256, read in 1 MiB chunks; its path where it is not a
+    readable regular file (a FIFO would block; its runs say why)."""
+    sha = hashlib.sha256()
+    try:
+        if not path.is_file():
+            return str(path)
+        with open(path, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                sha.update(chunk)
+    except OSError:
+        return str(path)
+    return "sha256:" + sha.hexdigest()
+
+
 def load_sweep(path: Path) -> Sweep:
     """Read and validate a sweep file (ScenarioError, exit 2, on any bad input)."""
     from gcalign.io.scenario.loader import read_yaml
@@ -111,12 +140,6 @@ def load_sweep(path: Path) -> Sweep:
     data = read_yaml(path)
     return sweep_from_mapping(data, str(path), path.parent, path.read_text(encoding="utf-8"),
                               default_name=path.stem)
-
-
-def _whole(v: Any, least: int, what: str) -> int:
-    if isinstance(v, bool) or not isinstance(v, int) or v < least:
-        raise ValueError(f"must be a whole number ≥ {least}{what}, got {cut(v)}")
-    return v
 
 
 class SweepFile(Model):
@@ -155,15 +178,13 @@ class SweepFile(Model):
                              f"{type(v).__name__} {cut(v)}")
         return v
 
-    @field_validator("seeds", mode="before")
+    @field_validator("seeds", "seed_start", mode="before")
     @classmethod
-    def _seeds(cls, v: Any) -> int:
-        return _whole(v, 1, " (the seed count)")
-
-    @field_validator("seed_start", mode="before")
-    @classmethod
-    def _seed_start(cls, v: Any) -> int:
-        return _whole(v, 0, "")
+    def _whole(cls, v: Any, info: ValidationInfo) -> int:
+        least, what = (1, " (the seed count)") if info.field_name == "seeds" else (0, "")
+        if isinstance(v, bool) or not isinstance(v, int) or v < least:
+            raise ValueError(f"must be a whole number ≥ {least}{what}, got {cut(v)}")
+        return v
 
     @field_validator("metrics", mode="before")
     @classmethod
@@ -240,25 +261,24 @@ class SweepFile(Model):
         return self
 
 
-def _read_base(spec: SweepFile, source: str, base_dir: Path) -> tuple[dict, str, str, Path]:
-    """The base scenario's mapping (``imu_file`` made absolute), source and text, and the
-    folder its relative paths start from."""
+def _read_base(spec: SweepFile, source: str, base_dir: Path) -> tuple[dict, str, str]:
+    """The base scenario's mapping (its file paths made absolute: workers may run
+    elsewhere), source and text."""
     import yaml
 
     from gcalign.io.scenario.loader import read_yaml
 
-    base = spec.base
-    if isinstance(base, str):
-        path = (base_dir / base) if not Path(base).is_absolute() else Path(base)
-        if not path.is_file():
-            raise ScenarioError(f"{source}: base: {cut(base)}: file not found ({path})")
-        data, where, text, folder = read_yaml(path), str(path), path.read_text(
-            encoding="utf-8"), path.parent
+    if isinstance(spec.base, dict):
+        data, where, folder = copy.deepcopy(spec.base), f"{source}: base", base_dir
+        text = yaml.safe_dump(spec.base, sort_keys=False)
     else:
-        data, where = copy.deepcopy(base), f"{source}: base"
-        text, folder = yaml.safe_dump(base, sort_keys=False), base_dir
-    absolute_paths(data, folder)  # workers may run elsewhere
-    return data, where, text, folder
+        path = base_dir / spec.base  # (an absolute path stays itself)
+        if not path.is_file():
+            raise ScenarioError(f"{source}: base: {cut(spec.base)}: file not found ({path})")
+        data, where, folder = read_yaml(path), str(path), path.parent
+        text = path.read_text(encoding="utf-8")
+    absolute_paths(data, folder)
+    return data, where, text
 
 
 def _command_of(spec: SweepFile, base_data: Any, source: str) -> str:
@@ -298,7 +318,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
     except ValidationError as err:
         raise ScenarioError(scenario_errors(err, source, SweepFile, "sweep")) from None
     text = text if text is not None else yaml.safe_dump(data, sort_keys=False)
-    base_data, base_source, base_text, _ = _read_base(spec, source, Path(base_dir or "."))
+    base_data, base_source, base_text = _read_base(spec, source, Path(base_dir or "."))
     base_model = parse_scenario(base_data, base_source)
     if sets:
         grid_keys = set(spec.grid) | {k for over in spec.cases.values() for k in over}
@@ -346,7 +366,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
                    *((k, v) for k, v in overrides.items() if k != CASE_KEY)]
         scenario, lines = variant(applied, f"{source}: grid: variant {label}")
         unused.update(dict.fromkeys(lines))
-        variants.append(Variant(i, overrides, scenario, _hash(command, list(metrics), scenario)))
+        variants.append(Variant(i, overrides, scenario))
     return Sweep(name=spec.name or default_name, command=command, source=source, text=text,
                  base_source=base_source, base_text=base_text, grid=axes, cases=cases,
                  seeds=spec.seeds, seed_start=spec.seed_start, metrics=tuple(metrics),
@@ -448,7 +468,7 @@ def sweep_from_files(paths: list[Path], command: str | None = None, seeds: int =
     sweep = sweep_from_mapping({"name": name, "base": copy.deepcopy(datas[0]),
                                 "command": command, "seeds": seeds, "seed_start": seed_start,
                                 "metrics": spec["metrics"]}, "batch")
-    variants = [Variant(i, {FILE_KEY: label}, data, _hash(command, list(sweep.metrics), data))
+    variants = [Variant(i, {FILE_KEY: label}, data)
                 for i, (label, data) in enumerate(zip(labels, datas, strict=True))]
     return dataclasses.replace(
         sweep, source="batch of " + ", ".join(map(str, paths)),

@@ -20,6 +20,7 @@ the rest in ``Scenario.imu_layout``; it writes them back as one ``imu_file`` map
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -228,6 +229,12 @@ def recorded_scenario(section: str, imu_file) -> dict:
 def absolute_paths(data: Any, folder) -> None:
     """In a scenario mapping (before validation), the relative paths of :data:`FILE_KEYS`
     made absolute from `folder`, in place (batch workers may run elsewhere)."""
+    replace_paths(data, lambda p: str(p if p.is_absolute() else (Path(folder) / p).resolve()))
+
+
+def replace_paths(data: Any, new: Callable[[Path], str]) -> None:
+    """In a scenario mapping (before validation), each path of :data:`FILE_KEYS` replaced
+    by ``new(path)``, in place."""
     for key in FILE_KEYS:
         *head, last = key.split(".")
         parent = data
@@ -237,5 +244,4 @@ def absolute_paths(data: Any, folder) -> None:
         holder, field = (parent, last) if isinstance(node, str) and last != "aiding" else (
             node, "path")
         if isinstance(holder, dict) and isinstance(holder.get(field), str):
-            p = Path(holder[field])
-            holder[field] = str(p if p.is_absolute() else (Path(folder) / p).resolve())
+            holder[field] = new(Path(holder[field]))
