@@ -22,9 +22,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
+import h5py
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from gcalign import units
@@ -40,14 +42,14 @@ MAX_POINTS = 4000
 
 def new_figure(rows: int, cols: int = 1, *, width: float = 9.0, height: float | None = None,
                sharex: bool | Literal["none", "all", "row", "col"] = True
-               ) -> tuple[Figure, list]:
+               ) -> tuple[Figure, list[Axes]]:
     """A Figure on the Agg canvas (no global pyplot state) and its axes, flattened."""
     fig = Figure(figsize=(width, height or 2.4 * rows + 1.0), dpi=DPI, layout="constrained")
     axes = fig.subplots(rows, cols, sharex=sharex, squeeze=False)
     return fig, list(axes.ravel())
 
 
-def legend_below(fig: Figure, ax, ncols: int | None = None) -> None:
+def legend_below(fig: Figure, ax: Axes, ncols: int | None = None) -> None:
     """One legend for the figure, below the panels (it never covers a curve; above them,
     constrained layout would put it over the title), from the labelled series of `ax`."""
     handles, labels = ax.get_legend_handles_labels()
@@ -64,19 +66,19 @@ def suptitle(fig: Figure, text: str) -> None:
     fig.suptitle("\n".join(textwrap.wrap(text, width)) if len(text) > width else text)
 
 
-def legend_right(ax) -> None:
+def legend_right(ax: Axes) -> None:
     """The panel's legend outside it, on the right (constrained layout makes room)."""
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
               borderaxespad=0.0)
 
 
-def plain_numbers(ax) -> None:
+def plain_numbers(ax: Axes) -> None:
     """y tick labels that read as values in the axis's unit: no offset ("−2.88e2" at the end
     of the axis, to be added to every label) and no power of ten."""
     ax.ticklabel_format(axis="y", useOffset=False, style="plain")
 
 
-def steady(ax) -> None:
+def steady(ax: Axes) -> None:
     """A panel whose values agree to 1e-6 of their size (a noise-free sensor's output) drawn
     as matplotlib draws a constant, ±5 % about it: fitted to them, its labels would read the
     round-off ("1e−10+5.244972887" above the axis)."""
@@ -86,7 +88,8 @@ def steady(ax) -> None:
         ax.set_ylim(mid - 0.05 * abs(mid), mid + 0.05 * abs(mid))
 
 
-def finish(fig: Figure, axes, xlabel: str | Sequence[str], title: str, ylabels=None, *,
+def finish(fig: Figure, axes: Sequence[Axes], xlabel: str | Sequence[str], title: str,
+           ylabels: Sequence[str] | None = None, *,
            legend: Literal["right", "below"] | None = "right", ncols: int | None = None
            ) -> Figure:
     """The common ending of a figure of panels: each panel gridded (with its y label, if
@@ -137,7 +140,8 @@ def rate_scale(values_rad_s: np.ndarray) -> tuple[float, str]:
     return math.degrees(1.0) * 3600.0, "deg/h"
 
 
-def envelope(x: np.ndarray, y: np.ndarray, max_points: int = MAX_POINTS):
+def envelope(x: np.ndarray, y: np.ndarray, max_points: int = MAX_POINTS
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """A long series as bins: centre times, mean, min and max of each bin (all (n,));
     short series come back as they are (min = max = mean = y)."""
     x, y = np.asarray(x, float), np.asarray(y, float)
@@ -149,7 +153,7 @@ def envelope(x: np.ndarray, y: np.ndarray, max_points: int = MAX_POINTS):
     return xs.mean(1), ys.mean(1), ys.min(1), ys.max(1)
 
 
-def plot_series(ax, x, y, label: str, **style) -> None:
+def plot_series(ax: Axes, x: np.ndarray, y: np.ndarray, label: str, **style: Any) -> None:
     """A line, or for a long series its bin means and a band from min to max (a peak
     stays visible however many samples it stands for)."""
     xc, mean, lo, hi = envelope(x, y)
@@ -195,11 +199,11 @@ def imu_figure(t: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, ts: float,
                   f"{title}: increments / {ts * 1e3:g} ms, {frame} frame{bins}", legend=None)
 
 
-def _s(x) -> str:
+def _s(x: object) -> str:
     return x.decode() if isinstance(x, bytes) else str(x)
 
 
-def truth_and_imu(f, name: str) -> dict[str, Figure]:
+def truth_and_imu(f: h5py.File, name: str) -> dict[str, Figure]:
     """The truth (``/truth`` with velocities) and IMU output (``/imu``; its increments are
     sums over each stored interval when decimated: rates over that interval) figures of
     the open file `f`, read through the checked readers (a damaged file: one line)."""

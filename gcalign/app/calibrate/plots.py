@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -26,7 +27,7 @@ from gcalign.app.report import UNIT_TEXT
 from gcalign.estimation.calibration import CalibrationResult, Errors, Spans
 from gcalign.units import ANGLE_UNITS, angle_unit
 
-STYLE = {"both": dict(color="tab:red", linestyle="--"),
+STYLE: dict[str, dict[str, Any]] = {"both": dict(color="tab:red", linestyle="--"),
          "velocity": dict(color="tab:cyan", linestyle="-"),
          "position": dict(color="tab:purple", linestyle="-.")}
 AXES = ("x", "y", "z")
@@ -137,8 +138,8 @@ def estimates_figure(runs: list[ShownRun], attrs, states: list[str], title: str)
             tx, xlabel = _time_axis(r.result.t)
             minutes = xlabel.endswith("(min)")
             est, sig = r.result.estimate[:, i] * k, r.result.sigma[:, i] * k
-            style = STYLE[r.measure] if len(runs) > 1 else dict(color="tab:blue",
-                                                                   linestyle="-")
+            style = STYLE[r.measure] if len(runs) > 1 else {"color": "tab:blue",
+                                                              "linestyle": "-"}
             lab = r.measure if len(runs) > 1 else "estimate"
             ax.plot(tx, est, linewidth=1.1, label=lab, **style)
             if len(runs) == 1:
@@ -240,7 +241,7 @@ def innovations_figure(run: CalibrationResult, title: str, outages=()) -> Figure
         shade_outages(ax, outages, xlabel.endswith("(min)"))
     axes[1].axhspan(lo, hi, color="tab:green", alpha=0.15, label=f"χ²({m}) 95 %")
     axes[1].set_ylabel("NIS")
-    if has_nees:
+    if run.nees is not None:
         lo, hi = chi2.ppf([0.025, 0.975], 21)
         axes[2].plot(tx, run.nees, linewidth=0.9, label="NEES")
         axes[2].axhspan(lo, hi, color="tab:green", alpha=0.15,
@@ -309,15 +310,16 @@ def solution_figure(run: ShownRun, attrs, title: str) -> Figure:
             ("attitude", e.att * k_att, sig_att, ("pitch", "roll", "yaw"),
              UNIT_WORD.get(unit, unit)))
     sm = run.smoothed
-    sm_rows = None if sm is None else (sm.pos, sm.v_n, sm.att * k_att)
-    ts = None if sm is None else (sm.t / 60.0 if minutes else sm.t)
+    smoothed = None if sm is None else (sm.t / 60.0 if minutes else sm.t,
+                                        (sm.pos, sm.v_n, sm.att * k_att))
     for r, (what, err, sig, labels, u) in enumerate(rows):
         for c in range(3):
             ax = axes[3 * r + c]
             ax.plot(tx, err[:, c], color="black", linewidth=0.6, label="forward filter")
             ax.fill_between(te, -3 * sig[:, c], 3 * sig[:, c], step="post", color="tab:blue",
                             alpha=0.15, linewidth=0, label="±3σ (filter)")
-            if sm_rows is not None:
+            if smoothed is not None:
+                ts, sm_rows = smoothed
                 ax.plot(ts, sm_rows[r][:, c], color="tab:red", linewidth=1.0,
                         label="smoothed (filter epochs)")
             shade_outages(ax, attrs["outages"], minutes)
