@@ -14,12 +14,16 @@ from __future__ import annotations
 import io
 import math
 import os
+from collections.abc import Callable
+from typing import TypeVar
 
 import numpy as np
 
 from gcalign.io.imu_files import ImuFileError, read_bytes
 
 __all__ = ["arrays", "read_vectors", "shapes"]
+
+T = TypeVar("T")
 
 
 def arrays(name: str, data: bytes) -> dict[str, np.ndarray]:
@@ -34,20 +38,11 @@ def arrays(name: str, data: bytes) -> dict[str, np.ndarray]:
                 else "its first 128 bytes are not a MAT header")
         raise ImuFileError(f"{name}: {what}, not a MATLAB file; format psins-mat reads the MAT "
                            "v5/v7 files MATLAB's save writes (a text table: format csv)")
-    try:  # the arrays' sizes from their headers first: compressed ones can be huge
-        found = scipy.io.whosmat(io.BytesIO(data))
-        held = sum(8.0 * math.prod(int(n) for n in shape) for _, shape, _ in found)
-    except MemoryError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - scipy's parser of a damaged file raises anything
-        raise _refused(name, exc) from None
+    # the arrays' sizes from their headers first: compressed ones can be huge
+    found = _parsed(name, lambda: scipy.io.whosmat(io.BytesIO(data)))
+    held = sum(8.0 * math.prod(int(n) for n in shape) for _, shape, _ in found)
     limits.MAX_INPUT_MB.check(held / 2**20, f"{name} (its arrays)", "read a part of it")
-    try:
-        mat = scipy.io.loadmat(io.BytesIO(data))
-    except MemoryError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - as above (MatReadError, zlib.error, ...)
-        raise _refused(name, exc) from None
+    mat = _parsed(name, lambda: scipy.io.loadmat(io.BytesIO(data)))
     return {k: v for k, v in mat.items() if not k.startswith("__")
             and isinstance(v, np.ndarray) and v.dtype.kind in "fiu"}
 
@@ -75,18 +70,21 @@ def shapes(path) -> dict[str, tuple[int, ...]]:
     import scipy.io
 
     name = os.fspath(path)
+    return {k: tuple(int(n) for n in shape)
+            for k, shape, _ in _parsed(name, lambda: scipy.io.whosmat(name))}
+
+
+def _parsed(name: str, parse: Callable[[], T]) -> T:
+    """``parse()``, scipy reading the MAT file `name`; what it cannot read, in one line
+    naming the file."""
     try:
-        return {k: tuple(int(n) for n in shape) for k, shape, _ in scipy.io.whosmat(name)}
+        return parse()
     except MemoryError:
         raise
+    except NotImplementedError:  # scipy's word for a v7.3 (HDF5) file
+        raise ImuFileError(f"{name}: a MAT v7.3 (HDF5) file; save it with save(..., '-v7') "
+                           "for format psins-mat") from None
     except Exception as exc:  # noqa: BLE001 - scipy's parser of a damaged file raises anything
-        raise _refused(name, exc) from None
-
-
-def _refused(name: str, exc: Exception) -> ImuFileError:
-    """What scipy could not read, in one line naming the file."""
-    if isinstance(exc, NotImplementedError):  # scipy's word for a v7.3 (HDF5) file
-        return ImuFileError(f"{name}: a MAT v7.3 (HDF5) file; save it with save(..., '-v7') "
-                            "for format psins-mat")
-    why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-    return ImuFileError(f"{name}: not a MATLAB file that scipy.io.loadmat reads ({why})")
+        why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ImuFileError(f"{name}: not a MATLAB file that scipy.io.loadmat reads ({why})"
+                           ) from None

@@ -74,7 +74,7 @@ from gcalign import limits
 from gcalign import units as u
 from gcalign.errors import ScenarioError
 from gcalign.io.scenario import bounds as B
-from gcalign.io.scenario.base import Model, Vec3, vector
+from gcalign.io.scenario.base import Model, Vec3, one_of, vector
 from gcalign.io.scenario.schedule import RowModel, steps_of
 from gcalign.realtime.settings import (
     FilterSettings,
@@ -102,6 +102,10 @@ def _us(x: float | None) -> float | None:
 FIR_WINDOWS = ("hamming", "hann", "blackman", "boxcar", "triang", "parzen", "bohman", "nuttall",
                "blackmanharris", "flattop", "bartlett", "barthann", "cosine", "exponential",
                "tukey", "taylor", "lanczos")
+#: A window scipy.signal's design would refuse, refused by its key (the orders and
+#: frequencies are checked by FilterSettings): by name, so that validating a scenario does
+#: not import scipy.
+FirWindow = Annotated[str, one_of(FIR_WINDOWS, "scipy.signal window without parameters")]
 
 
 class FilterConfig(Model):
@@ -114,18 +118,8 @@ class FilterConfig(Model):
     align_cutoff_hz: float = 100.0
     notch_hz: float | None = Field(400.0, description="IIR notch (null: none)")
     notch_q: float = Field(10.0, gt=0)
-    window: str = Field("hamming", description="FIR window: a scipy.signal window that takes "
-                        "no parameter (hamming, hann, blackman, boxcar, ...)")
-
-    @model_validator(mode="after")
-    def _window(self):
-        """A window scipy.signal's design would refuse, refused here by its key (the
-        orders and frequencies are checked by FilterSettings); checked against the names,
-        so that validating a scenario does not import scipy."""
-        if self.window not in FIR_WINDOWS:
-            raise ValueError(f"window: {self.window!r} is not a scipy.signal window without "
-                             f"parameters; allowed: {', '.join(FIR_WINDOWS)}")
-        return self
+    window: FirWindow = Field("hamming", description="FIR window: a scipy.signal window "
+                              "that takes no parameter (hamming, hann, blackman, boxcar, ...)")
 
     def to_settings(self) -> FilterSettings:
         return FilterSettings(**self.model_dump())  # the same keys, in Hz as they are
