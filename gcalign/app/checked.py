@@ -201,8 +201,9 @@ def read_checked(path: Path) -> tuple[str, dict, dict]:
     if kind in SCHEMAS:
         results.check_layout(Path(path), kind, layout(kind), kind in STRICT)
         with results.open_results(path) as f:
-            for block in SCHEMAS.get(kind, ()):
-                for g in _groups(f, block.where):
+            tree = _Tree(f)
+            for block in SCHEMAS[kind]:
+                for g in tree.matches(block.where, h5py.Group):
                     _check_block(Path(path), f, g, block)
             extra = EXTRA.get(kind)
             if extra is not None:
@@ -211,15 +212,6 @@ def read_checked(path: Path) -> tuple[str, dict, dict]:
 
 
 # --------------------------------------------------------------------------- the check
-
-
-def _groups(f: h5py.File, where: str) -> list[h5py.Group]:
-    """The groups of `f` at the path `where`, each part a name or a pattern."""
-    found: list[h5py.Group] = [f]
-    for part in where.split("/"):
-        found = [g[k] for g in found for k in g
-                 if fnmatch.fnmatchcase(k, part) and isinstance(g[k], h5py.Group)]
-    return found
 
 
 class _Tree:
@@ -450,7 +442,7 @@ def _batch(path: Path, f: h5py.File, summary: dict) -> None:
             i = int(np.argmax(empty))
             raise ScenarioError(f"{path}: dataset {ds.name} holds no finite value at row {i}, "
                                 "a run that succeeded")
-        for stats in _groups(f, f"batch/aggregate/*/{m}"):  # one value per component
+        for stats in _Tree(f).matches(f"batch/aggregate/*/{m}", h5py.Group):  # per component
             for stat in stats.values():
                 if isinstance(stat, h5py.Dataset) and stat.shape != ds.shape[1:]:
                     raise ScenarioError(f"{path}: dataset {stat.name} must have shape "
