@@ -56,9 +56,9 @@ class Stored:
         by its command).
     label : its name in the summary, if not its own (``"attitude_t2"``: ``attitude_t2_deg``).
 
-    A ``{name}`` in its units, shape, names or description is that attribute of the result,
-    or of the result that holds it (a tuple joined by commas): ``stored("{measure_units}")``,
-    units that follow the measurement.
+    A ``{name}`` in its units, frame, shape, names or description is that attribute of the
+    result, or of the result that holds it (a tuple joined by commas):
+    ``stored("{measure_units}")``, units that follow the measurement.
 
     What its values must be when a results file is read back (the checks of
     :mod:`gcalign.app.checked`):

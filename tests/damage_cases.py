@@ -171,7 +171,7 @@ def undeclared(kind: str, path: Path) -> list[str]:
     named: set[str] = set()
     with h5py.File(path, "r") as f:
         for block in checked.SCHEMAS[f.attrs["kind"]]:
-            for g in checked._groups(f, block.where):
+            for g in checked._Tree(f).matches(block.where, h5py.Group):
                 tree = checked._Tree(g)
                 for rel in block.items:
                     named.update(d.name for d in tree.matches(rel.rstrip("?")))

@@ -87,13 +87,20 @@ class Block:
     "states")`` (``.``: the group itself; ``"a|b"``: a where the group has it, else b), by
     numeric attributes of one value per name (`numbers`, same form), or by a count attribute
     of the group (`counts`: ``("H", "order", 1)``, H = order + 1; absent from a file: no
-    say)."""
+    say). Each level the entries name may hold the index scales of HDF5's netCDF view
+    (``component``, ``component4``, ...: :func:`gcalign.io.results.add_dimension_scales`),
+    which the block adds as its last entries."""
 
     where: str
     items: dict[str, Data]
     names: tuple[tuple[str, str, str], ...] = ()  #: (size, group or ".", attribute)
     numbers: tuple[tuple[str, str, str], ...] = ()
     counts: tuple[tuple[str, str, int], ...] = ()  #: (size, attribute of the group, + k)
+
+    def __post_init__(self) -> None:
+        levels = dict.fromkeys(rel.rpartition("/")[0] + "/" for rel in self.items)
+        object.__setattr__(self, "items", self.items | {
+            f"{level}component*?".lstrip("/"): INDEX for level in levels})
 
 
 def from_fields(cls: type, under: str = "", **sizes: str) -> dict[str, Data]:
@@ -122,27 +129,25 @@ def from_fields(cls: type, under: str = "", **sizes: str) -> dict[str, Data]:
 
 
 V3 = num(("N", 3))
-INDEX = num(("_",), rule="range")  # the dimension scales of HDF5's netCDF view
+INDEX = num(("_",), rule="range")  # the index scales of HDF5's netCDF view (Block)
 #: a filter's states S, named by the group's attributes with a display unit and scale each
 STATES = (("S", ".", "states"), ("S", ".", "display_units"))
 SCALES = (("S", ".", "display_scale"),)
 
-TRUTH = Block("truth", {**from_fields(Truth), "segment_names?": text(("G",)),
-                        "component*?": INDEX})
-REFERENCE = Block("reference", {"t": times("N"), "att": V3, "component*?": INDEX})
+TRUTH = Block("truth", {**from_fields(Truth), "segment_names?": text(("G",))})
+REFERENCE = Block("reference", {"t": times("N"), "att": V3})
 IMU = Block("imu", {"t": times("N"), "dtheta": V3, "dv": V3,
-                    "q_bs?": num(("N", 4), rule="unit"), "component*?": INDEX})
-NAVIGATION = {**from_fields(NavRows), "component*?": INDEX}
+                    "q_bs?": num(("N", 4), rule="unit")})
 
 SCHEMAS: dict[str, tuple[Block, ...]] = {
     "simulate": (TRUTH, IMU),
-    "navigate": (Block("navigate", {**NAVIGATION, "att": V3, "v_n": V3, "pos": V3}), TRUTH,
-                 REFERENCE),
+    "navigate": (Block("navigate", {**from_fields(NavRows), "att": V3, "v_n": V3, "pos": V3}),
+                 TRUTH, REFERENCE),
     "align": (
-        Block("align/pass_*", {**from_fields(PassRows), "component*?": INDEX}),
+        Block("align/pass_*", from_fields(PassRows)),
         Block("align/result", from_fields(AlignmentAt)),
-        Block("align/transfer", {**from_fields(TransferResult), "nis?": num(("K",)),
-                                 "component*?": INDEX}, STATES, SCALES),
+        Block("align/transfer", {**from_fields(TransferResult), "nis?": num(("K",))},
+              STATES, SCALES),
         TRUTH, REFERENCE),
     "northfind": (Block("northfind", from_fields(NorthfindResult),
                         counts=(("P", "positions", 0), ("R", "repeats", 0))),),
@@ -157,10 +162,7 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
             "navigation/t?": times("R"), "navigation/t_run?": times("R"),
             "navigation/att?": num(("R", 3)), "navigation/v_n?": num(("R", 3)),
             "navigation/pos?": num(("R", 3)), **from_fields(Errors, "navigation/error/", D="Q"),
-            "navigation/component*?": INDEX,
-            "navigation/error/component*?": INDEX, "smoothed/error/component*?": INDEX,
-            "reference_error/component*?": INDEX,
-            **from_fields(Errors, "reference_error/", D="E"), "component*?": INDEX},
+            **from_fields(Errors, "reference_error/", D="E")},
             names=(("S", "calibrate", "states"), ("m", ".", "measure_names"))),
         TRUTH, REFERENCE),
     "observability": (
@@ -169,12 +171,12 @@ SCHEMAS: dict[str, tuple[Block, ...]] = {
             names=(("S", ".", "states"), ("C", ".", "covariance_states|states"))),
         TRUTH),
     "realtime": (
-        Block("realtime/cases/*", {**from_fields(CaseResult), "component*?": INDEX}),
+        Block("realtime/cases/*", from_fields(CaseResult)),
         Block("realtime/filter", from_fields(ChainResponse), counts=(("H", "order", 1),))),
     "modulate": (Block("modulate/*", {
-        **NAVIGATION, "error/pos": V3, "error/phi": V3,
-        **from_fields(SchemeAnalysis), "mechanism/component*?": INDEX, "invariants/*?": num((3,)),
-        **from_fields(LinearSeries, "linear/"), "linear/component*?": INDEX}),),
+        **from_fields(NavRows), "error/pos": V3, "error/phi": V3,
+        **from_fields(SchemeAnalysis), "invariants/*?": num((3,)),
+        **from_fields(LinearSeries, "linear/")}),),
     "allan": (Block("allan/*", from_fields(TriadRecord)),),
     "batch": (
         Block("batch/runs", {
@@ -201,8 +203,9 @@ def read_checked(path: Path) -> tuple[str, dict, dict]:
     if kind in SCHEMAS:
         results.check_layout(Path(path), kind, layout(kind), kind in STRICT)
         with results.open_results(path) as f:
-            for block in SCHEMAS.get(kind, ()):
-                for g in _groups(f, block.where):
+            tree = _Tree(f)
+            for block in SCHEMAS[kind]:
+                for g in tree.matches(block.where, h5py.Group):
                     _check_block(Path(path), f, g, block)
             extra = EXTRA.get(kind)
             if extra is not None:
@@ -211,15 +214,6 @@ def read_checked(path: Path) -> tuple[str, dict, dict]:
 
 
 # --------------------------------------------------------------------------- the check
-
-
-def _groups(f: h5py.File, where: str) -> list[h5py.Group]:
-    """The groups of `f` at the path `where`, each part a name or a pattern."""
-    found: list[h5py.Group] = [f]
-    for part in where.split("/"):
-        found = [g[k] for g in found for k in g
-                 if fnmatch.fnmatchcase(k, part) and isinstance(g[k], h5py.Group)]
-    return found
 
 
 class _Tree:
@@ -450,7 +444,7 @@ def _batch(path: Path, f: h5py.File, summary: dict) -> None:
             i = int(np.argmax(empty))
             raise ScenarioError(f"{path}: dataset {ds.name} holds no finite value at row {i}, "
                                 "a run that succeeded")
-        for stats in _groups(f, f"batch/aggregate/*/{m}"):  # one value per component
+        for stats in _Tree(f).matches(f"batch/aggregate/*/{m}", h5py.Group):  # per component
             for stat in stats.values():
                 if isinstance(stat, h5py.Dataset) and stat.shape != ds.shape[1:]:
                     raise ScenarioError(f"{path}: dataset {stat.name} must have shape "

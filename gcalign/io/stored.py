@@ -62,7 +62,7 @@ def write_fields(g: h5py.Group, result: Any, outer: Any = None) -> None:
             _put(g, name, value, _filled(how, result, outer))
 
 
-def columns(result: Any, outer: Any = None, under: str = "") -> dict[str, tuple[Any, Stored]]:
+def series_of(result: Any, outer: Any = None, under: str = "") -> dict[str, tuple[Any, Stored]]:
     """The stored arrays of the dataclass `result` by their path in its group (those of a
     result it holds under its name), each with how it is stored, its texts filled as
     :func:`write_fields` fills them: the columns of rows written block by block
@@ -73,7 +73,7 @@ def columns(result: Any, outer: Any = None, under: str = "") -> dict[str, tuple[
         how, value = spec(f), getattr(result, f.name)
         if how is not None and value is not None:
             name = under + (how.name or f.name)
-            out |= (columns(value, outer, name + "/") if dataclasses.is_dataclass(value)
+            out |= (series_of(value, outer, name + "/") if dataclasses.is_dataclass(value)
                     else {name: (value, _filled(how, result, outer))})
     return out
 

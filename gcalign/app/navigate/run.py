@@ -146,7 +146,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
     hears of every block (seconds of data navigated). With `reference` (recorded data) the
     errors are against it (see the module docstring)."""
     from gcalign.io.results import Series
-    from gcalign.io.stored import columns
+    from gcalign.io.stored import series_of
 
     ts = stream.ts
     k_end = stream.samples if duration_s is None else min(
@@ -162,8 +162,8 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         error = None if stream.truth0 is None and reference is None else (
             NavErrors(*[np.zeros((1, 3))] * 4) if reference is None
             else _start_error(start.state, reference, t_start, stream.earth))
-        row0 = columns(NavRows(np.array([t_start]), start.state.att[None],
-                               start.state.v_n[None], start.state.pos[None], error), texts)
+        row0 = series_of(NavRows(np.array([t_start]), start.state.att[None],
+                                 start.state.v_n[None], start.state.pos[None], error), texts)
         series = Series(sink, {name: (a.shape[1] if a.ndim > 1 else None, how.units or "",
                                       how.frame)
                                for name, (a, how) in row0.items()},
@@ -173,7 +173,7 @@ def navigate_stream(stream: Stream, start: Start, vertical: Vertical, stride: in
         series.append(**{name: a for name, (a, _) in row0.items()})
 
     def rows_out(rows: NavRows) -> None:  # always given, so the rows are never all held
-        data = {name: a for name, (a, _) in columns(rows, texts).items()}
+        data = {name: a for name, (a, _) in series_of(rows, texts).items()}
         if series is not None:
             series.append(**data)
         if on_rows is not None:
