@@ -153,6 +153,20 @@ def test_figures_show_and_the_set_route(sim):
     assert again["separation"] == s["separation"] and again["weakest"] == s["weakest"]
 
 
+def test_plot_of_a_file_without_the_filter_sigma_names_the_dataset(sim, tmp_path):
+    """The σ per epoch lies beside the table, outside its checks: a file without it is
+    refused in one line naming the dataset, no figure written."""
+    _, _, out = sim
+    for name in ("t", "sigma"):
+        h5 = tmp_path / f"no_{name}.h5"
+        h5.write_bytes(out["velocity"][1].read_bytes())
+        with h5py.File(h5, "a") as f:
+            del f[f"observability/{name}"]
+        res = runner.invoke(app, ["plot", str(h5), "-o", str(tmp_path / name)])
+        assert_bad_input(res, tmp_path / name / "sigma_reduction.png",
+                         f"dataset /observability/{name} missing")
+
+
 def test_matching_on_a_flight_and_bad_values_are_one_line(sim, tmp_path):
     _, path, _ = sim
     out = tmp_path / "o.h5"

@@ -22,6 +22,7 @@ import numpy as np
 
 from gcalign.app.align.transfer import DECIMALS, GROUP_ENDS, display, write_display
 from gcalign.app.command import DOUBLE, Cost, Outcome
+from gcalign.errors import ScenarioError
 from gcalign.schema import stored
 
 PWCS_N = 15
@@ -194,6 +195,10 @@ def figures(f, name: str) -> dict:
     from gcalign.transfer.observability import TransferObservability
 
     g = f["observability"]
+    for ds in ("t", "sigma"):  # beside the table, outside its checks
+        if not isinstance(g.get(ds), h5py.Dataset):
+            raise ScenarioError(f"{f.filename}: dataset {g.name}/{ds} missing (a results "
+                                "file of a transfer run has it)")
     obs, run = read_fields(g, TransferObservability), read_fields(g, SigmaSeries)
     how = f"{obs.matching} matching, scaling {obs.scaling}"
     figs = {
