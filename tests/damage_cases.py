@@ -150,6 +150,8 @@ def damage(path: Path, name: str, how: str) -> None:
                 a[len(a) // 2:] = b"" if is_text else 0
         elif how == "NaN":
             a = np.full(ds.shape, np.nan)
+        elif how == "two columns":  # the dataset stacked beside itself
+            a = np.stack([ds[()]] * 2, axis=-1)
         else:
             a = np.zeros(3) if how == "zeros(3)" else np.array([b"a", b"b"])
         del f[name]

@@ -16,6 +16,7 @@ from typer.testing import CliRunner
 
 from gcalign.cli import app
 from gcalign.cli.common import builtin_text
+from gcalign.io.scenario.loader import loads
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()
@@ -120,7 +121,8 @@ def test_scheme_option_runs_one_scheme_and_dwell_sets_its_timing(tmp_path):
     assert s["schemes"]["dual-16"]["cycle_s"] == pytest.approx(16 * 212.0)
     assert s["schemes"]["dual-16"]["reference"] == "body"
     with h5py.File(tmp_path / "d.h5") as f:
-        assert "mechanism:\n  scheme: dual-16" in f.attrs["scenario_yaml"]
+        stored = loads(f.attrs["scenario_yaml"], "scenario_yaml")  # no key given twice
+    assert stored["mechanism.scheme"] == "dual-16" and stored["mechanism.dwell_s"] == 200
 
 
 @pytest.mark.slow

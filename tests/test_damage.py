@@ -64,6 +64,25 @@ def test_a_zeroed_time_is_refused_naming_it(kind, results_of_every_kind, tmp_pat
     assert "monotonic" in r.stderr or "must increase" in r.stderr, r.stderr
 
 
+@pytest.mark.parametrize("kind", [k for k in D.KINDS if k not in ("northfind", "batch")])
+def test_a_time_with_a_second_column_is_refused_by_its_shape(kind, results_of_every_kind,
+                                                             tmp_path):
+    """A time vector stacked beside itself (two columns) is no time: refused, naming it and
+    its shape, not an internal error of the check that times increase."""
+    import h5py
+
+    src = results_of_every_kind[kind]
+    with h5py.File(src, "r") as f:
+        name, size = next((n, f[n].size) for n in D.datasets(src)
+                          if n.rsplit("/", 1)[-1] == "t" and f[n].size > 2)
+    path = tmp_path / "d.h5"
+    path.write_bytes(src.read_bytes())
+    D.damage(path, name, "two columns")
+    r = D._run("show", path, tmp_path, kind, None)
+    assert r.code == 2 and f"dataset {name} must have shape" in r.stderr, r.stderr
+    assert f"got ({size}, 2)" in r.stderr, r.stderr
+
+
 @pytest.fixture(scope="module")
 def baselines(results_of_every_kind, tmp_path_factory):
     return D.baselines(results_of_every_kind, tmp_path_factory.mktemp("baselines"))

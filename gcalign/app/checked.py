@@ -379,7 +379,7 @@ def _check_values(path: Path, ds: h5py.Dataset, spec: Data) -> None:
     if spec.whole and np.any(a[~bad] != np.round(a[~bad])):
         raise ScenarioError(f"{path}: dataset {ds.name} must hold whole numbers (indices, "
                             "counts)")
-    if spec.rule == "increasing" and a.size > 1:
+    if spec.rule == "increasing" and a.ndim == 1 and a.size > 1:  # else its shape is refused
         step = np.diff(a)
         if not (step > 0).all():
             i = int(np.argmax(~(step > 0)))

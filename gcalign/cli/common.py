@@ -190,6 +190,7 @@ def load_with_overrides(
         import yaml
 
         from gcalign.io.scenario import parse_scenario
+        from gcalign.io.scenario.loader import with_overrides
 
     if data is not None:
         source = str(path) if path is not None else f"<built-in {builtin}>"
@@ -220,9 +221,8 @@ def load_with_overrides(
         sc.resolve_paths(Path(path).parent)  # imu_file, reference.path
     applied = [(f"{section}.{k}", v) for k, v in named.items()] + done
     if applied:
-        text += "\n# command-line overrides:\n" + yaml.safe_dump(
-            {k: (str(v) if isinstance(v, Path) else v) for k, v in applied},
-            sort_keys=False)
+        text = with_overrides(text, "", {k: (str(v) if isinstance(v, Path) else v)
+                                         for k, v in applied})
     return Loaded(sc, text, applied)
 
 

@@ -18,7 +18,7 @@ def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
     into ``mechanism`` and the other options into ``modulate`` before validation. --scheme
     replaces the scenario's mechanism (a table too; its timing keys stay) and, without
     --compare, is the one scheme run."""
-    import yaml
+    from gcalign.io.scenario.loader import with_overrides
 
     data, text, _ = read_source(path, COMMANDS["modulate"].builtin or "")
     given = {k: v for k, v in (("scheme", scheme), ("dwell_s", dwell)) if v is not None}
@@ -32,8 +32,8 @@ def load_modulate(path: Path | None, overrides: dict, scheme: str | None,
                 overrides["compare"] = [scheme]
         mech.update(given)
         data["mechanism"] = mech
-        text += "\n# command-line overrides of mechanism:\n" + yaml.safe_dump(
-            {"mechanism": given}, sort_keys=False)
+        text = with_overrides(text, " of mechanism",
+                              {f"mechanism.{k}": v for k, v in given.items()})
     return load_with_overrides("modulate", path, overrides, data=data, text=text, sets=sets)
 
 

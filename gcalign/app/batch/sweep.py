@@ -311,6 +311,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
 
     from gcalign.app.preflight import total_runs
     from gcalign.io.scenario import parse_scenario
+    from gcalign.io.scenario.loader import with_overrides
     if not isinstance(data, dict):
         raise ScenarioError(f"{source}: a sweep must be a YAML mapping, got {type(data).__name__}")
     try:
@@ -324,8 +325,7 @@ def sweep_from_mapping(data, source: str = "sweep", base_dir: Path | None = None
         grid_keys = set(spec.grid) | {k for over in spec.cases.values() for k in over}
         apply_sets(base_data, sets, base_model, grid_keys)
         base_model = parse_scenario(base_data, base_source)
-        text += "\n# command-line overrides of the base:\n" + yaml.safe_dump(
-            dict(sets), sort_keys=False)
+        text = with_overrides(text, " of the base", dict(sets))
     command = _command_of(spec, base_data, source)
     metrics = spec.metrics or list(batchable()[command])
     axes, cases = dict(spec.grid), spec.cases
