@@ -170,16 +170,18 @@ def loads(text: str, source: str):
         loader.dispose()
 
 
-def with_overrides(text: str, what: str, overrides: dict) -> str:
+def with_overrides(text: str, what: str, overrides: dict[str, object]) -> str:
     """Scenario `text` with `overrides` recorded after it as YAML keys, under a comment
     naming `what` was overridden: the text a results file stores. A document in flow style
     (``{...}``) cannot take keys after it: it is written out in block style first."""
-    tail = f"\n# command-line overrides{what}:\n" + yaml.safe_dump(overrides, sort_keys=False)
+    dumped: str = yaml.safe_dump(overrides, sort_keys=False)
+    tail = f"\n# command-line overrides{what}:\n" + dumped
     try:
         yaml.safe_load(text + tail)
         return text + tail
     except yaml.YAMLError:
-        return yaml.safe_dump(loads(text, "scenario"), sort_keys=False) + tail
+        block: str = yaml.safe_dump(loads(text, "scenario"), sort_keys=False)
+        return block + tail
 
 
 def parse_override(item: str, option: str = "--set") -> tuple[str, object]:
