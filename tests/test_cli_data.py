@@ -79,6 +79,20 @@ def test_a_flow_style_scenario_with_overrides_is_stored_as_text_that_reads_back(
     assert res.exit_code == 0, res.output
 
 
+def test_an_override_repeated_on_a_file_that_records_it_is_recorded_once(tmp_path):
+    """navigate --set KEY on a results file whose text records KEY already: the stored text
+    gives KEY once, with the last value, and reads back."""
+    sim, nav = tmp_path / "sim.h5", tmp_path / "nav.h5"
+    src = write(tmp_path, SCENARIO)
+    res = runner.invoke(app, ["simulate", str(src), "--set", "output.rate_hz=full", "-o", str(sim)])
+    assert res.exit_code == 0, res.output
+    res = runner.invoke(app, ["navigate", str(sim), "--set", "output.rate_hz=50", "-o", str(nav)])
+    assert res.exit_code == 0, res.output
+    with h5py.File(nav) as f:
+        text = f.attrs["scenario_yaml"]
+    assert text.count("output.rate_hz") == 1 and loads(text, "t")["output.rate_hz"] == 50
+
+
 def test_same_seed_same_file_numbers(tmp_path):
     p = write(tmp_path, SCENARIO)
     outs = []

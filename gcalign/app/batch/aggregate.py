@@ -17,15 +17,15 @@ STATS = ("mean", "std", "rms", "median", "p05", "p95")
 
 
 def components(command: str, metric: str, k: int | None) -> list[str] | None:
-    """Names of a vector metric's components: the command's room says (attitude triples
-    are pitch, roll, yaw in align), else their indices."""
+    """Names of a vector metric's components, as the command's ``components`` gives them
+    (attitude triples are pitch, roll, yaw in align; else their indices)."""
     from gcalign.app.registry import COMMANDS
 
     return None if k is None else COMMANDS[command].components(metric, k)
 
 
 def metric_label(command: str, metric: str) -> str:
-    """A metric's name for figures: the command's room may name a picked component
+    """A metric's name for figures: the command's ``label`` may name a picked component
     (``error_t3_deg.2`` -> ``error_t3_deg yaw`` in align)."""
     from gcalign.app.registry import COMMANDS
 

@@ -170,16 +170,21 @@ def loads(text: str, source: str):
         loader.dispose()
 
 
-def with_overrides(text: str, what: str, overrides: dict) -> str:
+def with_overrides(text: str, what: str, overrides: dict[str, object]) -> str:
     """Scenario `text` with `overrides` recorded after it as YAML keys, under a comment
-    naming `what` was overridden: the text a results file stores. A document in flow style
-    (``{...}``) cannot take keys after it: it is written out in block style first."""
-    tail = f"\n# command-line overrides{what}:\n" + yaml.safe_dump(overrides, sort_keys=False)
+    naming `what` was overridden: the text a results file stores, which must read back. A
+    document in flow style (``{...}``) cannot take keys after it, and a key the text already
+    records (an override of a run this one read) must not be given twice: then the text is
+    written out in block style first, without those keys."""
+    dumped: str = yaml.safe_dump(overrides, sort_keys=False)
+    tail = f"\n# command-line overrides{what}:\n" + dumped
     try:
-        yaml.safe_load(text + tail)
+        loads(text + tail, "scenario")
         return text + tail
-    except yaml.YAMLError:
-        return yaml.safe_dump(loads(text, "scenario"), sort_keys=False) + tail
+    except ScenarioError:
+        kept = {k: v for k, v in loads(text, "scenario").items() if k not in overrides}
+        block: str = yaml.safe_dump(kept, sort_keys=False)
+        return block + tail
 
 
 def parse_override(item: str, option: str = "--set") -> tuple[str, object]:
