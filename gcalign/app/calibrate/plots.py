@@ -28,8 +28,8 @@ from gcalign.estimation.calibration import CalibrationResult, Errors, Spans
 from gcalign.units import ANGLE_UNITS, angle_unit
 
 STYLE: dict[str, dict[str, Any]] = {"both": dict(color="tab:red", linestyle="--"),
-         "velocity": dict(color="tab:cyan", linestyle="-"),
-         "position": dict(color="tab:purple", linestyle="-.")}
+                                    "velocity": dict(color="tab:cyan", linestyle="-"),
+                                    "position": dict(color="tab:purple", linestyle="-.")}
 AXES = ("x", "y", "z")
 
 
