@@ -582,3 +582,18 @@ def test_northfind_sweep(tmp_path):
     # the coordinate method stays at the noise level.
     assert none[0] < 0.5 and 7.5 < none[1] < 9.5
     assert coord[1] < 0.1
+
+
+def test_a_lost_scheduler_leaves_no_log_of_dask_or_tornado_on_stderr(caplog):
+    """When the scheduler dies, Dask's client and tornado's IO loop (a gather in flight)
+    log their errors with tracebacks; a batch's client silences both, so that its one line
+    (lost the scheduler, rerun with --resume) is all stderr holds."""
+    import logging
+
+    from gcalign.app.batch.backends import _quiet_dask
+
+    _quiet_dask()
+    with caplog.at_level(logging.DEBUG):
+        for name in ("distributed.client", "tornado.application"):
+            logging.getLogger(name).error("Exception in callback: Stream is closed")
+    assert caplog.records == []

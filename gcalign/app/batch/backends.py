@@ -282,11 +282,12 @@ def dask_client(address: str, timeout: float = SCHEDULER_TIMEOUT_S,
 def _quiet_dask() -> None:
     """Silence Dask's own loggers in this process: when the scheduler dies, the client logs
     "distributed.client - ERROR - Failed to reconnect ..." on stderr before our one error
-    line says the same (and what to do: --resume)."""
+    line says the same (and what to do: --resume); a gather in flight then also ends in
+    tornado's log of the failed callback, with its traceback ("tornado.application")."""
     import logging
 
-    names = ["distributed", *(n for n in logging.root.manager.loggerDict
-                              if n.startswith("distributed."))]
+    names = ["distributed", "tornado.application", *(
+        n for n in logging.root.manager.loggerDict if n.startswith("distributed."))]
     for name in names:
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
